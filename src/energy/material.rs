@@ -1,0 +1,165 @@
+//! Material laws for the shell's in-plane (stretching) and bending strains.
+//!
+//! ## Plane-stress Lamé parameters
+//! A thin shell is in plane stress, so its energy uses the 2D Lamé parameters
+//! `α = Eν/(1−ν²)`, `β = E/(2(1+ν))` (DESIGN.md). Seed 000 prints the 3D formula
+//! `α = Eν/((1+ν)(1−2ν))`, which is singular at ν = ½ (the value MorphoShell's liquid-crystal
+//! runs use) and gives the wrong plate stiffness. With the 2D parameters,
+//! `α/2 tr²M + β tr M² = E/(2(1−ν²)) [ν tr²M + (1−ν) tr M²] = E/(2(1−ν²)) Q(M)`, so seed 000's
+//! bending term equals `D/2 Q(ā⁻¹(b − b̄))` with `D = Eh³/(12(1−ν²))` and its stretching term is
+//! the standard Koiter `Eh/(8(1−ν²)) Q(ā⁻¹(a − ā))`.
+
+use crate::math::{sym_det, sym_to_mat, Mat2, Mat3, Real, Sym2};
+
+/// Plane-stress (2D) Lamé parameters (Pa).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lame2d {
+    /// `α = Eν/(1−ν²)` (Pa).
+    pub alpha: Real,
+    /// `β = E/(2(1+ν))`, the shear modulus (Pa).
+    pub beta: Real,
+}
+
+impl Lame2d {
+    /// From Young's modulus `E` (Pa) and Poisson's ratio `ν` (dimensionless, −1 < ν ≤ ½).
+    pub fn from_young_poisson(young: Real, poisson: Real) -> Self {
+        Lame2d {
+            alpha: young * poisson / (1.0 - poisson * poisson),
+            beta: young / (2.0 * (1.0 + poisson)),
+        }
+    }
+}
+
+/// Which stretching normalisation to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StretchConvention {
+    /// Standard Koiter, strain `(a − ā)/2`: seed 000's `h/4 ‖ā⁻¹a − I‖²_SV`.
+    #[default]
+    Koiter,
+    /// MorphoShell's handbook and code: strain `a − ā` without the ½, a stretching energy 4×
+    /// larger. Offered so that MorphoShell users can reproduce earlier results.
+    Morphoshell,
+}
+
+impl StretchConvention {
+    /// Multiplier on the stretching term.
+    pub fn factor(self) -> Real {
+        match self {
+            StretchConvention::Koiter => 1.0,
+            StretchConvention::Morphoshell => 4.0,
+        }
+    }
+}
+
+/// The St Venant–Kirchhoff quadratic form in `[m11, m12, m22]` coordinates:
+/// `‖ā⁻¹M‖²_SV = α/2 tr²(ā⁻¹M) + β tr((ā⁻¹M)²) = mᵀ C m`, with
+/// `C = α/2 t tᵀ + β S`, `t = (Ā11, 2Ā12, Ā22)`, `S_pq = tr(Ā E_p Ā E_q)`, `Ā = ā⁻¹` and
+/// `E_p` the symmetric basis matrices. Units: Pa / m⁴ (a is in m²).
+pub fn sv_matrix(abar: &Sym2, lame: Lame2d) -> Mat3 {
+    let ainv = sym_to_mat(abar).try_inverse().unwrap_or_else(Mat2::zeros);
+    let t = crate::math::SVec::<3>::new(ainv[(0, 0)], 2.0 * ainv[(0, 1)], ainv[(1, 1)]);
+    let basis = [
+        Mat2::new(1.0, 0.0, 0.0, 0.0),
+        Mat2::new(0.0, 1.0, 1.0, 0.0),
+        Mat2::new(0.0, 0.0, 0.0, 1.0),
+    ];
+    let ae: Vec<Mat2> = basis.iter().map(|e| ainv * e).collect();
+    let mut c = t * t.transpose() * (0.5 * lame.alpha);
+    for p in 0..3 {
+        for q in 0..3 {
+            c[(p, q)] += lame.beta * (ae[p] * ae[q]).trace();
+        }
+    }
+    c
+}
+
+/// An energy density of one face as a function of its fundamental forms `a` and `b`
+/// (both `[11, 12, 22]`, in the face's barycentric coordinates). Returns the energy (J) and
+/// fills the first and second derivatives with respect to `a` and `b`. Stretching and bending
+/// are uncoupled (no `∂²/∂a∂b`).
+pub trait FaceDensity {
+    /// Whether the density depends on `b` at all (lets the kernel skip the bending geometry).
+    fn uses_b(&self) -> bool;
+    /// Energy and derivatives.
+    fn eval(&self, a: &Sym2, b: &Sym2, d: &mut DensityDerivs) -> Real;
+}
+
+/// Derivatives filled by [`FaceDensity::eval`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct DensityDerivs {
+    /// `∂W/∂a`.
+    pub ga: Sym2,
+    /// `∂W/∂b`.
+    pub gb: Sym2,
+    /// `∂²W/∂a²`.
+    pub haa: Mat3,
+    /// `∂²W/∂b²`.
+    pub hbb: Mat3,
+}
+
+/// The discrete Koiter density of seed 000 §3 (eq. for `E_elastic`), plus optional Kelvin–Voigt
+/// damping of the same form:
+///
+/// `W = ws (a − a*)ᵀ C (a − a*) + wb (b − b*)ᵀ C (b − b*)`
+///
+/// * elastic: `a* = ā`, `b* = b̄`, `ws = √det ā/2 · h/4 · f`, `wb = √det ā/2 · h³/12`, where `f`
+///   is 1 (Koiter) or 4 (MorphoShell's convention) and `C` from [`sv_matrix`];
+/// * damping (seed 000 §3 "Viscous Damping"): `a* = a_prev`, `b* = b_prev`, both weights times
+///   `η/Δt` (η a retardation time in s).
+///
+/// Units: J. The `√det ā / 2` is the rest area of the face.
+#[derive(Clone, Copy, Debug)]
+pub struct KoiterDensity {
+    /// The St Venant–Kirchhoff matrix of the rest metric.
+    pub c: Mat3,
+    /// Up to two quadratic wells in `a`: (weight, target).
+    pub stretch: [(Real, Sym2); 2],
+    /// Up to two quadratic wells in `b`: (weight, target).
+    pub bend: [(Real, Sym2); 2],
+}
+
+impl KoiterDensity {
+    /// Rest-area weights `(ws, wb)` for thickness `h`, rest metric `ā` and stretching factor.
+    pub fn weights(abar: &Sym2, h: Real, stretch_factor: Real) -> (Real, Real) {
+        let area = 0.5 * sym_det(abar).max(0.0).sqrt();
+        (area * h / 4.0 * stretch_factor, area * h * h * h / 12.0)
+    }
+}
+
+impl FaceDensity for KoiterDensity {
+    #[inline]
+    fn uses_b(&self) -> bool {
+        self.bend[0].0 != 0.0 || self.bend[1].0 != 0.0
+    }
+
+    #[inline]
+    fn eval(&self, a: &Sym2, b: &Sym2, d: &mut DensityDerivs) -> Real {
+        let mut e = 0.0;
+        d.ga = Sym2::zeros();
+        d.gb = Sym2::zeros();
+        let mut ws = 0.0;
+        let mut wb = 0.0;
+        for (w, t) in &self.stretch {
+            if *w != 0.0 {
+                let m = a - t;
+                let cm = self.c * m;
+                e += w * m.dot(&cm);
+                d.ga += cm * (2.0 * w);
+                ws += w;
+            }
+        }
+        for (w, t) in &self.bend {
+            if *w != 0.0 {
+                let m = b - t;
+                let cm = self.c * m;
+                e += w * m.dot(&cm);
+                d.gb += cm * (2.0 * w);
+                wb += w;
+            }
+        }
+        d.haa = self.c * (2.0 * ws);
+        d.hbb = self.c * (2.0 * wb);
+        e
+    }
+}

@@ -1,0 +1,141 @@
+//! The discrete Koiter shell face of seed 000 §3: stretching from the face's first fundamental
+//! form, bending from the mid-edge-average second fundamental form (see [`crate::geometry`]).
+//!
+//! DOF order (18): `x[v0], x[v1], x[v2], x[p0], x[p1], x[p2]`, where `p_i` is the far vertex of
+//! the neighbour across the edge opposite `v_i`. On a boundary edge (`has[i] = false`) `q_i = 0`
+//! and the `p_i` entries of the gradient and Hessian are zero.
+
+use super::material::{DensityDerivs, FaceDensity};
+use crate::geometry::{
+    b_from_q, b_from_q_matrix, first_fundamental_form, first_fundamental_form_hessian_pattern,
+    first_fundamental_form_jacobian, midedge_average_q, UnitNormal,
+};
+use crate::math::{Real, SMat, SVec, Sym2, Vec3};
+
+/// Fundamental forms of one face (for output and the damping term's previous state).
+pub fn face_forms(x: &[Vec3; 6], has: [bool; 3]) -> (Sym2, Sym2) {
+    let xf = [x[0], x[1], x[2]];
+    let opp = [0, 1, 2].map(|i| has[i].then_some(x[3 + i]));
+    (
+        first_fundamental_form(&xf),
+        crate::geometry::midedge_average_b(&xf, &opp),
+    )
+}
+
+/// Energy (J) of one shell face under density `dens`, with optional gradient (+∂E/∂x, N) and
+/// Hessian (N/m), 18 DOFs in the order of the module doc.
+///
+/// `E = W(a(x), b(x))` with `b = B q`; chain rule:
+/// `∇E = Jaᵀ ∂W/∂a + Σ_i (Bᵀ∂W/∂b)_i ∇q_i`,
+/// `∇²E = Jaᵀ W_aa Ja + Σ_k (∂W/∂a_k) ∇²a_k + G (Bᵀ W_bb B) Gᵀ + Σ_i (Bᵀ∂W/∂b)_i ∇²q_i`,
+/// with `G = [∇q_0 ∇q_1 ∇q_2]`.
+pub fn shell_face<D: FaceDensity>(
+    x: &[Vec3; 6],
+    has: [bool; 3],
+    dens: &D,
+    grad: Option<&mut SVec<18>>,
+    hess: Option<&mut SMat<18, 18>>,
+) -> Real {
+    let xf = [x[0], x[1], x[2]];
+    let a = first_fundamental_form(&xf);
+    let bending = dens.uses_b();
+    let want_h = hess.is_some();
+    let want_g = grad.is_some() || want_h;
+    let nf = UnitNormal::new(&xf);
+    let mut q = SVec::<3>::zeros();
+    let mut gq = [SVec::<12>::zeros(); 3];
+    let mut hq = [SMat::<12, 12>::zeros(); 3];
+    let mut fnf = [Vec3::zeros(); 3];
+    if bending {
+        for i in 0..3 {
+            if !has[i] {
+                continue;
+            }
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            let (eq, f) = midedge_average_q(
+                &nf,
+                [i, j, k],
+                &[xf[i], xf[j], xf[k]],
+                &x[3 + i],
+                if want_h { Some(&mut hq[i]) } else { None },
+            );
+            q[i] = eq.q;
+            gq[i] = eq.grad;
+            fnf[i] = f;
+        }
+    }
+    let b = b_from_q(&q);
+    let mut d = DensityDerivs::default();
+    let e = dens.eval(&a, &b, &mut d);
+    if !want_g {
+        return e;
+    }
+    let ja = first_fundamental_form_jacobian(&xf);
+    let bq = b_from_q_matrix();
+    let gqv = bq.transpose() * d.gb; // ∂E/∂q
+    let slots = |i: usize| [i, (i + 1) % 3, (i + 2) % 3, 3 + i];
+    let mut g = SVec::<18>::zeros();
+    g.fixed_rows_mut::<9>(0).copy_from(&(ja.transpose() * d.ga));
+    if bending {
+        for i in 0..3 {
+            if !has[i] {
+                continue;
+            }
+            for (l, &s) in slots(i).iter().enumerate() {
+                for c in 0..3 {
+                    g[3 * s + c] += gqv[i] * gq[i][3 * l + c];
+                }
+            }
+        }
+    }
+    if let Some(h) = hess {
+        h.fill(0.0);
+        let hm = ja.transpose() * d.haa * ja;
+        h.fixed_view_mut::<9, 9>(0, 0).copy_from(&hm);
+        let pat = first_fundamental_form_hessian_pattern(&d.ga);
+        for r in 0..3 {
+            for s in 0..3 {
+                for c in 0..3 {
+                    h[(3 * r + c, 3 * s + c)] += pat[(r, s)];
+                }
+            }
+        }
+        if bending {
+            let hqq = bq.transpose() * d.hbb * bq;
+            let mut gmat = SMat::<18, 3>::zeros();
+            for i in 0..3 {
+                if !has[i] {
+                    continue;
+                }
+                for (l, &s) in slots(i).iter().enumerate() {
+                    for c in 0..3 {
+                        gmat[(3 * s + c, i)] = gq[i][3 * l + c];
+                    }
+                }
+            }
+            *h += gmat * hqq * gmat.transpose();
+            let mut lam_f = Vec3::zeros();
+            for i in 0..3 {
+                if !has[i] || gqv[i] == 0.0 {
+                    continue;
+                }
+                lam_f += fnf[i] * gqv[i];
+                let sl = slots(i);
+                for (la, &sa) in sl.iter().enumerate() {
+                    for (lb, &sb) in sl.iter().enumerate() {
+                        let blk = hq[i].fixed_view::<3, 3>(3 * la, 3 * lb) * gqv[i];
+                        let mut dst = h.fixed_view_mut::<3, 3>(3 * sa, 3 * sb);
+                        dst += blk;
+                    }
+                }
+            }
+            let hn = nf.hessian_contract(&lam_f);
+            let mut dst = h.fixed_view_mut::<9, 9>(0, 0);
+            dst += hn;
+        }
+    }
+    if let Some(gout) = grad {
+        *gout = g;
+    }
+    e
+}

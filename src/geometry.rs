@@ -1,0 +1,309 @@
+//! Discrete fundamental forms of a triangle and their derivatives.
+//!
+//! Conventions (DESIGN.md, seed 000 §3):
+//! * A face `[v0, v1, v2]` is parameterised over the unit triangle by `e1 = v1 − v0`,
+//!   `e2 = v2 − v0`; its first fundamental form is `a = [e1·e1, e1·e2; e1·e2, e2·e2]`, stored as
+//!   `[a11, a12, a22]`.
+//! * Edge `i` is the edge opposite vertex `i`. Across it lies the neighbouring face, whose vertex
+//!   not on the edge is `p_i`.
+//! * The second fundamental form `b` has the sign for which, with outward normals, a sphere of
+//!   radius R has `b = a/R`; a positive `b` bulges toward the side the normal points to
+//!   (`b_αβ = −N·∂αβr`, MorphoShell's convention, seed 001 §2).
+//!
+//! ## Mid-edge second fundamental form, derived from the offset definition
+//! Offset each edge midpoint `m_i` by `ε n_i` along its mid-edge normal. A triangle's vertices
+//! are `v_i = m_j + m_k − m_i`, so the offset triangle has `e1^ε = e1 + 2ε(n_0 − n_1)`,
+//! `e2^ε = e2 + 2ε(n_0 − n_2)` and `a^ε = a + 2ε b + O(ε²)` (offset toward the normal) with
+//!
+//! `b = 2 [q0 + q1, q0; q0, q0 + q2]`, where `q_i = (v_j − v_i)·n_i` for either `j ≠ i`
+//! (the same value, because `n_i ⟂` edge `i`).
+//!
+//! For the mid-edge *average* normal `n_i = (N_f + N_g)/|N_f + N_g|`, since `N_f ⟂ (v_j − v_i)`,
+//! `q_i = (v_j − v_i)·N_g / |N_f + N_g| = h_i sin(θ_i/2)`, with `h_i` the height of `v_i` over
+//! edge `i` and `θ_i` the signed dihedral angle. On a boundary edge `n_i = N_f` and `q_i = 0`.
+//! Check (tests/geometry): on a sphere `b → a/R` face by face as a regular mesh is refined.
+//!
+//! The seed's displayed matrix (`½[(n_i − n_j)·(v_i − v_j) ...]`) has the opposite sign and a
+//! factor 1/4 relative to its own offset definition; shellsim uses the derivation above.
+
+use crate::math::{skew, Mat2, Mat3, Real, SMat, SVec, Sym2, Vec3};
+
+/// First fundamental form `[e1·e1, e1·e2, e2·e2]` of a triangle (m²).
+#[inline]
+pub fn first_fundamental_form(x: &[Vec3; 3]) -> Sym2 {
+    let e1 = x[1] - x[0];
+    let e2 = x[2] - x[0];
+    Sym2::new(e1.dot(&e1), e1.dot(&e2), e2.dot(&e2))
+}
+
+/// Jacobian of `a` with respect to `[v0, v1, v2]` (3×9).
+#[inline]
+pub fn first_fundamental_form_jacobian(x: &[Vec3; 3]) -> SMat<3, 9> {
+    let e1 = x[1] - x[0];
+    let e2 = x[2] - x[0];
+    let mut j = SMat::<3, 9>::zeros();
+    for c in 0..3 {
+        // a11 = e1·e1
+        j[(0, c)] = -2.0 * e1[c];
+        j[(0, 3 + c)] = 2.0 * e1[c];
+        // a12 = e1·e2
+        j[(1, c)] = -e1[c] - e2[c];
+        j[(1, 3 + c)] = e2[c];
+        j[(1, 6 + c)] = e1[c];
+        // a22 = e2·e2
+        j[(2, c)] = -2.0 * e2[c];
+        j[(2, 6 + c)] = 2.0 * e2[c];
+    }
+    j
+}
+
+/// `Σ_k g_k ∇²a_k` as a 3×3 vertex-block pattern `S` (the 9×9 Hessian is `S ⊗ I₃`).
+#[inline]
+pub fn first_fundamental_form_hessian_pattern(g: &Sym2) -> Mat3 {
+    let (g0, g1, g2) = (g[0], g[1], g[2]);
+    Mat3::new(
+        2.0 * g0 + 2.0 * g1 + 2.0 * g2,
+        -2.0 * g0 - g1,
+        -g1 - 2.0 * g2,
+        -2.0 * g0 - g1,
+        2.0 * g0,
+        g1,
+        -g1 - 2.0 * g2,
+        g1,
+        2.0 * g2,
+    )
+}
+
+/// Unnormalised face normal `(v1 − v0) × (v2 − v0)` (twice the area vector).
+#[inline]
+pub fn area_normal(x: &[Vec3; 3]) -> Vec3 {
+    (x[1] - x[0]).cross(&(x[2] - x[0]))
+}
+
+/// Unit normal of a triangle with its first derivatives, and the means to contract its second
+/// derivatives with a covector.
+#[derive(Clone, Copy, Debug)]
+pub struct UnitNormal {
+    /// The unit normal `N = c/|c|`.
+    pub n: Vec3,
+    /// `|c|` = twice the area.
+    pub r: Real,
+    /// `∂c/∂v_a` for a = 0, 1, 2.
+    pub dc: [Mat3; 3],
+    /// `∂N/∂v_a = (I − N Nᵀ)/|c| · ∂c/∂v_a`.
+    pub dn: [Mat3; 3],
+}
+
+impl UnitNormal {
+    /// Unit normal of `[v0, v1, v2]` and its Jacobian.
+    #[inline]
+    pub fn new(x: &[Vec3; 3]) -> Self {
+        let c = area_normal(x);
+        let r = c.norm();
+        let n = c / r;
+        let p = (Mat3::identity() - n * n.transpose()) / r;
+        let dc = [
+            skew(&(x[2] - x[1])),
+            skew(&(x[0] - x[2])),
+            skew(&(x[1] - x[0])),
+        ];
+        let dn = [p * dc[0], p * dc[1], p * dc[2]];
+        UnitNormal { n, r, dc, dn }
+    }
+
+    /// The 9×9 Hessian of `λ·N` with respect to `[v0, v1, v2]`.
+    ///
+    /// With `g(c) = λ·c/|c|`: `∂²g/∂c² = [−λNᵀ − Nλᵀ − (λ·N)I + 3(λ·N)NNᵀ]/|c|²`, plus the
+    /// constant second derivative of the bilinear `c` contracted with `μ = ∂g/∂c = Pλ/|c|`:
+    /// `μ·(Δ1 × Δ2)` gives blocks `±M`, `M = −[μ]×`.
+    #[inline]
+    pub fn hessian_contract(&self, lambda: &Vec3) -> SMat<9, 9> {
+        let n = self.n;
+        let ln = lambda.dot(&n);
+        let r2 = self.r * self.r;
+        let g = (-(lambda * n.transpose()) - n * lambda.transpose() - Mat3::identity() * ln
+            + n * n.transpose() * (3.0 * ln))
+            / r2;
+        let mu = (lambda - n * ln) / self.r;
+        let m = -skew(&mu);
+        let mt = m.transpose();
+        let mut h = SMat::<9, 9>::zeros();
+        for a in 0..3 {
+            let ga = g * self.dc[a];
+            for b in a..3 {
+                let mut blk = self.dc[b].transpose() * ga;
+                blk = blk.transpose(); // dc_aᵀ G dc_b
+                let extra = match (a, b) {
+                    (0, 1) => -mt,
+                    (0, 2) => -m,
+                    (1, 2) => m,
+                    _ => Mat3::zeros(),
+                };
+                blk += extra;
+                h.fixed_view_mut::<3, 3>(3 * a, 3 * b).copy_from(&blk);
+                if a != b {
+                    h.fixed_view_mut::<3, 3>(3 * b, 3 * a)
+                        .copy_from(&blk.transpose());
+                }
+            }
+        }
+        h
+    }
+}
+
+/// Derivatives of one edge quantity `q` with respect to its 12 local DOFs
+/// `[v_i, v_j, v_k, p]` (the face's vertex opposite the edge, the edge's two ends in face order,
+/// and the neighbour's far vertex).
+#[derive(Clone, Copy, Debug)]
+pub struct EdgeQ {
+    /// The value of `q_i` (m).
+    pub q: Real,
+    /// `∂q/∂x`, 12 entries.
+    pub grad: SVec<12>,
+}
+
+/// Mid-edge-average `q_i = (v_j − v_i)·N_g / |N_f + N_g|` with its gradient, and (when `hess` is
+/// given) its Hessian excluding the `N_f` second-derivative term, which the caller contracts once
+/// per face; the `N_f` covector `∂q/∂N_f` is returned for that.
+///
+/// `xf = [v_i, v_j, v_k]` in the face's cyclic order, `p` the neighbour's far vertex; the
+/// neighbour is oriented `[p, v_k, v_j]`.
+#[inline]
+pub fn midedge_average_q(
+    nf: &UnitNormal,
+    slots: [usize; 3],
+    xf: &[Vec3; 3],
+    p: &Vec3,
+    hess: Option<&mut SMat<12, 12>>,
+) -> (EdgeQ, Vec3) {
+    let (vi, vj, vk) = (xf[0], xf[1], xf[2]);
+    let ng_data = UnitNormal::new(&[*p, vk, vj]);
+    let ng = ng_data.n;
+    let nfv = nf.n;
+    let w = vj - vi;
+    let u = nfv + ng;
+    let s = u.norm();
+    let s3 = s * s * s;
+    let t = w.dot(&ng);
+    let q = t / s;
+    let f_w = ng / s;
+    let f_ng = w / s - u * (t / s3);
+    let f_nf = -u * (t / s3);
+
+    // Jacobians into local slots [v_i(0), v_j(1), v_k(2), p(3)].
+    // Nf: face slots are given by `slots` (which of nf.dn corresponds to v_i, v_j, v_k).
+    let jnf = [nf.dn[slots[0]], nf.dn[slots[1]], nf.dn[slots[2]]];
+    // Ng over [p, v_k, v_j] → local [3, 2, 1].
+    let jng = [
+        (1usize, ng_data.dn[2]),
+        (2usize, ng_data.dn[1]),
+        (3usize, ng_data.dn[0]),
+    ];
+    let mut grad = SVec::<12>::zeros();
+    {
+        let gw = f_w;
+        for c in 0..3 {
+            grad[c] -= gw[c];
+            grad[3 + c] += gw[c];
+        }
+        for (a, j) in jnf.iter().enumerate() {
+            let v = j.transpose() * f_nf;
+            for c in 0..3 {
+                grad[3 * a + c] += v[c];
+            }
+        }
+        for (slot, j) in &jng {
+            let v = j.transpose() * f_ng;
+            for c in 0..3 {
+                grad[3 * slot + c] += v[c];
+            }
+        }
+    }
+    if let Some(h) = hess {
+        // Hessian of F(w, Nf, Ng) (9×9).
+        let i3 = Mat3::identity();
+        let uu = u * u.transpose();
+        let k = (i3 / s3 - uu * (3.0 / (s3 * s * s))) * t;
+        let fw_nf = -(ng * u.transpose()) / s3;
+        let fw_ng = i3 / s - (ng * u.transpose()) / s3;
+        let fnf_nf = -k;
+        let fnf_ng = -(u * w.transpose()) / s3 - k;
+        let fng_ng = -(w * u.transpose()) / s3 - (u * w.transpose()) / s3 - k;
+        // J (9×12): rows [w; Nf; Ng].
+        let mut jac = SMat::<9, 12>::zeros();
+        for c in 0..3 {
+            jac[(c, c)] = -1.0;
+            jac[(c, 3 + c)] = 1.0;
+        }
+        for (a, j) in jnf.iter().enumerate() {
+            jac.fixed_view_mut::<3, 3>(3, 3 * a).copy_from(j);
+        }
+        for (slot, j) in &jng {
+            jac.fixed_view_mut::<3, 3>(6, 3 * slot).copy_from(j);
+        }
+        let mut hf = SMat::<9, 9>::zeros();
+        hf.fixed_view_mut::<3, 3>(0, 3).copy_from(&fw_nf);
+        hf.fixed_view_mut::<3, 3>(3, 0)
+            .copy_from(&fw_nf.transpose());
+        hf.fixed_view_mut::<3, 3>(0, 6).copy_from(&fw_ng);
+        hf.fixed_view_mut::<3, 3>(6, 0)
+            .copy_from(&fw_ng.transpose());
+        hf.fixed_view_mut::<3, 3>(3, 3).copy_from(&fnf_nf);
+        hf.fixed_view_mut::<3, 3>(3, 6).copy_from(&fnf_ng);
+        hf.fixed_view_mut::<3, 3>(6, 3)
+            .copy_from(&fnf_ng.transpose());
+        hf.fixed_view_mut::<3, 3>(6, 6).copy_from(&fng_ng);
+        *h = jac.transpose() * hf * jac;
+        // Ng second derivative contracted with ∂F/∂Ng, over [p, v_k, v_j] → local [3, 2, 1].
+        let hg = ng_data.hessian_contract(&f_ng);
+        let map = [3usize, 2, 1];
+        for a in 0..3 {
+            for b in 0..3 {
+                let blk = hg.fixed_view::<3, 3>(3 * a, 3 * b);
+                let mut dst = h.fixed_view_mut::<3, 3>(3 * map[a], 3 * map[b]);
+                dst += blk;
+            }
+        }
+    }
+    (EdgeQ { q, grad }, f_nf)
+}
+
+/// `b = 2 [q0 + q1, q0; q0, q0 + q2]` as `[b11, b12, b22]` (1/m · m² = m).
+#[inline]
+pub fn b_from_q(q: &SVec<3>) -> Sym2 {
+    Sym2::new(2.0 * (q[0] + q[1]), 2.0 * q[0], 2.0 * (q[0] + q[2]))
+}
+
+/// The constant map `∂b/∂q` (3×3).
+#[inline]
+pub fn b_from_q_matrix() -> Mat3 {
+    Mat3::new(2.0, 2.0, 0.0, 2.0, 0.0, 0.0, 2.0, 0.0, 2.0)
+}
+
+/// Mid-edge-average second fundamental form of one face from its vertices and the (optional)
+/// far vertices of its neighbours. Value only.
+pub fn midedge_average_b(x: &[Vec3; 3], opp: &[Option<Vec3>; 3]) -> Sym2 {
+    let nf = UnitNormal::new(x);
+    let mut q = SVec::<3>::zeros();
+    for i in 0..3 {
+        if let Some(p) = opp[i] {
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            let ng = UnitNormal::new(&[p, x[k], x[j]]).n;
+            q[i] = (x[j] - x[i]).dot(&ng) / (nf.n + ng).norm();
+        }
+    }
+    b_from_q(&q)
+}
+
+/// Curvatures of a face from its forms: the shape operator `S = a⁻¹ b`; mean curvature
+/// `H = tr S / 2`, Gauss curvature `K = det S`, principal curvatures (eigenvalues, ascending),
+/// all in 1/m or 1/m².
+pub fn curvatures(a: &Sym2, b: &Sym2) -> (Real, Real, Real, Real) {
+    let am = crate::math::sym_to_mat(a);
+    let bm = crate::math::sym_to_mat(b);
+    let s = am.try_inverse().unwrap_or_else(Mat2::zeros) * bm;
+    let h = 0.5 * s.trace();
+    let k = s.determinant();
+    let (k1, k2) = crate::math::eig2(&s);
+    (h, k, k1, k2)
+}

@@ -1,0 +1,254 @@
+//! Triangle meshes: the reference positions, the faces, and the per-face and per-vertex fields
+//! that a mesh file carries (`abar_info`, `ref_thicknesses`, `constraint_indicators`, ...).
+//!
+//! Consumes: a VTK file (or a generator's parameters). Produces: a validated [`Mesh`] and its
+//! [`Topology`]. Nothing downstream touches files.
+
+pub mod generate;
+pub mod io;
+pub mod topology;
+
+pub use topology::Topology;
+
+use crate::math::{Real, Vec3};
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// A named field with `components` values per entry, stored entry-major.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Field {
+    /// Number of components per face or vertex.
+    pub components: usize,
+    /// `len = components × entries`.
+    pub data: Vec<Real>,
+}
+
+impl Field {
+    /// A scalar field.
+    pub fn scalar(data: Vec<Real>) -> Self {
+        Field {
+            components: 1,
+            data,
+        }
+    }
+    /// Number of entries (faces or vertices).
+    pub fn len(&self) -> usize {
+        self.data.len().checked_div(self.components).unwrap_or(0)
+    }
+    /// True when the field holds no entries.
+    pub fn is_empty(&self) -> bool {
+        self.data.is_empty()
+    }
+    /// Components of entry `i`.
+    pub fn get(&self, i: usize) -> &[Real] {
+        &self.data[i * self.components..(i + 1) * self.components]
+    }
+}
+
+/// A triangle mesh with its fields, as read from a file.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Vertex positions (m).
+    pub positions: Vec<Vec3>,
+    /// Faces as vertex index triples, counter-clockwise seen from the normal side.
+    pub faces: Vec<[usize; 3]>,
+    /// Per-face fields by name (VTK CELL_DATA).
+    pub face_fields: BTreeMap<String, Field>,
+    /// Per-vertex fields by name (VTK POINT_DATA).
+    pub vertex_fields: BTreeMap<String, Field>,
+    /// Where the mesh came from (for error messages).
+    pub source: Option<PathBuf>,
+}
+
+/// Errors in reading or validating a mesh. Each names the file and the offending index.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum MeshError {
+    /// The file could not be read or parsed.
+    #[error("{path}: cannot read mesh: {reason}")]
+    Read {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        reason: String,
+    },
+    /// The file could not be written.
+    #[error("{path}: cannot write: {reason}")]
+    Write {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        reason: String,
+    },
+    /// The mesh is structurally invalid.
+    #[error("{path}: {reason}")]
+    Invalid {
+        /// The file (or `<generated>`).
+        path: String,
+        /// What is wrong, naming the face, vertex or field.
+        reason: String,
+    },
+}
+
+impl Mesh {
+    /// Display name of the source, for messages.
+    pub fn name(&self) -> String {
+        self.source
+            .as_ref()
+            .map(|p| p.display().to_string())
+            .unwrap_or_else(|| "<generated>".into())
+    }
+
+    pub(crate) fn invalid(&self, reason: impl Into<String>) -> MeshError {
+        MeshError::Invalid {
+            path: self.name(),
+            reason: reason.into(),
+        }
+    }
+
+    /// Vertices of face `f`.
+    #[inline]
+    pub fn face_positions(&self, f: usize) -> [Vec3; 3] {
+        let [i, j, k] = self.faces[f];
+        [self.positions[i], self.positions[j], self.positions[k]]
+    }
+
+    /// Checks coordinates, faces and fields; returns the unused vertices (a warning, not an
+    /// error). Topological checks (manifoldness, orientation) live in [`Topology::build`].
+    pub fn validate(&self) -> Result<Vec<usize>, MeshError> {
+        let nv = self.positions.len();
+        if nv < 3 || self.faces.is_empty() {
+            return Err(self.invalid(format!(
+                "mesh needs at least one triangle (has {} vertices, {} faces)",
+                nv,
+                self.faces.len()
+            )));
+        }
+        for (i, p) in self.positions.iter().enumerate() {
+            if !p.iter().all(|c| c.is_finite()) {
+                return Err(self.invalid(format!("vertex {i} has a non-finite coordinate {p:?}")));
+            }
+        }
+        let mut used = vec![false; nv];
+        let mut lmax: Real = 0.0;
+        for f in &self.faces {
+            for &v in f {
+                if v < nv {
+                    lmax = lmax.max((self.positions[v] - self.positions[f[0]]).norm());
+                }
+            }
+        }
+        for (fi, f) in self.faces.iter().enumerate() {
+            for &v in f {
+                if v >= nv {
+                    return Err(self.invalid(format!(
+                        "face {fi} refers to vertex {v}, but there are only {nv} vertices"
+                    )));
+                }
+                used[v] = true;
+            }
+            if f[0] == f[1] || f[1] == f[2] || f[0] == f[2] {
+                return Err(self.invalid(format!("face {fi} repeats a vertex: {f:?}")));
+            }
+            let [a, b, c] = self.face_positions(fi);
+            let cr = (b - a).cross(&(c - a)).norm();
+            let l2 = (b - a)
+                .norm_squared()
+                .max((c - a).norm_squared())
+                .max((c - b).norm_squared());
+            if cr <= 1e-12 * l2 || l2 == 0.0 {
+                return Err(self.invalid(format!(
+                    "face {fi} {f:?} has zero area (degenerate triangle)"
+                )));
+            }
+        }
+        let nf = self.faces.len();
+        for (name, field) in &self.face_fields {
+            check_field(self, name, field, nf, "face")?;
+        }
+        for (name, field) in &self.vertex_fields {
+            check_field(self, name, field, nv, "vertex")?;
+        }
+        Ok((0..nv).filter(|&i| !used[i]).collect())
+    }
+
+    /// True when all vertices lie in a plane `z = const` (the reference frame for fields given in
+    /// reference Cartesian coordinates).
+    pub fn is_flat_xy(&self) -> bool {
+        let z0 = self.positions[0].z;
+        let scale = self.bbox_diagonal().max(Real::MIN_POSITIVE);
+        self.positions
+            .iter()
+            .all(|p| (p.z - z0).abs() <= 1e-12 * scale)
+    }
+
+    /// Length of the diagonal of the axis-aligned bounding box.
+    pub fn bbox_diagonal(&self) -> Real {
+        let mut lo = Vec3::repeat(Real::INFINITY);
+        let mut hi = Vec3::repeat(Real::NEG_INFINITY);
+        for p in &self.positions {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        (hi - lo).norm()
+    }
+
+    /// Mean edge length over all face edges.
+    pub fn mean_edge_length(&self) -> Real {
+        let mut s = 0.0;
+        for f in 0..self.faces.len() {
+            let [a, b, c] = self.face_positions(f);
+            s += (b - a).norm() + (c - b).norm() + (a - c).norm();
+        }
+        s / (3.0 * self.faces.len() as Real)
+    }
+
+    /// Looks up a face field and checks its component count.
+    pub fn face_field(&self, name: &str, components: usize) -> Result<Option<&Field>, MeshError> {
+        match self.face_fields.get(name) {
+            None => Ok(None),
+            Some(f) if f.components == components => Ok(Some(f)),
+            Some(f) => Err(self.invalid(format!(
+                "face field '{name}' has {} components, expected {components}",
+                f.components
+            ))),
+        }
+    }
+
+    /// Looks up a vertex field and checks its component count.
+    pub fn vertex_field(&self, name: &str, components: usize) -> Result<Option<&Field>, MeshError> {
+        match self.vertex_fields.get(name) {
+            None => Ok(None),
+            Some(f) if f.components == components => Ok(Some(f)),
+            Some(f) => Err(self.invalid(format!(
+                "vertex field '{name}' has {} components, expected {components}",
+                f.components
+            ))),
+        }
+    }
+}
+
+fn check_field(
+    mesh: &Mesh,
+    name: &str,
+    field: &Field,
+    n: usize,
+    what: &str,
+) -> Result<(), MeshError> {
+    if field.components == 0 || field.data.len() != n * field.components {
+        return Err(mesh.invalid(format!(
+            "{what} field '{name}' has {} values, expected {} ({n} {what}s × {} components)",
+            field.data.len(),
+            n * field.components.max(1),
+            field.components
+        )));
+    }
+    if let Some(bad) = field.data.iter().position(|x| !x.is_finite()) {
+        return Err(mesh.invalid(format!(
+            "{what} field '{name}' is not finite at {what} {} (value {})",
+            bad / field.components,
+            field.data[bad]
+        )));
+    }
+    Ok(())
+}

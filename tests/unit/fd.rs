@@ -1,0 +1,121 @@
+//! Finite-difference checks of every kernel: gradient against energy, Hessian against gradient,
+//! central differences, on random non-degenerate configurations including boundary faces.
+
+use shellsim::energy::{material::sv_matrix, shell_face, KoiterDensity, Lame2d};
+use shellsim::math::{Real, SMat, SVec, Sym2, Vec3};
+use shellsim::mesh::generate::Rng;
+
+/// A face with its three neighbours' far vertices, randomly bent and sheared.
+pub fn random_patch(rng: &mut Rng, amp: Real) -> [Vec3; 6] {
+    let base = [
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.3, 0.9, 0.0),
+        // p0 across edge (v1, v2), p1 across (v2, v0), p2 across (v0, v1)
+        Vec3::new(1.2, 1.0, 0.0),
+        Vec3::new(-0.6, 0.5, 0.0),
+        Vec3::new(0.5, -0.8, 0.0),
+    ];
+    base.map(|p| p + Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * amp)
+}
+
+pub fn random_density(rng: &mut Rng, damping: bool) -> KoiterDensity {
+    let abar = Sym2::new(
+        1.0 + 0.2 * rng.uniform(),
+        0.1 * rng.symmetric(),
+        0.8 + 0.2 * rng.uniform(),
+    );
+    let bbar = Sym2::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * 0.5;
+    let lame = Lame2d::from_young_poisson(1.0 + rng.uniform(), 0.45 * rng.uniform());
+    let h = 0.1;
+    let (ws, wb) = KoiterDensity::weights(&abar, h, 1.0);
+    let mut d = KoiterDensity {
+        c: sv_matrix(&abar, lame),
+        stretch: [(ws, abar), (0.0, Sym2::zeros())],
+        bend: [(wb, bbar), (0.0, Sym2::zeros())],
+    };
+    if damping {
+        d.stretch[1] = (0.3 * ws, Sym2::new(1.1, 0.05, 0.9));
+        d.bend[1] = (0.3 * wb, Sym2::new(0.1, -0.2, 0.3));
+    }
+    d
+}
+
+fn flat(x: &[Vec3; 6]) -> SVec<18> {
+    SVec::<18>::from_iterator(x.iter().flat_map(|p| [p.x, p.y, p.z]))
+}
+fn unflat(v: &SVec<18>) -> [Vec3; 6] {
+    std::array::from_fn(|i| Vec3::new(v[3 * i], v[3 * i + 1], v[3 * i + 2]))
+}
+
+/// Max relative errors (gradient, Hessian) of central differences with step `eps`.
+pub fn fd_errors(x: &[Vec3; 6], has: [bool; 3], d: &KoiterDensity, eps: Real) -> (Real, Real) {
+    let mut g = SVec::<18>::zeros();
+    let mut h = SMat::<18, 18>::zeros();
+    shell_face(x, has, d, Some(&mut g), Some(&mut h));
+    let x0 = flat(x);
+    let mut gfd = SVec::<18>::zeros();
+    let mut hfd = SMat::<18, 18>::zeros();
+    for k in 0..18 {
+        let mut xp = x0;
+        xp[k] += eps;
+        let mut xm = x0;
+        xm[k] -= eps;
+        let mut gp = SVec::<18>::zeros();
+        let mut gm = SVec::<18>::zeros();
+        let ep = shell_face(&unflat(&xp), has, d, Some(&mut gp), None);
+        let em = shell_face(&unflat(&xm), has, d, Some(&mut gm), None);
+        gfd[k] = (ep - em) / (2.0 * eps);
+        hfd.set_column(k, &((gp - gm) / (2.0 * eps)));
+    }
+    let ge = (g - gfd).amax() / g.amax().max(1e-300);
+    let he = (h - hfd).amax() / h.amax().max(1e-300);
+    (ge, he)
+}
+
+#[test]
+fn shell_face_derivatives_match_finite_differences() {
+    let mut rng = Rng::new(7);
+    let patterns = [
+        [true, true, true],
+        [false, true, true],
+        [true, false, false],
+        [false, false, false],
+    ];
+    for trial in 0..40 {
+        let x = random_patch(&mut rng, 0.25);
+        let d = random_density(&mut rng, trial % 2 == 1);
+        let has = patterns[trial % patterns.len()];
+        let (ge, he) = fd_errors(&x, has, &d, 1e-6);
+        assert!(ge < 1e-6, "trial {trial}: gradient rel. error {ge:e}");
+        assert!(he < 1e-6, "trial {trial}: Hessian rel. error {he:e}");
+    }
+}
+
+#[test]
+fn hessian_is_symmetric() {
+    let mut rng = Rng::new(11);
+    for _ in 0..10 {
+        let x = random_patch(&mut rng, 0.3);
+        let d = random_density(&mut rng, true);
+        let mut h = SMat::<18, 18>::zeros();
+        shell_face(&x, [true; 3], &d, None, Some(&mut h));
+        let asym = (h - h.transpose()).amax() / h.amax();
+        assert!(asym < 1e-13, "asymmetry {asym:e}");
+    }
+}
+
+/// Prints the error-vs-step table for h = 1e-2 … 1e-6 (run with `--ignored --nocapture`).
+#[test]
+#[ignore]
+fn fd_error_table() {
+    let mut rng = Rng::new(3);
+    let x = random_patch(&mut rng, 0.25);
+    let d = random_density(&mut rng, true);
+    println!("{:>8} {:>12} {:>12}", "h", "grad err", "hess err");
+    for p in 2..=6 {
+        let eps = 10f64.powi(-p);
+        let (ge, he) = fd_errors(&x, [true; 3], &d, eps);
+        println!("{eps:>8.0e} {ge:>12.3e} {he:>12.3e}");
+    }
+}
