@@ -278,7 +278,7 @@ fn single_piece<P>(pieces: Vec<Piece<P>>) -> Result<P, String> {
 
 /// Output format of a mesh or frame file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[serde(rename_all = "snake_case")]
 pub enum Format {
     /// XML UnstructuredGrid with inline base64 data (ParaView's `.vtu`).
     Vtu,

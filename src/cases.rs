@@ -1,0 +1,236 @@
+//! Analytic benchmark cases: programmed forms with a known exact shape, and the error of a
+//! simulated shape against it after rigid alignment.
+//!
+//! Seed 000 Table 1 (on the unit square `[−½, ½]²`, forms in reference Cartesian coordinates):
+//!
+//! | case | ā | b̄ | exact surface, material point (x, y) ↦ |
+//! |---|---|---|---|
+//! | `enlarged_square` | 4I | 0 | (2x, 2y, 0) |
+//! | `spherical_cap` | (1−x²−y²)⁻¹[[1−y², xy], [xy, 1−x²]] | = ā | (x, y, √(1−x²−y²)) (unit sphere) |
+//! | `hyperboloid` | [[1+x², −xy], [−xy, 1+y²]] | (1+x²+y²)^(−½) diag(−1, 1) | (x, y, (x²−y²)/2) |
+//! | `rhombus` | [[2, 1], [1, 2]] | 0 | (F (x, y), 0) with F = √ā |
+//! | `cylinder` | I | diag(1, 0) | (sin x, y, cos x − 1) (radius 1, axis ∥ y) |
+//!
+//! Signs follow shellsim's convention (positive b̄ bulges toward the normal, +z here). The
+//! hyperboloid's forms are those of the graph `z = (x² − y²)/2`, whose normal-side curvature is
+//! `−∂²f/√(1+|∇f|²)`.
+
+use crate::math::{sym_to_mat, Mat2, Mat3, Real, Sym2, Vec3};
+use crate::mesh::{Field, Mesh};
+
+/// A programmed shape with a known answer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Case {
+    /// ā = 4I: a square twice as large.
+    EnlargedSquare,
+    /// The unit sphere's forms: a spherical cap.
+    SphericalCap,
+    /// The forms of the saddle z = (x² − y²)/2.
+    Hyperboloid,
+    /// ā = [[2, 1], [1, 2]]: a flat rhombus.
+    Rhombus,
+    /// ā = I, b̄ = diag(1, 0): a cylinder of radius 1.
+    Cylinder,
+}
+
+impl Case {
+    /// All Table 1 cases.
+    pub const ALL: [Case; 5] = [
+        Case::EnlargedSquare,
+        Case::SphericalCap,
+        Case::Hyperboloid,
+        Case::Rhombus,
+        Case::Cylinder,
+    ];
+
+    /// Name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Case::EnlargedSquare => "enlarged_square",
+            Case::SphericalCap => "spherical_cap",
+            Case::Hyperboloid => "hyperboloid",
+            Case::Rhombus => "rhombus",
+            Case::Cylinder => "cylinder",
+        }
+    }
+
+    /// Parses a name.
+    pub fn from_name(s: &str) -> Option<Case> {
+        Case::ALL.into_iter().find(|c| c.name() == s)
+    }
+
+    /// Target forms `(ā, b̄)` at reference point (x, y), as `[xx, xy, yy]`.
+    pub fn forms(self, x: Real, y: Real) -> (Sym2, Sym2) {
+        match self {
+            Case::EnlargedSquare => (Sym2::new(4.0, 0.0, 4.0), Sym2::zeros()),
+            Case::SphericalCap => {
+                let d = 1.0 - x * x - y * y;
+                let a = Sym2::new(1.0 - y * y, x * y, 1.0 - x * x) / d;
+                (a, a)
+            }
+            Case::Hyperboloid => (
+                Sym2::new(1.0 + x * x, -x * y, 1.0 + y * y),
+                Sym2::new(-1.0, 0.0, 1.0) / (1.0 + x * x + y * y).sqrt(),
+            ),
+            Case::Rhombus => (Sym2::new(2.0, 1.0, 2.0), Sym2::zeros()),
+            Case::Cylinder => (Sym2::new(1.0, 0.0, 1.0), Sym2::new(1.0, 0.0, 0.0)),
+        }
+    }
+
+    /// The exact position of material point (x, y).
+    pub fn exact(self, x: Real, y: Real) -> Vec3 {
+        match self {
+            Case::EnlargedSquare => Vec3::new(2.0 * x, 2.0 * y, 0.0),
+            Case::SphericalCap => Vec3::new(x, y, (1.0 - x * x - y * y).sqrt()),
+            Case::Hyperboloid => Vec3::new(x, y, 0.5 * (x * x - y * y)),
+            Case::Rhombus => {
+                let f = sqrt_spd(&sym_to_mat(&Sym2::new(2.0, 1.0, 2.0)));
+                let p = f * crate::math::Vec2::new(x, y);
+                Vec3::new(p.x, p.y, 0.0)
+            }
+            Case::Cylinder => Vec3::new(x.sin(), y, x.cos() - 1.0),
+        }
+    }
+
+    /// Exact mean and Gauss curvature at (x, y) (normal-side convention).
+    pub fn exact_curvatures(self, x: Real, y: Real) -> (Real, Real) {
+        let (a, b) = self.forms(x, y);
+        let s = sym_to_mat(&a).try_inverse().unwrap_or_else(Mat2::zeros) * sym_to_mat(&b);
+        (0.5 * s.trace(), s.determinant())
+    }
+
+    /// Writes this case's target forms into a mesh as `abar_info`, `bbar_info` (face centroids).
+    pub fn program(self, mesh: &mut Mesh) {
+        let nf = mesh.faces.len();
+        let mut a = Vec::with_capacity(3 * nf);
+        let mut b = Vec::with_capacity(3 * nf);
+        for f in 0..nf {
+            let [p, q, r] = mesh.face_positions(f);
+            let c = (p + q + r) / 3.0;
+            let (fa, fb) = self.forms(c.x, c.y);
+            a.extend_from_slice(fa.as_slice());
+            b.extend_from_slice(fb.as_slice());
+        }
+        mesh.face_fields.insert(
+            "abar_info".into(),
+            Field {
+                components: 3,
+                data: a,
+            },
+        );
+        mesh.face_fields.insert(
+            "bbar_info".into(),
+            Field {
+                components: 3,
+                data: b,
+            },
+        );
+    }
+}
+
+fn sqrt_spd(m: &Mat2) -> Mat2 {
+    let e = nalgebra::SymmetricEigen::new(*m);
+    let d = Mat2::from_diagonal(&e.eigenvalues.map(|l| l.max(0.0).sqrt()));
+    e.eigenvectors * d * e.eigenvectors.transpose()
+}
+
+/// Errors of a simulated shape against the exact one, after the best rigid alignment.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct ShapeError {
+    /// Largest distance between a vertex and its exact material point (m).
+    pub max: Real,
+    /// Root-mean-square of those distances (m).
+    pub rms: Real,
+    /// Size of the exact shape: the largest extent of its bounding box (m).
+    pub size: Real,
+    /// `max / size`.
+    pub max_rel: Real,
+    /// `rms / size`.
+    pub rms_rel: Real,
+    /// Vertex with the largest error.
+    pub worst_vertex: usize,
+    /// Its reference position.
+    pub worst_reference: [Real; 3],
+}
+
+/// Best rotation R and translation t with `R p + t ≈ q` in the least-squares sense (Kabsch,
+/// proper rotations only). Returns the aligned points.
+pub fn align(p: &[Vec3], q: &[Vec3]) -> Vec<Vec3> {
+    let n = p.len() as Real;
+    let cp = p.iter().sum::<Vec3>() / n;
+    let cq = q.iter().sum::<Vec3>() / n;
+    let mut h = Mat3::zeros();
+    for (a, b) in p.iter().zip(q) {
+        h += (a - cp) * (b - cq).transpose();
+    }
+    let svd = h.svd(true, true);
+    let (u, vt) = (
+        svd.u.unwrap_or_else(Mat3::identity),
+        svd.v_t.unwrap_or_else(Mat3::identity),
+    );
+    let mut d = Mat3::identity();
+    if (vt.transpose() * u.transpose()).determinant() < 0.0 {
+        d[(2, 2)] = -1.0;
+    }
+    let r = vt.transpose() * d * u.transpose();
+    p.iter().map(|a| r * (a - cp) + cq).collect()
+}
+
+/// Material-point error of `x` (simulated positions of the reference vertices `reference`)
+/// against the exact shape of `case`.
+pub fn shape_error(case: Case, reference: &[Vec3], x: &[Vec3]) -> ShapeError {
+    let exact: Vec<Vec3> = reference.iter().map(|p| case.exact(p.x, p.y)).collect();
+    let aligned = align(x, &exact);
+    let mut max: Real = 0.0;
+    let mut worst = 0;
+    let mut sum = 0.0;
+    for (i, (a, e)) in aligned.iter().zip(&exact).enumerate() {
+        let d = (a - e).norm();
+        if d > max {
+            max = d;
+            worst = i;
+        }
+        sum += d * d;
+    }
+    let rms = (sum / x.len() as Real).sqrt();
+    let mut lo = Vec3::repeat(Real::INFINITY);
+    let mut hi = Vec3::repeat(Real::NEG_INFINITY);
+    for e in &exact {
+        lo = lo.inf(e);
+        hi = hi.sup(e);
+    }
+    let size = (hi - lo).max();
+    ShapeError {
+        max,
+        rms,
+        size,
+        max_rel: max / size,
+        rms_rel: rms / size,
+        worst_vertex: worst,
+        worst_reference: reference[worst].into(),
+    }
+}
+
+/// RMS over faces of the error in mean and Gauss curvature, using the discrete mid-edge forms
+/// of the simulated shape against the exact values at the reference centroids (seed 000's
+/// measure for the hyperboloid). Returns (H error, K error), in 1/m and 1/m².
+pub fn curvature_error(
+    case: Case,
+    mesh: &Mesh,
+    topo: &crate::mesh::Topology,
+    x: &[Vec3],
+) -> (Real, Real) {
+    let (a, b) = crate::rest::mesh_forms(x, mesh, topo);
+    let mut eh = 0.0;
+    let mut ek = 0.0;
+    for f in 0..mesh.faces.len() {
+        let [p, q, r] = mesh.face_positions(f);
+        let c = (p + q + r) / 3.0;
+        let (h, k, _, _) = crate::geometry::curvatures(&a[f], &b[f]);
+        let (he, ke) = case.exact_curvatures(c.x, c.y);
+        eh += (h - he).powi(2);
+        ek += (k - ke).powi(2);
+    }
+    let n = mesh.faces.len() as Real;
+    ((eh / n).sqrt(), (ek / n).sqrt())
+}

@@ -1,0 +1,358 @@
+//! The command line: `shellsim SETTINGS MESH [--out DIR] [--threads N] [--set key=value]...`
+//! runs a scene; `shellsim mesh ...` writes generated meshes; `shellsim error ...` measures a
+//! frame against an analytic case.
+//!
+//! Exit codes: 0 converged, 1 ran but did not converge, 2 bad input or I/O error.
+
+use crate::cases::{curvature_error, shape_error, Case};
+use crate::integrate::{run, Progress, Quiet};
+use crate::math::{Real, Vec3};
+use crate::mesh::generate::{annulus, rectangle, Spacing};
+use crate::mesh::io::{read_mesh, write_mesh, Format};
+use crate::mesh::Topology;
+use crate::output::Writer;
+use crate::scene::Scene;
+use crate::settings::Settings;
+use anyhow::{anyhow, bail, Context, Result};
+use clap::{Parser, Subcommand, ValueEnum};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// shellsim: thin shells whose rest shape changes.
+#[derive(Parser, Debug)]
+#[command(
+    name = "shellsim",
+    version,
+    about,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true,
+    after_help = "Exit codes: 0 converged, 1 ran but did not converge, 2 bad input or I/O error."
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Settings file (TOML); see docs/settings.md.
+    #[arg(required = true)]
+    settings: Option<PathBuf>,
+    /// Triangle mesh (.vtk legacy ASCII/binary, or .vtu/.vtp XML with inline data).
+    #[arg(required = true)]
+    mesh: Option<PathBuf>,
+    /// Output folder (created if needed).
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    /// Worker threads for assembly (default: all cores). Results do not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Override a settings key, e.g. --set material.thickness=0.002 (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// No progress bar even on a terminal.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Write a generated triangle mesh.
+    Mesh(MeshArgs),
+    /// Error of a frame written by shellsim against an analytic case (prints JSON).
+    Error(ErrorArgs),
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum Shape {
+    /// Square of side --size.
+    Square,
+    /// Rectangle or strip --lx × --ly.
+    Rectangle,
+    /// Disk of radius --radius.
+    Disk,
+    /// Annulus --inner ≤ r ≤ --radius, optionally a sector of --sweep degrees.
+    Annulus,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum MeshFormat {
+    Vtk,
+    VtkAscii,
+    Vtu,
+}
+
+#[derive(clap::Args, Debug)]
+struct MeshArgs {
+    /// Shape to mesh.
+    shape: Shape,
+    /// Output file.
+    #[arg(long, short)]
+    out: PathBuf,
+    /// Target edge length (m).
+    #[arg(long)]
+    edge: Real,
+    /// Side of a square (m).
+    #[arg(long, default_value_t = 1.0)]
+    size: Real,
+    /// Rectangle length along x (m).
+    #[arg(long, default_value_t = 1.0)]
+    lx: Real,
+    /// Rectangle width along y (m).
+    #[arg(long, default_value_t = 0.1)]
+    ly: Real,
+    /// Outer radius of a disk or annulus (m).
+    #[arg(long, default_value_t = 1.0)]
+    radius: Real,
+    /// Inner radius of an annulus (m).
+    #[arg(long, default_value_t = 0.5)]
+    inner: Real,
+    /// Angular extent of an annulus in degrees (360 = full ring).
+    #[arg(long, default_value_t = 360.0)]
+    sweep: Real,
+    /// Ratio of largest to smallest spacing (1 = uniform).
+    #[arg(long, default_value_t = 1.0)]
+    grading: Real,
+    /// Random interior-vertex offset as a fraction of the local edge length (0 = none).
+    #[arg(long, default_value_t = 0.0)]
+    jitter: Real,
+    /// Seed of the jitter.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Squares and rectangles: split cells along alternating diagonals instead of the same one.
+    #[arg(long)]
+    checkerboard: bool,
+    /// Write abar_info/bbar_info for an analytic case (enlarged_square, spherical_cap,
+    /// hyperboloid, rhombus, cylinder).
+    #[arg(long)]
+    program: Option<String>,
+    /// Per-face thickness written as ref_thicknesses (m).
+    #[arg(long)]
+    thickness: Option<Real>,
+    /// File format (default from the extension: .vtu → vtu, .vtk → binary legacy).
+    #[arg(long, value_enum)]
+    format: Option<MeshFormat>,
+}
+
+#[derive(clap::Args, Debug)]
+struct ErrorArgs {
+    /// Analytic case (enlarged_square, spherical_cap, hyperboloid, rhombus, cylinder).
+    case: String,
+    /// A frame written by shellsim (its reference positions are positions − displacement).
+    frame: PathBuf,
+}
+
+/// Parses arguments, runs, prints errors, returns the exit code.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match dispatch(cli) {
+        Ok(code) => ExitCode::from(code),
+        Err(err) => {
+            // Every error that reaches here is bad input or I/O: exit code 2.
+            eprintln!("error: {err:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn dispatch(cli: Cli) -> Result<u8> {
+    match cli.command {
+        Some(Command::Mesh(a)) => mesh_cmd(a).map(|_| 0),
+        Some(Command::Error(a)) => error_cmd(a).map(|_| 0),
+        None => {
+            let (Some(settings), Some(mesh)) = (cli.settings.clone(), cli.mesh.clone()) else {
+                bail!("usage: shellsim SETTINGS MESH [--out DIR]");
+            };
+            run_cmd(&cli, settings, mesh)
+        }
+    }
+}
+
+struct Bar(indicatif::ProgressBar);
+impl Progress for Bar {
+    fn update(&mut self, fraction: Real, message: &str) {
+        self.0
+            .set_position((fraction.clamp(0.0, 1.0) * 1000.0) as u64);
+        self.0.set_message(message.to_string());
+    }
+}
+
+fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> {
+    let settings = Settings::load(&settings_path, &cli.set)?;
+    let mesh = read_mesh(&mesh_path)?;
+    let scene = Scene::build(mesh, settings)?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    let threads = match cli.threads {
+        Some(0) => bail!("--threads must be at least 1"),
+        Some(n) => n,
+        None => std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1),
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| anyhow!("cannot start {threads} threads: {e}"))?;
+    let mut writer = Writer::new(&cli.out, &scene)
+        .with_context(|| format!("output folder {}", cli.out.display()))?;
+    let summary = pool.install(|| {
+        if !cli.quiet && std::io::stderr().is_terminal() {
+            let pb = indicatif::ProgressBar::new(1000);
+            pb.set_style(
+                indicatif::ProgressStyle::with_template("{bar:30} {percent:>3}% {elapsed} {msg}")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            );
+            let mut bar = Bar(pb);
+            let r = run(&scene, &mut writer, &mut bar, threads);
+            bar.0.finish_and_clear();
+            r
+        } else {
+            run(&scene, &mut writer, &mut Quiet, threads)
+        }
+    })?;
+    if summary.converged {
+        Ok(0)
+    } else {
+        eprintln!(
+            "shellsim: did not converge: {} (see {})",
+            summary.reason,
+            cli.out.join("summary.json").display()
+        );
+        Ok(1)
+    }
+}
+
+fn mesh_cmd(a: MeshArgs) -> Result<()> {
+    let pos = |name: &str, v: Real| -> Result<()> {
+        if !(v.is_finite() && v > 0.0) {
+            bail!("--{name} must be positive, got {v}");
+        }
+        Ok(())
+    };
+    pos("edge", a.edge)?;
+    pos("grading", a.grading)?;
+    if !(0.0..0.5).contains(&a.jitter) {
+        bail!("--jitter must lie in [0, 0.5), got {}", a.jitter);
+    }
+    let sp = Spacing {
+        grading: a.grading,
+        jitter: a.jitter,
+        seed: a.seed,
+        checkerboard: a.checkerboard,
+    };
+    let mut mesh = match a.shape {
+        Shape::Square => {
+            pos("size", a.size)?;
+            rectangle(-0.5 * a.size, -0.5 * a.size, a.size, a.size, a.edge, sp)
+        }
+        Shape::Rectangle => {
+            pos("lx", a.lx)?;
+            pos("ly", a.ly)?;
+            rectangle(-0.5 * a.lx, -0.5 * a.ly, a.lx, a.ly, a.edge, sp)
+        }
+        Shape::Disk => {
+            pos("radius", a.radius)?;
+            annulus(0.0, a.radius, 2.0 * std::f64::consts::PI, a.edge, sp)
+        }
+        Shape::Annulus => {
+            pos("radius", a.radius)?;
+            pos("inner", a.inner)?;
+            pos("sweep", a.sweep)?;
+            if a.inner >= a.radius {
+                bail!(
+                    "--inner ({}) must be smaller than --radius ({})",
+                    a.inner,
+                    a.radius
+                );
+            }
+            annulus(
+                a.inner,
+                a.radius,
+                a.sweep.min(360.0).to_radians(),
+                a.edge,
+                sp,
+            )
+        }
+    };
+    if let Some(p) = &a.program {
+        let case = Case::from_name(p).ok_or_else(|| {
+            anyhow!(
+                "unknown --program '{p}' (one of: {})",
+                Case::ALL.map(|c| c.name()).join(", ")
+            )
+        })?;
+        case.program(&mut mesh);
+    }
+    if let Some(t) = a.thickness {
+        pos("thickness", t)?;
+        mesh.face_fields.insert(
+            "ref_thicknesses".into(),
+            crate::mesh::Field::scalar(vec![t; mesh.faces.len()]),
+        );
+    }
+    mesh.validate()?;
+    Topology::build(&mesh)?;
+    let ext = a.out.extension().and_then(|s| s.to_str()).unwrap_or("");
+    let format = match (a.format, ext) {
+        (Some(MeshFormat::Vtk), _) => Format::Vtk,
+        (Some(MeshFormat::VtkAscii), _) => Format::VtkAscii,
+        (Some(MeshFormat::Vtu), _) => Format::Vtu,
+        (None, "vtu") => Format::Vtu,
+        (None, "vtk") => Format::Vtk,
+        (None, other) => bail!(
+            "{}: unknown extension '.{other}' (use .vtk or .vtu)",
+            a.out.display()
+        ),
+    };
+    write_mesh(&a.out, &mesh, format, "shellsim generated mesh")?;
+    println!(
+        "{}: {} vertices, {} faces",
+        a.out.display(),
+        mesh.positions.len(),
+        mesh.faces.len()
+    );
+    Ok(())
+}
+
+fn error_cmd(a: ErrorArgs) -> Result<()> {
+    let case = Case::from_name(&a.case).ok_or_else(|| {
+        anyhow!(
+            "unknown case '{}' (one of: {})",
+            a.case,
+            Case::ALL.map(|c| c.name()).join(", ")
+        )
+    })?;
+    let frame = read_mesh(&a.frame)?;
+    let disp = frame.vertex_field("displacement", 3)?.ok_or_else(|| {
+        anyhow!(
+            "{}: no 'displacement' vertex field; is it a shellsim frame?",
+            a.frame.display()
+        )
+    })?;
+    let reference: Vec<Vec3> = frame
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| p - Vec3::from_column_slice(disp.get(i)))
+        .collect();
+    let err = shape_error(case, &reference, &frame.positions);
+    let mut ref_mesh = frame.clone();
+    ref_mesh.positions = reference;
+    let topo = Topology::build(&ref_mesh)?;
+    let (eh, ek) = curvature_error(case, &ref_mesh, &topo, &frame.positions);
+    let out = serde_json::json!({
+        "case": case.name(),
+        "vertices": frame.positions.len(),
+        "faces": frame.faces.len(),
+        "max_error": err.max,
+        "rms_error": err.rms,
+        "size": err.size,
+        "max_error_rel": err.max_rel,
+        "rms_error_rel": err.rms_rel,
+        "worst_vertex": err.worst_vertex,
+        "worst_reference_position": err.worst_reference,
+        "mean_curvature_rms_error": eh,
+        "gauss_curvature_rms_error": ek,
+    });
+    println!("{}", serde_json::to_string_pretty(&out)?);
+    Ok(())
+}

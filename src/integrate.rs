@@ -1,0 +1,487 @@
+//! Drivers: static equilibrium by adaptive continuation of the dial factor, and implicit-Euler
+//! dynamics with adaptive time steps. Both call Newton on a [`Potential`] and write frames
+//! through an [`output::Writer`](crate::output::Writer).
+//!
+//! Symmetry breaking: a perfectly flat start is a saddle for many programmed shapes (a metric
+//! that asks for a cone, for one). When the initial sheet is exactly planar, every free vertex is
+//! moved along the vertex normal by `symmetry_breaking × mean edge × u`, `u` uniform in [−1, 1)
+//! from a SplitMix64 stream seeded by `solver.seed`: deterministic and reproducible. After a
+//! static solve, the equilibrium is tested for stability (Cholesky of `H + δ·mean|diag|·I`,
+//! δ = 1e-9, which fails iff H has an eigenvalue below −δ·mean|diag|); a saddle is perturbed again
+//! (amplitude ×10 each time) and re-solved. A saddle is never reported as an equilibrium.
+
+use crate::assembly::{Pattern, Want};
+use crate::math::{Real, Vec3};
+use crate::mesh::generate::Rng;
+use crate::output::{LogRow, OutputError, Summary, Writer};
+use crate::rest::mesh_forms;
+use crate::scene::Scene;
+use crate::settings::Mode;
+use crate::solve::linear::LinearError;
+use crate::solve::newton::Workspace;
+use crate::solve::potential::{Damping, Inertia};
+use crate::solve::{newton, LinearSolver, NewtonOptions, NewtonReport, Potential};
+use std::time::Instant;
+
+/// Errors that stop a run (as opposed to non-convergence, which is reported in the summary).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RunError {
+    /// Output could not be written.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// The linear solver could not be set up.
+    #[error(transparent)]
+    Linear(#[from] LinearError),
+}
+
+/// Receives progress updates (a terminal progress bar, or nothing).
+pub trait Progress {
+    /// Called after every accepted step with (progress in [0, 1], label).
+    fn update(&mut self, fraction: Real, message: &str);
+}
+
+/// A progress sink that ignores everything.
+pub struct Quiet;
+impl Progress for Quiet {
+    fn update(&mut self, _: Real, _: &str) {}
+}
+
+/// Area-weighted vertex normals.
+pub fn vertex_normals(scene: &Scene, x: &[Vec3]) -> Vec<Vec3> {
+    let mut n = vec![Vec3::zeros(); x.len()];
+    for f in &scene.mesh.faces {
+        let c = (x[f[1]] - x[f[0]]).cross(&(x[f[2]] - x[f[0]]));
+        for &v in f {
+            n[v] += c;
+        }
+    }
+    for v in &mut n {
+        let l = v.norm();
+        if l > 0.0 {
+            *v /= l;
+        }
+    }
+    n
+}
+
+/// True when all face normals are parallel (the sheet is planar).
+pub fn is_planar(scene: &Scene, x: &[Vec3]) -> bool {
+    let mut n0: Option<Vec3> = None;
+    for f in &scene.mesh.faces {
+        let c = (x[f[1]] - x[f[0]]).cross(&(x[f[2]] - x[f[0]])).normalize();
+        match n0 {
+            None => n0 = Some(c),
+            Some(n) => {
+                if n.dot(&c) < 1.0 - 1e-12 {
+                    return false;
+                }
+            }
+        }
+    }
+    true
+}
+
+/// Moves free vertices along their normals by `amp × u`, u uniform in [−1, 1) (seeded).
+pub fn perturb(scene: &Scene, x: &mut [Vec3], amp: Real, seed: u64) {
+    let normals = vertex_normals(scene, x);
+    let mut rng = Rng::new(seed);
+    for (v, p) in x.iter_mut().enumerate() {
+        let u = rng.symmetric();
+        if !scene.fixed[v] {
+            *p += normals[v] * (amp * u);
+        }
+    }
+}
+
+struct Solver<'a> {
+    scene: &'a Scene,
+    pattern: &'a Pattern,
+    lin: LinearSolver,
+    ws: Workspace,
+    gravity: Vec3,
+    summary: Summary,
+    start: Instant,
+    iters_since_frame: usize,
+    steps_since_frame: usize,
+}
+
+impl<'a> Solver<'a> {
+    fn new(scene: &'a Scene, pattern: &'a Pattern, threads: usize) -> Result<Self, RunError> {
+        let lin = LinearSolver::new(pattern)?;
+        let ws = Workspace::new(pattern.n, pattern.nnz());
+        let summary = Summary {
+            mode: match scene.settings.solver.mode {
+                Mode::Static => "static",
+                Mode::Dynamic => "dynamic",
+            }
+            .into(),
+            vertices: scene.num_vertices(),
+            faces: scene.num_faces(),
+            threads,
+            warnings: scene.warnings.clone(),
+            ..Default::default()
+        };
+        Ok(Solver {
+            scene,
+            pattern,
+            lin,
+            ws,
+            gravity: Vec3::from(scene.settings.loads.gravity),
+            summary,
+            start: Instant::now(),
+            iters_since_frame: 0,
+            steps_since_frame: 0,
+        })
+    }
+
+    fn potential(&self, dial: Real) -> Potential<'a> {
+        Potential {
+            scene: self.scene,
+            pattern: self.pattern,
+            dial,
+            inertia: None,
+            damping: None,
+            gravity: self.gravity,
+        }
+    }
+
+    fn record(&mut self, rep: &NewtonReport) {
+        self.summary.newton_iterations += rep.iterations;
+        self.summary.shifted_iterations += rep.shifted_iterations;
+        self.iters_since_frame += rep.iterations;
+        self.summary.residual = rep.residual;
+    }
+
+    fn frame(
+        &mut self,
+        writer: &mut Writer,
+        pot: &Potential,
+        x: &[Vec3],
+        v: &[Vec3],
+        time: Real,
+    ) -> Result<(), RunError> {
+        let row = LogRow {
+            frame: 0,
+            time,
+            dial: pot.dial,
+            energy: Default::default(),
+            residual: self.summary.residual,
+            newton_iterations: self.iters_since_frame,
+            steps: self.steps_since_frame,
+            wall_seconds: self.start.elapsed().as_secs_f64(),
+        };
+        writer.frame(pot, x, v, row)?;
+        self.iters_since_frame = 0;
+        self.steps_since_frame = 0;
+        Ok(())
+    }
+
+    /// Tests `H + δI ≻ 0` at `x` (see module doc).
+    fn is_stable(&mut self, dial: Real, x: &[Vec3]) -> bool {
+        let pot = self.potential(dial);
+        let mut values = vec![0.0; self.pattern.nnz()];
+        let mut g = vec![0.0; self.pattern.n];
+        pot.eval(x, Want::Hessian, &mut g, &mut values);
+        let n = self.pattern.n;
+        let scale: Real = (0..n)
+            .map(|i| values[self.pattern.diag(i)].abs())
+            .sum::<Real>()
+            / n as Real;
+        for i in 0..n {
+            values[self.pattern.diag(i)] += 1e-9 * scale;
+        }
+        self.lin.factor(&values).is_ok()
+    }
+}
+
+/// Runs a scene to completion, writing frames, the log and the summary.
+pub fn run(
+    scene: &Scene,
+    writer: &mut Writer,
+    progress: &mut dyn Progress,
+    threads: usize,
+) -> Result<Summary, RunError> {
+    let pattern = Pattern::new(
+        scene.num_vertices(),
+        &scene.mesh.faces,
+        &scene.topo.opposite_vertex,
+    );
+    let mut s = Solver::new(scene, &pattern, threads)?;
+    let mut x = scene.mesh.positions.clone();
+    let sb = scene.settings.solver.symmetry_breaking;
+    if sb > 0.0 && is_planar(scene, &x) {
+        perturb(
+            scene,
+            &mut x,
+            sb * scene.mean_edge,
+            scene.settings.solver.seed,
+        );
+    }
+    match scene.settings.solver.mode {
+        Mode::Static => run_static(&mut s, writer, progress, x)?,
+        Mode::Dynamic => run_dynamic(&mut s, writer, progress, x)?,
+    }
+    s.summary.wall_seconds = s.start.elapsed().as_secs_f64();
+    s.summary.frames = writer.num_frames();
+    s.summary.final_frame = writer.last_frame();
+    writer.summary(&s.summary)?;
+    Ok(s.summary)
+}
+
+fn run_static(
+    s: &mut Solver,
+    writer: &mut Writer,
+    progress: &mut dyn Progress,
+    mut x: Vec<Vec3>,
+) -> Result<(), RunError> {
+    let st = &s.scene.settings.solver;
+    let (tol, max_iter) = (st.tolerance, st.max_newton_iterations);
+    let (min_step, sb, seed) = (st.min_continuation_step, st.symmetry_breaking, st.seed);
+    let (check, max_escapes) = (st.check_stability, st.max_saddle_escapes);
+    let cont_frames = s.scene.settings.output.continuation_frames;
+    let zeros = vec![Vec3::zeros(); x.len()];
+    {
+        let pot = s.potential(0.0);
+        s.frame(writer, &pot, &x, &zeros, 0.0)?;
+    }
+    let mut dial = 0.0;
+    let mut step = st.continuation_step;
+    let mut trial = x.clone();
+    let mut failure: Option<String> = None;
+    while dial < 1.0 {
+        let target = (dial + step).min(1.0);
+        // Intermediate continuation steps need not be solved to full accuracy.
+        let t = if target < 1.0 {
+            (tol * 1e3).min(1e-5).max(tol)
+        } else {
+            tol
+        };
+        trial.copy_from_slice(&x);
+        let pot = s.potential(target);
+        let rep = newton(
+            &pot,
+            &mut s.lin,
+            &mut s.ws,
+            &mut trial,
+            NewtonOptions { tol: t, max_iter },
+        );
+        s.record(&rep);
+        if rep.converged {
+            x.copy_from_slice(&trial);
+            dial = target;
+            s.summary.steps += 1;
+            s.steps_since_frame += 1;
+            if rep.iterations <= 5 {
+                step = (step * 2.0).min(1.0);
+            }
+            progress.update(
+                dial,
+                &format!("dial {dial:.4} E {:.4e} r {:.1e}", rep.energy, rep.residual),
+            );
+            if cont_frames && dial < 1.0 {
+                let pot = s.potential(dial);
+                s.frame(writer, &pot, &x, &zeros, dial)?;
+            }
+        } else {
+            s.summary.rejected_steps += 1;
+            step *= 0.5;
+            if step < min_step {
+                failure = Some(format!(
+                    "continuation step fell below {min_step} at dial {dial:.6}: {}",
+                    rep.reason
+                ));
+                break;
+            }
+        }
+    }
+    if failure.is_none() && check {
+        let mut escapes = 0;
+        while !s.is_stable(1.0, &x) {
+            if escapes >= max_escapes {
+                failure = Some(format!(
+                    "equilibrium is a saddle (Hessian indefinite) after {escapes} perturbations"
+                ));
+                break;
+            }
+            escapes += 1;
+            let amp = sb.max(1e-3) * s.scene.mean_edge * 10f64.powi(escapes as i32);
+            perturb(s.scene, &mut x, amp, seed.wrapping_add(escapes as u64));
+            let pot = s.potential(1.0);
+            let rep = newton(
+                &pot,
+                &mut s.lin,
+                &mut s.ws,
+                &mut x,
+                NewtonOptions {
+                    tol,
+                    max_iter: max_iter * 5,
+                },
+            );
+            s.record(&rep);
+            if !rep.converged {
+                failure = Some(format!("after escaping a saddle: {}", rep.reason));
+                break;
+            }
+        }
+        s.summary.saddle_escapes = escapes;
+    }
+    s.summary.dial = dial;
+    s.summary.converged = failure.is_none();
+    s.summary.reason = failure.unwrap_or_default();
+    let pot = s.potential(dial);
+    s.summary.energy = Writer::energies(&pot, &x, &zeros);
+    s.frame(writer, &pot, &x, &zeros, 1.0_f64.max(dial))?;
+    Ok(())
+}
+
+fn run_dynamic(
+    s: &mut Solver,
+    writer: &mut Writer,
+    progress: &mut dyn Progress,
+    mut x: Vec<Vec3>,
+) -> Result<(), RunError> {
+    let sc = s.scene;
+    let tm = sc.settings.time.clone();
+    let (tol, max_iter) = (
+        sc.settings.solver.tolerance,
+        sc.settings.solver.max_newton_iterations,
+    );
+    let dial_time = sc.settings.rest.dial_time;
+    let dial_at = |t: Real| {
+        if dial_time > 0.0 {
+            (t / dial_time).min(1.0)
+        } else {
+            1.0
+        }
+    };
+    let n = x.len();
+    let mut v = vec![Vec3::zeros(); n];
+    let mut xhat = x.clone();
+    let mut trial = x.clone();
+    let damping = tm.damping > 0.0;
+    let (mut a_prev, mut b_prev) = if damping {
+        mesh_forms(&x, &sc.mesh, &sc.topo)
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    {
+        let pot = s.potential(dial_at(0.0));
+        s.frame(writer, &pot, &x, &v, 0.0)?;
+    }
+    let mut t = 0.0;
+    let mut dt = tm.dt;
+    let mut next_out = tm.output_interval.min(tm.end);
+    let mut easy = 0;
+    let mut failure: Option<String> = None;
+    let eps_t = 1e-12 * tm.end;
+    while t < tm.end - eps_t {
+        let h = dt.min(next_out - t).min(tm.end - t);
+        let dial = dial_at(t + h);
+        for i in 0..n {
+            xhat[i] = x[i] + v[i] * h;
+        }
+        trial.copy_from_slice(&xhat);
+        let pot = Potential {
+            scene: sc,
+            pattern: s.pattern,
+            dial,
+            inertia: Some(Inertia {
+                inv_dt2: 1.0 / (h * h),
+                xhat: &xhat,
+            }),
+            damping: damping.then_some(Damping {
+                eta_over_dt: tm.damping / h,
+                a_prev: &a_prev,
+                b_prev: &b_prev,
+            }),
+            gravity: s.gravity,
+        };
+        let rep = newton(
+            &pot,
+            &mut s.lin,
+            &mut s.ws,
+            &mut trial,
+            NewtonOptions { tol, max_iter },
+        );
+        s.summary.newton_iterations += rep.iterations;
+        s.summary.shifted_iterations += rep.shifted_iterations;
+        s.iters_since_frame += rep.iterations;
+        s.summary.residual = rep.residual;
+        if !rep.converged {
+            s.summary.rejected_steps += 1;
+            dt = h * 0.5;
+            easy = 0;
+            if dt < tm.dt_min {
+                failure = Some(format!(
+                    "time step fell below dt_min = {} at t = {t:.6e}: {}",
+                    tm.dt_min, rep.reason
+                ));
+                break;
+            }
+            continue;
+        }
+        for i in 0..n {
+            v[i] = (trial[i] - x[i]) / h;
+        }
+        x.copy_from_slice(&trial);
+        t += h;
+        s.summary.steps += 1;
+        s.steps_since_frame += 1;
+        if damping {
+            let (a, b) = mesh_forms(&x, &sc.mesh, &sc.topo);
+            a_prev = a;
+            b_prev = b;
+        }
+        if rep.iterations <= 3 {
+            easy += 1;
+            if easy >= 3 {
+                dt = (dt * 1.5).min(tm.dt_max);
+                easy = 0;
+            }
+        } else {
+            easy = 0;
+        }
+        progress.update(
+            t / tm.end,
+            &format!("t {t:.4e} s  E {:.4e}  r {:.1e}", rep.energy, rep.residual),
+        );
+        let at_output = t >= next_out - 1e-9 * h.max(eps_t);
+        let mut stop = false;
+        if tm.stop_at_equilibrium {
+            let pot = s.potential(dial);
+            let mut g = vec![0.0; s.pattern.n];
+            pot.eval(&x, Want::Gradient, &mut g, &mut []);
+            let r = g.iter().fold(0.0 as Real, |m, v| m.max(v.abs())) / sc.force_scale;
+            let en = Writer::energies(&pot, &x, &v);
+            stop = dial >= 1.0
+                && r <= tol
+                && en.kinetic
+                    <= tm.equilibrium_kinetic
+                        * (en.stretching + en.bending).max(Real::MIN_POSITIVE);
+        }
+        if at_output || stop || t >= tm.end - eps_t {
+            let pot = s.potential(dial);
+            s.frame(writer, &pot, &x, &v, t)?;
+            while next_out <= t + eps_t {
+                next_out += tm.output_interval;
+            }
+            next_out = next_out.min(tm.end);
+        }
+        if stop {
+            break;
+        }
+    }
+    s.summary.time = t;
+    s.summary.dial = dial_at(t);
+    s.summary.converged = failure.is_none();
+    s.summary.reason = failure.unwrap_or_default();
+    let pot = s.potential(dial_at(t));
+    s.summary.energy = Writer::energies(&pot, &x, &v);
+    if s.summary.reason.is_empty() {
+        return Ok(());
+    }
+    // Record the state reached when the run stopped early.
+    s.frame(writer, &pot, &x, &v, t)?;
+    Ok(())
+}

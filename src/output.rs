@@ -1,0 +1,393 @@
+//! Output: one VTK frame per output time, a ParaView series file (`series.pvd`) that opens the
+//! whole run, a per-frame CSV log (`log.csv`) and a run summary (`summary.json`). Every file is
+//! written to a temporary name and renamed into place, and a frame with a non-finite value is
+//! never written.
+//!
+//! Frame fields (per face, tensors as `[xx, xy, yy]` in reference Cartesian coordinates: the
+//! (x, y) frame of a flat reference mesh, otherwise each reference face's own orthonormal frame
+//! `t1 = e1/|e1|`, `t2 = N × t1`): `a`, `b`, `abar`, `bbar`, `mean_curvature`,
+//! `gauss_curvature`, `k1`, `k2` (principal curvatures, ascending), `stretching_energy_density`,
+//! `bending_energy_density` (J/m² of rest area), `thickness`, and `tri_tags` when the input has
+//! it. Per vertex: `displacement`, `velocity`, `constraint_indicators`, and `node_tags` when
+//! present.
+
+use crate::geometry::curvatures;
+use crate::math::{Mat2, Real, Sym2, Vec3};
+use crate::mesh::io::{mesh_to_bytes, write_atomic, Format};
+use crate::mesh::{Field, Mesh};
+use crate::rest::{mesh_forms, push_forward, reference_frame};
+use crate::scene::Scene;
+use crate::solve::Potential;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// Errors while writing output.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum OutputError {
+    /// A file or folder could not be written.
+    #[error("{path}: {reason}")]
+    Io {
+        /// The path.
+        path: String,
+        /// Why.
+        reason: String,
+    },
+    /// A frame contained NaN or infinity; it was not written.
+    #[error("frame {index} at t = {time} contains non-finite values in '{field}'; not written")]
+    NonFinite {
+        /// Frame index.
+        index: usize,
+        /// Time.
+        time: Real,
+        /// The field.
+        field: String,
+    },
+}
+
+/// Energies of a state, by term (J).
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Energies {
+    /// Sum of the terms below.
+    pub total: Real,
+    /// Stretching (membrane) energy.
+    pub stretching: Real,
+    /// Bending energy.
+    pub bending: Real,
+    /// Gravitational potential energy.
+    pub gravity: Real,
+    /// Kinetic energy ½ Σ m |v|².
+    pub kinetic: Real,
+}
+
+/// One row of the per-frame log.
+#[derive(Clone, Debug, Serialize)]
+pub struct LogRow {
+    /// Frame index.
+    pub frame: usize,
+    /// Simulated time (s); in static mode, the dial factor.
+    pub time: Real,
+    /// Dial factor of the rest forms.
+    pub dial: Real,
+    /// Energies.
+    #[serde(flatten)]
+    pub energy: Energies,
+    /// Relative residual ‖∇Φ‖∞/F of the last solve.
+    pub residual: Real,
+    /// Newton iterations since the previous frame.
+    pub newton_iterations: usize,
+    /// Steps (time steps or continuation steps) since the previous frame.
+    pub steps: usize,
+    /// Wall time since the start (s).
+    pub wall_seconds: Real,
+}
+
+/// The run summary written to `summary.json`.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Summary {
+    /// Whether the run reached its goal (static: a stable equilibrium at dial 1; dynamic: the end
+    /// time, or equilibrium when asked to stop there).
+    pub converged: bool,
+    /// Why it stopped, when not converged.
+    pub reason: String,
+    /// `"static"` or `"dynamic"`.
+    pub mode: String,
+    /// Last frame, relative to the output folder.
+    pub final_frame: String,
+    /// Frames written.
+    pub frames: usize,
+    /// Wall time (s).
+    pub wall_seconds: Real,
+    /// Accepted steps (time steps or continuation steps).
+    pub steps: usize,
+    /// Rejected steps (cut after a failed Newton solve).
+    pub rejected_steps: usize,
+    /// Total Newton iterations.
+    pub newton_iterations: usize,
+    /// Newton iterations that needed a diagonal shift.
+    pub shifted_iterations: usize,
+    /// Saddle points detected and escaped by perturbation.
+    pub saddle_escapes: usize,
+    /// Vertices.
+    pub vertices: usize,
+    /// Faces.
+    pub faces: usize,
+    /// Worker threads.
+    pub threads: usize,
+    /// Final simulated time (s) (static: 0).
+    pub time: Real,
+    /// Final dial factor.
+    pub dial: Real,
+    /// Final relative residual.
+    pub residual: Real,
+    /// Final energies.
+    pub energy: Energies,
+    /// Warnings raised while loading.
+    pub warnings: Vec<String>,
+}
+
+/// Writes frames, the series, the log and the summary into one folder.
+pub struct Writer {
+    dir: PathBuf,
+    format: Format,
+    prefix: String,
+    frames: Vec<(Real, String)>,
+    log: Vec<LogRow>,
+    frame_mesh: Mesh,
+    frames_t: Vec<Mat2>,
+}
+
+fn ioerr(path: &Path, e: impl ToString) -> OutputError {
+    OutputError::Io {
+        path: path.display().to_string(),
+        reason: e.to_string(),
+    }
+}
+
+/// Per-face frames mapping barycentric to reference Cartesian coordinates (see module doc).
+fn output_frames(mesh: &Mesh) -> Vec<Mat2> {
+    let flat = mesh.is_flat_xy();
+    (0..mesh.faces.len())
+        .map(|f| {
+            if flat {
+                reference_frame(mesh, f)
+            } else {
+                let [p0, p1, p2] = mesh.face_positions(f);
+                let (e1, e2) = (p1 - p0, p2 - p0);
+                let t1 = e1.normalize();
+                let n = e1.cross(&e2).normalize();
+                let t2 = n.cross(&t1);
+                Mat2::new(t1.dot(&e1), t1.dot(&e2), t2.dot(&e1), t2.dot(&e2))
+            }
+        })
+        .collect()
+}
+
+impl Writer {
+    /// Creates (or reuses) the output folder and checks it is writable, before any work.
+    pub fn new(dir: &Path, scene: &Scene) -> Result<Self, OutputError> {
+        std::fs::create_dir_all(dir).map_err(|e| ioerr(dir, e))?;
+        let probe = dir.join(".shellsim-write-test");
+        std::fs::write(&probe, b"").map_err(|e| ioerr(dir, format!("not writable: {e}")))?;
+        let _ = std::fs::remove_file(&probe);
+        let mesh = &scene.mesh;
+        let mut frame_mesh = Mesh {
+            positions: mesh.positions.clone(),
+            faces: mesh.faces.clone(),
+            ..Default::default()
+        };
+        if let Some(t) = mesh.face_fields.get("tri_tags") {
+            frame_mesh.face_fields.insert("tri_tags".into(), t.clone());
+        }
+        if let Some(t) = mesh.vertex_fields.get("node_tags") {
+            frame_mesh
+                .vertex_fields
+                .insert("node_tags".into(), t.clone());
+        }
+        Ok(Writer {
+            dir: dir.to_path_buf(),
+            format: scene.settings.output.format,
+            prefix: scene.settings.output.prefix.clone(),
+            frames: Vec::new(),
+            log: Vec::new(),
+            frames_t: output_frames(mesh),
+            frame_mesh,
+        })
+    }
+
+    /// Number of frames written.
+    pub fn num_frames(&self) -> usize {
+        self.frames.len()
+    }
+
+    /// Name of the last frame, relative to the output folder.
+    pub fn last_frame(&self) -> String {
+        self.frames.last().map(|f| f.1.clone()).unwrap_or_default()
+    }
+
+    /// Energies of a state by term.
+    pub fn energies(pot: &Potential, x: &[Vec3], v: &[Vec3]) -> Energies {
+        let sc = pot.scene;
+        let (a, b) = mesh_forms(x, &sc.mesh, &sc.topo);
+        let mut en = Energies::default();
+        for f in 0..sc.num_faces() {
+            let d = pot.density(f);
+            let (ws, ta) = d.stretch[0];
+            let (wb, tb) = d.bend[0];
+            let da = a[f] - ta;
+            let db = b[f] - tb;
+            en.stretching += ws * da.dot(&(d.c * da));
+            en.bending += wb * db.dot(&(d.c * db));
+        }
+        for (i, xv) in x.iter().enumerate() {
+            en.gravity -= sc.mass[i] * pot.gravity.dot(xv);
+            en.kinetic += 0.5 * sc.mass[i] * v[i].norm_squared();
+        }
+        en.total = en.stretching + en.bending + en.gravity + en.kinetic;
+        en
+    }
+
+    /// Writes one frame and appends its log row; rewrites the series and the log.
+    pub fn frame(
+        &mut self,
+        pot: &Potential,
+        x: &[Vec3],
+        v: &[Vec3],
+        mut row: LogRow,
+    ) -> Result<(), OutputError> {
+        let sc = pot.scene;
+        let index = self.frames.len();
+        row.frame = index;
+        row.energy = Self::energies(pot, x, v);
+        let nf = sc.num_faces();
+        let (a, b) = mesh_forms(x, &sc.mesh, &sc.topo);
+        let mut fa = Vec::with_capacity(3 * nf);
+        let mut fb = Vec::with_capacity(3 * nf);
+        let mut fab = Vec::with_capacity(3 * nf);
+        let mut fbb = Vec::with_capacity(3 * nf);
+        let (mut hh, mut kk, mut k1s, mut k2s, mut es, mut eb) = (
+            Vec::with_capacity(nf),
+            Vec::with_capacity(nf),
+            Vec::with_capacity(nf),
+            Vec::with_capacity(nf),
+            Vec::with_capacity(nf),
+            Vec::with_capacity(nf),
+        );
+        for f in 0..nf {
+            let t = &self.frames_t[f];
+            let d = pot.density(f);
+            let (abar, bbar) = (d.stretch[0].1, d.bend[0].1);
+            let push = |out: &mut Vec<Real>, s: &Sym2| {
+                out.extend_from_slice(push_forward(t, s).as_slice())
+            };
+            push(&mut fa, &a[f]);
+            push(&mut fb, &b[f]);
+            push(&mut fab, &abar);
+            push(&mut fbb, &bbar);
+            let (h, k, k1, k2) = curvatures(&a[f], &b[f]);
+            hh.push(h);
+            kk.push(k);
+            k1s.push(k1);
+            k2s.push(k2);
+            let area = 0.5 * crate::math::sym_det(&abar).max(0.0).sqrt();
+            let (da, db) = (a[f] - abar, b[f] - bbar);
+            es.push(d.stretch[0].0 * da.dot(&(d.c * da)) / area);
+            eb.push(d.bend[0].0 * db.dot(&(d.c * db)) / area);
+        }
+        let m = &mut self.frame_mesh;
+        m.positions.copy_from_slice(x);
+        let ff = &mut m.face_fields;
+        let vec3 = |d: Vec<Real>| Field {
+            components: 3,
+            data: d,
+        };
+        ff.insert("a".into(), vec3(fa));
+        ff.insert("b".into(), vec3(fb));
+        ff.insert("abar".into(), vec3(fab));
+        ff.insert("bbar".into(), vec3(fbb));
+        ff.insert("mean_curvature".into(), Field::scalar(hh));
+        ff.insert("gauss_curvature".into(), Field::scalar(kk));
+        ff.insert("k1".into(), Field::scalar(k1s));
+        ff.insert("k2".into(), Field::scalar(k2s));
+        ff.insert("stretching_energy_density".into(), Field::scalar(es));
+        ff.insert("bending_energy_density".into(), Field::scalar(eb));
+        ff.insert("thickness".into(), Field::scalar(sc.thickness.clone()));
+        let vf = &mut m.vertex_fields;
+        let disp: Vec<Real> = x
+            .iter()
+            .zip(&sc.mesh.positions)
+            .flat_map(|(p, q)| (p - q).iter().copied().collect::<Vec<_>>())
+            .collect();
+        vf.insert("displacement".into(), vec3(disp));
+        vf.insert(
+            "velocity".into(),
+            vec3(v.iter().flat_map(|p| [p.x, p.y, p.z]).collect()),
+        );
+        vf.insert(
+            "constraint_indicators".into(),
+            Field::scalar(sc.fixed.iter().map(|&b| b as u8 as Real).collect()),
+        );
+        // Never write NaN.
+        if let Some(p) = m
+            .positions
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(OutputError::NonFinite {
+                index,
+                time: row.time,
+                field: format!("positions (vertex {p})"),
+            });
+        }
+        for (name, fld) in m.face_fields.iter().chain(m.vertex_fields.iter()) {
+            if fld.data.iter().any(|v| !v.is_finite()) {
+                return Err(OutputError::NonFinite {
+                    index,
+                    time: row.time,
+                    field: name.clone(),
+                });
+            }
+        }
+        let name = format!("{}_{index:05}.{}", self.prefix, self.format.extension());
+        let path = self.dir.join(&name);
+        let bytes = mesh_to_bytes(
+            m,
+            self.format,
+            &format!("shellsim frame {index} t={}", row.time),
+        )
+        .map_err(|e| ioerr(&path, e))?;
+        write_atomic(&path, &bytes).map_err(|e| ioerr(&path, e))?;
+        self.frames.push((row.time, name));
+        self.log.push(row);
+        self.write_series()?;
+        self.write_log()
+    }
+
+    fn write_series(&self) -> Result<(), OutputError> {
+        let mut s = String::from(
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n",
+        );
+        for (t, name) in &self.frames {
+            s.push_str(&format!(
+                "    <DataSet timestep=\"{t:.12e}\" group=\"\" part=\"0\" file=\"{name}\"/>\n"
+            ));
+        }
+        s.push_str("  </Collection>\n</VTKFile>\n");
+        let path = self.dir.join("series.pvd");
+        write_atomic(&path, s.as_bytes()).map_err(|e| ioerr(&path, e))
+    }
+
+    fn write_log(&self) -> Result<(), OutputError> {
+        let mut s = String::from(
+            "frame,time,dial,energy_total,energy_stretching,energy_bending,energy_gravity,\
+             energy_kinetic,residual,newton_iterations,steps,wall_seconds\n",
+        );
+        for r in &self.log {
+            let e = &r.energy;
+            s.push_str(&format!(
+                "{},{:.12e},{:.6},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{},{},{:.6}\n",
+                r.frame,
+                r.time,
+                r.dial,
+                e.total,
+                e.stretching,
+                e.bending,
+                e.gravity,
+                e.kinetic,
+                r.residual,
+                r.newton_iterations,
+                r.steps,
+                r.wall_seconds
+            ));
+        }
+        let path = self.dir.join("log.csv");
+        write_atomic(&path, s.as_bytes()).map_err(|e| ioerr(&path, e))
+    }
+
+    /// Writes `summary.json`.
+    pub fn summary(&self, summary: &Summary) -> Result<(), OutputError> {
+        let path = self.dir.join("summary.json");
+        let text = serde_json::to_string_pretty(summary).map_err(|e| ioerr(&path, e))?;
+        write_atomic(&path, text.as_bytes()).map_err(|e| ioerr(&path, e))
+    }
+}

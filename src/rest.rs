@@ -1,0 +1,124 @@
+//! Rest fundamental forms per face (ā, b̄ in each face's barycentric coordinates, seed 000 §3)
+//! and their dial from initial to target values.
+//!
+//! Growth and swelling laws only ever rewrite a [`RestForms`]; kernels never branch on them.
+
+use crate::geometry::{first_fundamental_form, midedge_average_b};
+use crate::math::{Mat2, Real, Sym2, Vec3};
+use crate::mesh::{topology::NONE, Mesh, MeshError, Topology};
+
+/// Initial (dial 0) and target (dial 1) rest forms per face.
+#[derive(Clone, Debug)]
+pub struct RestForms {
+    /// ā at dial 0: the input mesh's first fundamental form a⁰ (m²).
+    pub abar0: Vec<Sym2>,
+    /// b̄ at dial 0: the input mesh's mid-edge second fundamental form b⁰ (m).
+    pub bbar0: Vec<Sym2>,
+    /// ā at dial 1 (m²).
+    pub abar1: Vec<Sym2>,
+    /// b̄ at dial 1 (m).
+    pub bbar1: Vec<Sym2>,
+}
+
+impl RestForms {
+    /// No growth: target = initial = forms of the input mesh (seed 000 "No Growth").
+    pub fn no_growth(mesh: &Mesh, topo: &Topology) -> Self {
+        let (a0, b0) = mesh_forms(&mesh.positions, mesh, topo);
+        RestForms {
+            abar1: a0.clone(),
+            bbar1: b0.clone(),
+            abar0: a0,
+            bbar0: b0,
+        }
+    }
+
+    /// Rest forms at dial factor `s ∈ [0, 1]`: linear interpolation, as MorphoShell's dial
+    /// (convex combinations keep ā positive definite).
+    #[inline]
+    pub fn at(&self, f: usize, s: Real) -> (Sym2, Sym2) {
+        if s >= 1.0 {
+            return (self.abar1[f], self.bbar1[f]);
+        }
+        (
+            self.abar0[f] * (1.0 - s) + self.abar1[f] * s,
+            self.bbar0[f] * (1.0 - s) + self.bbar1[f] * s,
+        )
+    }
+
+    /// Number of faces.
+    pub fn len(&self) -> usize {
+        self.abar0.len()
+    }
+
+    /// True when there are no faces.
+    pub fn is_empty(&self) -> bool {
+        self.abar0.is_empty()
+    }
+}
+
+/// First and mid-edge second fundamental forms of every face at `positions`.
+pub fn mesh_forms(positions: &[Vec3], mesh: &Mesh, topo: &Topology) -> (Vec<Sym2>, Vec<Sym2>) {
+    let mut a = Vec::with_capacity(mesh.faces.len());
+    let mut b = Vec::with_capacity(mesh.faces.len());
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let x = face.map(|v| positions[v]);
+        let opp = topo.opposite_vertex[f].map(|v| (v != NONE).then(|| positions[v]));
+        a.push(first_fundamental_form(&x));
+        b.push(midedge_average_b(&x, &opp));
+    }
+    (a, b)
+}
+
+/// `T = [e1 e2]` of a face of a flat reference mesh, restricted to x, y: maps barycentric
+/// vectors to reference Cartesian ones.
+pub fn reference_frame(mesh: &Mesh, f: usize) -> Mat2 {
+    let [p0, p1, p2] = mesh.face_positions(f);
+    let (e1, e2) = (p1 - p0, p2 - p0);
+    Mat2::new(e1.x, e2.x, e1.y, e2.y)
+}
+
+/// Pulls a tensor given in reference Cartesian coordinates back to the face's barycentric
+/// coordinates: `Tᵀ M T` (seed 000 "Pullback Forms").
+#[inline]
+pub fn pull_back(t: &Mat2, m: &Sym2) -> Sym2 {
+    crate::math::mat_to_sym(&(t.transpose() * crate::math::sym_to_mat(m) * t))
+}
+
+/// Pushes a barycentric tensor forward to reference Cartesian coordinates: `T⁻ᵀ M T⁻¹`.
+#[inline]
+pub fn push_forward(t: &Mat2, m: &Sym2) -> Sym2 {
+    let ti = t.try_inverse().unwrap_or_else(Mat2::zeros);
+    crate::math::mat_to_sym(&(ti.transpose() * crate::math::sym_to_mat(m) * ti))
+}
+
+/// Target forms given per face in reference Cartesian coordinates (e.g. the `abar_info` and
+/// `bbar_info` fields), pulled back. Requires a flat reference mesh; checks ā > 0 per face.
+pub fn pulled_back_targets(
+    mesh: &Mesh,
+    abar_xy: impl Fn(usize) -> Sym2,
+    bbar_xy: impl Fn(usize) -> Sym2,
+    what: &str,
+) -> Result<(Vec<Sym2>, Vec<Sym2>), MeshError> {
+    if !mesh.is_flat_xy() {
+        return Err(mesh.invalid(format!(
+            "{what} gives forms in reference Cartesian (x, y) coordinates, which needs a flat \
+             reference mesh in a plane z = const"
+        )));
+    }
+    let nf = mesh.faces.len();
+    let mut a = Vec::with_capacity(nf);
+    let mut b = Vec::with_capacity(nf);
+    for f in 0..nf {
+        let axy = abar_xy(f);
+        if !(axy[0] > 0.0 && crate::math::sym_det(&axy) > 0.0) {
+            return Err(mesh.invalid(format!(
+                "{what}: abar at face {f} is not positive definite: [{}, {}, {}]",
+                axy[0], axy[1], axy[2]
+            )));
+        }
+        let t = reference_frame(mesh, f);
+        a.push(pull_back(&t, &axy));
+        b.push(pull_back(&t, &bbar_xy(f)));
+    }
+    Ok((a, b))
+}

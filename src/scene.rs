@@ -1,0 +1,201 @@
+//! A scene: the validated mesh, its topology, rest forms, per-face material, per-vertex mass
+//! and the fixed vertices, built once from the settings and the mesh file.
+
+use crate::energy::Lame2d;
+use crate::math::{Real, Sym2, Vec3};
+use crate::mesh::{Mesh, MeshError, Topology};
+use crate::rest::{pulled_back_targets, RestForms};
+use crate::settings::{Settings, TargetForms};
+
+/// Everything the integrators need, derived once.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The input mesh (reference positions and fields).
+    pub mesh: Mesh,
+    /// Its connectivity.
+    pub topo: Topology,
+    /// The settings.
+    pub settings: Settings,
+    /// Rest forms at dial 0 and 1.
+    pub rest: RestForms,
+    /// Thickness per face (m).
+    pub thickness: Vec<Real>,
+    /// Young's modulus per face (Pa).
+    pub young: Vec<Real>,
+    /// Plane-stress Lamé parameters per face.
+    pub lame: Vec<Lame2d>,
+    /// Multiplier on stretching (1 Koiter, 4 MorphoShell).
+    pub stretch_factor: Real,
+    /// Lumped mass per vertex: Σ ρ h A / 3 over incident faces, reference areas (kg).
+    pub mass: Vec<Real>,
+    /// True for fixed vertices.
+    pub fixed: Vec<bool>,
+    /// Force scale F = max(E h) × mean edge length (N), for the convergence test.
+    pub force_scale: Real,
+    /// Mean edge length of the input mesh (m).
+    pub mean_edge: Real,
+    /// Warnings found while building (unused vertices, ...).
+    pub warnings: Vec<String>,
+}
+
+fn positive_face_field(mesh: &Mesh, name: &str) -> Result<Option<Vec<Real>>, MeshError> {
+    let Some(f) = mesh.face_field(name, 1)? else {
+        return Ok(None);
+    };
+    if let Some(i) = f.data.iter().position(|&v| !(v > 0.0)) {
+        return Err(mesh.invalid(format!(
+            "face field '{name}' must be positive, but face {i} has {}",
+            f.data[i]
+        )));
+    }
+    Ok(Some(f.data.clone()))
+}
+
+impl Scene {
+    /// Validates the mesh and builds the scene. Errors name the file, field and index.
+    pub fn build(mesh: Mesh, settings: Settings) -> Result<Scene, MeshError> {
+        let unused = mesh.validate()?;
+        let topo = Topology::build(&mesh)?;
+        let mut warnings = Vec::new();
+        if !unused.is_empty() {
+            warnings.push(format!(
+                "{}: {} vertices are used by no face (first: {}); they are held fixed",
+                mesh.name(),
+                unused.len(),
+                unused[0]
+            ));
+        }
+        let nf = mesh.faces.len();
+        let nv = mesh.positions.len();
+        let m = &settings.material;
+        let thickness = match (
+            m.use_mesh_thickness,
+            positive_face_field(&mesh, "ref_thicknesses")?,
+        ) {
+            (true, Some(t)) => t,
+            _ => vec![m.thickness; nf],
+        };
+        let young = match (
+            m.use_mesh_shear_modulus,
+            positive_face_field(&mesh, "ref_shear_moduli")?,
+        ) {
+            (true, Some(mu)) => mu.iter().map(|mu| 2.0 * mu * (1.0 + m.poisson)).collect(),
+            _ => vec![m.young; nf],
+        };
+        let lame = young
+            .iter()
+            .map(|&e| Lame2d::from_young_poisson(e, m.poisson))
+            .collect();
+
+        let mut rest = RestForms::no_growth(&mesh, &topo);
+        match settings.rest.target {
+            TargetForms::None => {}
+            TargetForms::Uniform => {
+                let a = Sym2::from(settings.rest.abar);
+                let b = Sym2::from(settings.rest.bbar);
+                let (a1, b1) =
+                    pulled_back_targets(&mesh, |_| a, |_| b, "rest.target = \"uniform\"")?;
+                rest.abar1 = a1;
+                rest.bbar1 = b1;
+            }
+            TargetForms::Mesh => {
+                let af = mesh.face_field("abar_info", 3)?.ok_or_else(|| {
+                    mesh.invalid(
+                        "rest.target = \"mesh\" needs the per-face field 'abar_info' (3 components \
+                         xx, xy, yy)",
+                    )
+                })?;
+                let bf = mesh.face_field("bbar_info", 3)?;
+                let (a1, b1) = pulled_back_targets(
+                    &mesh,
+                    |f| Sym2::from_column_slice(af.get(f)),
+                    |f| {
+                        bf.map(|b| Sym2::from_column_slice(b.get(f)))
+                            .unwrap_or_else(Sym2::zeros)
+                    },
+                    "abar_info/bbar_info",
+                )?;
+                rest.abar1 = a1;
+                rest.bbar1 = b1;
+            }
+        }
+
+        let mut mass = vec![0.0; nv];
+        for (f, face) in mesh.faces.iter().enumerate() {
+            let [p0, p1, p2] = mesh.face_positions(f);
+            let area = 0.5 * (p1 - p0).cross(&(p2 - p0)).norm();
+            let mf = m.density * thickness[f] * area / 3.0;
+            for &v in face {
+                mass[v] += mf;
+            }
+        }
+
+        let mut fixed: Vec<bool> = unused_mask(nv, &unused);
+        let c = &settings.constraints;
+        if c.use_constraint_indicators {
+            if let Some(ci) = mesh.vertex_field("constraint_indicators", 1)? {
+                for (v, &val) in ci.data.iter().enumerate() {
+                    fixed[v] |= val != 0.0;
+                }
+            }
+        }
+        if !c.fix_tags.is_empty() {
+            let tags = mesh.vertex_field("node_tags", 1)?.ok_or_else(|| {
+                mesh.invalid("constraints.fix_tags needs the per-vertex field 'node_tags'")
+            })?;
+            for (v, &t) in tags.data.iter().enumerate() {
+                fixed[v] |= c.fix_tags.contains(&(t.round() as i64));
+            }
+        }
+        for b in &c.fix_boxes {
+            for (v, p) in mesh.positions.iter().enumerate() {
+                fixed[v] |= (0..3).all(|k| p[k] >= b.min[k] && p[k] <= b.max[k]);
+            }
+        }
+
+        let mean_edge = mesh.mean_edge_length();
+        let eh = young
+            .iter()
+            .zip(&thickness)
+            .map(|(e, h)| e * h)
+            .fold(0.0, Real::max);
+        Ok(Scene {
+            stretch_factor: m.stretch_convention.factor(),
+            force_scale: eh * mean_edge,
+            mean_edge,
+            mesh,
+            topo,
+            settings,
+            rest,
+            thickness,
+            young,
+            lame,
+            mass,
+            fixed,
+            warnings,
+        })
+    }
+
+    /// Number of vertices.
+    pub fn num_vertices(&self) -> usize {
+        self.mesh.positions.len()
+    }
+
+    /// Number of faces.
+    pub fn num_faces(&self) -> usize {
+        self.mesh.faces.len()
+    }
+
+    /// Reference (input) positions.
+    pub fn reference_positions(&self) -> &[Vec3] {
+        &self.mesh.positions
+    }
+}
+
+fn unused_mask(nv: usize, unused: &[usize]) -> Vec<bool> {
+    let mut m = vec![false; nv];
+    for &u in unused {
+        m[u] = true;
+    }
+    m
+}

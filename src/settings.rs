@@ -1,0 +1,488 @@
+//! The settings file: a TOML schema with every field's unit and default, strict parsing
+//! (unknown keys are errors), `--set key=value` overrides, and validation with messages that
+//! name the key. The full reference with examples is `docs/settings.md`.
+
+use crate::energy::{HessianProjection, StretchConvention};
+use crate::math::Real;
+use crate::mesh::io::Format;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Errors in the settings file or its overrides.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SettingsError {
+    /// The file could not be read.
+    #[error("{path}: cannot read settings: {reason}")]
+    Read {
+        /// The file.
+        path: String,
+        /// Why.
+        reason: String,
+    },
+    /// The TOML is malformed, has an unknown key or a wrong type.
+    #[error("{path}: {reason}")]
+    Parse {
+        /// The file.
+        path: String,
+        /// The parser's message, with line and key.
+        reason: String,
+    },
+    /// A value is out of range or inconsistent.
+    #[error("{path}: invalid '{key}': {reason}")]
+    Invalid {
+        /// The file.
+        path: String,
+        /// Dotted key.
+        key: String,
+        /// Why.
+        reason: String,
+    },
+    /// A `--set` override is malformed.
+    #[error("--set {arg}: {reason}")]
+    Override {
+        /// The argument as given.
+        arg: String,
+        /// Why.
+        reason: String,
+    },
+}
+
+/// A whole settings file.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Settings {
+    /// Material constants.
+    pub material: Material,
+    /// Rest (programmed) fundamental forms and how they are dialled.
+    pub rest: Rest,
+    /// What is solved: statics or dynamics, and the Newton solver's controls.
+    pub solver: Solver,
+    /// Time stepping (dynamic mode).
+    pub time: Time,
+    /// External loads.
+    pub loads: Loads,
+    /// Fixed vertices.
+    pub constraints: Constraints,
+    /// Output files.
+    pub output: Output,
+}
+
+/// Material constants. Per-face mesh fields (`ref_thicknesses`, `ref_shear_moduli`) override
+/// the uniform values when present and enabled.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Material {
+    /// Young's modulus E (Pa, default: `1.0e6`).
+    pub young: Real,
+    /// Poisson's ratio ν (dimensionless, −1 < ν ≤ 0.5, default: `0.3`).
+    pub poisson: Real,
+    /// Mass density per unit volume ρ (kg/m³, default: `1000.0`).
+    pub density: Real,
+    /// Shell thickness h (m, default: `0.01`).
+    pub thickness: Real,
+    /// Use the mesh's per-face `ref_thicknesses` field when present (default: `true`).
+    pub use_mesh_thickness: bool,
+    /// Use the mesh's per-face `ref_shear_moduli` μ when present, with E = 2μ(1+ν)
+    /// (default: `true`).
+    pub use_mesh_shear_modulus: bool,
+    /// Stretching normalisation: `"koiter"` (standard, seed 000) or `"morphoshell"` (4× larger,
+    /// MorphoShell's convention) (default: `"koiter"`).
+    pub stretch_convention: StretchConvention,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material {
+            young: 1.0e6,
+            poisson: 0.3,
+            density: 1000.0,
+            thickness: 0.01,
+            use_mesh_thickness: true,
+            use_mesh_shear_modulus: true,
+            stretch_convention: StretchConvention::Koiter,
+        }
+    }
+}
+
+/// Where the target rest forms come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TargetForms {
+    /// No growth: ā = a⁰, b̄ = b⁰ of the input mesh (seed 000 "No Growth").
+    #[default]
+    None,
+    /// Uniform `abar`, `bbar` from these settings, in reference Cartesian coordinates.
+    Uniform,
+    /// Per-face `abar_info` (required) and `bbar_info` (optional, default 0) mesh fields, in
+    /// reference Cartesian coordinates (MorphoShell's files).
+    Mesh,
+}
+
+/// Rest forms.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Rest {
+    /// Target forms: `"none"`, `"uniform"` or `"mesh"` (default: `"none"`).
+    pub target: TargetForms,
+    /// Uniform target ā as `[xx, xy, yy]` in reference Cartesian coordinates (dimensionless,
+    /// default: `[1, 0, 1]`).
+    pub abar: [Real; 3],
+    /// Uniform target b̄ as `[xx, xy, yy]` in reference Cartesian coordinates (1/m, default:
+    /// `[0, 0, 0]`).
+    pub bbar: [Real; 3],
+    /// Dynamic mode: time over which the forms are dialled linearly from the input mesh's forms to
+    /// the target (s, default: `0` = target from the start).
+    pub dial_time: Real,
+}
+
+impl Default for Rest {
+    fn default() -> Self {
+        Rest {
+            target: TargetForms::None,
+            abar: [1.0, 0.0, 1.0],
+            bbar: [0.0; 3],
+            dial_time: 0.0,
+        }
+    }
+}
+
+/// Static equilibrium or dynamics.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    /// Minimise the potential energy, dialling the rest forms in by adaptive continuation.
+    #[default]
+    Static,
+    /// Implicit Euler dynamics with Kelvin–Voigt damping.
+    Dynamic,
+}
+
+/// Solver controls.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Solver {
+    /// `"static"` or `"dynamic"` (default: `"static"`).
+    pub mode: Mode,
+    /// Newton converges when ‖∇E‖∞ ≤ tolerance × F, with F = max(E·h) × mean edge length, the
+    /// membrane force of a unit strain on one edge (dimensionless, default: `1e-9`).
+    pub tolerance: Real,
+    /// Newton iterations allowed per solve before the step is cut (default: `40`).
+    pub max_newton_iterations: usize,
+    /// Per-element Hessian projection: `"none"`, `"clamp_zero"` or `"abs"` (default: `"none"`).
+    pub hessian_projection: HessianProjection,
+    /// Static mode: first continuation increment of the dial factor (dimensionless, (0, 1],
+    /// default: `1.0`).
+    pub continuation_step: Real,
+    /// Static mode: the increment below which continuation gives up (default: `1e-4`).
+    pub min_continuation_step: Real,
+    /// Out-of-plane perturbation that breaks the symmetry of a flat start, as a fraction of the
+    /// mean edge length (dimensionless, default: `1e-3`; 0 disables). Applied when the sheet is
+    /// exactly planar, and again (×10 each time) when a converged state is found to be a saddle.
+    pub symmetry_breaking: Real,
+    /// Seed of the symmetry-breaking perturbation (default: `1`).
+    pub seed: u64,
+    /// Check that a static equilibrium is a minimum (Cholesky of H + δI with a tiny δ), and
+    /// perturb and re-solve if it is a saddle (default: `true`).
+    pub check_stability: bool,
+    /// Newton solves allowed to escape a saddle before giving up (default: `4`).
+    pub max_saddle_escapes: usize,
+}
+
+impl Default for Solver {
+    fn default() -> Self {
+        Solver {
+            mode: Mode::Static,
+            tolerance: 1e-9,
+            max_newton_iterations: 40,
+            hessian_projection: HessianProjection::None,
+            continuation_step: 1.0,
+            min_continuation_step: 1e-4,
+            symmetry_breaking: 1e-3,
+            seed: 1,
+            check_stability: true,
+            max_saddle_escapes: 4,
+        }
+    }
+}
+
+/// Time stepping for dynamic mode.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Time {
+    /// End time (s, default: `1.0`).
+    pub end: Real,
+    /// First time step (s, default: `1e-3`).
+    pub dt: Real,
+    /// Smallest time step before the run stops unconverged (s, default: `1e-9`).
+    pub dt_min: Real,
+    /// Largest time step (s, default: `0.1`).
+    pub dt_max: Real,
+    /// Interval between output frames (s, default: `0.1`).
+    pub output_interval: Real,
+    /// Kelvin–Voigt retardation time η of seed 000's damping potential (s, default: `0` = off).
+    pub damping: Real,
+    /// Stop early when the residual without inertia is below tolerance and the kinetic energy is
+    /// below `equilibrium_kinetic` × elastic energy (default: `false`).
+    pub stop_at_equilibrium: bool,
+    /// Relative kinetic-energy threshold for `stop_at_equilibrium` (dimensionless, default: `1e-10`).
+    pub equilibrium_kinetic: Real,
+}
+
+impl Default for Time {
+    fn default() -> Self {
+        Time {
+            end: 1.0,
+            dt: 1e-3,
+            dt_min: 1e-9,
+            dt_max: 0.1,
+            output_interval: 0.1,
+            damping: 0.0,
+            stop_at_equilibrium: false,
+            equilibrium_kinetic: 1e-10,
+        }
+    }
+}
+
+/// External loads.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Loads {
+    /// Gravitational acceleration (m/s², default: `[0, 0, 0]`; Earth: `[0, 0, -9.81]`).
+    pub gravity: [Real; 3],
+}
+
+/// An axis-aligned box of vertices to hold fixed.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FixBox {
+    /// Lower corner (m).
+    pub min: [Real; 3],
+    /// Upper corner (m).
+    pub max: [Real; 3],
+}
+
+/// Fixed vertices: the union of all the selections below.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Constraints {
+    /// Fix vertices whose `constraint_indicators` mesh field is non-zero (default: `true`).
+    pub use_constraint_indicators: bool,
+    /// Fix vertices whose `node_tags` value is in this list (default: `[]`).
+    pub fix_tags: Vec<i64>,
+    /// Fix vertices inside any of these boxes (default: none).
+    pub fix_boxes: Vec<FixBox>,
+}
+
+impl Default for Constraints {
+    fn default() -> Self {
+        Constraints {
+            use_constraint_indicators: true,
+            fix_tags: Vec::new(),
+            fix_boxes: Vec::new(),
+        }
+    }
+}
+
+/// Output files.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Output {
+    /// Frame format: `"vtu"` (XML), `"vtk"` (legacy binary) or `"vtk_ascii"` (default: `"vtu"`).
+    pub format: Format,
+    /// Static mode: also write a frame after every accepted continuation step (default: `false`).
+    pub continuation_frames: bool,
+    /// Basename of frame files, `{prefix}_{index:05}.{ext}` (default: `"frame"`).
+    pub prefix: String,
+}
+
+impl Default for Output {
+    fn default() -> Self {
+        Output {
+            format: Format::Vtu,
+            continuation_frames: false,
+            prefix: "frame".into(),
+        }
+    }
+}
+
+/// Parses a `--set key=value` value as TOML (number, bool, array, quoted string), falling back
+/// to a bare string.
+fn parse_override_value(v: &str) -> toml::Value {
+    let doc = format!("v = {v}");
+    match doc.parse::<toml::Table>() {
+        Ok(mut t) => t.remove("v").unwrap_or(toml::Value::String(v.into())),
+        Err(_) => toml::Value::String(v.into()),
+    }
+}
+
+/// Applies `key=value` overrides (dotted keys) to a TOML table.
+pub fn apply_overrides(table: &mut toml::Table, overrides: &[String]) -> Result<(), SettingsError> {
+    for arg in overrides {
+        let oerr = |reason: &str| SettingsError::Override {
+            arg: arg.clone(),
+            reason: reason.into(),
+        };
+        let (key, value) = arg
+            .split_once('=')
+            .ok_or_else(|| oerr("expected key=value"))?;
+        let parts: Vec<&str> = key.trim().split('.').collect();
+        if parts.iter().any(|p| p.is_empty()) {
+            return Err(oerr("empty key segment"));
+        }
+        let mut cur = &mut *table;
+        for p in &parts[..parts.len() - 1] {
+            let entry = cur
+                .entry(p.to_string())
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+            cur = entry
+                .as_table_mut()
+                .ok_or_else(|| oerr(&format!("'{p}' is not a table")))?;
+        }
+        cur.insert(
+            parts[parts.len() - 1].to_string(),
+            parse_override_value(value.trim()),
+        );
+    }
+    Ok(())
+}
+
+impl Settings {
+    /// Reads, overrides, parses and validates a settings file.
+    pub fn load(path: &Path, overrides: &[String]) -> Result<Settings, SettingsError> {
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| SettingsError::Read {
+            path: name.clone(),
+            reason: e.to_string(),
+        })?;
+        Self::from_str_with(&text, &name, overrides)
+    }
+
+    /// Parses settings from text (`name` is used in messages).
+    pub fn from_str_with(
+        text: &str,
+        name: &str,
+        overrides: &[String],
+    ) -> Result<Settings, SettingsError> {
+        let perr = |reason: String| SettingsError::Parse {
+            path: name.to_string(),
+            reason,
+        };
+        // Parse directly first, for messages with line numbers.
+        let direct: Result<Settings, _> = toml::from_str(text);
+        let settings = if overrides.is_empty() {
+            direct.map_err(|e| perr(e.to_string().trim_end().to_string()))?
+        } else {
+            let mut table: toml::Table = text
+                .parse()
+                .map_err(|e: toml::de::Error| perr(e.to_string().trim_end().to_string()))?;
+            apply_overrides(&mut table, overrides)?;
+            toml::Value::Table(table)
+                .try_into()
+                .map_err(|e: toml::de::Error| {
+                    perr(format!(
+                        "after --set overrides: {}",
+                        e.to_string().trim_end()
+                    ))
+                })?
+        };
+        settings.validate(name)?;
+        Ok(settings)
+    }
+
+    /// Checks ranges and consistency.
+    pub fn validate(&self, name: &str) -> Result<(), SettingsError> {
+        let inv = |key: &str, reason: String| {
+            Err(SettingsError::Invalid {
+                path: name.to_string(),
+                key: key.into(),
+                reason,
+            })
+        };
+        let pos = |key: &str, v: Real| -> Result<(), SettingsError> {
+            if !(v.is_finite() && v > 0.0) {
+                return inv(key, format!("must be a positive number, got {v}"));
+            }
+            Ok(())
+        };
+        let nonneg = |key: &str, v: Real| -> Result<(), SettingsError> {
+            if !(v.is_finite() && v >= 0.0) {
+                return inv(key, format!("must be a non-negative number, got {v}"));
+            }
+            Ok(())
+        };
+        let m = &self.material;
+        pos("material.young", m.young)?;
+        pos("material.density", m.density)?;
+        pos("material.thickness", m.thickness)?;
+        if !(m.poisson > -1.0 && m.poisson <= 0.5) {
+            return inv(
+                "material.poisson",
+                format!("must lie in (-1, 0.5], got {}", m.poisson),
+            );
+        }
+        let r = &self.rest;
+        if r.abar.iter().chain(r.bbar.iter()).any(|v| !v.is_finite()) {
+            return inv("rest.abar/bbar", "must be finite".into());
+        }
+        if r.target == TargetForms::Uniform
+            && !(r.abar[0] > 0.0 && r.abar[0] * r.abar[2] - r.abar[1] * r.abar[1] > 0.0)
+        {
+            return inv(
+                "rest.abar",
+                format!("must be positive definite, got {:?}", r.abar),
+            );
+        }
+        nonneg("rest.dial_time", r.dial_time)?;
+        let s = &self.solver;
+        pos("solver.tolerance", s.tolerance)?;
+        if s.max_newton_iterations == 0 {
+            return inv("solver.max_newton_iterations", "must be at least 1".into());
+        }
+        if !(s.continuation_step > 0.0 && s.continuation_step <= 1.0) {
+            return inv(
+                "solver.continuation_step",
+                format!("must lie in (0, 1], got {}", s.continuation_step),
+            );
+        }
+        pos("solver.min_continuation_step", s.min_continuation_step)?;
+        nonneg("solver.symmetry_breaking", s.symmetry_breaking)?;
+        let t = &self.time;
+        pos("time.end", t.end)?;
+        pos("time.dt", t.dt)?;
+        pos("time.dt_min", t.dt_min)?;
+        pos("time.dt_max", t.dt_max)?;
+        pos("time.output_interval", t.output_interval)?;
+        nonneg("time.damping", t.damping)?;
+        pos("time.equilibrium_kinetic", t.equilibrium_kinetic)?;
+        if t.dt_min > t.dt || t.dt > t.dt_max {
+            return inv(
+                "time.dt",
+                format!(
+                    "need dt_min ≤ dt ≤ dt_max, got {} ≤ {} ≤ {}",
+                    t.dt_min, t.dt, t.dt_max
+                ),
+            );
+        }
+        if self.loads.gravity.iter().any(|g| !g.is_finite()) {
+            return inv("loads.gravity", "must be finite".into());
+        }
+        for (i, b) in self.constraints.fix_boxes.iter().enumerate() {
+            if b.min.iter().chain(b.max.iter()).any(|v| !v.is_finite())
+                || (0..3).any(|k| b.min[k] > b.max[k])
+            {
+                return inv(
+                    &format!("constraints.fix_boxes[{i}]"),
+                    "needs finite min ≤ max".into(),
+                );
+            }
+        }
+        if self.output.prefix.is_empty() || self.output.prefix.contains(['/', '\\']) {
+            return inv(
+                "output.prefix",
+                "must be a plain, non-empty file name".into(),
+            );
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,11 @@
+//! Nonlinear solves: the incremental potential of a step ([`potential`]), Newton's method with a
+//! backtracking line search and a growing diagonal shift ([`newton`]), and the sparse Cholesky
+//! it uses ([`linear`]).
+
+pub mod linear;
+pub mod newton;
+pub mod potential;
+
+pub use linear::LinearSolver;
+pub use newton::{newton, NewtonOptions, NewtonReport};
+pub use potential::Potential;

@@ -1,0 +1,195 @@
+//! Newton's method on a [`Potential`].
+//!
+//! Each iteration assembles the gradient and Hessian, factorises `H + τ D` (D = mean |diagonal|,
+//! τ = 0 first; on a non-positive pivot τ grows ×10 from 1e-8 until the factorisation succeeds,
+//! and the shift is recorded), solves for the step, and backtracks (Armijo, c = 1e-4, halving) on
+//! Φ. Convergence: ‖∇Φ‖∞ ≤ tol · F over free DOFs, with F the scene's force scale. Non-finite
+//! energies are treated as a failed trial point, never accepted.
+
+use super::linear::LinearSolver;
+use super::potential::Potential;
+use crate::assembly::Want;
+use crate::math::{Real, Vec3};
+
+/// Controls of one Newton solve.
+#[derive(Clone, Copy, Debug)]
+pub struct NewtonOptions {
+    /// Relative tolerance on ‖∇Φ‖∞ / F.
+    pub tol: Real,
+    /// Iteration limit.
+    pub max_iter: usize,
+}
+
+/// What happened in one Newton solve.
+#[derive(Clone, Debug, Default)]
+pub struct NewtonReport {
+    /// Whether the tolerance was reached.
+    pub converged: bool,
+    /// Iterations (Hessian factorisations that produced a step).
+    pub iterations: usize,
+    /// Final ‖∇Φ‖∞ / F.
+    pub residual: Real,
+    /// Final Φ (J).
+    pub energy: Real,
+    /// Largest relative diagonal shift τ used (0 = none).
+    pub max_shift: Real,
+    /// Iterations that needed a shift.
+    pub shifted_iterations: usize,
+    /// Total step halvings in line searches.
+    pub line_search_cuts: usize,
+    /// Why it stopped, when it did not converge.
+    pub reason: String,
+}
+
+/// Reusable buffers of a Newton solve.
+pub struct Workspace {
+    grad: Vec<Real>,
+    values: Vec<Real>,
+    shifted: Vec<Real>,
+    step: Vec<Real>,
+    trial: Vec<Vec3>,
+}
+
+impl Workspace {
+    /// Buffers for `n` DOFs and `nnz` Hessian entries.
+    pub fn new(n: usize, nnz: usize) -> Self {
+        Workspace {
+            grad: vec![0.0; n],
+            values: vec![0.0; nnz],
+            shifted: vec![0.0; nnz],
+            step: vec![0.0; n],
+            trial: vec![Vec3::zeros(); n / 3],
+        }
+    }
+
+    /// The gradient of the last evaluation.
+    pub fn gradient(&self) -> &[Real] {
+        &self.grad
+    }
+}
+
+fn inf_norm(v: &[Real]) -> Real {
+    v.iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
+/// Factorises `values + τ·scale·I`, growing τ until it succeeds. Returns τ, or None if even a
+/// huge shift fails (non-finite entries).
+pub fn factor_with_shift(
+    lin: &mut LinearSolver,
+    pot: &Potential,
+    values: &[Real],
+    shifted: &mut [Real],
+    tau0: Real,
+) -> Option<Real> {
+    let n = pot.pattern.n;
+    let scale = {
+        let s: Real = (0..n).map(|i| values[pot.pattern.diag(i)].abs()).sum();
+        if s > 0.0 {
+            s / n as Real
+        } else {
+            1.0
+        }
+    };
+    let mut tau = tau0;
+    loop {
+        shifted.copy_from_slice(values);
+        if tau > 0.0 {
+            for i in 0..n {
+                shifted[pot.pattern.diag(i)] += tau * scale;
+            }
+        }
+        match lin.factor(shifted) {
+            Ok(()) => return Some(tau),
+            Err(_) => {
+                tau = if tau == 0.0 { 1e-8 } else { tau * 10.0 };
+                if tau > 1e6 {
+                    return None;
+                }
+            }
+        }
+    }
+}
+
+/// Minimises `pot` from `x` (updated in place).
+pub fn newton(
+    pot: &Potential,
+    lin: &mut LinearSolver,
+    ws: &mut Workspace,
+    x: &mut [Vec3],
+    opts: NewtonOptions,
+) -> NewtonReport {
+    let force = pot.scene.force_scale.max(Real::MIN_POSITIVE);
+    let mut rep = NewtonReport::default();
+    let mut tau_prev: Real = 0.0;
+    loop {
+        let e = pot.eval(x, Want::Hessian, &mut ws.grad, &mut ws.values);
+        rep.energy = e;
+        let gnorm = inf_norm(&ws.grad);
+        rep.residual = gnorm / force;
+        if !e.is_finite() || !gnorm.is_finite() {
+            rep.reason = "non-finite energy or gradient".into();
+            return rep;
+        }
+        if rep.residual <= opts.tol {
+            rep.converged = true;
+            return rep;
+        }
+        if rep.iterations >= opts.max_iter {
+            rep.reason = format!(
+                "no convergence in {} Newton iterations (residual {:.3e})",
+                opts.max_iter, rep.residual
+            );
+            return rep;
+        }
+        if ws.values.iter().any(|v| !v.is_finite()) {
+            rep.reason = "non-finite Hessian".into();
+            return rep;
+        }
+        let tau0 = if tau_prev > 1e-8 { tau_prev * 0.1 } else { 0.0 };
+        let Some(tau) = factor_with_shift(lin, pot, &ws.values, &mut ws.shifted, tau0) else {
+            rep.reason = "Hessian could not be factorised even with a large shift".into();
+            return rep;
+        };
+        tau_prev = tau;
+        if tau > 0.0 {
+            rep.shifted_iterations += 1;
+            rep.max_shift = rep.max_shift.max(tau);
+        }
+        for (s, g) in ws.step.iter_mut().zip(&ws.grad) {
+            *s = -g;
+        }
+        lin.solve_in_place(&mut ws.step);
+        rep.iterations += 1;
+        let slope: Real = ws.step.iter().zip(&ws.grad).map(|(d, g)| d * g).sum();
+        if !(slope < 0.0) {
+            rep.reason = "Newton step is not a descent direction".into();
+            return rep;
+        }
+        // Backtracking line search. Near convergence Φ changes at round-off level; allow a
+        // round-off slack so that a tiny, correct step is not rejected.
+        let slack = 1e-13 * e.abs().max(Real::MIN_POSITIVE);
+        let mut alpha = 1.0;
+        let mut accepted = false;
+        for _ in 0..40 {
+            for (v, t) in ws.trial.iter_mut().enumerate() {
+                *t = x[v]
+                    + Vec3::new(ws.step[3 * v], ws.step[3 * v + 1], ws.step[3 * v + 2]) * alpha;
+            }
+            let et = pot.eval(&ws.trial, Want::Energy, &mut [], &mut []);
+            if et.is_finite() && et <= e + 1e-4 * alpha * slope + slack {
+                accepted = true;
+                break;
+            }
+            alpha *= 0.5;
+            rep.line_search_cuts += 1;
+        }
+        if !accepted {
+            rep.reason = format!(
+                "line search stalled (residual {:.3e}, directional derivative {:.3e})",
+                rep.residual, slope
+            );
+            return rep;
+        }
+        x.copy_from_slice(&ws.trial);
+    }
+}

@@ -1,0 +1,139 @@
+//! The potential minimised by one Newton solve:
+//!
+//! `Φ(x) = E_elastic(x; ā(s), b̄(s)) + E_damp(x; a_prev, b_prev) + Σ_i m_i/(2Δt²)|x_i − x̂_i|²
+//!        − Σ_i m_i g·x_i`
+//!
+//! Statics use only the elastic and gravity terms. Dynamics (implicit Euler, seed 000 §3) add
+//! inertia with `x̂ = x_n + Δt v_n` (its minimiser satisfies `M(v_{n+1} − v_n)/Δt = F(x_{n+1})`)
+//! and the Kelvin–Voigt damping potential. Only the terms a scene enables are assembled.
+
+use crate::assembly::{assemble_faces, Pattern, Want};
+use crate::energy::material::sv_matrix;
+use crate::energy::KoiterDensity;
+use crate::math::{Real, Sym2, Vec3};
+use crate::scene::Scene;
+
+/// Inertia of an implicit-Euler step.
+#[derive(Clone, Copy, Debug)]
+pub struct Inertia<'a> {
+    /// 1/Δt² (1/s²).
+    pub inv_dt2: Real,
+    /// Predicted positions x_n + Δt v_n (m).
+    pub xhat: &'a [Vec3],
+}
+
+/// Kelvin–Voigt damping of seed 000: the elastic form with targets at the previous step's
+/// forms and weights × η/Δt.
+#[derive(Clone, Copy, Debug)]
+pub struct Damping<'a> {
+    /// η/Δt (dimensionless).
+    pub eta_over_dt: Real,
+    /// Previous step's first fundamental forms.
+    pub a_prev: &'a [Sym2],
+    /// Previous step's second fundamental forms.
+    pub b_prev: &'a [Sym2],
+}
+
+/// The potential of one solve.
+#[derive(Clone, Copy)]
+pub struct Potential<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// The Hessian pattern.
+    pub pattern: &'a Pattern,
+    /// Dial factor s ∈ [0, 1] of the rest forms.
+    pub dial: Real,
+    /// Inertia (dynamics only).
+    pub inertia: Option<Inertia<'a>>,
+    /// Damping (dynamics with η > 0 only).
+    pub damping: Option<Damping<'a>>,
+    /// Gravitational acceleration (m/s²).
+    pub gravity: Vec3,
+}
+
+impl<'a> Potential<'a> {
+    /// Elastic (+ damping) density of face `f`.
+    #[inline]
+    pub fn density(&self, f: usize) -> KoiterDensity {
+        let sc = self.scene;
+        let (abar, bbar) = sc.rest.at(f, self.dial);
+        let (ws, wb) = KoiterDensity::weights(&abar, sc.thickness[f], sc.stretch_factor);
+        let mut d = KoiterDensity {
+            c: sv_matrix(&abar, sc.lame[f]),
+            stretch: [(ws, abar), (0.0, Sym2::zeros())],
+            bend: [(wb, bbar), (0.0, Sym2::zeros())],
+        };
+        if let Some(dm) = &self.damping {
+            d.stretch[1] = (ws * dm.eta_over_dt, dm.a_prev[f]);
+            d.bend[1] = (wb * dm.eta_over_dt, dm.b_prev[f]);
+        }
+        d
+    }
+
+    /// Evaluates Φ and, as wanted, its gradient (len 3n) and Hessian values (pattern order).
+    /// Fixed vertices get zero gradient and a unit-scaled identity block.
+    pub fn eval(&self, x: &[Vec3], want: Want, grad: &mut [Real], values: &mut [Real]) -> Real {
+        let sc = self.scene;
+        let mut e = assemble_faces(
+            self.pattern,
+            x,
+            |f| self.density(f),
+            &sc.fixed,
+            sc.settings.solver.hessian_projection,
+            want,
+            grad,
+            values,
+        );
+        let g = self.gravity;
+        let has_g = g != Vec3::zeros();
+        for (v, xv) in x.iter().enumerate() {
+            if sc.fixed[v] {
+                continue;
+            }
+            let m = sc.mass[v];
+            if let Some(inr) = &self.inertia {
+                let dx = xv - inr.xhat[v];
+                e += 0.5 * inr.inv_dt2 * m * dx.norm_squared();
+                if want != Want::Energy {
+                    for c in 0..3 {
+                        grad[3 * v + c] += inr.inv_dt2 * m * dx[c];
+                    }
+                }
+                if want == Want::Hessian {
+                    for c in 0..3 {
+                        values[self.pattern.diag(3 * v + c)] += inr.inv_dt2 * m;
+                    }
+                }
+            }
+            if has_g {
+                e -= m * g.dot(xv);
+                if want != Want::Energy {
+                    for c in 0..3 {
+                        grad[3 * v + c] -= m * g[c];
+                    }
+                }
+            }
+        }
+        if want == Want::Hessian {
+            let n = self.pattern.n;
+            let mut sum = 0.0;
+            let mut cnt = 0usize;
+            for i in 0..n {
+                let d = values[self.pattern.diag(i)];
+                if d != 0.0 {
+                    sum += d.abs();
+                    cnt += 1;
+                }
+            }
+            let scale = if cnt > 0 { sum / cnt as Real } else { 1.0 };
+            for (v, &fx) in sc.fixed.iter().enumerate() {
+                if fx {
+                    for c in 0..3 {
+                        values[self.pattern.diag(3 * v + c)] = scale;
+                    }
+                }
+            }
+        }
+        e
+    }
+}
