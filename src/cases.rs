@@ -99,32 +99,47 @@ impl Case {
         (0.5 * s.trace(), s.determinant())
     }
 
-    /// Writes this case's target forms into a mesh as `abar_info`, `bbar_info` (face centroids).
+    /// Writes this case's target forms into a mesh as `abar_info`, `bbar_info`.
+    ///
+    /// Each face's tensors are built edge by edge so that they are second-order consistent: the
+    /// barycentric entries `M(e, e)` for the face's three edge vectors `e` are sampled at the
+    /// edge midpoints (`ā(e, e)` is then the squared rest length of that edge to O(ℓ⁴)), and the
+    /// tensor is pushed forward to reference Cartesian coordinates. Sampling all entries at the
+    /// centroid is only first-order consistent, which leaves an O(ℓ) shape error at corners.
     pub fn program(self, mesh: &mut Mesh) {
         let nf = mesh.faces.len();
         let mut a = Vec::with_capacity(3 * nf);
         let mut b = Vec::with_capacity(3 * nf);
         for f in 0..nf {
-            let [p, q, r] = mesh.face_positions(f);
-            let c = (p + q + r) / 3.0;
-            let (fa, fb) = self.forms(c.x, c.y);
-            a.extend_from_slice(fa.as_slice());
-            b.extend_from_slice(fb.as_slice());
+            let [p0, p1, p2] = mesh.face_positions(f);
+            let t = crate::rest::reference_frame(mesh, f);
+            let e1 = crate::math::Vec2::new(t[(0, 0)], t[(1, 0)]);
+            let e2 = crate::math::Vec2::new(t[(0, 1)], t[(1, 1)]);
+            let e3 = e2 - e1;
+            let m01 = (p0 + p1) / 2.0;
+            let m02 = (p0 + p2) / 2.0;
+            let m12 = (p1 + p2) / 2.0;
+            let quad = |m: &Sym2, e: &crate::math::Vec2| (e.transpose() * sym_to_mat(m) * e)[(0, 0)];
+            let bary = |k: usize| -> Sym2 {
+                let pick = |p: &Vec3| {
+                    let (fa, fb) = self.forms(p.x, p.y);
+                    if k == 0 {
+                        fa
+                    } else {
+                        fb
+                    }
+                };
+                let m11 = quad(&pick(&m01), &e1);
+                let m22 = quad(&pick(&m02), &e2);
+                let m33 = quad(&pick(&m12), &e3);
+                // M(e2 − e1, e2 − e1) = m11 + m22 − 2 m12.
+                Sym2::new(m11, 0.5 * (m11 + m22 - m33), m22)
+            };
+            a.extend_from_slice(crate::rest::push_forward(&t, &bary(0)).as_slice());
+            b.extend_from_slice(crate::rest::push_forward(&t, &bary(1)).as_slice());
         }
-        mesh.face_fields.insert(
-            "abar_info".into(),
-            Field {
-                components: 3,
-                data: a,
-            },
-        );
-        mesh.face_fields.insert(
-            "bbar_info".into(),
-            Field {
-                components: 3,
-                data: b,
-            },
-        );
+        mesh.face_fields.insert("abar_info".into(), Field { components: 3, data: a });
+        mesh.face_fields.insert("bbar_info".into(), Field { components: 3, data: b });
     }
 }
 
@@ -233,4 +248,138 @@ pub fn curvature_error(
     }
     let n = mesh.faces.len() as Real;
     ((eh / n).sqrt(), (ek / n).sqrt())
+}
+
+/// Closest point to `p` on triangle `(a, b, c)` (Ericson, Real-Time Collision Detection §5.1.5).
+pub fn closest_point_on_triangle(p: &Vec3, a: &Vec3, b: &Vec3, c: &Vec3) -> Vec3 {
+    let ab = b - a;
+    let ac = c - a;
+    let ap = p - a;
+    let d1 = ab.dot(&ap);
+    let d2 = ac.dot(&ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return *a;
+    }
+    let bp = p - b;
+    let d3 = ab.dot(&bp);
+    let d4 = ac.dot(&bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return *b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let d5 = ab.dot(&cp);
+    let d6 = ac.dot(&cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return *c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denom = 1.0 / (va + vb + vc);
+    a + ab * (vb * denom) + ac * (vc * denom)
+}
+
+/// Distance from `p` to the exact surface of `case` over the reference domain bounding box
+/// `[lo, hi]`, by projected Gauss–Newton on the parameters starting from `(u0, v0)`.
+fn distance_to_exact(case: Case, p: &Vec3, u0: Real, v0: Real, lo: [Real; 2], hi: [Real; 2]) -> Real {
+    let (mut u, mut v) = (u0, v0);
+    let h = 1e-6;
+    for _ in 0..30 {
+        let s = case.exact(u, v);
+        let su = (case.exact(u + h, v) - case.exact(u - h, v)) / (2.0 * h);
+        let sv = (case.exact(u, v + h) - case.exact(u, v - h)) / (2.0 * h);
+        let r = s - p;
+        let m = Mat2::new(su.dot(&su), su.dot(&sv), su.dot(&sv), sv.dot(&sv));
+        let g = crate::math::Vec2::new(su.dot(&r), sv.dot(&r));
+        let Some(mi) = m.try_inverse() else { break };
+        let d = mi * g;
+        let (nu, nv) = ((u - d.x).clamp(lo[0], hi[0]), (v - d.y).clamp(lo[1], hi[1]));
+        let moved = (nu - u).abs() + (nv - v).abs();
+        u = nu;
+        v = nv;
+        if moved < 1e-14 {
+            break;
+        }
+    }
+    (case.exact(u, v) - p).norm()
+}
+
+/// Two-sided Hausdorff distance (m) between the simulated surface and the exact one, after the
+/// material-point rigid alignment of [`align`]. Simulated → exact: vertices, edge midpoints and
+/// face centroids projected onto the exact surface. Exact → simulated: the exact images of the
+/// reference vertices and face centroids, to the nearest simulated triangle among the material
+/// face's neighbours. Bounded above by the material-point error.
+pub fn hausdorff(case: Case, mesh: &Mesh, topo: &crate::mesh::Topology, x: &[Vec3]) -> Real {
+    let reference = &mesh.positions;
+    let exact: Vec<Vec3> = reference.iter().map(|p| case.exact(p.x, p.y)).collect();
+    let y = align(x, &exact);
+    let mut lo = [Real::INFINITY; 2];
+    let mut hi = [Real::NEG_INFINITY; 2];
+    for p in reference {
+        lo = [lo[0].min(p.x), lo[1].min(p.y)];
+        hi = [hi[0].max(p.x), hi[1].max(p.y)];
+    }
+    let mut d: Real = 0.0;
+    // Simulated → exact.
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let [i, j, k] = *face;
+        let samples = [
+            (y[i], reference[i]),
+            ((y[i] + y[j]) / 2.0, (reference[i] + reference[j]) / 2.0),
+            ((y[i] + y[k]) / 2.0, (reference[i] + reference[k]) / 2.0),
+            ((y[i] + y[j] + y[k]) / 3.0, (reference[i] + reference[j] + reference[k]) / 3.0),
+        ];
+        let _ = f;
+        for (p, r) in samples {
+            d = d.max(distance_to_exact(case, &p, r.x, r.y, lo, hi));
+        }
+    }
+    // Exact → simulated.
+    let mut vertex_faces: Vec<Vec<usize>> = vec![Vec::new(); reference.len()];
+    for (f, face) in mesh.faces.iter().enumerate() {
+        for &v in face {
+            vertex_faces[v].push(f);
+        }
+    }
+    let near = |f: usize, out: &mut Vec<usize>| {
+        out.push(f);
+        for &g in &topo.face_neighbors[f] {
+            if g != crate::mesh::topology::NONE {
+                out.push(g);
+            }
+        }
+    };
+    let mut cand = Vec::new();
+    let dist_to_faces = |p: &Vec3, faces: &[usize]| -> Real {
+        faces
+            .iter()
+            .map(|&g| {
+                let [a, b, c] = mesh.faces[g];
+                (closest_point_on_triangle(p, &y[a], &y[b], &y[c]) - p).norm()
+            })
+            .fold(Real::INFINITY, Real::min)
+    };
+    for (v, fs) in vertex_faces.iter().enumerate() {
+        cand.clear();
+        for &f in fs {
+            near(f, &mut cand);
+        }
+        d = d.max(dist_to_faces(&exact[v], &cand));
+    }
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let c = (reference[face[0]] + reference[face[1]] + reference[face[2]]) / 3.0;
+        cand.clear();
+        near(f, &mut cand);
+        d = d.max(dist_to_faces(&case.exact(c.x, c.y), &cand));
+    }
+    d
 }

@@ -339,10 +339,13 @@ fn error_cmd(a: ErrorArgs) -> Result<()> {
     ref_mesh.positions = reference;
     let topo = Topology::build(&ref_mesh)?;
     let (eh, ek) = curvature_error(case, &ref_mesh, &topo, &frame.positions);
+    let hd = crate::cases::hausdorff(case, &ref_mesh, &topo, &frame.positions);
     let out = serde_json::json!({
         "case": case.name(),
         "vertices": frame.positions.len(),
         "faces": frame.faces.len(),
+        "hausdorff": hd,
+        "hausdorff_rel": hd / err.size,
         "max_error": err.max,
         "rms_error": err.rms,
         "size": err.size,

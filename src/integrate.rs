@@ -149,6 +149,7 @@ impl<'a> Solver<'a> {
     fn record(&mut self, rep: &NewtonReport) {
         self.summary.newton_iterations += rep.iterations;
         self.summary.shifted_iterations += rep.shifted_iterations;
+        self.summary.projected_iterations += rep.projected_iterations;
         self.iters_since_frame += rep.iterations;
         self.summary.residual = rep.residual;
     }
@@ -406,6 +407,7 @@ fn run_dynamic(
         );
         s.summary.newton_iterations += rep.iterations;
         s.summary.shifted_iterations += rep.shifted_iterations;
+        s.summary.projected_iterations += rep.projected_iterations;
         s.iters_since_frame += rep.iterations;
         s.summary.residual = rep.residual;
         if !rep.converged {

@@ -106,6 +106,8 @@ pub struct Summary {
     pub newton_iterations: usize,
     /// Newton iterations that needed a diagonal shift.
     pub shifted_iterations: usize,
+    /// Newton iterations that used projected element Hessians.
+    pub projected_iterations: usize,
     /// Saddle points detected and escaped by perturbation.
     pub saddle_escapes: usize,
     /// Vertices.

@@ -169,7 +169,9 @@ pub struct Solver {
     pub tolerance: Real,
     /// Newton iterations allowed per solve before the step is cut (default: `40`).
     pub max_newton_iterations: usize,
-    /// Per-element Hessian projection: `"none"`, `"clamp_zero"` or `"abs"` (default: `"none"`).
+    /// Per-element Hessian projection: `"adaptive"` (exact when it factorises, |λ|-projected
+    /// otherwise), `"none"` (exact + diagonal shift), `"clamp_zero"` or `"abs"` (always projected)
+    /// (default: `"adaptive"`).
     pub hessian_projection: HessianProjection,
     /// Static mode: first continuation increment of the dial factor (dimensionless, (0, 1],
     /// default: `1.0`).
@@ -195,7 +197,7 @@ impl Default for Solver {
             mode: Mode::Static,
             tolerance: 1e-9,
             max_newton_iterations: 40,
-            hessian_projection: HessianProjection::None,
+            hessian_projection: HessianProjection::Adaptive,
             continuation_step: 1.0,
             min_continuation_step: 1e-4,
             symmetry_breaking: 1e-3,

@@ -8,9 +8,12 @@ use crate::math::{Real, SMat};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum HessianProjection {
-    /// Use the exact Hessian (default; indefiniteness is handled by the solver's shift).
-    #[default]
+    /// Use the exact Hessian; indefiniteness is handled by the solver's diagonal shift.
     None,
+    /// Exact Hessian when it factorises, |λ|-projected element Hessians for iterations where it
+    /// does not (default: quadratic convergence near a minimum, robust far from one).
+    #[default]
+    Adaptive,
     /// Clamp negative eigenvalues to zero.
     ClampZero,
     /// Replace eigenvalues by their absolute values.
@@ -19,7 +22,7 @@ pub enum HessianProjection {
 
 /// Projects a symmetric `N×N` matrix in place: `H = V max(Λ, 0) Vᵀ` or `V |Λ| Vᵀ`.
 pub fn project<const N: usize>(h: &mut SMat<N, N>, mode: HessianProjection) {
-    if mode == HessianProjection::None {
+    if matches!(mode, HessianProjection::None | HessianProjection::Adaptive) {
         return;
     }
     let dm = nalgebra::DMatrix::<Real>::from_column_slice(N, N, h.as_slice());

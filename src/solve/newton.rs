@@ -3,12 +3,16 @@
 //! Each iteration assembles the gradient and Hessian, factorises `H + τ D` (D = mean |diagonal|,
 //! τ = 0 first; on a non-positive pivot τ grows ×10 from 1e-8 until the factorisation succeeds,
 //! and the shift is recorded), solves for the step, and backtracks (Armijo, c = 1e-4, halving) on
-//! Φ. Convergence: ‖∇Φ‖∞ ≤ tol · F over free DOFs, with F the scene's force scale. Non-finite
+//! Φ. With the `adaptive` projection (default), an iteration whose exact Hessian is not positive
+//! definite is redone with |λ|-projected element Hessians (a descent direction that respects the
+//! curvature scale, where a global shift would degrade to gradient descent); the next iteration
+//! tries the exact Hessian again. Convergence: ‖∇Φ‖∞ ≤ tol · F over free DOFs, with F the scene's force scale. Non-finite
 //! energies are treated as a failed trial point, never accepted.
 
 use super::linear::LinearSolver;
 use super::potential::Potential;
 use crate::assembly::Want;
+use crate::energy::HessianProjection;
 use crate::math::{Real, Vec3};
 
 /// Controls of one Newton solve.
@@ -35,6 +39,8 @@ pub struct NewtonReport {
     pub max_shift: Real,
     /// Iterations that needed a shift.
     pub shifted_iterations: usize,
+    /// Iterations that used projected element Hessians (adaptive mode).
+    pub projected_iterations: usize,
     /// Total step halvings in line searches.
     pub line_search_cuts: usize,
     /// Why it stopped, when it did not converge.
@@ -81,6 +87,18 @@ pub fn factor_with_shift(
     shifted: &mut [Real],
     tau0: Real,
 ) -> Option<Real> {
+    factor_with_shift_upto(lin, pot, values, shifted, tau0, 1e6)
+}
+
+/// As [`factor_with_shift`], giving up once τ would exceed `tau_max`.
+pub fn factor_with_shift_upto(
+    lin: &mut LinearSolver,
+    pot: &Potential,
+    values: &[Real],
+    shifted: &mut [Real],
+    tau0: Real,
+    tau_max: Real,
+) -> Option<Real> {
     let n = pot.pattern.n;
     let scale = {
         let s: Real = (0..n).map(|i| values[pot.pattern.diag(i)].abs()).sum();
@@ -102,7 +120,7 @@ pub fn factor_with_shift(
             Ok(()) => return Some(tau),
             Err(_) => {
                 tau = if tau == 0.0 { 1e-8 } else { tau * 10.0 };
-                if tau > 1e6 {
+                if tau > tau_max {
                     return None;
                 }
             }
@@ -121,8 +139,14 @@ pub fn newton(
     let force = pot.scene.force_scale.max(Real::MIN_POSITIVE);
     let mut rep = NewtonReport::default();
     let mut tau_prev: Real = 0.0;
+    let mode = pot.scene.settings.solver.hessian_projection;
     loop {
-        let e = pot.eval(x, Want::Hessian, &mut ws.grad, &mut ws.values);
+        let first = if mode == HessianProjection::Adaptive {
+            HessianProjection::None
+        } else {
+            mode
+        };
+        let e = pot.eval_projected(x, Want::Hessian, first, &mut ws.grad, &mut ws.values);
         rep.energy = e;
         let gnorm = inf_norm(&ws.grad);
         rep.residual = gnorm / force;
@@ -145,10 +169,33 @@ pub fn newton(
             rep.reason = "non-finite Hessian".into();
             return rep;
         }
-        let tau0 = if tau_prev > 1e-8 { tau_prev * 0.1 } else { 0.0 };
-        let Some(tau) = factor_with_shift(lin, pot, &ws.values, &mut ws.shifted, tau0) else {
-            rep.reason = "Hessian could not be factorised even with a large shift".into();
-            return rep;
+        let mut tau0 = if tau_prev > 1e-8 { tau_prev * 0.1 } else { 0.0 };
+        let mut factored = false;
+        if mode == HessianProjection::Adaptive {
+            // Exact Hessian, at most with the tiny shift that free rigid-body modes need; if it
+            // is genuinely indefinite, project the element Hessians instead.
+            match factor_with_shift_upto(lin, pot, &ws.values, &mut ws.shifted, tau0.min(1e-8), 1e-8) {
+                Some(t) if t <= 1e-8 => {
+                    factored = true;
+                    tau0 = t;
+                }
+                _ => {
+                    pot.eval_projected(x, Want::Hessian, HessianProjection::Abs, &mut ws.grad, &mut ws.values);
+                    rep.projected_iterations += 1;
+                    tau0 = 0.0;
+                }
+            }
+        }
+        let tau = if factored {
+            tau0
+        } else {
+            match factor_with_shift(lin, pot, &ws.values, &mut ws.shifted, tau0) {
+                Some(t) => t,
+                None => {
+                    rep.reason = "Hessian could not be factorised even with a large shift".into();
+                    return rep;
+                }
+            }
         };
         tau_prev = tau;
         if tau > 0.0 {

@@ -9,7 +9,7 @@
 
 use crate::assembly::{assemble_faces, Pattern, Want};
 use crate::energy::material::sv_matrix;
-use crate::energy::KoiterDensity;
+use crate::energy::{HessianProjection, KoiterDensity};
 use crate::math::{Real, Sym2, Vec3};
 use crate::scene::Scene;
 
@@ -70,16 +70,28 @@ impl<'a> Potential<'a> {
         d
     }
 
-    /// Evaluates Φ and, as wanted, its gradient (len 3n) and Hessian values (pattern order).
-    /// Fixed vertices get zero gradient and a unit-scaled identity block.
+    /// Evaluates Φ and, as wanted, its gradient (len 3n) and exact Hessian values (pattern
+    /// order). Fixed vertices get zero gradient and a unit-scaled identity block.
     pub fn eval(&self, x: &[Vec3], want: Want, grad: &mut [Real], values: &mut [Real]) -> Real {
+        self.eval_projected(x, want, HessianProjection::None, grad, values)
+    }
+
+    /// As [`Potential::eval`], with the element Hessians projected as `projection` says.
+    pub fn eval_projected(
+        &self,
+        x: &[Vec3],
+        want: Want,
+        projection: HessianProjection,
+        grad: &mut [Real],
+        values: &mut [Real],
+    ) -> Real {
         let sc = self.scene;
         let mut e = assemble_faces(
             self.pattern,
             x,
             |f| self.density(f),
             &sc.fixed,
-            sc.settings.solver.hessian_projection,
+            projection,
             want,
             grad,
             values,
