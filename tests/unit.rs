@@ -1,5 +1,11 @@
 //! Unit tests: kernels, geometry, I/O. One test binary (see STYLE.md §5).
+#[path = "unit/assembly.rs"]
+mod assembly;
 #[path = "unit/fd.rs"]
 mod fd;
 #[path = "unit/geometry.rs"]
 mod geometry;
+#[path = "unit/io.rs"]
+mod io;
+#[path = "unit/settings.rs"]
+mod settings;

@@ -81,6 +81,21 @@ fn parse_legacy(bytes: &[u8]) -> Result<Vtk, String> {
             ))
         }
     }
+    if head
+        .get(2)
+        .is_some_and(|l| l.trim_ascii().eq_ignore_ascii_case(b"ASCII"))
+    {
+        // vtkio cannot parse `nan`/`inf`; name the line instead of a parser trace.
+        let text = String::from_utf8_lossy(bytes);
+        for (i, line) in text.lines().enumerate().skip(3) {
+            for tok in line.split_ascii_whitespace() {
+                let t = tok.trim_start_matches(['-', '+']).to_ascii_lowercase();
+                if matches!(t.as_str(), "nan" | "inf" | "infinity" | "nan(ind)") {
+                    return Err(format!("line {}: non-finite value '{tok}'", i + 1));
+                }
+            }
+        }
+    }
     Vtk::parse_legacy_be(bytes).map_err(|e| format!("malformed or truncated legacy VTK: {e}"))
 }
 

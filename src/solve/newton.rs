@@ -174,13 +174,26 @@ pub fn newton(
         if mode == HessianProjection::Adaptive {
             // Exact Hessian, at most with the tiny shift that free rigid-body modes need; if it
             // is genuinely indefinite, project the element Hessians instead.
-            match factor_with_shift_upto(lin, pot, &ws.values, &mut ws.shifted, tau0.min(1e-8), 1e-8) {
+            match factor_with_shift_upto(
+                lin,
+                pot,
+                &ws.values,
+                &mut ws.shifted,
+                tau0.min(1e-8),
+                1e-8,
+            ) {
                 Some(t) if t <= 1e-8 => {
                     factored = true;
                     tau0 = t;
                 }
                 _ => {
-                    pot.eval_projected(x, Want::Hessian, HessianProjection::Abs, &mut ws.grad, &mut ws.values);
+                    pot.eval_projected(
+                        x,
+                        Want::Hessian,
+                        HessianProjection::Abs,
+                        &mut ws.grad,
+                        &mut ws.values,
+                    );
                     rep.projected_iterations += 1;
                     tau0 = 0.0;
                 }

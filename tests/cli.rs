@@ -1,0 +1,406 @@
+//! CLI tests: run the real binary in a temporary folder and check exit codes, messages and the
+//! files written (or not written).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_shellsim"))
+}
+
+struct Run {
+    code: i32,
+    stderr: String,
+    stdout: String,
+}
+
+fn run(args: &[&str], dir: &Path) -> Run {
+    let out = bin()
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("binary runs");
+    Run {
+        code: out.status.code().unwrap_or(-1),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+    }
+}
+
+fn tmp() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+/// A 2-triangle square with programmed cylinder forms, as MorphoShell writes it (legacy ASCII,
+/// FIELD arrays, a free title line).
+const TWO_TRIANGLES: &str = "# vtk DataFile Version 4.2
+MorphoShell-style input dial_factor = 0
+ASCII
+DATASET UNSTRUCTURED_GRID
+POINTS 4 double
+0 0 0
+1 0 0
+1 1 0
+0 1 0
+CELLS 2 8
+3 0 1 2
+3 0 2 3
+CELL_TYPES 2
+5
+5
+CELL_DATA 2
+FIELD FieldData 5
+abar_info 3 2 double
+1 0 1 1 0 1
+bbar_info 3 2 double
+0.5 0 0 0.5 0 0
+ref_thicknesses 1 2 double
+0.05 0.05
+ref_shear_moduli 1 2 double
+1000 1000
+tri_tags 1 2 int
+0 1
+POINT_DATA 4
+FIELD FieldData 2
+constraint_indicators 1 4 int
+0 0 0 0
+node_tags 1 4 int
+0 0 1 1
+";
+
+const STATIC: &str = "[rest]\ntarget = \"mesh\"\n[solver]\nmode = \"static\"\n";
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn frames(dir: &Path) -> usize {
+    std::fs::read_dir(dir)
+        .map(|r| {
+            r.filter(|e| {
+                e.as_ref()
+                    .map(|e| e.file_name().to_string_lossy().starts_with("frame_"))
+                    .unwrap_or(false)
+            })
+            .count()
+        })
+        .unwrap_or(0)
+}
+
+#[test]
+fn two_triangles_static_run_writes_frames_series_log_and_summary() {
+    let d = tmp();
+    write(d.path(), "m.vtk", TWO_TRIANGLES);
+    write(d.path(), "s.toml", STATIC);
+    let r = run(&["s.toml", "m.vtk", "--out", "out"], d.path());
+    assert_eq!(r.code, 0, "stderr: {}", r.stderr);
+    let out = d.path().join("out");
+    assert_eq!(frames(&out), 2);
+    assert!(out.join("series.pvd").exists());
+    let log = std::fs::read_to_string(out.join("log.csv")).unwrap();
+    assert_eq!(log.lines().count(), 3, "{log}");
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    for key in [
+        "converged",
+        "final_frame",
+        "wall_seconds",
+        "steps",
+        "newton_iterations",
+        "vertices",
+        "faces",
+        "threads",
+        "energy",
+    ] {
+        assert!(s.get(key).is_some(), "summary lacks {key}");
+    }
+    assert_eq!(s["converged"], true);
+    assert_eq!(s["faces"], 2);
+    assert!(out.join(s["final_frame"].as_str().unwrap()).exists());
+}
+
+#[test]
+fn every_example_scene_runs_at_small_size() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let d = tmp();
+    let mut n = 0;
+    for entry in std::fs::read_dir(root.join("settings")).unwrap() {
+        let p = entry.unwrap().path();
+        if p.extension().and_then(|e| e.to_str()) != Some("toml") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&p).unwrap();
+        // Each scene names its mesh on a line `# mesh: meshes/<file>`.
+        let mesh = text
+            .lines()
+            .find_map(|l| l.strip_prefix("# mesh: "))
+            .unwrap_or_else(|| panic!("{} names no mesh", p.display()));
+        let out = d.path().join(p.file_stem().unwrap());
+        let r = run(
+            &[
+                p.to_str().unwrap(),
+                root.join(mesh.trim()).to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--set",
+                "time.end=0.1",
+            ],
+            d.path(),
+        );
+        assert_eq!(r.code, 0, "{}: {}", p.display(), r.stderr);
+        assert!(frames(&out) >= 2);
+        n += 1;
+    }
+    assert!(n >= 2, "expected example scenes in settings/");
+}
+
+fn expect_bad(args: &[&str], dir: &Path, needle: &str) {
+    let r = run(args, dir);
+    assert_eq!(
+        r.code, 2,
+        "expected exit 2 for {args:?}; stderr: {}",
+        r.stderr
+    );
+    assert!(
+        r.stderr.contains(needle),
+        "stderr for {args:?} should mention '{needle}': {}",
+        r.stderr
+    );
+    assert!(!r.stderr.contains("panicked"), "{}", r.stderr);
+    assert!(!r.stderr.contains("stack backtrace"), "{}", r.stderr);
+    assert_eq!(frames(&dir.join("out")), 0, "frames written for {args:?}");
+}
+
+#[test]
+fn bad_meshes_are_rejected_with_exit_2_and_nothing_written() {
+    let d = tmp();
+    let p = d.path();
+    write(p, "s.toml", STATIC);
+    write(p, "garbage.vtk", "hello world\n");
+    expect_bad(&["s.toml", "garbage.vtk"], p, "garbage.vtk");
+    write(
+        p,
+        "trunc.vtk",
+        &TWO_TRIANGLES[..TWO_TRIANGLES.find("CELL_TYPES").unwrap()],
+    );
+    expect_bad(&["s.toml", "trunc.vtk"], p, "trunc.vtk");
+    write(p, "nan.vtk", &TWO_TRIANGLES.replace("1 1 0\n", "nan 1 0\n"));
+    expect_bad(&["s.toml", "nan.vtk"], p, "line 8");
+    write(
+        p,
+        "zero.vtk",
+        &TWO_TRIANGLES.replace("1 1 0\n0 1 0", "1 1 0\n2 2 0"),
+    );
+    expect_bad(&["s.toml", "zero.vtk"], p, "face 1");
+    let wrong_len = TWO_TRIANGLES.replace(
+        "ref_thicknesses 1 2 double\n0.05 0.05",
+        "ref_thicknesses 1 3 double\n0.05 0.05 0.05",
+    );
+    write(p, "len.vtk", &wrong_len);
+    expect_bad(&["s.toml", "len.vtk"], p, "ref_thicknesses");
+    write(
+        p,
+        "neg.vtk",
+        &TWO_TRIANGLES.replace("0.05 0.05", "0.05 -0.05"),
+    );
+    expect_bad(&["s.toml", "neg.vtk"], p, "face 1");
+    write(
+        p,
+        "noabar.vtk",
+        &TWO_TRIANGLES.replace("abar_info", "other_info"),
+    );
+    expect_bad(&["s.toml", "noabar.vtk"], p, "abar_info");
+    // Inconsistent orientation: second triangle reversed.
+    write(
+        p,
+        "orient.vtk",
+        &TWO_TRIANGLES.replace("3 0 2 3", "3 0 3 2"),
+    );
+    expect_bad(&["s.toml", "orient.vtk"], p, "oriented");
+    // Non-manifold edge: three triangles on edge (0, 2).
+    let nm = "# vtk DataFile Version 3.0\nnm\nASCII\nDATASET POLYDATA\nPOINTS 5 double\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\nPOLYGONS 3 12\n3 0 1 2\n3 0 2 3\n3 2 0 4\n";
+    write(p, "nm.vtk", &nm);
+    write(p, "none.toml", "");
+    expect_bad(&["none.toml", "nm.vtk"], p, "non-manifold");
+    // Non-triangle cell.
+    let quad = "# vtk DataFile Version 2.0\nq\nASCII\nDATASET POLYDATA\nPOINTS 4 double\n0 0 0 1 0 0 1 1 0 0 1 0\nPOLYGONS 1 5\n4 0 1 2 3\n";
+    write(p, "quad.vtk", quad);
+    expect_bad(&["none.toml", "quad.vtk"], p, "not a triangle");
+    expect_bad(&["s.toml", "missing.vtk"], p, "missing.vtk");
+}
+
+#[test]
+fn bad_settings_are_rejected_with_exit_2() {
+    let d = tmp();
+    let p = d.path();
+    write(p, "m.vtk", TWO_TRIANGLES);
+    let cases = [
+        ("[material]\nyoungs = 1.0\n", "youngs"),
+        ("[material]\nyoung = \"soft\"\n", "young"),
+        ("[material]\nthickness = -0.1\n", "material.thickness"),
+        ("[material]\nyoung = 0.0\n", "material.young"),
+        ("[material]\ndensity = -1.0\n", "material.density"),
+        ("[material]\npoisson = 0.6\n", "material.poisson"),
+        ("[material]\npoisson = -1.0\n", "material.poisson"),
+        ("[solver]\nmode = \"sideways\"\n", "mode"),
+        ("[time]\ndt = 0.0\n", "time.dt"),
+        (
+            "[rest]\ntarget = \"uniform\"\nabar = [1.0, 2.0, 1.0]\n",
+            "rest.abar",
+        ),
+        ("[material\n", "s.toml"),
+    ];
+    for (text, needle) in cases {
+        write(p, "s.toml", text);
+        expect_bad(&["s.toml", "m.vtk"], p, needle);
+    }
+    write(p, "s.toml", STATIC);
+    expect_bad(
+        &["s.toml", "m.vtk", "--set", "material.thikness=1"],
+        p,
+        "thikness",
+    );
+    expect_bad(&["s.toml", "m.vtk", "--set", "nokey"], p, "key=value");
+}
+
+#[test]
+fn unwritable_output_folder_is_exit_2() {
+    let d = tmp();
+    let p = d.path();
+    write(p, "m.vtk", TWO_TRIANGLES);
+    write(p, "s.toml", STATIC);
+    write(p, "afile", "x");
+    let r = run(&["s.toml", "m.vtk", "--out", "afile/sub"], p);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("afile"), "{}", r.stderr);
+}
+
+#[test]
+fn set_overrides_reach_the_run() {
+    let d = tmp();
+    let p = d.path();
+    write(p, "m.vtk", TWO_TRIANGLES);
+    write(p, "s.toml", STATIC);
+    let r = run(
+        &[
+            "s.toml",
+            "m.vtk",
+            "--out",
+            "o",
+            "--set",
+            "output.format=\"vtk\"",
+            "--set",
+            "output.prefix=shape",
+        ],
+        p,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(p.join("o/shape_00001.vtk").exists());
+}
+
+#[test]
+fn non_convergence_exits_1_with_a_reason() {
+    let d = tmp();
+    let p = d.path();
+    write(p, "m.vtk", TWO_TRIANGLES);
+    write(p, "s.toml", "[rest]\ntarget = \"uniform\"\nabar = [9.0, 0.0, 9.0]\n[solver]\nmax_newton_iterations = 1\ncontinuation_step = 1.0\nmin_continuation_step = 0.5\n");
+    let r = run(&["s.toml", "m.vtk", "--out", "o"], p);
+    assert_eq!(r.code, 1, "{}", r.stderr);
+    assert!(r.stderr.contains("did not converge"), "{}", r.stderr);
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(p.join("o/summary.json")).unwrap()).unwrap();
+    assert_eq!(s["converged"], false);
+    assert!(!s["reason"].as_str().unwrap().is_empty());
+}
+
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let d = tmp();
+    let p = d.path();
+    let r = run(
+        &[
+            "mesh",
+            "square",
+            "--edge",
+            "0.1",
+            "--jitter",
+            "0.2",
+            "--program",
+            "spherical_cap",
+            "-o",
+            "m.vtk",
+        ],
+        p,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    write(
+        p,
+        "s.toml",
+        "[material]\nthickness = 0.05\n[rest]\ntarget = \"mesh\"\n",
+    );
+    for t in ["1", "2", "3"] {
+        let r = run(
+            &["s.toml", "m.vtk", "--out", &format!("o{t}"), "--threads", t],
+            p,
+        );
+        assert_eq!(r.code, 0, "{}", r.stderr);
+    }
+    let a = std::fs::read(p.join("o1/frame_00001.vtu")).unwrap();
+    let b = std::fs::read(p.join("o2/frame_00001.vtu")).unwrap();
+    let c = std::fs::read(p.join("o3/frame_00001.vtu")).unwrap();
+    assert!(a == b && b == c, "frames differ between thread counts");
+}
+
+#[test]
+fn mesh_generator_and_error_command() {
+    let d = tmp();
+    let p = d.path();
+    for (shape, extra) in [
+        ("square", vec!["--edge", "0.25"]),
+        (
+            "rectangle",
+            vec![
+                "--edge",
+                "0.05",
+                "--lx",
+                "0.3",
+                "--ly",
+                "0.1",
+                "--grading",
+                "2",
+            ],
+        ),
+        ("disk", vec!["--edge", "0.2", "--jitter", "0.25"]),
+        (
+            "annulus",
+            vec!["--edge", "0.1", "--inner", "0.5", "--sweep", "300"],
+        ),
+    ] {
+        let mut args = vec!["mesh", shape, "-o", "g.vtu"];
+        args.extend(extra);
+        let r = run(&args, p);
+        assert_eq!(r.code, 0, "{shape}: {}", r.stderr);
+        assert!(r.stdout.contains("faces"));
+    }
+    let r = run(&["mesh", "square", "--edge", "-1", "-o", "g.vtk"], p);
+    assert_eq!(r.code, 2);
+    let r = run(
+        &[
+            "mesh",
+            "square",
+            "--edge",
+            "0.2",
+            "--program",
+            "teapot",
+            "-o",
+            "g.vtk",
+        ],
+        p,
+    );
+    assert_eq!(r.code, 2);
+    assert!(r.stderr.contains("teapot"));
+    let r = run(&["error", "cylinder", "nothere.vtu"], p);
+    assert_eq!(r.code, 2);
+}
