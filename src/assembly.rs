@@ -58,12 +58,12 @@ impl Pattern {
         let mut col_ptr = Vec::with_capacity(n + 1);
         let mut row_idx = Vec::new();
         col_ptr.push(0);
-        for v in 0..nv {
+        for (v, hv) in hi.iter().enumerate() {
             for d in 0..3 {
                 for c in d..3 {
                     row_idx.push(3 * v + c);
                 }
-                for &u in &hi[v] {
+                for &u in hv {
                     for c in 0..3 {
                         row_idx.push(3 * u + c);
                     }
@@ -222,9 +222,7 @@ where
             for (k, l) in buf.iter().enumerate() {
                 let f = start + k;
                 total += l.e;
-                let st = &pattern.stencil[f];
-                for s in 0..6 {
-                    let u = st[s];
+                for (s, &u) in pattern.stencil[f].iter().enumerate() {
                     if u == NONE || fixed[u] {
                         continue;
                     }

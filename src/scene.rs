@@ -42,7 +42,7 @@ fn positive_face_field(mesh: &Mesh, name: &str) -> Result<Option<Vec<Real>>, Mes
     let Some(f) = mesh.face_field(name, 1)? else {
         return Ok(None);
     };
-    if let Some(i) = f.data.iter().position(|&v| !(v > 0.0)) {
+    if let Some(i) = f.data.iter().position(|&v| !v.is_finite() || v <= 0.0) {
         return Err(mesh.invalid(format!(
             "face field '{name}' must be positive, but face {i} has {}",
             f.data[i]

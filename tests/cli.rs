@@ -221,7 +221,7 @@ fn bad_meshes_are_rejected_with_exit_2_and_nothing_written() {
     expect_bad(&["s.toml", "orient.vtk"], p, "oriented");
     // Non-manifold edge: three triangles on edge (0, 2).
     let nm = "# vtk DataFile Version 3.0\nnm\nASCII\nDATASET POLYDATA\nPOINTS 5 double\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\nPOLYGONS 3 12\n3 0 1 2\n3 0 2 3\n3 2 0 4\n";
-    write(p, "nm.vtk", &nm);
+    write(p, "nm.vtk", nm);
     write(p, "none.toml", "");
     expect_bad(&["none.toml", "nm.vtk"], p, "non-manifold");
     // Non-triangle cell.

@@ -1,4 +1,5 @@
 //! Unit tests: kernels, geometry, I/O. One test binary (see STYLE.md §5).
+#![allow(clippy::needless_range_loop)]
 #[path = "unit/assembly.rs"]
 mod assembly;
 #[path = "unit/fd.rs"]

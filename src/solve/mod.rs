@@ -1,5 +1,5 @@
 //! Nonlinear solves: the incremental potential of a step ([`potential`]), Newton's method with a
-//! backtracking line search and a growing diagonal shift ([`newton`]), and the sparse Cholesky
+//! backtracking line search and a growing diagonal shift ([`mod@newton`]), and the sparse Cholesky
 //! it uses ([`linear`]).
 
 pub mod linear;

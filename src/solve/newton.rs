@@ -221,7 +221,7 @@ pub fn newton(
         lin.solve_in_place(&mut ws.step);
         rep.iterations += 1;
         let slope: Real = ws.step.iter().zip(&ws.grad).map(|(d, g)| d * g).sum();
-        if !(slope < 0.0) {
+        if slope.is_nan() || slope >= 0.0 {
             rep.reason = "Newton step is not a descent direction".into();
             return rep;
         }
