@@ -1,10 +1,14 @@
 //! Global assembly of energy, gradient and sparse Hessian.
 //!
 //! The sparsity pattern (lower triangle, compressed sparse columns, 3 DOFs per vertex in the
-//! order `x, y, z`) is built once per mesh from each face's 6-vertex stencil. Element kernels run
-//! in parallel (rayon) over fixed-size chunks of faces into per-element buffers; the buffers are
-//! then scattered serially in face order. No floating-point atomics, no per-thread accumulators:
-//! results are bitwise identical for any number of threads.
+//! order `x, y, z`) is built once per mesh from each face's 6-vertex stencil, together with a
+//! greedy colouring of the faces in which no two faces of a colour share a stencil vertex.
+//! Colours are processed in order; within a colour, faces are evaluated in parallel (rayon) and
+//! each scatters its gradient and Hessian directly into entries no other face of that colour
+//! touches. Every entry therefore receives its contributions in a fixed order (colour by colour)
+//! that does not depend on the threads: no floating-point atomics, no per-thread accumulators,
+//! results bitwise identical for any number of threads. Energies are stored per face and summed
+//! in face order.
 
 use crate::energy::projection::{project, HessianProjection};
 use crate::energy::shell::shell_face;
@@ -12,9 +16,6 @@ use crate::energy::KoiterDensity;
 use crate::math::{Real, SMat, SVec, Vec3};
 use crate::mesh::topology::NONE;
 use rayon::prelude::*;
-
-/// Faces per parallel chunk (fixed, so the evaluation order never depends on the threads).
-const CHUNK: usize = 2048;
 
 /// The Hessian's sparsity pattern and, per face, where its entries go.
 #[derive(Clone, Debug)]
@@ -30,11 +31,19 @@ pub struct Pattern {
     /// Per face and slot pair (s, t) with `u_s > u_t`: rank of `u_s` among the neighbours of
     /// `u_t` with larger index.
     ranks: Vec<[u16; 36]>,
+    /// Blocks of faces grouped by colour; blocks of one colour share no stencil vertex.
+    colours: Vec<Vec<Vec<usize>>>,
 }
 
+/// Faces per block: large enough for cache locality and cheap scheduling, small enough that a
+/// colour holds many blocks.
+pub const BLOCK: usize = 256;
+
 impl Pattern {
-    /// Builds the pattern for faces and their opposite vertices.
-    pub fn new(nv: usize, faces: &[[usize; 3]], opposite: &[[usize; 3]]) -> Pattern {
+    /// Builds the pattern for faces and their opposite vertices; `positions` (any configuration,
+    /// usually the reference one) only orders the faces into spatially coherent blocks.
+    pub fn new(positions: &[Vec3], faces: &[[usize; 3]], opposite: &[[usize; 3]]) -> Pattern {
+        let nv = positions.len();
         let stencil: Vec<[usize; 6]> = faces
             .iter()
             .zip(opposite)
@@ -86,13 +95,25 @@ impl Pattern {
                 r
             })
             .collect();
+        let colours = colour_blocks(nv, &stencil, &morton_blocks(positions, faces));
         Pattern {
             n,
             col_ptr,
             row_idx,
             stencil,
             ranks,
+            colours,
         }
+    }
+
+    /// Number of block colours.
+    pub fn num_colours(&self) -> usize {
+        self.colours.len()
+    }
+
+    /// Blocks of faces by colour (no two blocks of a colour share a stencil vertex).
+    pub fn colours(&self) -> &[Vec<Vec<usize>>] {
+        &self.colours
     }
 
     /// Number of stored entries.
@@ -106,9 +127,12 @@ impl Pattern {
         self.col_ptr[i]
     }
 
-    /// Adds an element Hessian (lower parts) into `values`, skipping fixed vertices.
+    /// Adds an element Hessian (lower parts) into the values, skipping fixed vertices.
+    ///
+    /// # Safety
+    /// No other thread writes the Hessian columns of face `f`'s stencil vertices concurrently.
     #[inline]
-    fn scatter_hessian(&self, f: usize, h: &SMat<18, 18>, fixed: &[bool], values: &mut [Real]) {
+    unsafe fn scatter_hessian(&self, f: usize, h: &SMat<18, 18>, fixed: &[bool], values: Shared) {
         let st = &self.stencil[f];
         let rk = &self.ranks[f];
         for t in 0..6 {
@@ -125,12 +149,12 @@ impl Pattern {
                     let base = self.col_ptr[3 * v + d];
                     if u == v {
                         for c in d..3 {
-                            values[base + c - d] += h[(3 * s + c, 3 * t + d)];
+                            unsafe { values.add(base + c - d, h[(3 * s + c, 3 * t + d)]) };
                         }
                     } else {
                         let off = base + (3 - d) + 3 * rk[6 * s + t] as usize;
                         for c in 0..3 {
-                            values[off + c] += h[(3 * s + c, 3 * t + d)];
+                            unsafe { values.add(off + c, h[(3 * s + c, 3 * t + d)]) };
                         }
                     }
                 }
@@ -150,11 +174,104 @@ pub enum Want {
     Hessian,
 }
 
-/// Per-face element evaluation: energy, and the local gradient and Hessian when wanted.
-struct Local {
-    e: Real,
-    g: SVec<18>,
-    h: SMat<18, 18>,
+/// Splits the faces into blocks of [`BLOCK`] consecutive faces along the Morton curve of their
+/// centroids (ties by face index), each block sorted by face index.
+fn morton_blocks(positions: &[Vec3], faces: &[[usize; 3]]) -> Vec<Vec<usize>> {
+    let mut lo = Vec3::repeat(Real::INFINITY);
+    let mut hi = Vec3::repeat(Real::NEG_INFINITY);
+    for p in positions {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    let ext = (hi - lo).map(|e| if e > 0.0 { e } else { 1.0 });
+    let spread = |mut v: u64| {
+        // Spread the low 21 bits of v to every third bit.
+        v &= 0x1f_ffff;
+        v = (v | (v << 32)) & 0x1f00000000ffff;
+        v = (v | (v << 16)) & 0x1f0000ff0000ff;
+        v = (v | (v << 8)) & 0x100f00f00f00f00f;
+        v = (v | (v << 4)) & 0x10c30c30c30c30c3;
+        (v | (v << 2)) & 0x1249249249249249
+    };
+    let mut keyed: Vec<(u64, usize)> = faces
+        .iter()
+        .enumerate()
+        .map(|(f, t)| {
+            let c = (positions[t[0]] + positions[t[1]] + positions[t[2]]) / 3.0;
+            let q = (c - lo).component_div(&ext) * ((1u64 << 21) - 1) as Real;
+            let k = spread(q.x as u64) | (spread(q.y as u64) << 1) | (spread(q.z as u64) << 2);
+            (k, f)
+        })
+        .collect();
+    keyed.sort_unstable();
+    keyed
+        .chunks(BLOCK)
+        .map(|c| {
+            let mut b: Vec<usize> = c.iter().map(|k| k.1).collect();
+            b.sort_unstable();
+            b
+        })
+        .collect()
+}
+
+/// Greedy colouring of blocks: each takes the smallest colour not used by a block sharing one of
+/// its stencil vertices. Deterministic.
+fn colour_blocks(nv: usize, stencil: &[[usize; 6]], blocks: &[Vec<usize>]) -> Vec<Vec<Vec<usize>>> {
+    let mut used: Vec<Vec<u32>> = vec![Vec::new(); nv];
+    let mut colours: Vec<Vec<Vec<usize>>> = Vec::new();
+    let mut taken: Vec<bool> = Vec::new();
+    let mut verts: Vec<usize> = Vec::new();
+    for block in blocks {
+        verts.clear();
+        for &f in block {
+            verts.extend(stencil[f].iter().copied().filter(|&v| v != NONE));
+        }
+        verts.sort_unstable();
+        verts.dedup();
+        taken.clear();
+        taken.resize(colours.len() + 1, false);
+        for &v in &verts {
+            for &c in &used[v] {
+                taken[c as usize] = true;
+            }
+        }
+        let c = taken.iter().position(|t| !t).unwrap_or(colours.len());
+        if c == colours.len() {
+            colours.push(Vec::new());
+        }
+        colours[c].push(block.clone());
+        for &v in &verts {
+            if !used[v].contains(&(c as u32)) {
+                used[v].push(c as u32);
+            }
+        }
+    }
+    colours
+}
+
+/// A raw pointer to a buffer written concurrently at disjoint indices.
+#[derive(Clone, Copy)]
+struct Shared(*mut Real, usize);
+// SAFETY: `Shared` is only used within one colour of `Pattern::colours`, whose blocks write
+// pairwise disjoint indices (they share no stencil vertex, hence no gradient entry and no
+// Hessian column; a block's own faces run sequentially), and each face writes its own energy
+// slot.
+unsafe impl Send for Shared {}
+unsafe impl Sync for Shared {}
+
+impl Shared {
+    fn new(s: &mut [Real]) -> Self {
+        Shared(s.as_mut_ptr(), s.len())
+    }
+    /// Adds `v` at `i`.
+    ///
+    /// # Safety
+    /// No other thread accesses index `i` concurrently.
+    #[inline]
+    unsafe fn add(self, i: usize, v: Real) {
+        debug_assert!(i < self.1);
+        unsafe { *self.0.add(i) += v };
+    }
 }
 
 /// Assembles face terms. `density(f)` gives the face's energy density; `fixed` is per vertex.
@@ -175,69 +292,57 @@ where
     F: Fn(usize) -> KoiterDensity + Sync,
 {
     let nf = pattern.stencil.len();
-    if want != Want::Energy {
-        grad.fill(0.0);
+    if want == Want::Energy {
+        let es: Vec<Real> = (0..nf)
+            .into_par_iter()
+            .map(|f| {
+                let (xs, has) = gather(pattern, x, f);
+                shell_face(&xs, has, &density(f), None, None)
+            })
+            .collect();
+        return es.iter().sum();
     }
+    grad.fill(0.0);
     if want == Want::Hessian {
         values.fill(0.0);
     }
-    let mut total = 0.0;
-    let mut buf: Vec<Local> = Vec::new();
-    let mut start = 0;
-    while start < nf {
-        let end = (start + CHUNK).min(nf);
-        if want == Want::Energy {
-            let es: Vec<Real> = (start..end)
-                .into_par_iter()
-                .map(|f| {
-                    let (xs, has) = gather(pattern, x, f);
-                    shell_face(&xs, has, &density(f), None, None)
-                })
-                .collect();
-            total += es.iter().sum::<Real>();
-        } else {
-            (start..end)
-                .into_par_iter()
-                .map(|f| {
-                    let (xs, has) = gather(pattern, x, f);
-                    let d = density(f);
-                    let mut l = Local {
-                        e: 0.0,
-                        g: SVec::zeros(),
-                        h: SMat::zeros(),
-                    };
-                    l.e = shell_face(
-                        &xs,
-                        has,
-                        &d,
-                        Some(&mut l.g),
-                        (want == Want::Hessian).then_some(&mut l.h),
-                    );
+    let mut energies = vec![0.0; nf];
+    let (ep, gp) = (Shared::new(&mut energies), Shared::new(grad));
+    let vp = Shared::new(values);
+    for blocks in &pattern.colours {
+        blocks.par_iter().for_each(|block| {
+            for &f in block {
+                let (xs, has) = gather(pattern, x, f);
+                let d = density(f);
+                let mut g = SVec::<18>::zeros();
+                let mut h = SMat::<18, 18>::zeros();
+                let e = shell_face(
+                    &xs,
+                    has,
+                    &d,
+                    Some(&mut g),
+                    (want == Want::Hessian).then_some(&mut h),
+                );
+                // SAFETY: see `Shared`: faces of one colour touch disjoint entries.
+                unsafe {
+                    ep.add(f, e);
+                    for (s, &u) in pattern.stencil[f].iter().enumerate() {
+                        if u == NONE || fixed[u] {
+                            continue;
+                        }
+                        for c in 0..3 {
+                            gp.add(3 * u + c, g[3 * s + c]);
+                        }
+                    }
                     if want == Want::Hessian {
-                        project(&mut l.h, projection);
+                        project(&mut h, projection);
+                        pattern.scatter_hessian(f, &h, fixed, vp);
                     }
-                    l
-                })
-                .collect_into_vec(&mut buf);
-            for (k, l) in buf.iter().enumerate() {
-                let f = start + k;
-                total += l.e;
-                for (s, &u) in pattern.stencil[f].iter().enumerate() {
-                    if u == NONE || fixed[u] {
-                        continue;
-                    }
-                    for c in 0..3 {
-                        grad[3 * u + c] += l.g[3 * s + c];
-                    }
-                }
-                if want == Want::Hessian {
-                    pattern.scatter_hessian(f, &l.h, fixed, values);
                 }
             }
-        }
-        start = end;
+        });
     }
-    total
+    energies.iter().sum()
 }
 
 /// The face's 6 stencil positions (absent neighbours get the face's own first vertex, unused).

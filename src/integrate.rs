@@ -204,7 +204,7 @@ pub fn run(
     threads: usize,
 ) -> Result<Summary, RunError> {
     let pattern = Pattern::new(
-        scene.num_vertices(),
+        &scene.mesh.positions,
         &scene.mesh.faces,
         &scene.topo.opposite_vertex,
     );

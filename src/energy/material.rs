@@ -64,7 +64,7 @@ pub fn sv_matrix(abar: &Sym2, lame: Lame2d) -> Mat3 {
         Mat2::new(0.0, 1.0, 1.0, 0.0),
         Mat2::new(0.0, 0.0, 0.0, 1.0),
     ];
-    let ae: Vec<Mat2> = basis.iter().map(|e| ainv * e).collect();
+    let ae = basis.map(|e| ainv * e);
     let mut c = t * t.transpose() * (0.5 * lame.alpha);
     for p in 0..3 {
         for q in 0..3 {

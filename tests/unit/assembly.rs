@@ -10,12 +10,17 @@ use shellsim::settings::Settings;
 use shellsim::solve::Potential;
 
 fn scene(settings: &str, program: Option<Case>) -> Scene {
+    scene_with_edge(settings, program, 0.125)
+}
+
+/// With edge 0.02 the mesh has 5000 faces, about 20 blocks: enough to run blocks in parallel.
+fn scene_with_edge(settings: &str, program: Option<Case>, edge: f64) -> Scene {
     let mut m = rectangle(
         -0.5,
         -0.5,
         1.0,
         1.0,
-        0.125,
+        edge,
         Spacing {
             jitter: 0.2,
             seed: 4,
@@ -29,7 +34,7 @@ fn scene(settings: &str, program: Option<Case>) -> Scene {
 }
 
 fn pattern(sc: &Scene) -> Pattern {
-    Pattern::new(sc.num_vertices(), &sc.mesh.faces, &sc.topo.opposite_vertex)
+    Pattern::new(&sc.mesh.positions, &sc.mesh.faces, &sc.topo.opposite_vertex)
 }
 
 fn bumpy(sc: &Scene) -> Vec<Vec3> {
@@ -64,7 +69,11 @@ fn rest_state_has_zero_energy_and_gradient() {
 
 #[test]
 fn assembly_is_bitwise_identical_for_any_thread_count() {
-    let sc = scene("[rest]\ntarget = \"mesh\"\n", Some(Case::SphericalCap));
+    let sc = scene_with_edge(
+        "[rest]\ntarget = \"mesh\"\n",
+        Some(Case::SphericalCap),
+        0.02,
+    );
     let p = pattern(&sc);
     let x = bumpy(&sc);
     let eval = |threads: usize| {
@@ -157,4 +166,38 @@ fn assembled_derivatives_match_finite_differences() {
             );
         }
     }
+}
+
+#[test]
+fn colouring_separates_stencils() {
+    let sc = scene_with_edge("", None, 0.02);
+    let p = pattern(&sc);
+    let mut seen = vec![usize::MAX; sc.num_vertices()];
+    let mut total = 0;
+    for (c, blocks) in p.colours().iter().enumerate() {
+        for (b, block) in blocks.iter().enumerate() {
+            let tag = c * 100_000 + b;
+            for &f in block {
+                total += 1;
+                let mut st: Vec<usize> = p.stencil[f]
+                    .iter()
+                    .copied()
+                    .filter(|&v| v != usize::MAX)
+                    .collect();
+                st.sort_unstable();
+                st.dedup();
+                for v in st {
+                    // A vertex may appear in several faces of one block, never in two blocks of a colour.
+                    assert!(
+                        seen[v] == usize::MAX || seen[v] / 100_000 != c || seen[v] == tag,
+                        "colour {c}: vertex {v} shared by two blocks"
+                    );
+                    seen[v] = tag;
+                }
+            }
+        }
+    }
+    assert_eq!(total, sc.num_faces());
+    assert!(p.colours().iter().map(|c| c.len()).sum::<usize>() >= 16);
+    assert!(p.num_colours() < 16, "{} colours", p.num_colours());
 }

@@ -1,0 +1,215 @@
+//! Criterion benches: the shell kernel per face, assembly of ~100k faces on 1 and 2 threads,
+//! and one Newton iteration (assemble + numeric Cholesky + solve) on a ~5k-face mesh.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use shellsim::assembly::{Pattern, Want};
+use shellsim::cases::Case;
+use shellsim::energy::{material::sv_matrix, shell_face, KoiterDensity, Lame2d};
+use shellsim::math::{SMat, SVec, Sym2, Vec3};
+use shellsim::mesh::generate::{rectangle, Rng, Spacing};
+use shellsim::scene::Scene;
+use shellsim::settings::Settings;
+use shellsim::solve::{LinearSolver, Potential};
+use std::hint::black_box;
+
+fn patch() -> ([Vec3; 6], KoiterDensity) {
+    let mut rng = Rng::new(3);
+    let base = [
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.3, 0.9, 0.0),
+        Vec3::new(1.2, 1.0, 0.0),
+        Vec3::new(-0.6, 0.5, 0.0),
+        Vec3::new(0.5, -0.8, 0.0),
+    ];
+    let x = base.map(|p| p + Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * 0.2);
+    let abar = Sym2::new(1.1, 0.05, 0.9);
+    let (ws, wb) = KoiterDensity::weights(&abar, 0.01, 1.0);
+    let d = KoiterDensity {
+        c: sv_matrix(&abar, Lame2d::from_young_poisson(1e6, 0.3)),
+        stretch: [(ws, abar), (0.0, Sym2::zeros())],
+        bend: [(wb, Sym2::new(0.3, 0.0, -0.2)), (0.0, Sym2::zeros())],
+    };
+    (x, d)
+}
+
+fn kernel(c: &mut Criterion) {
+    let (x, d) = patch();
+    let mut g = c.benchmark_group("kernel");
+    g.throughput(Throughput::Elements(1));
+    g.bench_function("energy", |b| {
+        b.iter(|| shell_face(black_box(&x), [true; 3], &d, None, None))
+    });
+    g.bench_function("energy+gradient", |b| {
+        let mut gr = SVec::<18>::zeros();
+        b.iter(|| shell_face(black_box(&x), [true; 3], &d, Some(&mut gr), None))
+    });
+    g.bench_function("energy+gradient+hessian", |b| {
+        let mut gr = SVec::<18>::zeros();
+        let mut h = SMat::<18, 18>::zeros();
+        b.iter(|| shell_face(black_box(&x), [true; 3], &d, Some(&mut gr), Some(&mut h)))
+    });
+    g.finish();
+}
+
+fn scene(edge: f64) -> Scene {
+    let mut m = rectangle(
+        -0.5,
+        -0.5,
+        1.0,
+        1.0,
+        edge,
+        Spacing {
+            jitter: 0.2,
+            seed: 1,
+            ..Default::default()
+        },
+    );
+    Case::SphericalCap.program(&mut m);
+    let s = Settings::from_str_with(
+        "[material]\nthickness = 0.05\n[rest]\ntarget = \"mesh\"\n",
+        "bench",
+        &[],
+    )
+    .unwrap();
+    Scene::build(m, s).unwrap()
+}
+
+fn curved(sc: &Scene) -> Vec<Vec3> {
+    sc.mesh
+        .positions
+        .iter()
+        .map(|p| Vec3::new(p.x, p.y, (1.0 - p.x * p.x - p.y * p.y).sqrt()))
+        .collect()
+}
+
+fn assembly(c: &mut Criterion) {
+    // 224² cells × 2 ≈ 100k faces.
+    let sc = scene(1.0 / 224.0);
+    let p = Pattern::new(&sc.mesh.positions, &sc.mesh.faces, &sc.topo.opposite_vertex);
+    let x = curved(&sc);
+    let mut g = c.benchmark_group("assembly_100k");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(sc.num_faces() as u64));
+    for threads in [1usize, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        g.bench_with_input(BenchmarkId::new("energy", threads), &threads, |b, _| {
+            let pot = Potential {
+                scene: &sc,
+                pattern: &p,
+                dial: 1.0,
+                inertia: None,
+                damping: None,
+                gravity: Vec3::zeros(),
+            };
+            b.iter(|| pool.install(|| pot.eval(&x, Want::Energy, &mut [], &mut [])))
+        });
+        g.bench_with_input(BenchmarkId::new("gradient", threads), &threads, |b, _| {
+            let pot = Potential {
+                scene: &sc,
+                pattern: &p,
+                dial: 1.0,
+                inertia: None,
+                damping: None,
+                gravity: Vec3::zeros(),
+            };
+            let mut gr = vec![0.0; p.n];
+            b.iter(|| pool.install(|| pot.eval(&x, Want::Gradient, &mut gr, &mut [])))
+        });
+        g.bench_with_input(
+            BenchmarkId::new("kernels_only", threads),
+            &threads,
+            |b, _| {
+                use rayon::prelude::*;
+                let pot = Potential {
+                    scene: &sc,
+                    pattern: &p,
+                    dial: 1.0,
+                    inertia: None,
+                    damping: None,
+                    gravity: Vec3::zeros(),
+                };
+                b.iter(|| {
+                    pool.install(|| {
+                        (0..sc.num_faces())
+                            .into_par_iter()
+                            .map(|f| {
+                                let st = p.stencil[f];
+                                let has = [
+                                    st[3] != usize::MAX,
+                                    st[4] != usize::MAX,
+                                    st[5] != usize::MAX,
+                                ];
+                                let xs: [Vec3; 6] = std::array::from_fn(|s| {
+                                    if st[s] == usize::MAX {
+                                        x[st[0]]
+                                    } else {
+                                        x[st[s]]
+                                    }
+                                });
+                                let mut gr = SVec::<18>::zeros();
+                                let mut h = SMat::<18, 18>::zeros();
+                                shell_face(&xs, has, &pot.density(f), Some(&mut gr), Some(&mut h));
+                                h[(0, 0)] + gr[0]
+                            })
+                            .sum::<f64>()
+                    })
+                })
+            },
+        );
+        g.bench_with_input(BenchmarkId::new("hessian", threads), &threads, |b, _| {
+            let pot = Potential {
+                scene: &sc,
+                pattern: &p,
+                dial: 1.0,
+                inertia: None,
+                damping: None,
+                gravity: Vec3::zeros(),
+            };
+            let mut gr = vec![0.0; p.n];
+            let mut h = vec![0.0; p.nnz()];
+            b.iter(|| pool.install(|| pot.eval(&x, Want::Hessian, &mut gr, &mut h)))
+        });
+    }
+    g.finish();
+}
+
+fn newton_iteration(c: &mut Criterion) {
+    let mut g = c.benchmark_group("newton_iteration");
+    g.sample_size(10);
+    for edge in [1.0 / 50.0, 1.0 / 100.0] {
+        let sc = scene(edge);
+        let p = Pattern::new(&sc.mesh.positions, &sc.mesh.faces, &sc.topo.opposite_vertex);
+        let x = curved(&sc);
+        let mut lin = LinearSolver::new(&p).unwrap();
+        let pot = Potential {
+            scene: &sc,
+            pattern: &p,
+            dial: 1.0,
+            inertia: None,
+            damping: None,
+            gravity: Vec3::zeros(),
+        };
+        let mut gr = vec![0.0; p.n];
+        let mut h = vec![0.0; p.nnz()];
+        g.bench_function(BenchmarkId::new("faces", sc.num_faces()), |b| {
+            b.iter(|| {
+                pot.eval(&x, Want::Hessian, &mut gr, &mut h);
+                for i in 0..p.n {
+                    h[p.diag(i)] += 1e-6;
+                }
+                lin.factor(&h).unwrap();
+                let mut rhs = gr.clone();
+                lin.solve_in_place(&mut rhs);
+                black_box(rhs[0])
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, kernel, assembly, newton_iteration);
+criterion_main!(benches);
