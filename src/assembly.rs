@@ -11,7 +11,7 @@
 //! in face order.
 
 use crate::energy::projection::{project, HessianProjection};
-use crate::energy::shell::shell_face;
+use crate::energy::shell::{shell_face, shell_face_gauss_newton};
 use crate::energy::KoiterDensity;
 use crate::math::{Real, SMat, SVec, Vec3};
 use crate::mesh::topology::NONE;
@@ -316,13 +316,12 @@ where
                 let d = density(f);
                 let mut g = SVec::<18>::zeros();
                 let mut h = SMat::<18, 18>::zeros();
-                let e = shell_face(
-                    &xs,
-                    has,
-                    &d,
-                    Some(&mut g),
-                    (want == Want::Hessian).then_some(&mut h),
-                );
+                let hout = (want == Want::Hessian).then_some(&mut h);
+                let e = if projection == HessianProjection::GaussNewton {
+                    shell_face_gauss_newton(&xs, has, &d, Some(&mut g), hout)
+                } else {
+                    shell_face(&xs, has, &d, Some(&mut g), hout)
+                };
                 // SAFETY: see `Shared`: faces of one colour touch disjoint entries.
                 unsafe {
                     ep.add(f, e);

@@ -169,9 +169,9 @@ pub struct Solver {
     pub tolerance: Real,
     /// Newton iterations allowed per solve before the step is cut (default: `40`).
     pub max_newton_iterations: usize,
-    /// Per-element Hessian projection: `"adaptive"` (exact when it factorises, |λ|-projected
-    /// otherwise), `"none"` (exact + diagonal shift), `"clamp_zero"` or `"abs"` (always projected)
-    /// (default: `"adaptive"`).
+    /// Hessian used by Newton: `"adaptive"` (exact when it factorises, Gauss–Newton otherwise),
+    /// `"none"` (exact + growing diagonal shift), `"gauss_newton"` (always), or per-element
+    /// eigenvalue projection `"clamp_zero"` / `"abs"` (default: `"adaptive"`).
     pub hessian_projection: HessianProjection,
     /// Static mode: first continuation increment of the dial factor (dimensionless, (0, 1],
     /// default: `1.0`).

@@ -12,4 +12,4 @@ pub mod shell;
 
 pub use material::{FaceDensity, KoiterDensity, Lame2d, StretchConvention};
 pub use projection::HessianProjection;
-pub use shell::shell_face;
+pub use shell::{shell_face, shell_face_gauss_newton};

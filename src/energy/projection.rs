@@ -10,10 +10,12 @@ use crate::math::{Real, SMat};
 pub enum HessianProjection {
     /// Use the exact Hessian; indefiniteness is handled by the solver's diagonal shift.
     None,
-    /// Exact Hessian when it factorises, |λ|-projected element Hessians for iterations where it
-    /// does not (default: quadratic convergence near a minimum, robust far from one).
+    /// Exact Hessian when it factorises, the Gauss–Newton Hessian for iterations where it does
+    /// not (default: quadratic convergence near a minimum, robust far from one).
     #[default]
     Adaptive,
+    /// Always the Gauss–Newton Hessian (positive semi-definite by construction).
+    GaussNewton,
     /// Clamp negative eigenvalues to zero.
     ClampZero,
     /// Replace eigenvalues by their absolute values.
@@ -22,7 +24,7 @@ pub enum HessianProjection {
 
 /// Projects a symmetric `N×N` matrix in place: `H = V max(Λ, 0) Vᵀ` or `V |Λ| Vᵀ`.
 pub fn project<const N: usize>(h: &mut SMat<N, N>, mode: HessianProjection) {
-    if matches!(mode, HessianProjection::None | HessianProjection::Adaptive) {
+    if !matches!(mode, HessianProjection::ClampZero | HessianProjection::Abs) {
         return;
     }
     let dm = nalgebra::DMatrix::<Real>::from_column_slice(N, N, h.as_slice());

@@ -36,6 +36,31 @@ pub fn shell_face<D: FaceDensity>(
     grad: Option<&mut SVec<18>>,
     hess: Option<&mut SMat<18, 18>>,
 ) -> Real {
+    shell_face_impl::<D, false>(x, has, dens, grad, hess)
+}
+
+/// As [`shell_face`], but the Hessian is the Gauss–Newton part only,
+/// `Jaᵀ W_aa Ja + G (Bᵀ W_bb B) Gᵀ`, dropping the terms with second derivatives of `a` and `q`.
+/// For the Koiter density (`W_aa`, `W_bb` multiples of the positive semi-definite `C`) it is
+/// positive semi-definite by construction: a descent direction without an eigendecomposition.
+pub fn shell_face_gauss_newton<D: FaceDensity>(
+    x: &[Vec3; 6],
+    has: [bool; 3],
+    dens: &D,
+    grad: Option<&mut SVec<18>>,
+    hess: Option<&mut SMat<18, 18>>,
+) -> Real {
+    shell_face_impl::<D, true>(x, has, dens, grad, hess)
+}
+
+#[inline(always)]
+fn shell_face_impl<D: FaceDensity, const GN: bool>(
+    x: &[Vec3; 6],
+    has: [bool; 3],
+    dens: &D,
+    grad: Option<&mut SVec<18>>,
+    hess: Option<&mut SMat<18, 18>>,
+) -> Real {
     let xf = [x[0], x[1], x[2]];
     let a = first_fundamental_form(&xf);
     let bending = dens.uses_b();
@@ -57,7 +82,11 @@ pub fn shell_face<D: FaceDensity>(
                 [i, j, k],
                 &[xf[i], xf[j], xf[k]],
                 &x[3 + i],
-                if want_h { Some(&mut hq[i]) } else { None },
+                if want_h && !GN {
+                    Some(&mut hq[i])
+                } else {
+                    None
+                },
             );
             q[i] = eq.q;
             gq[i] = eq.grad;
@@ -92,11 +121,13 @@ pub fn shell_face<D: FaceDensity>(
         h.fill(0.0);
         let hm = ja.transpose() * d.haa * ja;
         h.fixed_view_mut::<9, 9>(0, 0).copy_from(&hm);
-        let pat = first_fundamental_form_hessian_pattern(&d.ga);
-        for r in 0..3 {
-            for s in 0..3 {
-                for c in 0..3 {
-                    h[(3 * r + c, 3 * s + c)] += pat[(r, s)];
+        if !GN {
+            let pat = first_fundamental_form_hessian_pattern(&d.ga);
+            for r in 0..3 {
+                for s in 0..3 {
+                    for c in 0..3 {
+                        h[(3 * r + c, 3 * s + c)] += pat[(r, s)];
+                    }
                 }
             }
         }
@@ -114,6 +145,9 @@ pub fn shell_face<D: FaceDensity>(
                 }
             }
             *h += gmat * hqq * gmat.transpose();
+            if GN {
+                return e_and_grad(e, g, grad);
+            }
             let mut lam_f = Vec3::zeros();
             for i in 0..3 {
                 if !has[i] || gqv[i] == 0.0 {
@@ -134,6 +168,11 @@ pub fn shell_face<D: FaceDensity>(
             dst += hn;
         }
     }
+    e_and_grad(e, g, grad)
+}
+
+#[inline(always)]
+fn e_and_grad(e: Real, g: SVec<18>, grad: Option<&mut SVec<18>>) -> Real {
     if let Some(gout) = grad {
         *gout = g;
     }

@@ -4,9 +4,10 @@
 //! τ = 0 first; on a non-positive pivot τ grows ×10 from 1e-8 until the factorisation succeeds,
 //! and the shift is recorded), solves for the step, and backtracks (Armijo, c = 1e-4, halving) on
 //! Φ. With the `adaptive` projection (default), an iteration whose exact Hessian is not positive
-//! definite is redone with |λ|-projected element Hessians (a descent direction that respects the
-//! curvature scale, where a global shift would degrade to gradient descent); the next iteration
-//! tries the exact Hessian again. Convergence: ‖∇Φ‖∞ ≤ tol · F over free DOFs, with F the scene's force scale. Non-finite
+//! definite (beyond the tiny shift that free rigid-body modes need) uses the Gauss–Newton Hessian
+//! instead: positive semi-definite by construction and of the right curvature scale, where a
+//! global shift would degrade to gradient descent. After a Gauss–Newton iteration, the exact
+//! Hessian is tried again once a full step is accepted (a sign of the quadratic region). Convergence: ‖∇Φ‖∞ ≤ tol · F over free DOFs, with F the scene's force scale. Non-finite
 //! energies are treated as a failed trial point, never accepted.
 
 use super::linear::LinearSolver;
@@ -140,11 +141,14 @@ pub fn newton(
     let mut rep = NewtonReport::default();
     let mut tau_prev: Real = 0.0;
     let mode = pot.scene.settings.solver.hessian_projection;
+    // Adaptive mode: whether this iteration tries the exact Hessian first.
+    let mut try_exact = true;
     loop {
-        let first = if mode == HessianProjection::Adaptive {
-            HessianProjection::None
-        } else {
-            mode
+        let mut projected = false;
+        let first = match mode {
+            HessianProjection::Adaptive if !try_exact => HessianProjection::GaussNewton,
+            HessianProjection::Adaptive => HessianProjection::None,
+            m => m,
         };
         let e = pot.eval_projected(x, Want::Hessian, first, &mut ws.grad, &mut ws.values);
         rep.energy = e;
@@ -169,32 +173,35 @@ pub fn newton(
             rep.reason = "non-finite Hessian".into();
             return rep;
         }
-        let mut tau0 = if tau_prev > 1e-8 { tau_prev * 0.1 } else { 0.0 };
+        let mut tau0 = if tau_prev > 1e-8 {
+            tau_prev * 0.1
+        } else {
+            tau_prev
+        };
         let mut factored = false;
         if mode == HessianProjection::Adaptive {
             // Exact Hessian, at most with the tiny shift that free rigid-body modes need; if it
-            // is genuinely indefinite, project the element Hessians instead.
-            match factor_with_shift_upto(
-                lin,
-                pot,
-                &ws.values,
-                &mut ws.shifted,
-                tau0.min(1e-8),
-                1e-8,
-            ) {
-                Some(t) if t <= 1e-8 => {
+            // is genuinely indefinite, use the Gauss–Newton Hessian instead.
+            let exact = if try_exact {
+                factor_with_shift_upto(lin, pot, &ws.values, &mut ws.shifted, tau0.min(1e-8), 1e-8)
+            } else {
+                None
+            };
+            match exact {
+                Some(t) => {
                     factored = true;
                     tau0 = t;
                 }
-                _ => {
+                None => {
                     pot.eval_projected(
                         x,
                         Want::Hessian,
-                        HessianProjection::Abs,
+                        HessianProjection::GaussNewton,
                         &mut ws.grad,
                         &mut ws.values,
                     );
                     rep.projected_iterations += 1;
+                    projected = true;
                     tau0 = 0.0;
                 }
             }
@@ -251,5 +258,8 @@ pub fn newton(
             return rep;
         }
         x.copy_from_slice(&ws.trial);
+        if mode == HessianProjection::Adaptive {
+            try_exact = !projected || alpha == 1.0;
+        }
     }
 }
