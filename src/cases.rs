@@ -31,17 +31,30 @@ pub enum Case {
     Rhombus,
     /// ā = I, b̄ = diag(1, 0): a cylinder of radius 1.
     Cylinder,
+    /// ā = λ_r² r̂r̂ᵀ + λ_θ² θ̂θ̂ᵀ with λ_r = 1, λ_θ = 0.8, b̄ = 0: a cone of half-angle
+    /// φ = asin(λ_θ/λ_r) = 53.13° (Modes, Bhattacharya & Warner 2011). Use it on an annulus: the
+    /// metric is singular at r = 0.
+    Cone,
 }
+
+/// Azimuthal stretch of [`Case::Cone`] (its radial stretch is 1).
+pub const CONE_LAMBDA_THETA: Real = 0.8;
 
 impl Case {
     /// All Table 1 cases.
-    pub const ALL: [Case; 5] = [
+    pub const ALL: [Case; 6] = [
         Case::EnlargedSquare,
         Case::SphericalCap,
         Case::Hyperboloid,
         Case::Rhombus,
         Case::Cylinder,
+        Case::Cone,
     ];
+
+    /// Whether the mirror image (z → −z) of the exact shape is equally exact (b̄ = 0).
+    pub fn mirror_symmetric(self) -> bool {
+        matches!(self, Case::EnlargedSquare | Case::Rhombus | Case::Cone)
+    }
 
     /// Name used on the command line.
     pub fn name(self) -> &'static str {
@@ -51,6 +64,7 @@ impl Case {
             Case::Hyperboloid => "hyperboloid",
             Case::Rhombus => "rhombus",
             Case::Cylinder => "cylinder",
+            Case::Cone => "cone",
         }
     }
 
@@ -74,6 +88,16 @@ impl Case {
             ),
             Case::Rhombus => (Sym2::new(2.0, 1.0, 2.0), Sym2::zeros()),
             Case::Cylinder => (Sym2::new(1.0, 0.0, 1.0), Sym2::new(1.0, 0.0, 0.0)),
+            Case::Cone => {
+                let r = (x * x + y * y).sqrt().max(1e-300);
+                let (c, s) = (x / r, y / r);
+                let l2 = CONE_LAMBDA_THETA * CONE_LAMBDA_THETA;
+                // r̂r̂ᵀ + λ_θ² θ̂θ̂ᵀ, θ̂ = (−s, c).
+                (
+                    Sym2::new(c * c + l2 * s * s, c * s * (1.0 - l2), s * s + l2 * c * c),
+                    Sym2::zeros(),
+                )
+            }
         }
     }
 
@@ -89,6 +113,13 @@ impl Case {
                 Vec3::new(p.x, p.y, 0.0)
             }
             Case::Cylinder => Vec3::new(x.sin(), y, x.cos() - 1.0),
+            Case::Cone => {
+                // Distance from the apex along a generator is r (λ_r = 1); the circle of radius
+                // r has radius λ_θ r, so sin φ = λ_θ and the height is r cos φ.
+                let r = (x * x + y * y).sqrt();
+                let cos_phi = (1.0 - CONE_LAMBDA_THETA * CONE_LAMBDA_THETA).sqrt();
+                Vec3::new(CONE_LAMBDA_THETA * x, CONE_LAMBDA_THETA * y, -r * cos_phi)
+            }
         }
     }
 
@@ -207,6 +238,30 @@ pub fn align(p: &[Vec3], q: &[Vec3]) -> Vec<Vec3> {
 /// Material-point error of `x` (simulated positions of the reference vertices `reference`)
 /// against the exact shape of `case`.
 pub fn shape_error(case: Case, reference: &[Vec3], x: &[Vec3]) -> ShapeError {
+    let e = shape_error_against(case, reference, x, false);
+    if case.mirror_symmetric() {
+        let m = shape_error_against(case, reference, x, true);
+        if m.max < e.max {
+            return m;
+        }
+    }
+    e
+}
+
+fn mirrored(x: &[Vec3], mirror: bool) -> Vec<Vec3> {
+    x.iter()
+        .map(|p| {
+            if mirror {
+                Vec3::new(p.x, p.y, -p.z)
+            } else {
+                *p
+            }
+        })
+        .collect()
+}
+
+fn shape_error_against(case: Case, reference: &[Vec3], x: &[Vec3], mirror: bool) -> ShapeError {
+    let x = &mirrored(x, mirror)[..];
     let exact: Vec<Vec3> = reference.iter().map(|p| case.exact(p.x, p.y)).collect();
     let aligned = align(x, &exact);
     let mut max: Real = 0.0;
@@ -340,6 +395,15 @@ fn distance_to_exact(
 /// face's neighbours. It includes the chord error of flat triangles on a curved surface, so it
 /// can exceed the vertex material-point error slightly, and is usually below it.
 pub fn hausdorff(case: Case, mesh: &Mesh, topo: &crate::mesh::Topology, x: &[Vec3]) -> Real {
+    let d = hausdorff_against(case, mesh, topo, &mirrored(x, false));
+    if case.mirror_symmetric() {
+        // A reflection reverses orientation: compare the mirrored shape.
+        return d.min(hausdorff_against(case, mesh, topo, &mirrored(x, true)));
+    }
+    d
+}
+
+fn hausdorff_against(case: Case, mesh: &Mesh, topo: &crate::mesh::Topology, x: &[Vec3]) -> Real {
     let reference = &mesh.positions;
     let exact: Vec<Vec3> = reference.iter().map(|p| case.exact(p.x, p.y)).collect();
     let y = align(x, &exact);
