@@ -104,6 +104,8 @@ struct Solver<'a> {
     start: Instant,
     iters_since_frame: usize,
     steps_since_frame: usize,
+    /// Summary counters at the previous frame (shifted, Gauss–Newton, rejected).
+    at_last_frame: (usize, usize, usize),
 }
 
 impl<'a> Solver<'a> {
@@ -132,6 +134,7 @@ impl<'a> Solver<'a> {
             start: Instant::now(),
             iters_since_frame: 0,
             steps_since_frame: 0,
+            at_last_frame: (0, 0, 0),
         })
     }
 
@@ -149,7 +152,7 @@ impl<'a> Solver<'a> {
     fn record(&mut self, rep: &NewtonReport) {
         self.summary.newton_iterations += rep.iterations;
         self.summary.shifted_iterations += rep.shifted_iterations;
-        self.summary.projected_iterations += rep.projected_iterations;
+        self.summary.gauss_newton_iterations += rep.projected_iterations;
         self.iters_since_frame += rep.iterations;
         self.summary.residual = rep.residual;
     }
@@ -170,8 +173,16 @@ impl<'a> Solver<'a> {
             residual: self.summary.residual,
             newton_iterations: self.iters_since_frame,
             steps: self.steps_since_frame,
+            shifted_iterations: self.summary.shifted_iterations - self.at_last_frame.0,
+            gauss_newton_iterations: self.summary.gauss_newton_iterations - self.at_last_frame.1,
+            rejected_steps: self.summary.rejected_steps - self.at_last_frame.2,
             wall_seconds: self.start.elapsed().as_secs_f64(),
         };
+        self.at_last_frame = (
+            self.summary.shifted_iterations,
+            self.summary.gauss_newton_iterations,
+            self.summary.rejected_steps,
+        );
         writer.frame(pot, x, v, row)?;
         self.iters_since_frame = 0;
         self.steps_since_frame = 0;
@@ -405,11 +416,7 @@ fn run_dynamic(
             &mut trial,
             NewtonOptions { tol, max_iter },
         );
-        s.summary.newton_iterations += rep.iterations;
-        s.summary.shifted_iterations += rep.shifted_iterations;
-        s.summary.projected_iterations += rep.projected_iterations;
-        s.iters_since_frame += rep.iterations;
-        s.summary.residual = rep.residual;
+        s.record(&rep);
         if !rep.converged {
             s.summary.rejected_steps += 1;
             dt = h * 0.5;

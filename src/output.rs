@@ -78,6 +78,12 @@ pub struct LogRow {
     pub newton_iterations: usize,
     /// Steps (time steps or continuation steps) since the previous frame.
     pub steps: usize,
+    /// Newton iterations since the previous frame that needed a diagonal shift.
+    pub shifted_iterations: usize,
+    /// Newton iterations since the previous frame that fell back to the Gauss–Newton Hessian.
+    pub gauss_newton_iterations: usize,
+    /// Steps rejected (and cut) since the previous frame.
+    pub rejected_steps: usize,
     /// Wall time since the start (s).
     pub wall_seconds: Real,
 }
@@ -106,8 +112,8 @@ pub struct Summary {
     pub newton_iterations: usize,
     /// Newton iterations that needed a diagonal shift.
     pub shifted_iterations: usize,
-    /// Newton iterations that used projected element Hessians.
-    pub projected_iterations: usize,
+    /// Newton iterations that fell back to the Gauss–Newton Hessian.
+    pub gauss_newton_iterations: usize,
     /// Saddle points detected and escaped by perturbation.
     pub saddle_escapes: usize,
     /// Vertices.
@@ -362,12 +368,13 @@ impl Writer {
     fn write_log(&self) -> Result<(), OutputError> {
         let mut s = String::from(
             "frame,time,dial,energy_total,energy_stretching,energy_bending,energy_gravity,\
-             energy_kinetic,residual,newton_iterations,steps,wall_seconds\n",
+             energy_kinetic,residual,newton_iterations,steps,shifted_iterations,\
+             gauss_newton_iterations,rejected_steps,wall_seconds\n",
         );
         for r in &self.log {
             let e = &r.energy;
             s.push_str(&format!(
-                "{},{:.12e},{:.6},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{},{},{:.6}\n",
+                "{},{:.12e},{:.6},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{},{},{},{},{},{:.6}\n",
                 r.frame,
                 r.time,
                 r.dial,
@@ -379,6 +386,9 @@ impl Writer {
                 r.residual,
                 r.newton_iterations,
                 r.steps,
+                r.shifted_iterations,
+                r.gauss_newton_iterations,
+                r.rejected_steps,
                 r.wall_seconds
             ));
         }

@@ -40,7 +40,7 @@ pub struct NewtonReport {
     pub max_shift: Real,
     /// Iterations that needed a shift.
     pub shifted_iterations: usize,
-    /// Iterations that used projected element Hessians (adaptive mode).
+    /// Iterations that fell back to the Gauss–Newton Hessian (adaptive mode).
     pub projected_iterations: usize,
     /// Total step halvings in line searches.
     pub line_search_cuts: usize,
