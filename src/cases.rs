@@ -123,8 +123,17 @@ impl Case {
         }
     }
 
-    /// Exact mean and Gauss curvature at (x, y) (normal-side convention).
+    /// Exact mean and Gauss curvature at (x, y) of the exact shape (normal-side convention).
     pub fn exact_curvatures(self, x: Real, y: Real) -> (Real, Real) {
+        if self == Case::Cone {
+            // The parallel through (x, y) has radius ρ = r sin φ; its normal curvature is
+            // cos φ / ρ (the other principal curvature is 0). The exact map opens toward +z,
+            // away from where the normal side bulges: negative.
+            let r = (x * x + y * y).sqrt();
+            let sin_phi = CONE_LAMBDA_THETA;
+            let cos_phi = (1.0 - sin_phi * sin_phi).sqrt();
+            return (-0.5 * cos_phi / (r * sin_phi), 0.0);
+        }
         let (a, b) = self.forms(x, y);
         let s = sym_to_mat(&a).try_inverse().unwrap_or_else(Mat2::zeros) * sym_to_mat(&b);
         (0.5 * s.trace(), s.determinant())
@@ -303,6 +312,24 @@ pub fn curvature_error(
     topo: &crate::mesh::Topology,
     x: &[Vec3],
 ) -> (Real, Real) {
+    let e = curvature_error_signed(case, mesh, topo, x, 1.0);
+    if case.mirror_symmetric() {
+        // The mirror image has the opposite mean curvature.
+        let m = curvature_error_signed(case, mesh, topo, x, -1.0);
+        if m.0 < e.0 {
+            return m;
+        }
+    }
+    e
+}
+
+fn curvature_error_signed(
+    case: Case,
+    mesh: &Mesh,
+    topo: &crate::mesh::Topology,
+    x: &[Vec3],
+    sign: Real,
+) -> (Real, Real) {
     let (a, b) = crate::rest::mesh_forms(x, mesh, topo);
     let mut eh = 0.0;
     let mut ek = 0.0;
@@ -311,7 +338,7 @@ pub fn curvature_error(
         let c = (p + q + r) / 3.0;
         let (h, k, _, _) = crate::geometry::curvatures(&a[f], &b[f]);
         let (he, ke) = case.exact_curvatures(c.x, c.y);
-        eh += (h - he).powi(2);
+        eh += (h - sign * he).powi(2);
         ek += (k - ke).powi(2);
     }
     let n = mesh.faces.len() as Real;
