@@ -404,3 +404,22 @@ fn mesh_generator_and_error_command() {
     let r = run(&["error", "cylinder", "nothere.vtu"], p);
     assert_eq!(r.code, 2);
 }
+
+#[test]
+fn unused_vertices_warn_and_are_held_fixed() {
+    let d = tmp();
+    let p = d.path();
+    let text = TWO_TRIANGLES
+        .replace("POINTS 4 double\n", "POINTS 5 double\n")
+        .replace("0 1 0\nCELLS", "0 1 0\n5 5 5\nCELLS")
+        .replace("POINT_DATA 4\nFIELD FieldData 2\nconstraint_indicators 1 4 int\n0 0 0 0\nnode_tags 1 4 int\n0 0 1 1\n", "");
+    write(p, "m.vtk", &text);
+    write(p, "s.toml", STATIC);
+    let r = run(&["s.toml", "m.vtk", "--out", "o"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("warning") && r.stderr.contains("used by no face"),
+        "{}",
+        r.stderr
+    );
+}

@@ -172,14 +172,18 @@ impl Mesh {
         Ok((0..nv).filter(|&i| !used[i]).collect())
     }
 
-    /// True when all vertices lie in a plane `z = const` (the reference frame for fields given in
-    /// reference Cartesian coordinates).
+    /// True when the vertices of all faces lie in a plane `z = const` (the reference frame for
+    /// fields given in reference Cartesian coordinates). Vertices used by no face do not count.
     pub fn is_flat_xy(&self) -> bool {
-        let z0 = self.positions[0].z;
+        let Some(first) = self.faces.first() else {
+            return true;
+        };
+        let z0 = self.positions[first[0]].z;
         let scale = self.bbox_diagonal().max(Real::MIN_POSITIVE);
-        self.positions
+        self.faces
             .iter()
-            .all(|p| (p.z - z0).abs() <= 1e-12 * scale)
+            .flatten()
+            .all(|&v| (self.positions[v].z - z0).abs() <= 1e-12 * scale)
     }
 
     /// Length of the diagonal of the axis-aligned bounding box.
