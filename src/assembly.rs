@@ -302,9 +302,9 @@ where
             .collect();
         return es.iter().sum();
     }
-    grad.fill(0.0);
+    grad.par_chunks_mut(1 << 14).for_each(|c| c.fill(0.0));
     if want == Want::Hessian {
-        values.fill(0.0);
+        values.par_chunks_mut(1 << 14).for_each(|c| c.fill(0.0));
     }
     let mut energies = vec![0.0; nf];
     let (ep, gp) = (Shared::new(&mut energies), Shared::new(grad));
