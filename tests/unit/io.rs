@@ -118,3 +118,17 @@ fn generated_meshes_are_valid_and_oriented() {
         }
     }
 }
+
+#[test]
+fn raw_appended_xml_gets_a_clear_message() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path().join("paraview.vtu");
+    std::fs::write(
+        &p,
+        "<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=\"3\" NumberOfCells=\"1\">\
+         </Piece></UnstructuredGrid><AppendedData encoding=\"raw\">_</AppendedData></VTKFile>",
+    )
+    .unwrap();
+    let e = read_mesh(&p).unwrap_err().to_string();
+    assert!(e.contains("paraview.vtu") && e.contains("appended"), "{e}");
+}
