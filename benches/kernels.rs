@@ -83,6 +83,17 @@ fn curved(sc: &Scene) -> Vec<Vec3> {
         .collect()
 }
 
+fn potential<'a>(sc: &'a Scene, p: &'a Pattern) -> Potential<'a> {
+    Potential {
+        scene: sc,
+        pattern: p,
+        dial: 1.0,
+        inertia: None,
+        damping: None,
+        gravity: Vec3::zeros(),
+    }
+}
+
 fn assembly(c: &mut Criterion) {
     // 224² cells × 2 ≈ 100k faces.
     let sc = scene(1.0 / 224.0);
@@ -97,25 +108,11 @@ fn assembly(c: &mut Criterion) {
             .build()
             .unwrap();
         g.bench_with_input(BenchmarkId::new("energy", threads), &threads, |b, _| {
-            let pot = Potential {
-                scene: &sc,
-                pattern: &p,
-                dial: 1.0,
-                inertia: None,
-                damping: None,
-                gravity: Vec3::zeros(),
-            };
+            let pot = potential(&sc, &p);
             b.iter(|| pool.install(|| pot.eval(&x, Want::Energy, &mut [], &mut [])))
         });
         g.bench_with_input(BenchmarkId::new("gradient", threads), &threads, |b, _| {
-            let pot = Potential {
-                scene: &sc,
-                pattern: &p,
-                dial: 1.0,
-                inertia: None,
-                damping: None,
-                gravity: Vec3::zeros(),
-            };
+            let pot = potential(&sc, &p);
             let mut gr = vec![0.0; p.n];
             b.iter(|| pool.install(|| pot.eval(&x, Want::Gradient, &mut gr, &mut [])))
         });
@@ -124,14 +121,7 @@ fn assembly(c: &mut Criterion) {
             &threads,
             |b, _| {
                 use rayon::prelude::*;
-                let pot = Potential {
-                    scene: &sc,
-                    pattern: &p,
-                    dial: 1.0,
-                    inertia: None,
-                    damping: None,
-                    gravity: Vec3::zeros(),
-                };
+                let pot = potential(&sc, &p);
                 b.iter(|| {
                     pool.install(|| {
                         (0..sc.num_faces())
@@ -161,14 +151,7 @@ fn assembly(c: &mut Criterion) {
             },
         );
         g.bench_with_input(BenchmarkId::new("hessian", threads), &threads, |b, _| {
-            let pot = Potential {
-                scene: &sc,
-                pattern: &p,
-                dial: 1.0,
-                inertia: None,
-                damping: None,
-                gravity: Vec3::zeros(),
-            };
+            let pot = potential(&sc, &p);
             let mut gr = vec![0.0; p.n];
             let mut h = vec![0.0; p.nnz()];
             b.iter(|| pool.install(|| pot.eval(&x, Want::Hessian, &mut gr, &mut h)))
@@ -185,14 +168,7 @@ fn newton_iteration(c: &mut Criterion) {
         let p = Pattern::new(&sc.mesh.positions, &sc.mesh.faces, &sc.topo.opposite_vertex);
         let x = curved(&sc);
         let mut lin = LinearSolver::new(&p).unwrap();
-        let pot = Potential {
-            scene: &sc,
-            pattern: &p,
-            dial: 1.0,
-            inertia: None,
-            damping: None,
-            gravity: Vec3::zeros(),
-        };
+        let pot = potential(&sc, &p);
         let mut gr = vec![0.0; p.n];
         let mut h = vec![0.0; p.nnz()];
         g.bench_function(BenchmarkId::new("faces", sc.num_faces()), |b| {

@@ -209,23 +209,26 @@ impl Mesh {
 
     /// Looks up a face field and checks its component count.
     pub fn face_field(&self, name: &str, components: usize) -> Result<Option<&Field>, MeshError> {
-        match self.face_fields.get(name) {
-            None => Ok(None),
-            Some(f) if f.components == components => Ok(Some(f)),
-            Some(f) => Err(self.invalid(format!(
-                "face field '{name}' has {} components, expected {components}",
-                f.components
-            ))),
-        }
+        self.lookup(&self.face_fields, "face", name, components)
     }
 
     /// Looks up a vertex field and checks its component count.
     pub fn vertex_field(&self, name: &str, components: usize) -> Result<Option<&Field>, MeshError> {
-        match self.vertex_fields.get(name) {
+        self.lookup(&self.vertex_fields, "vertex", name, components)
+    }
+
+    fn lookup<'m>(
+        &self,
+        fields: &'m BTreeMap<String, Field>,
+        what: &str,
+        name: &str,
+        components: usize,
+    ) -> Result<Option<&'m Field>, MeshError> {
+        match fields.get(name) {
             None => Ok(None),
             Some(f) if f.components == components => Ok(Some(f)),
             Some(f) => Err(self.invalid(format!(
-                "vertex field '{name}' has {} components, expected {components}",
+                "{what} field '{name}' has {} components, expected {components}",
                 f.components
             ))),
         }
