@@ -153,6 +153,15 @@ impl Scene {
             }
         }
 
+        let free = unused.len() < nv && fixed.iter().all(|&f| !f);
+        let gravity = settings.loads.gravity.iter().any(|&g| g != 0.0);
+        if free && gravity && settings.solver.mode == crate::settings::Mode::Static {
+            return Err(mesh.invalid(
+                "static mode under gravity (loads.gravity) needs fixed vertices: a free sheet has no \
+                 equilibrium. Fix some (constraint_indicators, constraints.fix_tags or \
+                 constraints.fix_boxes) or use solver.mode = \"dynamic\"",
+            ));
+        }
         let mean_edge = mesh.mean_edge_length();
         let eh = young
             .iter()

@@ -291,3 +291,42 @@ fn free_fall_follows_implicit_euler_exactly() {
         assert!(disp.get(i)[0].abs() < 1e-12 && disp.get(i)[1].abs() < 1e-12);
     }
 }
+
+/// Dynamics with damping settles: with `stop_at_equilibrium` the run ends before `time.end`,
+/// at dial 1, with a residual below tolerance and negligible kinetic energy.
+#[test]
+fn damped_dynamics_stops_at_equilibrium() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    shellsim(
+        &[
+            root.join("settings/dynamic_cylinder.toml")
+                .to_str()
+                .unwrap(),
+            root.join("meshes/strip.vtk").to_str().unwrap(),
+            "--out",
+            "o",
+            "-q",
+            "--set",
+            "time.end=20",
+            "--set",
+            "time.stop_at_equilibrium=true",
+            "--set",
+            "time.damping=0.05",
+        ],
+        dir,
+    );
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("o/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(s["converged"], true);
+    let t = s["time"].as_f64().unwrap();
+    assert!(t > 0.5 && t < 20.0, "stopped at {t}");
+    assert_eq!(s["dial"], 1.0);
+    let e = &s["energy"];
+    assert!(
+        e["kinetic"].as_f64().unwrap()
+            < 1e-9 * e["bending"].as_f64().unwrap().abs().max(1e-30) * 1e3
+    );
+}

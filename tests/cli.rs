@@ -423,3 +423,12 @@ fn unused_vertices_warn_and_are_held_fixed() {
         r.stderr
     );
 }
+
+#[test]
+fn static_gravity_without_supports_is_bad_input() {
+    let d = tmp();
+    let p = d.path();
+    write(p, "m.vtk", TWO_TRIANGLES);
+    write(p, "s.toml", "[loads]\ngravity = [0, 0, -9.81]\n");
+    expect_bad(&["s.toml", "m.vtk"], p, "fixed vertices");
+}
