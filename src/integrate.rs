@@ -102,10 +102,31 @@ struct Solver<'a> {
     gravity: Vec3,
     summary: Summary,
     start: Instant,
-    iters_since_frame: usize,
-    steps_since_frame: usize,
-    /// Summary counters at the previous frame (shifted, Gauss–Newton, rejected).
-    at_last_frame: (usize, usize, usize),
+    /// The summary's counters when the previous frame was written; log rows report the
+    /// differences.
+    at_last_frame: Counters,
+}
+
+/// Counters that log rows report per frame.
+#[derive(Clone, Copy, Default)]
+struct Counters {
+    newton: usize,
+    steps: usize,
+    shifted: usize,
+    gauss_newton: usize,
+    rejected: usize,
+}
+
+impl Counters {
+    fn of(s: &Summary) -> Self {
+        Counters {
+            newton: s.newton_iterations,
+            steps: s.steps,
+            shifted: s.shifted_iterations,
+            gauss_newton: s.gauss_newton_iterations,
+            rejected: s.rejected_steps,
+        }
+    }
 }
 
 impl<'a> Solver<'a> {
@@ -132,9 +153,7 @@ impl<'a> Solver<'a> {
             gravity: Vec3::from(scene.settings.loads.gravity),
             summary,
             start: Instant::now(),
-            iters_since_frame: 0,
-            steps_since_frame: 0,
-            at_last_frame: (0, 0, 0),
+            at_last_frame: Counters::default(),
         })
     }
 
@@ -152,8 +171,7 @@ impl<'a> Solver<'a> {
     fn record(&mut self, rep: &NewtonReport) {
         self.summary.newton_iterations += rep.iterations;
         self.summary.shifted_iterations += rep.shifted_iterations;
-        self.summary.gauss_newton_iterations += rep.projected_iterations;
-        self.iters_since_frame += rep.iterations;
+        self.summary.gauss_newton_iterations += rep.gauss_newton_iterations;
         self.summary.residual = rep.residual;
     }
 
@@ -165,27 +183,22 @@ impl<'a> Solver<'a> {
         v: &[Vec3],
         time: Real,
     ) -> Result<(), RunError> {
+        let (now, last) = (Counters::of(&self.summary), self.at_last_frame);
         let row = LogRow {
             frame: 0,
             time,
             dial: pot.dial,
             energy: Default::default(),
             residual: self.summary.residual,
-            newton_iterations: self.iters_since_frame,
-            steps: self.steps_since_frame,
-            shifted_iterations: self.summary.shifted_iterations - self.at_last_frame.0,
-            gauss_newton_iterations: self.summary.gauss_newton_iterations - self.at_last_frame.1,
-            rejected_steps: self.summary.rejected_steps - self.at_last_frame.2,
+            newton_iterations: now.newton - last.newton,
+            steps: now.steps - last.steps,
+            shifted_iterations: now.shifted - last.shifted,
+            gauss_newton_iterations: now.gauss_newton - last.gauss_newton,
+            rejected_steps: now.rejected - last.rejected,
             wall_seconds: self.start.elapsed().as_secs_f64(),
         };
-        self.at_last_frame = (
-            self.summary.shifted_iterations,
-            self.summary.gauss_newton_iterations,
-            self.summary.rejected_steps,
-        );
+        self.at_last_frame = now;
         writer.frame(pot, x, v, row)?;
-        self.iters_since_frame = 0;
-        self.steps_since_frame = 0;
         Ok(())
     }
 
@@ -283,7 +296,6 @@ fn run_static(
             x.copy_from_slice(&trial);
             dial = target;
             s.summary.steps += 1;
-            s.steps_since_frame += 1;
             if rep.iterations <= 5 {
                 step = (step * 2.0).min(1.0);
             }
@@ -436,7 +448,6 @@ fn run_dynamic(
         x.copy_from_slice(&trial);
         t += h;
         s.summary.steps += 1;
-        s.steps_since_frame += 1;
         if damping {
             let (a, b) = mesh_forms(&x, &sc.mesh, &sc.topo);
             a_prev = a;

@@ -41,7 +41,7 @@ pub struct NewtonReport {
     /// Iterations that needed a shift.
     pub shifted_iterations: usize,
     /// Iterations that fell back to the Gauss–Newton Hessian (adaptive mode).
-    pub projected_iterations: usize,
+    pub gauss_newton_iterations: usize,
     /// Total step halvings in line searches.
     pub line_search_cuts: usize,
     /// Why it stopped, when it did not converge.
@@ -200,7 +200,7 @@ pub fn newton(
                         &mut ws.grad,
                         &mut ws.values,
                     );
-                    rep.projected_iterations += 1;
+                    rep.gauss_newton_iterations += 1;
                     projected = true;
                     tau0 = 0.0;
                 }
