@@ -328,4 +328,20 @@ fn damped_dynamics_stops_at_equilibrium() {
     let e = &s["energy"];
     let elastic = e["stretching"].as_f64().unwrap() + e["bending"].as_f64().unwrap();
     assert!(e["kinetic"].as_f64().unwrap() <= 1e-9 * elastic, "{e}");
+    // The per-frame counters of log.csv add up to the summary's totals.
+    let log = std::fs::read_to_string(dir.join("o/log.csv")).unwrap();
+    let header: Vec<&str> = log.lines().next().unwrap().split(',').collect();
+    for (col, key) in [
+        ("newton_iterations", "newton_iterations"),
+        ("steps", "steps"),
+        ("rejected_steps", "rejected_steps"),
+    ] {
+        let k = header.iter().position(|h| *h == col).unwrap();
+        let sum: u64 = log
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(k).unwrap().parse::<u64>().unwrap())
+            .sum();
+        assert_eq!(sum, s[key].as_u64().unwrap(), "{col}");
+    }
 }

@@ -193,13 +193,17 @@ pub fn newton(
                     tau0 = t;
                 }
                 None => {
-                    pot.eval_projected(
-                        x,
-                        Want::Hessian,
-                        HessianProjection::GaussNewton,
-                        &mut ws.grad,
-                        &mut ws.values,
-                    );
+                    if try_exact {
+                        // The assembled exact Hessian is indefinite; `first` was already
+                        // Gauss–Newton otherwise.
+                        pot.eval_projected(
+                            x,
+                            Want::Hessian,
+                            HessianProjection::GaussNewton,
+                            &mut ws.grad,
+                            &mut ws.values,
+                        );
+                    }
                     rep.gauss_newton_iterations += 1;
                     projected = true;
                     tau0 = 0.0;
