@@ -152,6 +152,19 @@ fn ioerr(path: &Path, e: impl ToString) -> OutputError {
     }
 }
 
+/// Elastic (stretching, bending) energy of each face at forms `a`, `b` (J), without damping.
+fn face_energies(pot: &Potential, a: &[Sym2], b: &[Sym2]) -> Vec<(Real, Real)> {
+    (0..a.len())
+        .map(|f| {
+            let d = pot.density(f);
+            let (ws, ta) = d.stretch[0];
+            let (wb, tb) = d.bend[0];
+            let (da, db) = (a[f] - ta, b[f] - tb);
+            (ws * da.dot(&(d.c * da)), wb * db.dot(&(d.c * db)))
+        })
+        .collect()
+}
+
 /// Per-face frames mapping barycentric to reference Cartesian coordinates (see module doc).
 fn output_frames(mesh: &Mesh) -> Vec<Mat2> {
     let flat = mesh.is_flat_xy();
@@ -217,15 +230,16 @@ impl Writer {
     pub fn energies(pot: &Potential, x: &[Vec3], v: &[Vec3]) -> Energies {
         let sc = pot.scene;
         let (a, b) = mesh_forms(x, &sc.mesh, &sc.topo);
+        Self::energies_of(pot, x, v, &face_energies(pot, &a, &b))
+    }
+
+    /// Totals from per-face (stretching, bending) energies, plus gravity and kinetic energy.
+    fn energies_of(pot: &Potential, x: &[Vec3], v: &[Vec3], faces: &[(Real, Real)]) -> Energies {
+        let sc = pot.scene;
         let mut en = Energies::default();
-        for f in 0..sc.num_faces() {
-            let d = pot.density(f);
-            let (ws, ta) = d.stretch[0];
-            let (wb, tb) = d.bend[0];
-            let da = a[f] - ta;
-            let db = b[f] - tb;
-            en.stretching += ws * da.dot(&(d.c * da));
-            en.bending += wb * db.dot(&(d.c * db));
+        for (s, b) in faces {
+            en.stretching += s;
+            en.bending += b;
         }
         for (i, xv) in x.iter().enumerate() {
             en.gravity -= sc.mass[i] * pot.gravity.dot(xv);
@@ -246,9 +260,10 @@ impl Writer {
         let sc = pot.scene;
         let index = self.frames.len();
         row.frame = index;
-        row.energy = Self::energies(pot, x, v);
         let nf = sc.num_faces();
         let (a, b) = mesh_forms(x, &sc.mesh, &sc.topo);
+        let fe = face_energies(pot, &a, &b);
+        row.energy = Self::energies_of(pot, x, v, &fe);
         let mut fa = Vec::with_capacity(3 * nf);
         let mut fb = Vec::with_capacity(3 * nf);
         let mut fab = Vec::with_capacity(3 * nf);
@@ -278,9 +293,8 @@ impl Writer {
             k1s.push(k1);
             k2s.push(k2);
             let area = 0.5 * crate::math::sym_det(&abar).max(0.0).sqrt();
-            let (da, db) = (a[f] - abar, b[f] - bbar);
-            es.push(d.stretch[0].0 * da.dot(&(d.c * da)) / area);
-            eb.push(d.bend[0].0 * db.dot(&(d.c * db)) / area);
+            es.push(fe[f].0 / area);
+            eb.push(fe[f].1 / area);
         }
         let m = &mut self.frame_mesh;
         m.positions.copy_from_slice(x);
