@@ -1,4 +1,37 @@
 //! shellsim: a thin-shell simulator for shells whose rest shape changes.
+//!
+//! The binary (`shellsim SETTINGS MESH`) is a thin layer over this library; see the README and
+//! `docs/ARCHITECTURE.md` for the data flow. A scene can also be built and evaluated directly:
+//!
+//! ```
+//! use shellsim::assembly::{Pattern, Want};
+//! use shellsim::cases::Case;
+//! use shellsim::math::Vec3;
+//! use shellsim::mesh::generate::{rectangle, Spacing};
+//! use shellsim::scene::Scene;
+//! use shellsim::settings::Settings;
+//! use shellsim::solve::Potential;
+//!
+//! // A unit square programmed with the cylinder of seed 000's Table 1.
+//! let mut mesh = rectangle(-0.5, -0.5, 1.0, 1.0, 0.25, Spacing::default());
+//! Case::Cylinder.program(&mut mesh);
+//! let settings = Settings::from_str_with("[rest]\ntarget = \"mesh\"\n", "example", &[]).unwrap();
+//! let scene = Scene::build(mesh, settings).unwrap();
+//! let pattern = Pattern::new(&scene.mesh.positions, &scene.mesh.faces, &scene.topo.opposite_vertex);
+//! let pot = Potential {
+//!     scene: &scene,
+//!     pattern: &pattern,
+//!     dial: 1.0,
+//!     inertia: None,
+//!     damping: None,
+//!     gravity: Vec3::zeros(),
+//! };
+//! // The flat sheet is not at rest under the programmed curvature: positive bending energy and
+//! // a non-zero gradient.
+//! let mut grad = vec![0.0; pattern.n];
+//! let e = pot.eval(&scene.mesh.positions, Want::Gradient, &mut grad, &mut []);
+//! assert!(e > 0.0 && grad.iter().any(|g| g.abs() > 0.0));
+//! ```
 #![warn(missing_docs)]
 
 pub mod assembly;
