@@ -7,6 +7,7 @@
 use crate::cases::{curvature_error, shape_error, Case};
 use crate::integrate::{run, Progress, Quiet};
 use crate::math::{Real, Vec3};
+use crate::mesh::delaunay::delaunay_rectangle;
 use crate::mesh::generate::{annulus, rectangle, Spacing};
 use crate::mesh::io::{read_mesh, write_mesh, Format};
 use crate::mesh::Topology;
@@ -119,6 +120,10 @@ struct MeshArgs {
     /// Squares and rectangles: split cells along alternating diagonals instead of the same one.
     #[arg(long)]
     checkerboard: bool,
+    /// Squares and rectangles: Delaunay triangulation of well-spaced random points (seeded by
+    /// --seed) instead of a grid: an irregular mesh.
+    #[arg(long, conflicts_with_all = ["checkerboard", "grading"])]
+    delaunay: bool,
     /// Write abar_info/bbar_info for an analytic case (enlarged_square, spherical_cap,
     /// hyperboloid, rhombus, cylinder).
     #[arg(long)]
@@ -240,14 +245,30 @@ fn mesh_cmd(a: MeshArgs) -> Result<()> {
         checkerboard: a.checkerboard,
     };
     let mut mesh = match a.shape {
-        Shape::Square => {
-            pos("size", a.size)?;
-            rectangle(-0.5 * a.size, -0.5 * a.size, a.size, a.size, a.edge, sp)
-        }
-        Shape::Rectangle => {
-            pos("lx", a.lx)?;
-            pos("ly", a.ly)?;
-            rectangle(-0.5 * a.lx, -0.5 * a.ly, a.lx, a.ly, a.edge, sp)
+        Shape::Square | Shape::Rectangle => {
+            let (lx, ly) = match a.shape {
+                Shape::Square => {
+                    pos("size", a.size)?;
+                    (a.size, a.size)
+                }
+                _ => {
+                    pos("lx", a.lx)?;
+                    pos("ly", a.ly)?;
+                    (a.lx, a.ly)
+                }
+            };
+            if a.delaunay {
+                let mut m = delaunay_rectangle(-0.5 * lx, -0.5 * ly, lx, ly, a.edge, sp);
+                if a.jitter > 0.0 {
+                    bail!(
+                        "--jitter does not apply to --delaunay meshes (they are irregular already)"
+                    );
+                }
+                m.source = None;
+                m
+            } else {
+                rectangle(-0.5 * lx, -0.5 * ly, lx, ly, a.edge, sp)
+            }
         }
         Shape::Disk => {
             pos("radius", a.radius)?;

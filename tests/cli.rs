@@ -359,6 +359,7 @@ fn mesh_generator_and_error_command() {
     let p = d.path();
     for (shape, extra) in [
         ("square", vec!["--edge", "0.25"]),
+        ("square", vec!["--edge", "0.1", "--delaunay", "--seed", "4"]),
         (
             "rectangle",
             vec![

@@ -132,3 +132,75 @@ fn raw_appended_xml_gets_a_clear_message() {
     let e = read_mesh(&p).unwrap_err().to_string();
     assert!(e.contains("paraview.vtu") && e.contains("appended"), "{e}");
 }
+
+#[test]
+fn delaunay_rectangle_is_valid_delaunay_and_well_shaped() {
+    use shellsim::mesh::delaunay::delaunay_rectangle;
+    let m = delaunay_rectangle(
+        -0.5,
+        -0.5,
+        1.0,
+        1.0,
+        0.08,
+        Spacing {
+            seed: 7,
+            ..Default::default()
+        },
+    );
+    m.validate().unwrap();
+    Topology::build(&m).unwrap();
+    let area: f64 = (0..m.faces.len())
+        .map(|f| {
+            let [a, b, c] = m.face_positions(f);
+            0.5 * (b - a).cross(&(c - a)).z
+        })
+        .sum();
+    assert!(
+        (area - 1.0).abs() < 1e-12,
+        "triangles do not tile the square: area {area}"
+    );
+    let mut min_angle = f64::INFINITY;
+    for f in 0..m.faces.len() {
+        let [a, b, c] = m.face_positions(f);
+        assert!(
+            (b - a).cross(&(c - a)).z > 0.0,
+            "face {f} not counter-clockwise"
+        );
+        for (p, q, r) in [(a, b, c), (b, c, a), (c, a, b)] {
+            let (u, v) = (q - p, r - p);
+            min_angle = min_angle.min((u.dot(&v) / (u.norm() * v.norm())).acos().to_degrees());
+        }
+        // Empty circumcircle: no vertex strictly inside (brute force).
+        let (ax, ay, bx, by, cx, cy) = (a.x, a.y, b.x, b.y, c.x, c.y);
+        let d = 2.0 * (ax * (by - cy) + bx * (cy - ay) + cx * (ay - by));
+        let ux = ((ax * ax + ay * ay) * (by - cy)
+            + (bx * bx + by * by) * (cy - ay)
+            + (cx * cx + cy * cy) * (ay - by))
+            / d;
+        let uy = ((ax * ax + ay * ay) * (cx - bx)
+            + (bx * bx + by * by) * (ax - cx)
+            + (cx * cx + cy * cy) * (bx - ax))
+            / d;
+        let r2 = (ax - ux).powi(2) + (ay - uy).powi(2);
+        for p in &m.positions {
+            assert!(
+                (p.x - ux).powi(2) + (p.y - uy).powi(2) >= r2 * (1.0 - 1e-9),
+                "face {f} not Delaunay"
+            );
+        }
+    }
+    // Dart throwing keeps points ≥ 0.7 h apart: no slivers.
+    assert!(min_angle > 15.0, "min angle {min_angle}");
+    let again = delaunay_rectangle(
+        -0.5,
+        -0.5,
+        1.0,
+        1.0,
+        0.08,
+        Spacing {
+            seed: 7,
+            ..Default::default()
+        },
+    );
+    assert_eq!(again.faces, m.faces, "not deterministic");
+}
