@@ -97,7 +97,7 @@ fn potential<'a>(sc: &'a Scene, p: &'a Pattern) -> Potential<'a> {
 fn assembly(c: &mut Criterion) {
     // 224² cells × 2 ≈ 100k faces.
     let sc = scene(1.0 / 224.0);
-    let p = Pattern::new(&sc.mesh.positions, &sc.mesh.faces, &sc.topo.opposite_vertex);
+    let p = Pattern::new(&sc.mesh.positions, &sc.mesh.faces, &sc.stencil_extra());
     let x = curved(&sc);
     let mut g = c.benchmark_group("assembly_100k");
     g.sample_size(10);
@@ -165,7 +165,7 @@ fn newton_iteration(c: &mut Criterion) {
     g.sample_size(10);
     for edge in [1.0 / 50.0, 1.0 / 100.0] {
         let sc = scene(edge);
-        let p = Pattern::new(&sc.mesh.positions, &sc.mesh.faces, &sc.topo.opposite_vertex);
+        let p = Pattern::new(&sc.mesh.positions, &sc.mesh.faces, &sc.stencil_extra());
         let x = curved(&sc);
         let mut lin = LinearSolver::new(&p).unwrap();
         let pot = potential(&sc, &p);

@@ -10,6 +10,7 @@
 //! results bitwise identical for any number of threads. Energies are stored per face and summed
 //! in face order.
 
+use crate::energy::patch::{patch_face, Patch};
 use crate::energy::projection::{project, HessianProjection};
 use crate::energy::shell::{shell_face, shell_face_gauss_newton};
 use crate::energy::KoiterDensity;
@@ -274,13 +275,15 @@ impl Shared {
     }
 }
 
-/// Assembles face terms. `density(f)` gives the face's energy density; `fixed` is per vertex.
+/// Assembles face terms. `density(f)` gives the face's energy density; `fixed` is per vertex;
+/// `patches` selects the patch-fit bending kernel when non-empty (mid-edge average otherwise).
 /// Returns the total face energy; fills `grad` (len n) and `values` (len nnz) when wanted
 /// (they are overwritten, not accumulated).
 #[allow(clippy::too_many_arguments)]
 pub fn assemble_faces<F>(
     pattern: &Pattern,
     x: &[Vec3],
+    patches: &[Patch],
     density: F,
     fixed: &[bool],
     projection: HessianProjection,
@@ -297,7 +300,10 @@ where
             .into_par_iter()
             .map(|f| {
                 let (xs, has) = gather(pattern, x, f);
-                shell_face(&xs, has, &density(f), None, None)
+                match patches.get(f) {
+                    Some(p) => patch_face::<_, false>(&xs, &p.weights, &density(f), None, None),
+                    None => shell_face(&xs, has, &density(f), None, None),
+                }
             })
             .collect();
         return es.iter().sum();
@@ -317,10 +323,16 @@ where
                 let mut g = SVec::<18>::zeros();
                 let mut h = SMat::<18, 18>::zeros();
                 let hout = (want == Want::Hessian).then_some(&mut h);
-                let e = if projection == HessianProjection::GaussNewton {
-                    shell_face_gauss_newton(&xs, has, &d, Some(&mut g), hout)
-                } else {
-                    shell_face(&xs, has, &d, Some(&mut g), hout)
+                let gn = projection == HessianProjection::GaussNewton;
+                let e = match (patches.get(f), gn) {
+                    (Some(p), true) => {
+                        patch_face::<_, true>(&xs, &p.weights, &d, Some(&mut g), hout)
+                    }
+                    (Some(p), false) => {
+                        patch_face::<_, false>(&xs, &p.weights, &d, Some(&mut g), hout)
+                    }
+                    (None, true) => shell_face_gauss_newton(&xs, has, &d, Some(&mut g), hout),
+                    (None, false) => shell_face(&xs, has, &d, Some(&mut g), hout),
                 };
                 // SAFETY: see `Shared`: faces of one colour touch disjoint entries.
                 unsafe {

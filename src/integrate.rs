@@ -14,7 +14,6 @@ use crate::assembly::{Pattern, Want};
 use crate::math::{Real, Vec3};
 use crate::mesh::generate::Rng;
 use crate::output::{LogRow, OutputError, Summary, Writer};
-use crate::rest::mesh_forms;
 use crate::scene::Scene;
 use crate::settings::Mode;
 use crate::solve::linear::LinearError;
@@ -230,7 +229,7 @@ pub fn run(
     let pattern = Pattern::new(
         &scene.mesh.positions,
         &scene.mesh.faces,
-        &scene.topo.opposite_vertex,
+        &scene.stencil_extra(),
     );
     let mut s = Solver::new(scene, &pattern, threads)?;
     let mut x = scene.mesh.positions.clone();
@@ -385,7 +384,7 @@ fn run_dynamic(
     let mut trial = x.clone();
     let damping = tm.damping > 0.0;
     let (mut a_prev, mut b_prev) = if damping {
-        mesh_forms(&x, &sc.mesh, &sc.topo)
+        sc.forms(&x)
     } else {
         (Vec::new(), Vec::new())
     };
@@ -449,7 +448,7 @@ fn run_dynamic(
         t += h;
         s.summary.steps += 1;
         if damping {
-            let (a, b) = mesh_forms(&x, &sc.mesh, &sc.topo);
+            let (a, b) = sc.forms(&x);
             a_prev = a;
             b_prev = b;
         }

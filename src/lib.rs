@@ -17,7 +17,7 @@
 //! Case::Cylinder.program(&mut mesh);
 //! let settings = Settings::from_str_with("[rest]\ntarget = \"mesh\"\n", "example", &[]).unwrap();
 //! let scene = Scene::build(mesh, settings).unwrap();
-//! let pattern = Pattern::new(&scene.mesh.positions, &scene.mesh.faces, &scene.topo.opposite_vertex);
+//! let pattern = Pattern::new(&scene.mesh.positions, &scene.mesh.faces, &scene.stencil_extra());
 //! let pot = Potential {
 //!     scene: &scene,
 //!     pattern: &pattern,

@@ -15,7 +15,7 @@ use crate::geometry::curvatures;
 use crate::math::{Mat2, Real, Sym2, Vec3};
 use crate::mesh::io::{mesh_to_bytes, write_atomic, Format};
 use crate::mesh::{Field, Mesh};
-use crate::rest::{mesh_forms, push_forward, reference_frame};
+use crate::rest::{push_forward, reference_frame};
 use crate::scene::Scene;
 use crate::solve::Potential;
 use serde::Serialize;
@@ -229,7 +229,7 @@ impl Writer {
     /// Energies of a state by term.
     pub fn energies(pot: &Potential, x: &[Vec3], v: &[Vec3]) -> Energies {
         let sc = pot.scene;
-        let (a, b) = mesh_forms(x, &sc.mesh, &sc.topo);
+        let (a, b) = sc.forms(x);
         Self::energies_of(pot, x, v, &face_energies(pot, &a, &b))
     }
 
@@ -261,7 +261,7 @@ impl Writer {
         let index = self.frames.len();
         row.frame = index;
         let nf = sc.num_faces();
-        let (a, b) = mesh_forms(x, &sc.mesh, &sc.topo);
+        let (a, b) = sc.forms(x);
         let fe = face_energies(pot, &a, &b);
         row.energy = Self::energies_of(pot, x, v, &fe);
         let mut fa = Vec::with_capacity(3 * nf);

@@ -34,8 +34,10 @@ pub struct Scene {
     pub force_scale: Real,
     /// Mean edge length of the input mesh (m).
     pub mean_edge: Real,
-    /// Warnings found while building (unused vertices, ...).
+    /// Warnings found while building (unused vertices, ill-conditioned patches, ...).
     pub warnings: Vec<String>,
+    /// Patch-fit bending data per face (`material.bending = "patch_fit"`), else empty.
+    pub patches: Vec<crate::energy::patch::Patch>,
 }
 
 fn positive_face_field(mesh: &Mesh, name: &str) -> Result<Option<Vec<Real>>, MeshError> {
@@ -162,6 +164,13 @@ impl Scene {
                  constraints.fix_boxes) or use solver.mode = \"dynamic\"",
             ));
         }
+        let patches = if m.bending == crate::settings::BendingModel::PatchFit {
+            let (p, w) = crate::energy::patch::build_patches(&mesh)?;
+            warnings.extend(w);
+            p
+        } else {
+            Vec::new()
+        };
         let mean_edge = mesh.mean_edge_length();
         let eh = young
             .iter()
@@ -182,6 +191,7 @@ impl Scene {
             mass,
             fixed,
             warnings,
+            patches,
         })
     }
 
@@ -193,6 +203,42 @@ impl Scene {
     /// Number of faces.
     pub fn num_faces(&self) -> usize {
         self.mesh.faces.len()
+    }
+
+    /// The 3 extra vertices of each face's bending stencil: the neighbours' far vertices
+    /// (mid-edge) or the patch nodes (patch fit).
+    pub fn stencil_extra(&self) -> Vec<[usize; 3]> {
+        if self.patches.is_empty() {
+            self.topo.opposite_vertex.clone()
+        } else {
+            self.patches.iter().map(|p| p.nodes).collect()
+        }
+    }
+
+    /// First and second fundamental forms of every face at `x`, with this scene's bending model.
+    pub fn forms(&self, x: &[Vec3]) -> (Vec<Sym2>, Vec<Sym2>) {
+        let (a, b) = crate::rest::mesh_forms(x, &self.mesh, &self.topo);
+        if self.patches.is_empty() {
+            return (a, b);
+        }
+        let b = self
+            .mesh
+            .faces
+            .iter()
+            .zip(&self.patches)
+            .map(|(f, p)| {
+                let xs = [
+                    x[f[0]],
+                    x[f[1]],
+                    x[f[2]],
+                    x[p.nodes[0]],
+                    x[p.nodes[1]],
+                    x[p.nodes[2]],
+                ];
+                crate::energy::patch::patch_b(&xs, &p.weights)
+            })
+            .collect();
+        (a, b)
     }
 
     /// Reference (input) positions.

@@ -89,6 +89,21 @@ pub struct Material {
     /// Stretching normalisation: `"koiter"` (standard, seed 000) or `"morphoshell"` (4× larger,
     /// MorphoShell's convention) (default: `"koiter"`).
     pub stretch_convention: StretchConvention,
+    /// Discrete second fundamental form: `"midedge_average"` (seed 000) or `"patch_fit"`
+    /// (MorphoShell's quadratic patch fit, flat reference meshes only) (default:
+    /// `"midedge_average"`).
+    pub bending: BendingModel,
+}
+
+/// The discrete second fundamental form.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BendingModel {
+    /// Seed 000's mid-edge average normals.
+    #[default]
+    MidedgeAverage,
+    /// MorphoShell's quadratic patch fit through the face and 3 nearby nodes.
+    PatchFit,
 }
 
 impl Default for Material {
@@ -101,6 +116,7 @@ impl Default for Material {
             use_mesh_thickness: true,
             use_mesh_shear_modulus: true,
             stretch_convention: StretchConvention::Koiter,
+            bending: BendingModel::MidedgeAverage,
         }
     }
 }

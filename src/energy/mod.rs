@@ -7,6 +7,7 @@
 //! * [`projection`]: optional per-element projection of a Hessian to positive semi-definite.
 
 pub mod material;
+pub mod patch;
 pub mod projection;
 pub mod shell;
 

@@ -89,6 +89,7 @@ impl<'a> Potential<'a> {
         let mut e = assemble_faces(
             self.pattern,
             x,
+            &sc.patches,
             |f| self.density(f),
             &sc.fixed,
             projection,

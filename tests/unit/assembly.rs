@@ -34,7 +34,7 @@ fn scene_with_edge(settings: &str, program: Option<Case>, edge: f64) -> Scene {
 }
 
 fn pattern(sc: &Scene) -> Pattern {
-    Pattern::new(&sc.mesh.positions, &sc.mesh.faces, &sc.topo.opposite_vertex)
+    Pattern::new(&sc.mesh.positions, &sc.mesh.faces, &sc.stencil_extra())
 }
 
 fn bumpy(sc: &Scene) -> Vec<Vec3> {

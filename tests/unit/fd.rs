@@ -119,3 +119,40 @@ fn fd_error_table() {
         println!("{eps:>8.0e} {ge:>12.3e} {he:>12.3e}");
     }
 }
+
+/// Patch-fit kernel: gradient and Hessian against central differences, exact and Gauss–Newton
+/// gradients equal.
+#[test]
+fn patch_face_derivatives_match_finite_differences() {
+    use shellsim::energy::patch::{patch_face, PatchWeights};
+    let mut rng = Rng::new(21);
+    for trial in 0..20 {
+        let x = random_patch(&mut rng, 0.25);
+        let d = random_density(&mut rng, trial % 2 == 1);
+        let w = PatchWeights::from_fn(|_, _| rng.symmetric());
+        let mut g = SVec::<18>::zeros();
+        let mut h = SMat::<18, 18>::zeros();
+        patch_face::<_, false>(&x, &w, &d, Some(&mut g), Some(&mut h));
+        let mut ggn = SVec::<18>::zeros();
+        patch_face::<_, true>(&x, &w, &d, Some(&mut ggn), None);
+        assert_eq!(g, ggn);
+        let x0 = flat(&x);
+        let eps = 1e-6;
+        let mut gfd = SVec::<18>::zeros();
+        let mut hfd = SMat::<18, 18>::zeros();
+        for k in 0..18 {
+            let (mut xp, mut xm) = (x0, x0);
+            xp[k] += eps;
+            xm[k] -= eps;
+            let (mut gp, mut gm) = (SVec::<18>::zeros(), SVec::<18>::zeros());
+            let ep = patch_face::<_, false>(&unflat(&xp), &w, &d, Some(&mut gp), None);
+            let em = patch_face::<_, false>(&unflat(&xm), &w, &d, Some(&mut gm), None);
+            gfd[k] = (ep - em) / (2.0 * eps);
+            hfd.set_column(k, &((gp - gm) / (2.0 * eps)));
+        }
+        let ge = (g - gfd).amax() / g.amax();
+        let he = (h - hfd).amax() / h.amax();
+        assert!(ge < 1e-6 && he < 1e-6, "trial {trial}: {ge:e} {he:e}");
+        assert!((h - h.transpose()).amax() < 1e-12 * h.amax());
+    }
+}
