@@ -416,3 +416,52 @@ fn every_hessian_option_reaches_the_same_equilibrium() {
         );
     }
 }
+
+/// Patch-fit bending on irregular (Delaunay) meshes: the error falls with refinement, unlike the
+/// mid-edge average's floor. Measured Hausdorff at edge 0.1 / 0.05: cylinder 0.25% → 0.068%,
+/// cap 0.37% → 0.096% (observed order ≈ 1.9); the mid-edge average gives 1.4% and 0.97% at 0.05.
+#[test]
+fn patch_fit_converges_on_delaunay_meshes() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    std::fs::write(
+        dir.join("s.toml"),
+        "[material]\nthickness = 0.05\nbending = \"patch_fit\"\n[rest]\ntarget = \"mesh\"\n",
+    )
+    .unwrap();
+    for case in ["cylinder", "spherical_cap"] {
+        let mut errs = Vec::new();
+        for edge in ["0.1", "0.05"] {
+            shellsim(
+                &[
+                    "mesh",
+                    "square",
+                    "--edge",
+                    edge,
+                    "--delaunay",
+                    "--seed",
+                    "3",
+                    "--program",
+                    case,
+                    "-o",
+                    "d.vtk",
+                ],
+                dir,
+            );
+            let out = format!("o_{case}_{edge}");
+            shellsim(&["s.toml", "d.vtk", "--out", &out, "-q"], dir);
+            let s: serde_json::Value = serde_json::from_str(
+                &std::fs::read_to_string(dir.join(&out).join("summary.json")).unwrap(),
+            )
+            .unwrap();
+            assert_eq!(s["converged"], true);
+            let frame = format!("{out}/{}", s["final_frame"].as_str().unwrap());
+            let e: serde_json::Value =
+                serde_json::from_str(&shellsim(&["error", case, &frame], dir)).unwrap();
+            errs.push(e["hausdorff_rel"].as_f64().unwrap());
+        }
+        println!("patch fit on Delaunay meshes, {case}: {errs:?}");
+        assert!(errs[1] < errs[0], "{case}: {errs:?}");
+        assert!(errs[1] < 0.0012, "{case}: {errs:?}");
+    }
+}
