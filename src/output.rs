@@ -8,8 +8,8 @@
 //! `t1 = e1/|e1|`, `t2 = N × t1`): `a`, `b`, `abar`, `bbar`, `mean_curvature`,
 //! `gauss_curvature`, `k1`, `k2` (principal curvatures, ascending), `stretching_energy_density`,
 //! `bending_energy_density` (J/m² of rest area), `thickness`, and `tri_tags` when the input has
-//! it. Per vertex: `displacement`, `velocity`, `constraint_indicators`, and `node_tags` when
-//! present.
+//! it; with patch-fit bending, `patch_condition` (the condition number of each face's fit). Per
+//! vertex: `displacement`, `velocity`, `constraint_indicators`, and `node_tags` when present.
 
 use crate::geometry::curvatures;
 use crate::math::{Mat2, Real, Sym2, Vec3};
@@ -314,6 +314,12 @@ impl Writer {
         ff.insert("stretching_energy_density".into(), Field::scalar(es));
         ff.insert("bending_energy_density".into(), Field::scalar(eb));
         ff.insert("thickness".into(), Field::scalar(sc.thickness.clone()));
+        if !sc.patches.is_empty() {
+            ff.insert(
+                "patch_condition".into(),
+                Field::scalar(sc.patches.iter().map(|p| p.condition).collect()),
+            );
+        }
         let vf = &mut m.vertex_fields;
         let disp: Vec<Real> = x
             .iter()
