@@ -217,10 +217,15 @@ impl Scene {
 
     /// First and second fundamental forms of every face at `x`, with this scene's bending model.
     pub fn forms(&self, x: &[Vec3]) -> (Vec<Sym2>, Vec<Sym2>) {
-        let (a, b) = crate::rest::mesh_forms(x, &self.mesh, &self.topo);
         if self.patches.is_empty() {
-            return (a, b);
+            return crate::rest::mesh_forms(x, &self.mesh, &self.topo);
         }
+        let a = self
+            .mesh
+            .faces
+            .iter()
+            .map(|f| crate::geometry::first_fundamental_form(&f.map(|v| x[v])))
+            .collect();
         let b = self
             .mesh
             .faces
