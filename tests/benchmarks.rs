@@ -24,6 +24,17 @@ fn shellsim(args: &[&str], dir: &Path) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
+/// The `summary.json` of the run written to `dir/out`.
+fn summary(dir: &Path, out: &str) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join(out).join("summary.json")).unwrap())
+        .unwrap()
+}
+
+/// `shellsim error CASE FRAME` as JSON.
+fn measure(dir: &Path, case: &str, frame: &str) -> serde_json::Value {
+    serde_json::from_str(&shellsim(&["error", case, frame], dir)).unwrap()
+}
+
 struct Row {
     hausdorff: f64,
     max_err: f64,
@@ -43,19 +54,15 @@ fn run_case(case: &str, mesh_args: &[&str], dir: &Path, tag: &str) -> Row {
     )
     .unwrap();
     shellsim(&["s.toml", &mesh, "--out", &out, "-q"], dir);
-    let summary: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(dir.join(&out).join("summary.json")).unwrap(),
-    )
-    .unwrap();
-    assert_eq!(summary["converged"], true, "{case} {tag}");
-    let frame = format!("{out}/{}", summary["final_frame"].as_str().unwrap());
-    let e: serde_json::Value =
-        serde_json::from_str(&shellsim(&["error", case, &frame], dir)).unwrap();
+    let s = summary(dir, &out);
+    assert_eq!(s["converged"], true, "{case} {tag}");
+    let frame = format!("{out}/{}", s["final_frame"].as_str().unwrap());
+    let e = measure(dir, case, &frame);
     Row {
         hausdorff: e["hausdorff_rel"].as_f64().unwrap(),
         max_err: e["max_error_rel"].as_f64().unwrap(),
         curv_h: e["mean_curvature_rms_error"].as_f64().unwrap(),
-        newton: summary["newton_iterations"].as_u64().unwrap(),
+        newton: s["newton_iterations"].as_u64().unwrap(),
     }
 }
 
@@ -184,18 +191,14 @@ fn cone_metric_buckles_out_of_the_flat_saddle() {
             ],
             dir,
         );
-        let s: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string(dir.join(&out).join("summary.json")).unwrap(),
-        )
-        .unwrap();
+        let s = summary(dir, &out);
         assert_eq!(s["converged"], true);
         assert!(
             s["saddle_escapes"].as_u64().unwrap() >= escapes_min,
             "sb {sb}: {s}"
         );
         let frame = format!("{out}/{}", s["final_frame"].as_str().unwrap());
-        let e: serde_json::Value =
-            serde_json::from_str(&shellsim(&["error", "cone", &frame], dir)).unwrap();
+        let e = measure(dir, "cone", &frame);
         let h = e["hausdorff_rel"].as_f64().unwrap();
         println!(
             "cone, symmetry_breaking {sb}: Hausdorff {h:.3e}, saddle escapes {}",
@@ -317,9 +320,7 @@ fn damped_dynamics_stops_at_equilibrium() {
         ],
         dir,
     );
-    let s: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("o/summary.json")).unwrap())
-            .unwrap();
+    let s = summary(dir, "o");
     assert_eq!(s["converged"], true);
     let t = s["time"].as_f64().unwrap();
     assert!(t > 0.5 && t < 20.0, "stopped at {t}");
@@ -384,14 +385,10 @@ fn every_hessian_option_reaches_the_same_equilibrium() {
             ],
             dir,
         );
-        let s: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string(dir.join(&out).join("summary.json")).unwrap(),
-        )
-        .unwrap();
+        let s = summary(dir, &out);
         assert_eq!(s["converged"], true, "{mode}");
         let frame = format!("{out}/{}", s["final_frame"].as_str().unwrap());
-        let e: serde_json::Value =
-            serde_json::from_str(&shellsim(&["error", "hyperboloid", &frame], dir)).unwrap();
+        let e = measure(dir, "hyperboloid", &frame);
         // Measured 0.38% Hausdorff with the default at this resolution.
         assert!(e["hausdorff_rel"].as_f64().unwrap() < 0.0045, "{mode}: {e}");
         finals.push(read_positions(&dir.join(&frame)));
@@ -450,14 +447,10 @@ fn patch_fit_converges_on_delaunay_meshes() {
             );
             let out = format!("o_{case}_{edge}");
             shellsim(&["s.toml", "d.vtk", "--out", &out, "-q"], dir);
-            let s: serde_json::Value = serde_json::from_str(
-                &std::fs::read_to_string(dir.join(&out).join("summary.json")).unwrap(),
-            )
-            .unwrap();
+            let s = summary(dir, &out);
             assert_eq!(s["converged"], true);
             let frame = format!("{out}/{}", s["final_frame"].as_str().unwrap());
-            let e: serde_json::Value =
-                serde_json::from_str(&shellsim(&["error", case, &frame], dir)).unwrap();
+            let e = measure(dir, case, &frame);
             errs.push(e["hausdorff_rel"].as_f64().unwrap());
         }
         println!("patch fit on Delaunay meshes, {case}: {errs:?}");
