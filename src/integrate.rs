@@ -17,7 +17,7 @@ use crate::output::{LogRow, OutputError, Summary, Writer};
 use crate::scene::Scene;
 use crate::settings::Mode;
 use crate::solve::linear::LinearError;
-use crate::solve::newton::Workspace;
+use crate::solve::newton::{factor_with_shift_upto, Workspace};
 use crate::solve::potential::{Damping, Inertia};
 use crate::solve::{newton, LinearSolver, NewtonOptions, NewtonReport, Potential};
 use std::time::Instant;
@@ -207,15 +207,9 @@ impl<'a> Solver<'a> {
         let mut values = vec![0.0; self.pattern.nnz()];
         let mut g = vec![0.0; self.pattern.n];
         pot.eval(x, Want::Hessian, &mut g, &mut values);
-        let n = self.pattern.n;
-        let scale: Real = (0..n)
-            .map(|i| values[self.pattern.diag(i)].abs())
-            .sum::<Real>()
-            / n as Real;
-        for i in 0..n {
-            values[self.pattern.diag(i)] += 1e-9 * scale;
-        }
-        self.lin.factor(&values).is_ok()
+        // One factorisation of H + 1e-9·mean|diag|·I (τ may not grow beyond 1e-9).
+        let mut shifted = vec![0.0; values.len()];
+        factor_with_shift_upto(&mut self.lin, &pot, &values, &mut shifted, 1e-9, 1e-9).is_some()
     }
 }
 
