@@ -136,17 +136,20 @@ fn raw_appended_xml_gets_a_clear_message() {
 #[test]
 fn delaunay_rectangle_is_valid_delaunay_and_well_shaped() {
     use shellsim::mesh::delaunay::delaunay_rectangle;
-    let m = delaunay_rectangle(
-        -0.5,
-        -0.5,
-        1.0,
-        1.0,
-        0.08,
-        Spacing {
-            seed: 7,
-            ..Default::default()
-        },
-    );
+    let make = || {
+        delaunay_rectangle(
+            -0.5,
+            -0.5,
+            1.0,
+            1.0,
+            0.08,
+            Spacing {
+                seed: 7,
+                ..Default::default()
+            },
+        )
+    };
+    let m = make();
     m.validate().unwrap();
     Topology::build(&m).unwrap();
     let area: f64 = (0..m.faces.len())
@@ -191,16 +194,5 @@ fn delaunay_rectangle_is_valid_delaunay_and_well_shaped() {
     }
     // Dart throwing keeps points ≥ 0.7 h apart: no slivers.
     assert!(min_angle > 15.0, "min angle {min_angle}");
-    let again = delaunay_rectangle(
-        -0.5,
-        -0.5,
-        1.0,
-        1.0,
-        0.08,
-        Spacing {
-            seed: 7,
-            ..Default::default()
-        },
-    );
-    assert_eq!(again.faces, m.faces, "not deterministic");
+    assert_eq!(make().faces, m.faces, "not deterministic");
 }
