@@ -1,8 +1,9 @@
 //! Global assembly of energy, gradient and sparse Hessian.
 //!
 //! The sparsity pattern (lower triangle, compressed sparse columns, 3 DOFs per vertex in the
-//! order `x, y, z`) is built once per mesh from each face's 6-vertex stencil, together with a
-//! greedy colouring of the faces in which no two faces of a colour share a stencil vertex.
+//! order `x, y, z`, then one DOF per edge when the bending model has edge DOFs) is built once per
+//! mesh from each face's stencil (6 vertices, plus its 3 edges), together with a greedy colouring
+//! of the faces in which no two faces of a colour share a stencil node.
 //! Colours are processed in order; within a colour, faces are evaluated in parallel (rayon) and
 //! each scatters its gradient and Hessian directly into entries no other face of that colour
 //! touches. Every entry therefore receives its contributions in a fixed order (colour by colour)
@@ -10,6 +11,7 @@
 //! results bitwise identical for any number of threads. Energies are stored per face and summed
 //! in face order.
 
+use crate::energy::midedge_angle::{midedge_angle_face, AngleVariant};
 use crate::energy::patch::{patch_face, Patch};
 use crate::energy::projection::{project, HessianProjection};
 use crate::energy::shell::{shell_face, shell_face_gauss_newton};
@@ -18,21 +20,32 @@ use crate::math::{Real, SMat, SVec, Vec3};
 use crate::mesh::topology::NONE;
 use rayon::prelude::*;
 
+/// Stencil slots per face: 6 vertices, then up to 3 edge-DOF nodes.
+const SLOTS: usize = 9;
+
 /// The Hessian's sparsity pattern and, per face, where its entries go.
+///
+/// DOFs are grouped in *nodes*: vertex `v` (node `v`) owns the 3 DOFs `3v..3v+3`; with edge DOFs,
+/// edge `e` (node `nv + e`) owns the single DOF `3 nv + e`.
 #[derive(Clone, Debug)]
 pub struct Pattern {
-    /// Number of DOFs (3 × vertices).
+    /// Number of DOFs (3 × vertices + edge DOFs).
     pub n: usize,
+    /// Number of vertices.
+    pub num_vertices: usize,
+    /// Number of edge DOFs (0 unless the bending model has them).
+    pub num_edge_dofs: usize,
     /// CSC column pointers (lower triangle).
     pub col_ptr: Vec<usize>,
     /// CSC row indices.
     pub row_idx: Vec<usize>,
-    /// Per face: vertex ids of its 18-DOF stencil `[v0, v1, v2, p0, p1, p2]` (`NONE` if absent).
-    pub stencil: Vec<[usize; 6]>,
-    /// Per face and slot pair (s, t) with `u_s > u_t`: rank of `u_s` among the neighbours of
-    /// `u_t` with larger index.
-    ranks: Vec<[u16; 36]>,
-    /// Blocks of faces grouped by colour; blocks of one colour share no stencil vertex.
+    /// Per face: node ids of its stencil `[v0, v1, v2, p0, p1, p2, e0, e1, e2]` (`NONE` if
+    /// absent; the edge slots are `NONE` without edge DOFs).
+    pub stencil: Vec<[usize; SLOTS]>,
+    /// Per face and slot pair (s, t) with node `u_s > u_t`: offset of `u_s`'s rows among the
+    /// rows of `u_t`'s columns below its own diagonal block.
+    offsets: Vec<[u32; SLOTS * SLOTS]>,
+    /// Blocks of faces grouped by colour; blocks of one colour share no stencil node.
     colours: Vec<Vec<Vec<usize>>>,
 }
 
@@ -40,17 +53,60 @@ pub struct Pattern {
 /// colour holds many blocks.
 pub const BLOCK: usize = 256;
 
+/// Local DOF offset of stencil slot `s` in an element vector (vertices 3 each, then edges).
+#[inline(always)]
+fn local(s: usize) -> usize {
+    if s < 6 {
+        3 * s
+    } else {
+        12 + s
+    }
+}
+
 impl Pattern {
-    /// Builds the pattern for faces and their opposite vertices; `positions` (any configuration,
-    /// usually the reference one) only orders the faces into spatially coherent blocks.
-    pub fn new(positions: &[Vec3], faces: &[[usize; 3]], opposite: &[[usize; 3]]) -> Pattern {
+    /// Builds the pattern for faces and their extra bending vertices, without edge DOFs;
+    /// `positions` (any configuration, usually the reference one) only orders the faces into
+    /// spatially coherent blocks.
+    pub fn new(positions: &[Vec3], faces: &[[usize; 3]], extra: &[[usize; 3]]) -> Pattern {
+        Self::with_edges(positions, faces, extra, None)
+    }
+
+    /// The pattern of a scene (with edge DOFs when its bending model has them).
+    pub fn for_scene(scene: &crate::scene::Scene) -> Pattern {
+        let edges = scene
+            .has_edge_dofs()
+            .then(|| (scene.topo.face_edges.as_slice(), scene.topo.edges.len()));
+        Self::with_edges(
+            &scene.mesh.positions,
+            &scene.mesh.faces,
+            &scene.stencil_extra(),
+            edges,
+        )
+    }
+
+    /// As [`Pattern::new`], with one DOF per edge when `edges = Some((face_edges, num_edges))`
+    /// (`face_edges[f][i]` the edge opposite vertex `i` of face `f`).
+    pub fn with_edges(
+        positions: &[Vec3],
+        faces: &[[usize; 3]],
+        extra: &[[usize; 3]],
+        edges: Option<(&[[usize; 3]], usize)>,
+    ) -> Pattern {
         let nv = positions.len();
-        let stencil: Vec<[usize; 6]> = faces
+        let ne = edges.map_or(0, |e| e.1);
+        let nodes = nv + ne;
+        let stencil: Vec<[usize; SLOTS]> = faces
             .iter()
-            .zip(opposite)
-            .map(|(f, o)| [f[0], f[1], f[2], o[0], o[1], o[2]])
+            .zip(extra)
+            .enumerate()
+            .map(|(fi, (f, o))| {
+                let e = edges.map_or([NONE; 3], |(fe, _)| fe[fi].map(|e| nv + e));
+                [f[0], f[1], f[2], o[0], o[1], o[2], e[0], e[1], e[2]]
+            })
             .collect();
-        let mut hi: Vec<Vec<usize>> = vec![Vec::new(); nv];
+        let size = |u: usize| if u < nv { 3 } else { 1 };
+        let dof = |u: usize| if u < nv { 3 * u } else { 3 * nv + (u - nv) };
+        let mut hi: Vec<Vec<usize>> = vec![Vec::new(); nodes];
         for st in &stencil {
             for &u in st {
                 for &v in st {
@@ -64,45 +120,63 @@ impl Pattern {
             h.sort_unstable();
             h.dedup();
         }
-        let n = 3 * nv;
+        // prefix[v][r]: DOFs of v's higher neighbours before the r-th.
+        let prefix: Vec<Vec<u32>> = hi
+            .iter()
+            .map(|h| {
+                let mut acc = 0u32;
+                h.iter()
+                    .map(|&u| {
+                        let p = acc;
+                        acc += size(u) as u32;
+                        p
+                    })
+                    .collect()
+            })
+            .collect();
+        let n = 3 * nv + ne;
         let mut col_ptr = Vec::with_capacity(n + 1);
         let mut row_idx = Vec::new();
         col_ptr.push(0);
         for (v, hv) in hi.iter().enumerate() {
-            for d in 0..3 {
-                for c in d..3 {
-                    row_idx.push(3 * v + c);
+            let kv = size(v);
+            for d in 0..kv {
+                for c in d..kv {
+                    row_idx.push(dof(v) + c);
                 }
                 for &u in hv {
-                    for c in 0..3 {
-                        row_idx.push(3 * u + c);
+                    for c in 0..size(u) {
+                        row_idx.push(dof(u) + c);
                     }
                 }
                 col_ptr.push(row_idx.len());
             }
         }
-        let ranks = stencil
+        let offsets = stencil
             .iter()
             .map(|st| {
-                let mut r = [0u16; 36];
-                for s in 0..6 {
-                    for t in 0..6 {
+                let mut r = [0u32; SLOTS * SLOTS];
+                for s in 0..SLOTS {
+                    for t in 0..SLOTS {
                         let (u, v) = (st[s], st[t]);
                         if u != NONE && v != NONE && u > v {
-                            r[6 * s + t] = hi[v].binary_search(&u).unwrap_or(0) as u16;
+                            let rank = hi[v].binary_search(&u).unwrap_or(0);
+                            r[SLOTS * s + t] = prefix[v][rank];
                         }
                     }
                 }
                 r
             })
             .collect();
-        let colours = colour_blocks(nv, &stencil, &morton_blocks(positions, faces));
+        let colours = colour_blocks(nodes, &stencil, &morton_blocks(positions, faces));
         Pattern {
             n,
+            num_vertices: nv,
+            num_edge_dofs: ne,
             col_ptr,
             row_idx,
             stencil,
-            ranks,
+            offsets,
             colours,
         }
     }
@@ -112,7 +186,7 @@ impl Pattern {
         self.colours.len()
     }
 
-    /// Blocks of faces by colour (no two blocks of a colour share a stencil vertex).
+    /// Blocks of faces by colour (no two blocks of a colour share a stencil node).
     pub fn colours(&self) -> &[Vec<Vec<usize>>] {
         &self.colours
     }
@@ -128,34 +202,78 @@ impl Pattern {
         self.col_ptr[i]
     }
 
-    /// Adds an element Hessian (lower parts) into the values, skipping fixed vertices.
+    /// First DOF and number of DOFs of node `u`.
+    #[inline]
+    pub fn node_dofs(&self, u: usize) -> (usize, usize) {
+        let nv = self.num_vertices;
+        if u < nv {
+            (3 * u, 3)
+        } else {
+            (3 * nv + (u - nv), 1)
+        }
+    }
+
+    /// Adds an element gradient into `grad`, skipping fixed nodes.
     ///
     /// # Safety
-    /// No other thread writes the Hessian columns of face `f`'s stencil vertices concurrently.
+    /// No other thread writes the gradient entries of face `f`'s stencil nodes concurrently.
     #[inline]
-    unsafe fn scatter_hessian(&self, f: usize, h: &SMat<18, 18>, fixed: &[bool], values: Shared) {
+    unsafe fn scatter_gradient<const N: usize>(
+        &self,
+        f: usize,
+        g: &SVec<N>,
+        fixed: &[bool],
+        grad: Shared,
+    ) {
+        for (s, &u) in self.stencil[f].iter().enumerate() {
+            if u == NONE || fixed[u] {
+                continue;
+            }
+            let (d0, k) = self.node_dofs(u);
+            for c in 0..k {
+                unsafe { grad.add(d0 + c, g[local(s) + c]) };
+            }
+        }
+    }
+
+    /// Adds an element Hessian (lower parts) into the values, skipping fixed nodes.
+    ///
+    /// # Safety
+    /// No other thread writes the Hessian columns of face `f`'s stencil nodes concurrently.
+    #[inline]
+    unsafe fn scatter_hessian<const N: usize>(
+        &self,
+        f: usize,
+        h: &SMat<N, N>,
+        fixed: &[bool],
+        values: Shared,
+    ) {
         let st = &self.stencil[f];
-        let rk = &self.ranks[f];
-        for t in 0..6 {
+        let off = &self.offsets[f];
+        for t in 0..SLOTS {
             let v = st[t];
             if v == NONE || fixed[v] {
                 continue;
             }
-            for s in 0..6 {
+            let (dv, kv) = self.node_dofs(v);
+            let lt = local(t);
+            for s in 0..SLOTS {
                 let u = st[s];
                 if u == NONE || fixed[u] || u < v {
                     continue;
                 }
-                for d in 0..3 {
-                    let base = self.col_ptr[3 * v + d];
+                let ls = local(s);
+                let ku = self.node_dofs(u).1;
+                for d in 0..kv {
+                    let base = self.col_ptr[dv + d];
                     if u == v {
-                        for c in d..3 {
-                            unsafe { values.add(base + c - d, h[(3 * s + c, 3 * t + d)]) };
+                        for c in d..kv {
+                            unsafe { values.add(base + c - d, h[(ls + c, lt + d)]) };
                         }
                     } else {
-                        let off = base + (3 - d) + 3 * rk[6 * s + t] as usize;
-                        for c in 0..3 {
-                            unsafe { values.add(off + c, h[(3 * s + c, 3 * t + d)]) };
+                        let o = base + (kv - d) + off[SLOTS * s + t] as usize;
+                        for c in 0..ku {
+                            unsafe { values.add(o + c, h[(ls + c, lt + d)]) };
                         }
                     }
                 }
@@ -217,7 +335,10 @@ fn morton_blocks(positions: &[Vec3], faces: &[[usize; 3]]) -> Vec<Vec<usize>> {
 
 /// Greedy colouring of blocks: each takes the smallest colour not used by a block sharing one of
 /// its stencil vertices. Deterministic.
-fn colour_blocks(nv: usize, stencil: &[[usize; 6]], blocks: &[Vec<usize>]) -> Vec<Vec<Vec<usize>>> {
+fn colour_blocks(
+    nv: usize,
+    stencil: &[[usize; SLOTS]],
+    blocks: &[Vec<usize>]) -> Vec<Vec<Vec<usize>>> {
     let mut used: Vec<Vec<u32>> = vec![Vec::new(); nv];
     let mut colours: Vec<Vec<Vec<usize>>> = Vec::new();
     let mut taken: Vec<bool> = Vec::new();
@@ -275,15 +396,33 @@ impl Shared {
     }
 }
 
-/// Assembles face terms. `density(f)` gives the face's energy density; `fixed` is per vertex;
-/// `patches` selects the patch-fit bending kernel when non-empty (mid-edge average otherwise).
-/// Returns the total face energy; fills `grad` (len n) and `values` (len nnz) when wanted
-/// (they are overwritten, not accumulated).
+/// The bending model of the face kernel, with its per-face data.
+#[derive(Clone, Copy, Debug)]
+pub enum Bending<'a> {
+    /// Seed 000's mid-edge average ([`shell_face`]), 18 DOFs.
+    MidedgeAverage,
+    /// MorphoShell's patch fit ([`patch_face`]), 18 DOFs, one patch per face.
+    PatchFit(&'a [Patch]),
+    /// Mid-edge normals with edge DOFs ([`midedge_angle_face`]), 21 DOFs; `sigma[f][i]` is face
+    /// `f`'s orientation sign on its edge `i`.
+    MidedgeAngle {
+        /// `sin` or `tan`.
+        variant: AngleVariant,
+        /// Orientation signs per face and edge.
+        sigma: &'a [[Real; 3]],
+    },
+}
+
+/// Assembles face terms. `density(f)` gives the face's energy density; `fixed` is per node
+/// (vertices, then edge DOFs); `phi` holds the edge DOFs (empty without them). Returns the total
+/// face energy; fills `grad` (len n) and `values` (len nnz) when wanted (they are overwritten,
+/// not accumulated).
 #[allow(clippy::too_many_arguments)]
 pub fn assemble_faces<F>(
     pattern: &Pattern,
     x: &[Vec3],
-    patches: &[Patch],
+    phi: &[Real],
+    bending: Bending,
     density: F,
     fixed: &[bool],
     projection: HessianProjection,
@@ -294,17 +433,85 @@ pub fn assemble_faces<F>(
 where
     F: Fn(usize) -> KoiterDensity + Sync,
 {
+    let gn = projection == HessianProjection::GaussNewton;
+    match bending {
+        Bending::MidedgeAverage => assemble_generic::<18, _>(
+            pattern,
+            |f, g, h| {
+                let (xs, has) = gather(pattern, x, f);
+                if gn {
+                    shell_face_gauss_newton(&xs, has, &density(f), g, h)
+                } else {
+                    shell_face(&xs, has, &density(f), g, h)
+                }
+            },
+            fixed,
+            projection,
+            want,
+            grad,
+            values,
+        ),
+        Bending::PatchFit(patches) => assemble_generic::<18, _>(
+            pattern,
+            |f, g, h| {
+                let (xs, _) = gather(pattern, x, f);
+                let w = &patches[f].weights;
+                if gn {
+                    patch_face::<_, true>(&xs, w, &density(f), g, h)
+                } else {
+                    patch_face::<_, false>(&xs, w, &density(f), g, h)
+                }
+            },
+            fixed,
+            projection,
+            want,
+            grad,
+            values,
+        ),
+        Bending::MidedgeAngle { variant, sigma } => {
+            let nv = pattern.num_vertices;
+            assemble_generic::<21, _>(
+                pattern,
+                |f, g, h| {
+                    let (xs, has) = gather(pattern, x, f);
+                    let st = &pattern.stencil[f];
+                    let ph = [phi[st[6] - nv], phi[st[7] - nv], phi[st[8] - nv]];
+                    let d = density(f);
+                    if gn {
+                        midedge_angle_face::<_, true>(&xs, has, &ph, sigma[f], variant, &d, g, h)
+                    } else {
+                        midedge_angle_face::<_, false>(&xs, has, &ph, sigma[f], variant, &d, g, h)
+                    }
+                },
+                fixed,
+                projection,
+                want,
+                grad,
+                values,
+            )
+        }
+    }
+}
+
+/// The colour-by-colour assembly loop for a kernel with `N` local DOFs.
+#[allow(clippy::too_many_arguments)]
+fn assemble_generic<const N: usize, K>(
+    pattern: &Pattern,
+    kernel: K,
+    fixed: &[bool],
+    projection: HessianProjection,
+    want: Want,
+    grad: &mut [Real],
+    values: &mut [Real],
+) -> Real
+where
+    K: Fn(usize, Option<&mut SVec<N>>, Option<&mut SMat<N, N>>) -> Real + Sync,
+{
     let nf = pattern.stencil.len();
     if want == Want::Energy {
         let es: Vec<Real> = (0..nf)
             .into_par_iter()
-            .map(|f| {
-                let (xs, has) = gather(pattern, x, f);
-                match patches.get(f) {
-                    Some(p) => patch_face::<_, false>(&xs, &p.weights, &density(f), None, None),
-                    None => shell_face(&xs, has, &density(f), None, None),
-                }
-            })
+            .map(|f| kernel(f, None, None))
             .collect();
         return es.iter().sum();
     }
@@ -317,34 +524,15 @@ where
     let vp = Shared::new(values);
     for blocks in &pattern.colours {
         blocks.par_iter().for_each(|block| {
+            let mut g = SVec::<N>::zeros();
+            let mut h = SMat::<N, N>::zeros();
             for &f in block {
-                let (xs, has) = gather(pattern, x, f);
-                let d = density(f);
-                let mut g = SVec::<18>::zeros();
-                let mut h = SMat::<18, 18>::zeros();
                 let hout = (want == Want::Hessian).then_some(&mut h);
-                let gn = projection == HessianProjection::GaussNewton;
-                let e = match (patches.get(f), gn) {
-                    (Some(p), true) => {
-                        patch_face::<_, true>(&xs, &p.weights, &d, Some(&mut g), hout)
-                    }
-                    (Some(p), false) => {
-                        patch_face::<_, false>(&xs, &p.weights, &d, Some(&mut g), hout)
-                    }
-                    (None, true) => shell_face_gauss_newton(&xs, has, &d, Some(&mut g), hout),
-                    (None, false) => shell_face(&xs, has, &d, Some(&mut g), hout),
-                };
+                let e = kernel(f, Some(&mut g), hout);
                 // SAFETY: see `Shared`: faces of one colour touch disjoint entries.
                 unsafe {
                     ep.add(f, e);
-                    for (s, &u) in pattern.stencil[f].iter().enumerate() {
-                        if u == NONE || fixed[u] {
-                            continue;
-                        }
-                        for c in 0..3 {
-                            gp.add(3 * u + c, g[3 * s + c]);
-                        }
-                    }
+                    pattern.scatter_gradient(f, &g, fixed, gp);
                     if want == Want::Hessian {
                         project(&mut h, projection);
                         pattern.scatter_hessian(f, &h, fixed, vp);

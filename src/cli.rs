@@ -51,6 +51,10 @@ pub struct Cli {
     /// No progress bar even on a terminal.
     #[arg(long, short)]
     quiet: bool,
+    /// Start from a frame of an earlier run on the same mesh (positions, velocities, edge DOFs;
+    /// time or dial from the series.pvd next to it).
+    #[arg(long, value_name = "FRAME")]
+    restart: Option<PathBuf>,
 }
 
 #[derive(Subcommand, Debug)]
@@ -182,7 +186,15 @@ impl Progress for Bar {
 fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> {
     let settings = Settings::load(&settings_path, &cli.set)?;
     let mesh = read_mesh(&mesh_path)?;
-    let scene = Scene::build(mesh, settings)?;
+    let mut scene = Scene::build(mesh, settings)?;
+    let initial = match &cli.restart {
+        Some(p) => {
+            let (st, w) = crate::restart::read_restart(p, &scene)?;
+            scene.warnings.extend(w);
+            Some(st)
+        }
+        None => None,
+    };
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
@@ -207,11 +219,11 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
                     .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
             );
             let mut bar = Bar(pb);
-            let r = run(&scene, &mut writer, &mut bar, threads);
+            let r = run(&scene, &mut writer, &mut bar, threads, initial);
             bar.0.finish_and_clear();
             r
         } else {
-            run(&scene, &mut writer, &mut Quiet, threads)
+            run(&scene, &mut writer, &mut Quiet, threads, initial)
         }
     })?;
     if summary.converged {

@@ -131,7 +131,7 @@ impl Counters {
 impl<'a> Solver<'a> {
     fn new(scene: &'a Scene, pattern: &'a Pattern, threads: usize) -> Result<Self, RunError> {
         let lin = LinearSolver::new(pattern)?;
-        let ws = Workspace::new(pattern.n, pattern.nnz());
+        let ws = Workspace::new(pattern);
         let summary = Summary {
             mode: match scene.settings.solver.mode {
                 Mode::Static => "static",
@@ -179,6 +179,7 @@ impl<'a> Solver<'a> {
         writer: &mut Writer,
         pot: &Potential,
         x: &[Vec3],
+        phi: &[Real],
         v: &[Vec3],
         time: Real,
     ) -> Result<(), RunError> {
@@ -197,36 +198,55 @@ impl<'a> Solver<'a> {
             wall_seconds: self.start.elapsed().as_secs_f64(),
         };
         self.at_last_frame = now;
-        writer.frame(pot, x, v, row)?;
+        writer.frame(pot, x, phi, v, row)?;
         Ok(())
     }
 
     /// Tests `H + δI ≻ 0` at `x` (see module doc).
-    fn is_stable(&mut self, dial: Real, x: &[Vec3]) -> bool {
+    fn is_stable(&mut self, dial: Real, x: &[Vec3], phi: &[Real]) -> bool {
         let pot = self.potential(dial);
         let mut values = vec![0.0; self.pattern.nnz()];
         let mut g = vec![0.0; self.pattern.n];
-        pot.eval(x, Want::Hessian, &mut g, &mut values);
+        pot.eval(x, phi, Want::Hessian, &mut g, &mut values);
         // One factorisation of H + 1e-9·mean|diag|·I (τ may not grow beyond 1e-9).
         let mut shifted = vec![0.0; values.len()];
         factor_with_shift_upto(&mut self.lin, &pot, &values, &mut shifted, 1e-9, 1e-9).is_some()
     }
 }
 
-/// Runs a scene to completion, writing frames, the log and the summary.
+/// A state to start from instead of the reference mesh (a restart).
+#[derive(Clone, Debug)]
+pub struct InitialState {
+    /// Positions (m).
+    pub x: Vec<Vec3>,
+    /// Edge DOFs (rad), empty without them.
+    pub phi: Vec<Real>,
+    /// Velocities (m/s), for dynamics; `None` starts at rest.
+    pub v: Option<Vec<Vec3>>,
+    /// Time (dynamics, s) or dial factor (statics) to resume from.
+    pub time: Real,
+}
+
+/// Runs a scene to completion from the reference mesh, or from `initial` (a restart), writing
+/// frames, the log and the summary.
 pub fn run(
     scene: &Scene,
     writer: &mut Writer,
     progress: &mut dyn Progress,
     threads: usize,
+    initial: Option<InitialState>,
 ) -> Result<Summary, RunError> {
-    let pattern = Pattern::new(
-        &scene.mesh.positions,
-        &scene.mesh.faces,
-        &scene.stencil_extra(),
-    );
+    let pattern = Pattern::for_scene(scene);
     let mut s = Solver::new(scene, &pattern, threads)?;
-    let mut x = scene.mesh.positions.clone();
+    let (mut x, phi, v, start) = match initial {
+        Some(st) => (st.x, st.phi, st.v, Some(st.time)),
+        None => (
+            scene.mesh.positions.clone(),
+            vec![0.0; scene.num_edge_dofs()],
+            None,
+            None,
+        ),
+    };
     let sb = scene.settings.solver.symmetry_breaking;
     if sb > 0.0 && is_planar(scene, &x) {
         perturb(
@@ -237,8 +257,8 @@ pub fn run(
         );
     }
     match scene.settings.solver.mode {
-        Mode::Static => run_static(&mut s, writer, progress, x)?,
-        Mode::Dynamic => run_dynamic(&mut s, writer, progress, x)?,
+        Mode::Static => run_static(&mut s, writer, progress, x, phi, start)?,
+        Mode::Dynamic => run_dynamic(&mut s, writer, progress, x, phi, v, start.unwrap_or(0.0))?,
     }
     s.summary.wall_seconds = s.start.elapsed().as_secs_f64();
     s.summary.frames = writer.num_frames();
@@ -252,6 +272,8 @@ fn run_static(
     writer: &mut Writer,
     progress: &mut dyn Progress,
     mut x: Vec<Vec3>,
+    mut phi: Vec<Real>,
+    restart: Option<Real>,
 ) -> Result<(), RunError> {
     let st = &s.scene.settings.solver;
     let (tol, max_iter) = (st.tolerance, st.max_newton_iterations);
@@ -259,15 +281,19 @@ fn run_static(
     let (check, max_escapes) = (st.check_stability, st.max_saddle_escapes);
     let cont_frames = s.scene.settings.output.continuation_frames;
     let zeros = vec![Vec3::zeros(); x.len()];
+    let dial_start = restart.unwrap_or(0.0).clamp(0.0, 1.0);
     {
-        let pot = s.potential(0.0);
-        s.frame(writer, &pot, &x, &zeros, 0.0)?;
+        let pot = s.potential(dial_start);
+        s.frame(writer, &pot, &x, &phi, &zeros, dial_start)?;
     }
-    let mut dial = 0.0;
+    let mut dial = dial_start;
+    // A restart solves at least once, even from a frame at dial 1 (the settings may differ).
+    let mut need_solve = restart.is_some();
     let mut step = st.continuation_step;
     let mut trial = x.clone();
+    let mut trial_phi = phi.clone();
     let mut failure: Option<String> = None;
-    while dial < 1.0 {
+    while dial < 1.0 || need_solve {
         let target = (dial + step).min(1.0);
         // Intermediate continuation steps need not be solved to full accuracy.
         let t = if target < 1.0 {
@@ -276,18 +302,22 @@ fn run_static(
             tol
         };
         trial.copy_from_slice(&x);
+        trial_phi.copy_from_slice(&phi);
         let pot = s.potential(target);
         let rep = newton(
             &pot,
             &mut s.lin,
             &mut s.ws,
             &mut trial,
+            &mut trial_phi,
             NewtonOptions { tol: t, max_iter },
         );
         s.record(&rep);
         if rep.converged {
             x.copy_from_slice(&trial);
+            phi.copy_from_slice(&trial_phi);
             dial = target;
+            need_solve = false;
             s.summary.steps += 1;
             if rep.iterations <= 5 {
                 step = (step * 2.0).min(1.0);
@@ -298,7 +328,7 @@ fn run_static(
             );
             if cont_frames && dial < 1.0 {
                 let pot = s.potential(dial);
-                s.frame(writer, &pot, &x, &zeros, dial)?;
+                s.frame(writer, &pot, &x, &phi, &zeros, dial)?;
             }
         } else {
             s.summary.rejected_steps += 1;
@@ -314,7 +344,7 @@ fn run_static(
     }
     if failure.is_none() && check {
         let mut escapes = 0;
-        while !s.is_stable(1.0, &x) {
+        while !s.is_stable(1.0, &x, &phi) {
             if escapes >= max_escapes {
                 failure = Some(format!(
                     "equilibrium is a saddle (Hessian indefinite) after {escapes} perturbations"
@@ -330,6 +360,7 @@ fn run_static(
                 &mut s.lin,
                 &mut s.ws,
                 &mut x,
+                &mut phi,
                 NewtonOptions {
                     tol,
                     max_iter: max_iter * 5,
@@ -347,8 +378,8 @@ fn run_static(
     s.summary.converged = failure.is_none();
     s.summary.reason = failure.unwrap_or_default();
     let pot = s.potential(dial);
-    s.summary.energy = Writer::energies(&pot, &x, &zeros);
-    s.frame(writer, &pot, &x, &zeros, 1.0_f64.max(dial))?;
+    s.summary.energy = Writer::energies(&pot, &x, &phi, &zeros);
+    s.frame(writer, &pot, &x, &phi, &zeros, 1.0_f64.max(dial))?;
     Ok(())
 }
 
@@ -357,6 +388,9 @@ fn run_dynamic(
     writer: &mut Writer,
     progress: &mut dyn Progress,
     mut x: Vec<Vec3>,
+    mut phi: Vec<Real>,
+    v0: Option<Vec<Vec3>>,
+    t0: Real,
 ) -> Result<(), RunError> {
     let sc = s.scene;
     let tm = sc.settings.time.clone();
@@ -373,22 +407,25 @@ fn run_dynamic(
         }
     };
     let n = x.len();
-    let mut v = vec![Vec3::zeros(); n];
+    let mut v = v0.unwrap_or_else(|| vec![Vec3::zeros(); n]);
     let mut xhat = x.clone();
     let mut trial = x.clone();
+    let mut trial_phi = phi.clone();
     let damping = tm.damping > 0.0;
     let (mut a_prev, mut b_prev) = if damping {
-        sc.forms(&x)
+        sc.forms(&x, &phi)
     } else {
         (Vec::new(), Vec::new())
     };
     {
-        let pot = s.potential(dial_at(0.0));
-        s.frame(writer, &pot, &x, &v, 0.0)?;
+        let pot = s.potential(dial_at(t0));
+        s.frame(writer, &pot, &x, &phi, &v, t0)?;
     }
-    let mut t = 0.0;
+    let mut t = t0;
     let mut dt = tm.dt;
-    let mut next_out = tm.output_interval.min(tm.end);
+    // The next output time after the start (a restart resumes the output grid).
+    let mut next_out = (((t0 / tm.output_interval) + 1e-9).floor() + 1.0) * tm.output_interval;
+    next_out = next_out.min(tm.end);
     let mut easy = 0;
     let mut failure: Option<String> = None;
     let eps_t = 1e-12 * tm.end;
@@ -399,6 +436,7 @@ fn run_dynamic(
             xhat[i] = x[i] + v[i] * h;
         }
         trial.copy_from_slice(&xhat);
+        trial_phi.copy_from_slice(&phi);
         let pot = Potential {
             scene: sc,
             pattern: s.pattern,
@@ -419,6 +457,7 @@ fn run_dynamic(
             &mut s.lin,
             &mut s.ws,
             &mut trial,
+            &mut trial_phi,
             NewtonOptions { tol, max_iter },
         );
         s.record(&rep);
@@ -439,10 +478,11 @@ fn run_dynamic(
             v[i] = (trial[i] - x[i]) / h;
         }
         x.copy_from_slice(&trial);
+        phi.copy_from_slice(&trial_phi);
         t += h;
         s.summary.steps += 1;
         if damping {
-            let (a, b) = sc.forms(&x);
+            let (a, b) = sc.forms(&x, &phi);
             a_prev = a;
             b_prev = b;
         }
@@ -464,9 +504,9 @@ fn run_dynamic(
         if tm.stop_at_equilibrium {
             let pot = s.potential(dial);
             let mut g = vec![0.0; s.pattern.n];
-            pot.eval(&x, Want::Gradient, &mut g, &mut []);
-            let r = g.iter().fold(0.0 as Real, |m, v| m.max(v.abs())) / sc.force_scale;
-            let en = Writer::energies(&pot, &x, &v);
+            pot.eval(&x, &phi, Want::Gradient, &mut g, &mut []);
+            let r = pot.residual(&g);
+            let en = Writer::energies(&pot, &x, &phi, &v);
             stop = dial >= 1.0
                 && r <= tol
                 && en.kinetic
@@ -475,7 +515,7 @@ fn run_dynamic(
         }
         if at_output || stop || t >= tm.end - eps_t {
             let pot = s.potential(dial);
-            s.frame(writer, &pot, &x, &v, t)?;
+            s.frame(writer, &pot, &x, &phi, &v, t)?;
             while next_out <= t + eps_t {
                 next_out += tm.output_interval;
             }
@@ -490,11 +530,11 @@ fn run_dynamic(
     s.summary.converged = failure.is_none();
     s.summary.reason = failure.unwrap_or_default();
     let pot = s.potential(dial_at(t));
-    s.summary.energy = Writer::energies(&pot, &x, &v);
+    s.summary.energy = Writer::energies(&pot, &x, &phi, &v);
     if s.summary.reason.is_empty() {
         return Ok(());
     }
     // Record the state reached when the run stopped early.
-    s.frame(writer, &pot, &x, &v, t)?;
+    s.frame(writer, &pot, &x, &phi, &v, t)?;
     Ok(())
 }

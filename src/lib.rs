@@ -17,7 +17,7 @@
 //! Case::Cylinder.program(&mut mesh);
 //! let settings = Settings::from_str_with("[rest]\ntarget = \"mesh\"\n", "example", &[]).unwrap();
 //! let scene = Scene::build(mesh, settings).unwrap();
-//! let pattern = Pattern::new(&scene.mesh.positions, &scene.mesh.faces, &scene.stencil_extra());
+//! let pattern = Pattern::for_scene(&scene);
 //! let pot = Potential {
 //!     scene: &scene,
 //!     pattern: &pattern,
@@ -29,7 +29,9 @@
 //! // The flat sheet is not at rest under the programmed curvature: positive bending energy and
 //! // a non-zero gradient.
 //! let mut grad = vec![0.0; pattern.n];
-//! let e = pot.eval(&scene.mesh.positions, Want::Gradient, &mut grad, &mut []);
+//! // Edge DOFs (the default bending model has one per edge) start at 0.
+//! let phi = vec![0.0; scene.num_edge_dofs()];
+//! let e = pot.eval(&scene.mesh.positions, &phi, Want::Gradient, &mut grad, &mut []);
 //! assert!(e > 0.0 && grad.iter().any(|g| g.abs() > 0.0));
 //! ```
 #![warn(missing_docs)]
@@ -44,6 +46,7 @@ pub mod math;
 pub mod mesh;
 pub mod output;
 pub mod rest;
+pub mod restart;
 pub mod scene;
 pub mod settings;
 pub mod solve;

@@ -8,7 +8,9 @@
 //! `t1 = e1/|e1|`, `t2 = N × t1`): `a`, `b`, `abar`, `bbar`, `mean_curvature`,
 //! `gauss_curvature`, `k1`, `k2` (principal curvatures, ascending), `stretching_energy_density`,
 //! `bending_energy_density` (J/m² of rest area), `thickness`, and `tri_tags` when the input has
-//! it; with patch-fit bending, `patch_condition` (the condition number of each face's fit). Per
+//! it; with patch-fit bending, `patch_condition` (the condition number of each face's fit); with
+//! edge DOFs, `edge_angles` (rad, 3 components: the DOF `φ` of the edges opposite `v0, v1, v2`;
+//! each edge's value appears in both its faces, and a restart reads it back). Per
 //! vertex: `displacement`, `velocity`, `constraint_indicators`, and `node_tags` when present.
 
 use crate::geometry::curvatures;
@@ -227,9 +229,9 @@ impl Writer {
     }
 
     /// Energies of a state by term.
-    pub fn energies(pot: &Potential, x: &[Vec3], v: &[Vec3]) -> Energies {
+    pub fn energies(pot: &Potential, x: &[Vec3], phi: &[Real], v: &[Vec3]) -> Energies {
         let sc = pot.scene;
-        let (a, b) = sc.forms(x);
+        let (a, b) = sc.forms(x, phi);
         Self::energies_of(pot, x, v, &face_energies(pot, &a, &b))
     }
 
@@ -254,6 +256,7 @@ impl Writer {
         &mut self,
         pot: &Potential,
         x: &[Vec3],
+        phi: &[Real],
         v: &[Vec3],
         mut row: LogRow,
     ) -> Result<(), OutputError> {
@@ -261,7 +264,7 @@ impl Writer {
         let index = self.frames.len();
         row.frame = index;
         let nf = sc.num_faces();
-        let (a, b) = sc.forms(x);
+        let (a, b) = sc.forms(x, phi);
         let fe = face_energies(pot, &a, &b);
         row.energy = Self::energies_of(pot, x, v, &fe);
         let mut fa = Vec::with_capacity(3 * nf);
@@ -314,6 +317,10 @@ impl Writer {
         ff.insert("stretching_energy_density".into(), Field::scalar(es));
         ff.insert("bending_energy_density".into(), Field::scalar(eb));
         ff.insert("thickness".into(), Field::scalar(sc.thickness.clone()));
+        if sc.has_edge_dofs() {
+            let ea = sc.topo.face_edges.iter().flat_map(|fe| fe.map(|e| phi[e]));
+            ff.insert("edge_angles".into(), vec3(ea.collect()));
+        }
         if !sc.patches.is_empty() {
             ff.insert(
                 "patch_condition".into(),

@@ -38,6 +38,13 @@ pub struct Scene {
     pub warnings: Vec<String>,
     /// Patch-fit bending data per face (`material.bending = "patch_fit"`), else empty.
     pub patches: Vec<crate::energy::patch::Patch>,
+    /// Edge-DOF models: each face's orientation sign `σ` on its edges (+1 for the edge's first
+    /// face, −1 for its second), else empty.
+    pub edge_sign: Vec<[Real; 3]>,
+    /// True for fixed DOF nodes: the vertices, then (edge-DOF models) the edges. Edge DOFs are
+    /// free, including on the boundary (the natural free-edge condition, see
+    /// [`crate::energy::midedge_angle`]).
+    pub node_fixed: Vec<bool>,
 }
 
 fn positive_face_field(mesh: &Mesh, name: &str) -> Result<Option<Vec<Real>>, MeshError> {
@@ -171,6 +178,19 @@ impl Scene {
         } else {
             Vec::new()
         };
+        let (edge_sign, node_fixed) = if m.bending.angle_variant().is_some() {
+            let sign = topo
+                .face_edges
+                .iter()
+                .enumerate()
+                .map(|(f, fe)| fe.map(|e| if topo.edge_faces[e][0] == f { 1.0 } else { -1.0 }))
+                .collect();
+            let mut nf = fixed.clone();
+            nf.resize(nv + topo.edges.len(), false);
+            (sign, nf)
+        } else {
+            (Vec::new(), fixed.clone())
+        };
         let mean_edge = mesh.mean_edge_length();
         let eh = young
             .iter()
@@ -192,6 +212,8 @@ impl Scene {
             fixed,
             warnings,
             patches,
+            edge_sign,
+            node_fixed,
         })
     }
 
@@ -215,8 +237,71 @@ impl Scene {
         }
     }
 
-    /// First and second fundamental forms of every face at `x`, with this scene's bending model.
-    pub fn forms(&self, x: &[Vec3]) -> (Vec<Sym2>, Vec<Sym2>) {
+    /// Whether the bending model has one DOF per edge.
+    pub fn has_edge_dofs(&self) -> bool {
+        !self.edge_sign.is_empty()
+    }
+
+    /// Number of edge DOFs (0 without them).
+    pub fn num_edge_dofs(&self) -> usize {
+        if self.has_edge_dofs() {
+            self.topo.edges.len()
+        } else {
+            0
+        }
+    }
+
+    /// The bending model for the assembly.
+    pub fn bending(&self) -> crate::assembly::Bending<'_> {
+        use crate::assembly::Bending;
+        match self.settings.material.bending.angle_variant() {
+            Some(variant) => Bending::MidedgeAngle {
+                variant,
+                sigma: &self.edge_sign,
+            },
+            None if !self.patches.is_empty() => Bending::PatchFit(&self.patches),
+            None => Bending::MidedgeAverage,
+        }
+    }
+
+    /// First and second fundamental forms of every face at `x` (edge DOFs `phi`, empty without
+    /// them), with this scene's bending model.
+    pub fn forms(&self, x: &[Vec3], phi: &[Real]) -> (Vec<Sym2>, Vec<Sym2>) {
+        if let Some(variant) = self.settings.material.bending.angle_variant() {
+            let t = &self.topo;
+            let ab = self
+                .mesh
+                .faces
+                .iter()
+                .enumerate()
+                .map(|(f, face)| {
+                    let xf = face.map(|v| x[v]);
+                    let o = t.opposite_vertex[f];
+                    let has = o.map(|v| v != crate::mesh::topology::NONE);
+                    let xs = [0, 1, 2, 3, 4, 5].map(|s| {
+                        if s < 3 {
+                            xf[s]
+                        } else if has[s - 3] {
+                            x[o[s - 3]]
+                        } else {
+                            xf[0]
+                        }
+                    });
+                    let ph = t.face_edges[f].map(|e| phi[e]);
+                    (
+                        crate::geometry::first_fundamental_form(&xf),
+                        crate::energy::midedge_angle::midedge_angle_b(
+                            &xs,
+                            has,
+                            &ph,
+                            self.edge_sign[f],
+                            variant,
+                        ),
+                    )
+                })
+                .unzip();
+            return ab;
+        }
         if self.patches.is_empty() {
             return crate::rest::mesh_forms(x, &self.mesh, &self.topo);
         }

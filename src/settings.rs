@@ -89,9 +89,10 @@ pub struct Material {
     /// Stretching normalisation: `"koiter"` (standard, seed 000) or `"morphoshell"` (4× larger,
     /// MorphoShell's convention) (default: `"koiter"`).
     pub stretch_convention: StretchConvention,
-    /// Discrete second fundamental form: `"midedge_average"` (seed 000) or `"patch_fit"`
-    /// (MorphoShell's quadratic patch fit, flat reference meshes only) (default:
-    /// `"midedge_average"`).
+    /// Discrete second fundamental form: `"midedge_average"` (seed 000), `"patch_fit"`
+    /// (MorphoShell's quadratic patch fit, flat reference meshes only), `"midedge_sin"` or
+    /// `"midedge_tan"` (mid-edge normals with one rotation DOF per edge) (default:
+    /// `"midedge_sin"`).
     pub bending: BendingModel,
 }
 
@@ -100,10 +101,26 @@ pub struct Material {
 #[serde(rename_all = "snake_case")]
 pub enum BendingModel {
     /// Seed 000's mid-edge average normals.
-    #[default]
     MidedgeAverage,
     /// MorphoShell's quadratic patch fit through the face and 3 nearby nodes.
     PatchFit,
+    /// Mid-edge normals with one rotation DOF per edge, `q = h sin(θ/2 + σφ)`.
+    #[default]
+    MidedgeSin,
+    /// As `MidedgeSin` with `q = h tan(θ/2 + σφ)`.
+    MidedgeTan,
+}
+
+impl BendingModel {
+    /// The edge-DOF variant, if this model has edge DOFs.
+    pub fn angle_variant(self) -> Option<crate::energy::midedge_angle::AngleVariant> {
+        use crate::energy::midedge_angle::AngleVariant;
+        match self {
+            BendingModel::MidedgeSin => Some(AngleVariant::Sin),
+            BendingModel::MidedgeTan => Some(AngleVariant::Tan),
+            _ => None,
+        }
+    }
 }
 
 impl Default for Material {
@@ -116,7 +133,7 @@ impl Default for Material {
             use_mesh_thickness: true,
             use_mesh_shear_modulus: true,
             stretch_convention: StretchConvention::Koiter,
-            bending: BendingModel::MidedgeAverage,
+            bending: BendingModel::default(),
         }
     }
 }

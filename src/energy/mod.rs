@@ -4,9 +4,12 @@
 //!
 //! * [`material`]: plane-stress Lamé parameters and the Koiter (St Venant–Kirchhoff) density.
 //! * [`shell`]: the discrete Koiter shell face (stretching + mid-edge bending), seed 000 §3.
+//! * [`midedge_angle`]: the mid-edge shell with one rotation DOF per edge (sin/tan variants).
+//! * [`patch`]: MorphoShell's quadratic patch-fit curvature (seed 001 §2).
 //! * [`projection`]: optional per-element projection of a Hessian to positive semi-definite.
 
 pub mod material;
+pub mod midedge_angle;
 pub mod patch;
 pub mod projection;
 pub mod shell;

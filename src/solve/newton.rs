@@ -7,7 +7,8 @@
 //! definite (beyond the tiny shift that free rigid-body modes need) uses the Gauss–Newton Hessian
 //! instead: positive semi-definite by construction and of the right curvature scale, where a
 //! global shift would degrade to gradient descent. After a Gauss–Newton iteration, the exact
-//! Hessian is tried again once a full step is accepted (a sign of the quadratic region). Convergence: ‖∇Φ‖∞ ≤ tol · F over free DOFs, with F the scene's force scale. Non-finite
+//! Hessian is tried again once a full step is accepted (a sign of the quadratic region). Convergence: ‖∇Φ‖∞ ≤ tol · F over free DOFs, with F the scene's force scale (edge-DOF
+//! moments divided by the mean edge length, [`Potential::residual`]). Non-finite
 //! energies are treated as a failed trial point, never accepted.
 
 use super::linear::LinearSolver;
@@ -55,17 +56,21 @@ pub struct Workspace {
     shifted: Vec<Real>,
     step: Vec<Real>,
     trial: Vec<Vec3>,
+    trial_phi: Vec<Real>,
 }
 
 impl Workspace {
-    /// Buffers for `n` DOFs and `nnz` Hessian entries.
-    pub fn new(n: usize, nnz: usize) -> Self {
+    /// Buffers for a pattern's DOFs and Hessian entries.
+    pub fn new(pattern: &crate::assembly::Pattern) -> Self {
+        let n = pattern.n;
+        let nnz = pattern.nnz();
         Workspace {
             grad: vec![0.0; n],
             values: vec![0.0; nnz],
             shifted: vec![0.0; nnz],
             step: vec![0.0; n],
-            trial: vec![Vec3::zeros(); n / 3],
+            trial: vec![Vec3::zeros(); pattern.num_vertices],
+            trial_phi: vec![0.0; pattern.num_edge_dofs],
         }
     }
 
@@ -73,10 +78,6 @@ impl Workspace {
     pub fn gradient(&self) -> &[Real] {
         &self.grad
     }
-}
-
-fn inf_norm(v: &[Real]) -> Real {
-    v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
 /// Factorises `values + τ·scale·I`, growing τ until it succeeds. Returns τ, or None if even a
@@ -129,15 +130,15 @@ pub fn factor_with_shift_upto(
     }
 }
 
-/// Minimises `pot` from `x` (updated in place).
+/// Minimises `pot` from positions `x` and edge DOFs `phi` (both updated in place).
 pub fn newton(
     pot: &Potential,
     lin: &mut LinearSolver,
     ws: &mut Workspace,
     x: &mut [Vec3],
+    phi: &mut [Real],
     opts: NewtonOptions,
 ) -> NewtonReport {
-    let force = pot.scene.force_scale.max(Real::MIN_POSITIVE);
     let mut rep = NewtonReport::default();
     let mut tau_prev: Real = 0.0;
     let mode = pot.scene.settings.solver.hessian_projection;
@@ -150,11 +151,10 @@ pub fn newton(
             HessianProjection::Adaptive => HessianProjection::None,
             m => m,
         };
-        let e = pot.eval_projected(x, Want::Hessian, first, &mut ws.grad, &mut ws.values);
+        let e = pot.eval_projected(x, phi, Want::Hessian, first, &mut ws.grad, &mut ws.values);
         rep.energy = e;
-        let gnorm = inf_norm(&ws.grad);
-        rep.residual = gnorm / force;
-        if !e.is_finite() || !gnorm.is_finite() {
+        rep.residual = pot.residual(&ws.grad);
+        if !e.is_finite() || !rep.residual.is_finite() {
             rep.reason = "non-finite energy or gradient".into();
             return rep;
         }
@@ -198,6 +198,7 @@ pub fn newton(
                         // Gauss–Newton otherwise.
                         pot.eval_projected(
                             x,
+                            phi,
                             Want::Hessian,
                             HessianProjection::GaussNewton,
                             &mut ws.grad,
@@ -246,7 +247,11 @@ pub fn newton(
                 *t = x[v]
                     + Vec3::new(ws.step[3 * v], ws.step[3 * v + 1], ws.step[3 * v + 2]) * alpha;
             }
-            let et = pot.eval(&ws.trial, Want::Energy, &mut [], &mut []);
+            let off = 3 * x.len();
+            for (k, t) in ws.trial_phi.iter_mut().enumerate() {
+                *t = phi[k] + ws.step[off + k] * alpha;
+            }
+            let et = pot.eval(&ws.trial, &ws.trial_phi, Want::Energy, &mut [], &mut []);
             if et.is_finite() && et <= e + 1e-4 * alpha * slope + slack {
                 accepted = true;
                 break;
@@ -262,6 +267,7 @@ pub fn newton(
             return rep;
         }
         x.copy_from_slice(&ws.trial);
+        phi.copy_from_slice(&ws.trial_phi);
         if mode == HessianProjection::Adaptive {
             try_exact = !projected || alpha == 1.0;
         }

@@ -6,6 +6,10 @@
 //! Statics use only the elastic and gravity terms. Dynamics (implicit Euler, seed 000 §3) add
 //! inertia with `x̂ = x_n + Δt v_n` (its minimiser satisfies `M(v_{n+1} − v_n)/Δt = F(x_{n+1})`)
 //! and the Kelvin–Voigt damping potential. Only the terms a scene enables are assembled.
+//!
+//! With an edge-DOF bending model, Φ also depends on the edge angles φ (massless: they carry no
+//! inertia, so each implicit step sets them quasi-statically, as the bending they describe is a
+//! through-thickness rotation whose inertia is O(h²) smaller than the translational one).
 
 use crate::assembly::{assemble_faces, Pattern, Want};
 use crate::energy::material::sv_matrix;
@@ -70,16 +74,35 @@ impl<'a> Potential<'a> {
         d
     }
 
-    /// Evaluates Φ and, as wanted, its gradient (len 3n) and exact Hessian values (pattern
-    /// order). Fixed vertices get zero gradient and a unit-scaled identity block.
-    pub fn eval(&self, x: &[Vec3], want: Want, grad: &mut [Real], values: &mut [Real]) -> Real {
-        self.eval_projected(x, want, HessianProjection::None, grad, values)
+    /// Evaluates Φ at positions `x` and edge DOFs `phi` (empty without them) and, as wanted, its
+    /// gradient (len `pattern.n`) and exact Hessian values (pattern order). Fixed nodes get zero
+    /// gradient and a unit-scaled identity block.
+    pub fn eval(
+        &self,
+        x: &[Vec3],
+        phi: &[Real],
+        want: Want,
+        grad: &mut [Real],
+        values: &mut [Real],
+    ) -> Real {
+        self.eval_projected(x, phi, want, HessianProjection::None, grad, values)
+    }
+
+    /// The relative residual of a gradient: `max(‖g_x‖∞, ‖g_φ‖∞ / ℓ) / F`, with `F` the scene's
+    /// force scale and `ℓ` its mean edge length (an edge DOF's gradient is a moment, N·m).
+    pub fn residual(&self, grad: &[Real]) -> Real {
+        let nx = 3 * self.pattern.num_vertices;
+        let gx = grad[..nx].iter().fold(0.0 as Real, |m, v| m.max(v.abs()));
+        let gp = grad[nx..].iter().fold(0.0 as Real, |m, v| m.max(v.abs()));
+        let f = self.scene.force_scale.max(Real::MIN_POSITIVE);
+        gx.max(gp / self.scene.mean_edge) / f
     }
 
     /// As [`Potential::eval`], with the element Hessians projected as `projection` says.
     pub fn eval_projected(
         &self,
         x: &[Vec3],
+        phi: &[Real],
         want: Want,
         projection: HessianProjection,
         grad: &mut [Real],
@@ -89,9 +112,10 @@ impl<'a> Potential<'a> {
         let mut e = assemble_faces(
             self.pattern,
             x,
-            &sc.patches,
+            phi,
+            sc.bending(),
             |f| self.density(f),
-            &sc.fixed,
+            &sc.node_fixed,
             projection,
             want,
             grad,
@@ -139,10 +163,11 @@ impl<'a> Potential<'a> {
                 }
             }
             let scale = if cnt > 0 { sum / cnt as Real } else { 1.0 };
-            for (v, &fx) in sc.fixed.iter().enumerate() {
+            for (u, &fx) in sc.node_fixed.iter().enumerate() {
                 if fx {
-                    for c in 0..3 {
-                        values[self.pattern.diag(3 * v + c)] = scale;
+                    let (d0, k) = self.pattern.node_dofs(u);
+                    for c in 0..k {
+                        values[self.pattern.diag(d0 + c)] = scale;
                     }
                 }
             }

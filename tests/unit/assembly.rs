@@ -34,8 +34,24 @@ fn scene_with_edge(settings: &str, program: Option<Case>, edge: f64) -> Scene {
 }
 
 fn pattern(sc: &Scene) -> Pattern {
-    Pattern::new(&sc.mesh.positions, &sc.mesh.faces, &sc.stencil_extra())
+    Pattern::for_scene(sc)
 }
+
+/// Random edge DOFs of amplitude 0.05 rad (empty without them).
+fn angles(sc: &Scene) -> Vec<f64> {
+    let mut rng = Rng::new(9);
+    (0..sc.num_edge_dofs())
+        .map(|_| 0.05 * rng.symmetric())
+        .collect()
+}
+
+/// Every bending model, as a settings line.
+const MODELS: [&str; 4] = [
+    "bending = \"midedge_average\"",
+    "bending = \"patch_fit\"",
+    "bending = \"midedge_sin\"",
+    "bending = \"midedge_tan\"",
+];
 
 fn bumpy(sc: &Scene) -> Vec<Vec3> {
     let mut rng = Rng::new(1);
@@ -62,20 +78,28 @@ fn rest_state_has_zero_energy_and_gradient() {
         gravity: Vec3::zeros(),
     };
     let mut g = vec![0.0; p.n];
-    let e = pot.eval(&sc.mesh.positions, Want::Gradient, &mut g, &mut []);
+    let phi = vec![0.0; sc.num_edge_dofs()];
+    let e = pot.eval(&sc.mesh.positions, &phi, Want::Gradient, &mut g, &mut []);
     assert!(e.abs() < 1e-20, "E = {e}");
-    assert!(g.iter().all(|v| v.abs() < 1e-12), "gradient not zero");
+    assert!(g.iter().all(|v: &f64| v.abs() < 1e-12), "gradient not zero");
 }
 
 #[test]
 fn assembly_is_bitwise_identical_for_any_thread_count() {
+    for model in [MODELS[0], MODELS[2]] {
+        bitwise_identical(model);
+    }
+}
+
+fn bitwise_identical(model: &str) {
     let sc = scene_with_edge(
-        "[rest]\ntarget = \"mesh\"\n",
+        &format!("[material]\n{model}\n[rest]\ntarget = \"mesh\"\n"),
         Some(Case::SphericalCap),
         0.02,
     );
     let p = pattern(&sc);
     let x = bumpy(&sc);
+    let phi = angles(&sc);
     let eval = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -92,11 +116,11 @@ fn assembly_is_bitwise_identical_for_any_thread_count() {
             };
             let mut g = vec![0.0; p.n];
             let mut h = vec![0.0; p.nnz()];
-            let e = pot.eval(&x, Want::Hessian, &mut g, &mut h);
+            let e = pot.eval(&x, &phi, Want::Hessian, &mut g, &mut h);
             (
                 e.to_bits(),
-                g.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
-                h.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                g.iter().map(|v: &f64| v.to_bits()).collect::<Vec<_>>(),
+                h.iter().map(|v: &f64| v.to_bits()).collect::<Vec<_>>(),
             )
         })
     };
@@ -107,9 +131,18 @@ fn assembly_is_bitwise_identical_for_any_thread_count() {
 
 #[test]
 fn assembled_derivatives_match_finite_differences() {
-    let sc = scene("[rest]\ntarget = \"mesh\"\n[constraints]\nfix_boxes = [{ min = [-1, -1, -1], max = [-0.45, 1, 1] }]\n", Some(Case::Hyperboloid));
+    for model in MODELS {
+        assembled_derivatives(model);
+    }
+}
+
+fn assembled_derivatives(model: &str) {
+    let sc = scene(&format!("[material]\n{model}\n[rest]\ntarget = \"mesh\"\n[constraints]\nfix_boxes = [{{ min = [-1, -1, -1], max = [-0.45, 1, 1] }}]\n"), Some(Case::Hyperboloid));
     let p = pattern(&sc);
     let x = bumpy(&sc);
+    let phi = angles(&sc);
+    let nx = 3 * sc.num_vertices();
+    let node_of = |k: usize| if k < nx { k / 3 } else { sc.num_vertices() + (k - nx) };
     let xhat: Vec<Vec3> = x.iter().map(|v| v * 1.01).collect();
     let a_prev = vec![shellsim::math::Sym2::new(0.01, 0.001, 0.012); sc.num_faces()];
     let b_prev = vec![shellsim::math::Sym2::new(0.001, 0.0, -0.001); sc.num_faces()];
@@ -130,39 +163,42 @@ fn assembled_derivatives_match_finite_differences() {
     };
     let mut g = vec![0.0; p.n];
     let mut h = vec![0.0; p.nnz()];
-    pot.eval(&x, Want::Hessian, &mut g, &mut h);
+    pot.eval(&x, &phi, Want::Hessian, &mut g, &mut h);
     let eps = 1e-6;
     let gmax = g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let hmax = h.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     for k in (0..p.n).step_by(7) {
-        let (v, c) = (k / 3, k % 3);
-        if sc.fixed[v] {
+        if sc.node_fixed[node_of(k)] {
             continue;
         }
-        let mut xp = x.clone();
-        xp[v][c] += eps;
-        let mut xm = x.clone();
-        xm[v][c] -= eps;
+        let (mut xp, mut xm, mut pp, mut pm) = (x.clone(), x.clone(), phi.clone(), phi.clone());
+        if k < nx {
+            xp[k / 3][k % 3] += eps;
+            xm[k / 3][k % 3] -= eps;
+        } else {
+            pp[k - nx] += eps;
+            pm[k - nx] -= eps;
+        }
         let mut gp = vec![0.0; p.n];
         let mut gm = vec![0.0; p.n];
-        let ep = pot.eval(&xp, Want::Gradient, &mut gp, &mut []);
-        let em = pot.eval(&xm, Want::Gradient, &mut gm, &mut []);
+        let ep = pot.eval(&xp, &pp, Want::Gradient, &mut gp, &mut []);
+        let em = pot.eval(&xm, &pm, Want::Gradient, &mut gm, &mut []);
         let fd = (ep - em) / (2.0 * eps);
         assert!(
             (fd - g[k]).abs() < 1e-6 * gmax,
-            "grad {k}: {} vs {fd}",
+            "{model}: grad {k}: {} vs {fd}",
             g[k]
         );
         // Column k of the Hessian (lower part stored in column k, upper part in rows).
         for (pos, &row) in p.row_idx[p.col_ptr[k]..p.col_ptr[k + 1]].iter().enumerate() {
             let fd = (gp[row] - gm[row]) / (2.0 * eps);
             let val = h[p.col_ptr[k] + pos];
-            if sc.fixed[row / 3] {
+            if sc.node_fixed[node_of(row)] {
                 continue;
             }
             assert!(
                 (fd - val).abs() < 1e-6 * hmax,
-                "H({row},{k}): {val} vs {fd}"
+                "{model}: H({row},{k}): {val} vs {fd}"
             );
         }
     }
@@ -172,7 +208,7 @@ fn assembled_derivatives_match_finite_differences() {
 fn colouring_separates_stencils() {
     let sc = scene_with_edge("", None, 0.02);
     let p = pattern(&sc);
-    let mut seen = vec![usize::MAX; sc.num_vertices()];
+    let mut seen = vec![usize::MAX; sc.num_vertices() + sc.num_edge_dofs()];
     let mut total = 0;
     for (c, blocks) in p.colours().iter().enumerate() {
         for (b, block) in blocks.iter().enumerate() {

@@ -1,0 +1,303 @@
+//! The mid-edge shell with one rotation degree of freedom per edge: the mid-edge normal of each
+//! edge is free to turn about the edge, away from the average of the two face normals.
+//!
+//! ## Formula
+//! For face `f` and its edge `i` (opposite vertex `i`), with `h_i` the height of `v_i` over the
+//! edge, `θ_i` the signed dihedral angle between `f` and its neighbour across the edge, `φ_e` the
+//! edge's DOF (rad) and `σ = ±1` the face's orientation relative to the edge (+1 for the edge's
+//! first face, −1 for the second):
+//!
+//! `q_i = h_i g(θ_i/2 + σ φ_e)`, `g = sin` (variant `sin`) or `g = tan` (variant `tan`),
+//!
+//! and `b = 2 [q0 + q1, q0; q0, q0 + q2]` as for the average ([`crate::geometry`]). This is the
+//! per-edge quantity `2 h_e sin(θ_e/2 + σφ_e)` of the angle-based mid-edge shells that followed
+//! seed 000 (Chen, Sastry, van Rees & Vouga 2018, "Physical simulation of environmentally
+//! induced thin shell deformation", and its libshell "MidedgeAngleSin/Tan" formulations); the
+//! factor 2 is the one in `b = 2[…]`. With `φ = 0` the `sin` variant *is* the mid-edge average
+//! (`h sin(θ/2) = (v_j − v_i)·N_g/|N_f + N_g|`). Rotating the normal by `+φ` from one face is a
+//! rotation by `−φ` seen from the other, hence `σ`.
+//!
+//! ## How the derivatives are organised
+//! Write `α_i = θ_i/2`. With the average's `q̃_i = h_i sin α_i` (already differentiated in
+//! [`crate::geometry::midedge_average_q`]) and `w_i = h_i cos α_i = √(h_i² − q̃_i²)`,
+//! `α_i = atan2(q̃_i, w_i)`, and `h_i² = det a / ℓ_i²(a)` is a function of the first fundamental
+//! form only (`ℓ_0² = a11 − 2a12 + a22`, `ℓ_1² = a22`, `ℓ_2² = a11`). So the face energy is a
+//! function of 9 intermediate variables `y = (a[3], q̃[3], φ[3])`,
+//! `Ẽ(y) = W(a, B F(q̃, h(a), σφ))` with `F(q̃, h, ψ) = h g(α(q̃, h) + ψ)`; its 9-gradient and
+//! 9×9 Hessian are formed in closed form and pulled back through `J = ∂y/∂x` (21 DOFs), plus the
+//! second-derivative terms of `a` and `q̃`.
+//!
+//! ## Boundary edges
+//! An edge with one face has no dihedral angle: `θ = 0`, `q_i = h_i g(σφ_e)`. Its DOF is free, so
+//! the boundary normal settles where the face's bending moment vanishes: the natural (free-edge)
+//! boundary condition. (The mid-edge average instead pins `q = 0`, a spurious clamp that is the
+//! source of its corner error on curved shapes.)
+//!
+//! DOF order (21): `x[v0], x[v1], x[v2], x[p0], x[p1], x[p2]` (18, as [`super::shell`]), then
+//! `φ_{e0}, φ_{e1}, φ_{e2}` (rad), the DOFs of the edges opposite `v0, v1, v2`. Units: energy J,
+//! gradient N (positions) and N·m (angles).
+
+use super::material::{DensityDerivs, FaceDensity};
+use crate::geometry::{
+    b_from_q, b_from_q_matrix, first_fundamental_form, first_fundamental_form_hessian_pattern,
+    first_fundamental_form_jacobian, midedge_average_q, UnitNormal,
+};
+use crate::math::{Mat3, Real, SMat, SVec, Sym2, Vec3};
+
+/// The function `g` of `q = h g(θ/2 + σφ)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AngleVariant {
+    /// `g = sin`: the mid-edge normal's offset.
+    Sin,
+    /// `g = tan`.
+    Tan,
+}
+
+impl AngleVariant {
+    /// `(g, g', g'')` at `t`.
+    #[inline]
+    fn eval(self, t: Real) -> (Real, Real, Real) {
+        match self {
+            AngleVariant::Sin => {
+                let (s, c) = t.sin_cos();
+                (s, c, -s)
+            }
+            AngleVariant::Tan => {
+                let tn = t.tan();
+                let sec2 = 1.0 + tn * tn;
+                (tn, sec2, 2.0 * tn * sec2)
+            }
+        }
+    }
+}
+
+/// `ℓ_i²` as a linear form in `a = [a11, a12, a22]` for the edge opposite vertex `i`.
+const EDGE_LENGTH2: [[Real; 3]; 3] = [[1.0, -2.0, 1.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]];
+
+/// Height `h_i = √(det a / ℓ_i²)` of vertex `i` over its opposite edge (m), with its gradient
+/// and Hessian with respect to `a`.
+#[inline]
+pub fn height_from_a(a: &Sym2, i: usize) -> (Real, SVec<3>, Mat3) {
+    let l = SVec::<3>::from(EDGE_LENGTH2[i]);
+    let det = a[0] * a[2] - a[1] * a[1];
+    let len2 = l.dot(a);
+    let u = det / len2;
+    let h = u.max(0.0).sqrt();
+    let gd = SVec::<3>::new(a[2], -2.0 * a[1], a[0]);
+    let hd = Mat3::new(0.0, 0.0, 1.0, 0.0, -2.0, 0.0, 1.0, 0.0, 0.0);
+    let gu = gd / len2 - l * (det / (len2 * len2));
+    let hu = hd / len2 - (gd * l.transpose() + l * gd.transpose()) / (len2 * len2)
+        + l * l.transpose() * (2.0 * det / (len2 * len2 * len2));
+    let gh = gu / (2.0 * h);
+    let hh = hu / (2.0 * h) - gu * gu.transpose() / (4.0 * h * h * h);
+    (h, gh, hh)
+}
+
+/// `F(q̃, h, ψ) = h g(α + ψ)`, `α = atan2(q̃, √(h² − q̃²))`, with its gradient and Hessian in
+/// `(q̃, h, ψ)`.
+#[inline]
+pub fn edge_q(variant: AngleVariant, qt: Real, h: Real, psi: Real) -> (Real, SVec<3>, Mat3) {
+    let w = (h * h - qt * qt).max(0.0).sqrt();
+    let alpha = qt.atan2(w);
+    let (g, g1, g2) = variant.eval(alpha + psi);
+    // α's derivatives: α_q = 1/w, α_h = −q/(h w), and their second derivatives.
+    let (aq, ah) = (1.0 / w, -qt / (h * w));
+    let w3 = w * w * w;
+    let aqq = qt / w3;
+    let aqh = -h / w3;
+    let ahh = qt * (w * w + h * h) / (h * h * w3);
+    let f = h * g;
+    let grad = SVec::<3>::new(h * g1 * aq, g + h * g1 * ah, h * g1);
+    let fqq = h * (g2 * aq * aq + g1 * aqq);
+    let fqh = g1 * aq + h * (g2 * aq * ah + g1 * aqh);
+    let fhh = 2.0 * g1 * ah + h * (g2 * ah * ah + g1 * ahh);
+    let fqp = h * g2 * aq;
+    let fhp = g1 + h * g2 * ah;
+    let fpp = h * g2;
+    let hess = Mat3::new(fqq, fqh, fqp, fqh, fhh, fhp, fqp, fhp, fpp);
+    (f, grad, hess)
+}
+
+/// Second fundamental form of one face (value only), 6 stencil positions as in the module doc.
+pub fn midedge_angle_b(
+    x: &[Vec3; 6],
+    has: [bool; 3],
+    phi: &[Real; 3],
+    sigma: [Real; 3],
+    variant: AngleVariant,
+) -> Sym2 {
+    let xf = [x[0], x[1], x[2]];
+    let a = first_fundamental_form(&xf);
+    let nf = UnitNormal::new(&xf);
+    let mut q = SVec::<3>::zeros();
+    for i in 0..3 {
+        let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+        let qt = if has[i] {
+            let ng = UnitNormal::new(&[x[3 + i], xf[k], xf[j]]).n;
+            (xf[j] - xf[i]).dot(&ng) / (nf.n + ng).norm()
+        } else {
+            0.0
+        };
+        let h = height_from_a(&a, i).0;
+        let w = (h * h - qt * qt).max(0.0).sqrt();
+        q[i] = h * variant.eval(qt.atan2(w) + sigma[i] * phi[i]).0;
+    }
+    b_from_q(&q)
+}
+
+/// Energy (J) of one face of the mid-edge shell with edge DOFs, with optional gradient and
+/// Hessian in the 21-DOF order of the module doc. `GN` selects the Gauss–Newton Hessian
+/// `Jᵀ W'' J` (positive semi-definite for the Koiter density), dropping second derivatives of
+/// `a`, `q̃`, `h` and `F`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn midedge_angle_face<D: FaceDensity, const GN: bool>(
+    x: &[Vec3; 6],
+    has: [bool; 3],
+    phi: &[Real; 3],
+    sigma: [Real; 3],
+    variant: AngleVariant,
+    dens: &D,
+    grad: Option<&mut SVec<21>>,
+    hess: Option<&mut SMat<21, 21>>,
+) -> Real {
+    let xf = [x[0], x[1], x[2]];
+    let a = first_fundamental_form(&xf);
+    let want_h = hess.is_some();
+    let want_g = grad.is_some() || want_h;
+    let nf = UnitNormal::new(&xf);
+    let mut qt = [0.0; 3];
+    let mut gqt = [SVec::<12>::zeros(); 3];
+    let mut hqt = [SMat::<12, 12>::zeros(); 3];
+    let mut fnf = [Vec3::zeros(); 3];
+    for i in 0..3 {
+        if !has[i] {
+            continue;
+        }
+        let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+        let (eq, f) = midedge_average_q(
+            &nf,
+            [i, j, k],
+            &[xf[i], xf[j], xf[k]],
+            &x[3 + i],
+            if want_h && !GN {
+                Some(&mut hqt[i])
+            } else {
+                None
+            },
+        );
+        qt[i] = eq.q;
+        gqt[i] = if want_g { eq.grad } else { SVec::zeros() };
+        fnf[i] = f;
+    }
+    let mut q = SVec::<3>::zeros();
+    let mut dh = [(SVec::<3>::zeros(), Mat3::zeros()); 3];
+    let mut df = [(SVec::<3>::zeros(), Mat3::zeros()); 3];
+    for i in 0..3 {
+        let (h, gh, hh) = height_from_a(&a, i);
+        let (f, gf, hf) = edge_q(variant, qt[i], h, sigma[i] * phi[i]);
+        q[i] = f;
+        dh[i] = (gh, hh);
+        df[i] = (gf, hf);
+    }
+    let b = b_from_q(&q);
+    let mut d = DensityDerivs::default();
+    let e = dens.eval(&a, &b, &mut d);
+    if !want_g {
+        return e;
+    }
+    // Intermediate variables y = (a[0..3], q̃[3..6], φ[6..9]); Jq = ∂q/∂y (3×9).
+    let mut jq = SMat::<3, 9>::zeros();
+    for i in 0..3 {
+        let (gf, _) = df[i];
+        for c in 0..3 {
+            jq[(i, c)] = gf[1] * dh[i].0[c];
+        }
+        jq[(i, 3 + i)] = if has[i] { gf[0] } else { 0.0 };
+        jq[(i, 6 + i)] = gf[2] * sigma[i];
+    }
+    let bq = b_from_q_matrix();
+    let lam = bq.transpose() * d.gb; // ∂E/∂q
+    let mut gy = jq.transpose() * lam;
+    for c in 0..3 {
+        gy[c] += d.ga[c];
+    }
+    // J = ∂y/∂x (9×21).
+    let ja = first_fundamental_form_jacobian(&xf);
+    let slots = |i: usize| [i, (i + 1) % 3, (i + 2) % 3, 3 + i];
+    let mut jy = SMat::<9, 21>::zeros();
+    jy.fixed_view_mut::<3, 9>(0, 0).copy_from(&ja);
+    for i in 0..3 {
+        if has[i] {
+            for (l, &s) in slots(i).iter().enumerate() {
+                for c in 0..3 {
+                    jy[(3 + i, 3 * s + c)] = gqt[i][3 * l + c];
+                }
+            }
+        }
+        jy[(6 + i, 18 + i)] = 1.0;
+    }
+    let g: SVec<21> = jy.transpose() * gy;
+    if let Some(hout) = hess {
+        // Hessian of Ẽ in y.
+        let mut hy = jq.transpose() * (bq.transpose() * d.hbb * bq) * jq;
+        {
+            let mut aa = hy.fixed_view_mut::<3, 3>(0, 0);
+            aa += d.haa;
+        }
+        if !GN {
+            for i in 0..3 {
+                // λ_i ∇²_y q_i = λ_i (Kᵀ F'' K + F_h ∇²_a h).
+                let (gf, hf) = df[i];
+                let mut kmat = SMat::<3, 9>::zeros();
+                if has[i] {
+                    kmat[(0, 3 + i)] = 1.0;
+                }
+                for c in 0..3 {
+                    kmat[(1, c)] = dh[i].0[c];
+                }
+                kmat[(2, 6 + i)] = sigma[i];
+                hy += kmat.transpose() * hf * kmat * lam[i];
+                let mut aa = hy.fixed_view_mut::<3, 3>(0, 0);
+                aa += dh[i].1 * (lam[i] * gf[1]);
+            }
+        }
+        let mut h: SMat<21, 21> = jy.transpose() * hy * jy;
+        if !GN {
+            // Σ_k ∂Ẽ/∂a_k ∇²a_k.
+            let pat = first_fundamental_form_hessian_pattern(&Sym2::new(gy[0], gy[1], gy[2]));
+            for r in 0..3 {
+                for s in 0..3 {
+                    for c in 0..3 {
+                        h[(3 * r + c, 3 * s + c)] += pat[(r, s)];
+                    }
+                }
+            }
+            // Σ_i ∂Ẽ/∂q̃_i ∇²q̃_i, the N_f part contracted once.
+            let mut lam_f = Vec3::zeros();
+            for i in 0..3 {
+                let mu = gy[3 + i];
+                if !has[i] || mu == 0.0 {
+                    continue;
+                }
+                lam_f += fnf[i] * mu;
+                let sl = slots(i);
+                for (la, &sa) in sl.iter().enumerate() {
+                    for (lb, &sb) in sl.iter().enumerate() {
+                        let blk = hqt[i].fixed_view::<3, 3>(3 * la, 3 * lb) * mu;
+                        let mut dst = h.fixed_view_mut::<3, 3>(3 * sa, 3 * sb);
+                        dst += blk;
+                    }
+                }
+            }
+            let hn = nf.hessian_contract(&lam_f);
+            let mut dst = h.fixed_view_mut::<9, 9>(0, 0);
+            dst += hn;
+        }
+        *hout = h;
+    }
+    if let Some(gout) = grad {
+        *gout = g;
+    }
+    e
+}

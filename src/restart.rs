@@ -1,0 +1,115 @@
+//! Restart from a frame written by shellsim (seed 001, "restart from an earlier frame").
+//!
+//! A frame holds the deformed positions, the per-vertex `velocity` and, with an edge-DOF bending
+//! model, the per-face `edge_angles`. The reference geometry, rest forms and material come from
+//! the mesh file and settings of the new run, so the frame must have the same vertices and faces
+//! as that mesh. The frame's time (dynamics) or dial (statics) is looked up in the `series.pvd`
+//! next to it; without one the run starts its clock at 0 and says so in a warning.
+
+use crate::integrate::InitialState;
+use crate::math::{Real, Vec3};
+use crate::mesh::io::read_mesh;
+use crate::mesh::MeshError;
+use crate::scene::Scene;
+use std::path::Path;
+
+/// Largest disagreement tolerated between the two faces' copies of an edge angle (rad). Frames
+/// written by shellsim repeat the same value exactly; text formats round to ~1e-16 relative.
+const EDGE_ANGLE_TOLERANCE: Real = 1e-9;
+
+/// Reads a restart state for `scene` from `path`. Returns the state and any warnings.
+pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<String>), MeshError> {
+    let frame = read_mesh(path)?;
+    let name = path.display().to_string();
+    let bad = |reason: String| MeshError::Invalid {
+        path: name.clone(),
+        reason,
+    };
+    let mut warnings = Vec::new();
+    if frame.positions.len() != scene.num_vertices() || frame.faces != scene.mesh.faces {
+        return Err(bad(format!(
+            "restart frame has {} vertices and {} faces, the mesh {} has {} and {} (or the faces \
+             differ): a restart needs the frame of a run on the same mesh",
+            frame.positions.len(),
+            frame.faces.len(),
+            scene.mesh.name(),
+            scene.num_vertices(),
+            scene.num_faces()
+        )));
+    }
+    if let Some(v) = frame.positions.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+        return Err(bad(format!("vertex {v} has a non-finite position")));
+    }
+    let v = match frame.vertex_field("velocity", 3)? {
+        Some(f) => {
+            if let Some(i) = f.data.iter().position(|c| !c.is_finite()) {
+                return Err(bad(format!("field 'velocity' is not finite at vertex {}", i / 3)));
+            }
+            Some((0..frame.positions.len()).map(|i| Vec3::from_column_slice(f.get(i))).collect())
+        }
+        None => None,
+    };
+    let mut phi = vec![0.0; scene.num_edge_dofs()];
+    if scene.has_edge_dofs() {
+        match frame.face_field("edge_angles", 3)? {
+            Some(f) => {
+                let mut seen = vec![false; phi.len()];
+                for (fi, fe) in scene.topo.face_edges.iter().enumerate() {
+                    for (i, &e) in fe.iter().enumerate() {
+                        let val = f.get(fi)[i];
+                        if !val.is_finite() {
+                            return Err(bad(format!(
+                                "field 'edge_angles' is not finite at face {fi}, edge {i}"
+                            )));
+                        }
+                        if !seen[e] {
+                            phi[e] = val;
+                            seen[e] = true;
+                        } else if (phi[e] - val).abs() > EDGE_ANGLE_TOLERANCE {
+                            return Err(bad(format!(
+                                "field 'edge_angles': the two faces of edge {:?} disagree ({} \
+                                 at face {fi} vs {})",
+                                scene.topo.edges[e], val, phi[e]
+                            )));
+                        }
+                    }
+                }
+            }
+            None => warnings.push(format!(
+                "{name}: no 'edge_angles' field; the edge DOFs start at 0 (the mid-edge average \
+                 normals)"
+            )),
+        }
+    }
+    let time = match series_time(path) {
+        Some(t) => t,
+        None => {
+            warnings.push(format!(
+                "{name}: not listed in a series.pvd next to it; the restart starts at time 0"
+            ));
+            0.0
+        }
+    };
+    Ok((
+        InitialState {
+            x: frame.positions,
+            phi,
+            v,
+            time,
+        },
+        warnings,
+    ))
+}
+
+/// The `timestep` of `path`'s entry in the `series.pvd` of its folder.
+fn series_time(path: &Path) -> Option<Real> {
+    let dir = path.parent()?;
+    let file = path.file_name()?.to_str()?;
+    let text = std::fs::read_to_string(dir.join("series.pvd")).ok()?;
+    text.lines()
+        .filter(|l| l.contains(&format!("file=\"{file}\"")))
+        .find_map(|l| {
+            let rest = &l[l.find("timestep=\"")? + 10..];
+            rest[..rest.find('"')?].parse().ok()
+        })
+}
