@@ -1,5 +1,7 @@
-//! Criterion benches: the shell kernel per face, assembly of ~100k faces on 1 and 2 threads,
-//! and one Newton iteration (assemble + numeric Cholesky + solve) on a ~5k-face mesh.
+//! Criterion benches: the shell kernels per face (mid-edge average, edge-DOF sin, patch fit),
+//! assembly of ~100k faces on 1 and 2 threads, and one Newton iteration (assemble + numeric
+//! Cholesky + solve) on ~5k and ~20k-face meshes for every bending model, with the assembly and
+//! the factorisation also timed apart.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use shellsim::assembly::{Pattern, Want};
@@ -49,10 +51,49 @@ fn kernel(c: &mut Criterion) {
         let mut h = SMat::<18, 18>::zeros();
         b.iter(|| shell_face(black_box(&x), [true; 3], &d, Some(&mut gr), Some(&mut h)))
     });
+    {
+        use shellsim::energy::midedge_angle::{midedge_angle_face, AngleVariant};
+        let phi = [0.01, -0.02, 0.03];
+        let sigma = [1.0, -1.0, 1.0];
+        g.bench_function("midedge_sin/energy", |b| {
+            b.iter(|| {
+                midedge_angle_face::<_, false>(
+                    black_box(&x),
+                    [true; 3],
+                    &phi,
+                    sigma,
+                    AngleVariant::Sin,
+                    &d,
+                    None,
+                    None,
+                )
+            })
+        });
+        g.bench_function("midedge_sin/energy+gradient+hessian", |b| {
+            let mut gr = SVec::<21>::zeros();
+            let mut h = SMat::<21, 21>::zeros();
+            b.iter(|| {
+                midedge_angle_face::<_, false>(
+                    black_box(&x),
+                    [true; 3],
+                    &phi,
+                    sigma,
+                    AngleVariant::Sin,
+                    &d,
+                    Some(&mut gr),
+                    Some(&mut h),
+                )
+            })
+        });
+    }
     g.finish();
 }
 
 fn scene(edge: f64) -> Scene {
+    scene_with(edge, "midedge_average")
+}
+
+fn scene_with(edge: f64, model: &str) -> Scene {
     let mut m = rectangle(
         -0.5,
         -0.5,
@@ -67,7 +108,9 @@ fn scene(edge: f64) -> Scene {
     );
     Case::SphericalCap.program(&mut m);
     let s = Settings::from_str_with(
-        "[material]\nthickness = 0.05\n[rest]\ntarget = \"mesh\"\n",
+        &format!(
+            "[material]\nthickness = 0.05\nbending = \"{model}\"\n[rest]\ntarget = \"mesh\"\n"
+        ),
         "bench",
         &[],
     )
@@ -97,7 +140,7 @@ fn potential<'a>(sc: &'a Scene, p: &'a Pattern) -> Potential<'a> {
 fn assembly(c: &mut Criterion) {
     // 224² cells × 2 ≈ 100k faces.
     let sc = scene(1.0 / 224.0);
-    let p = Pattern::new(&sc.mesh.positions, &sc.mesh.faces, &sc.stencil_extra());
+    let p = Pattern::for_scene(&sc);
     let x = curved(&sc);
     let mut g = c.benchmark_group("assembly_100k");
     g.sample_size(10);
@@ -109,12 +152,12 @@ fn assembly(c: &mut Criterion) {
             .unwrap();
         g.bench_with_input(BenchmarkId::new("energy", threads), &threads, |b, _| {
             let pot = potential(&sc, &p);
-            b.iter(|| pool.install(|| pot.eval(&x, Want::Energy, &mut [], &mut [])))
+            b.iter(|| pool.install(|| pot.eval(&x, &[], Want::Energy, &mut [], &mut [])))
         });
         g.bench_with_input(BenchmarkId::new("gradient", threads), &threads, |b, _| {
             let pot = potential(&sc, &p);
             let mut gr = vec![0.0; p.n];
-            b.iter(|| pool.install(|| pot.eval(&x, Want::Gradient, &mut gr, &mut [])))
+            b.iter(|| pool.install(|| pot.eval(&x, &[], Want::Gradient, &mut gr, &mut [])))
         });
         g.bench_with_input(
             BenchmarkId::new("kernels_only", threads),
@@ -154,7 +197,7 @@ fn assembly(c: &mut Criterion) {
             let pot = potential(&sc, &p);
             let mut gr = vec![0.0; p.n];
             let mut h = vec![0.0; p.nnz()];
-            b.iter(|| pool.install(|| pot.eval(&x, Want::Hessian, &mut gr, &mut h)))
+            b.iter(|| pool.install(|| pot.eval(&x, &[], Want::Hessian, &mut gr, &mut h)))
         });
     }
     g.finish();
@@ -163,26 +206,40 @@ fn assembly(c: &mut Criterion) {
 fn newton_iteration(c: &mut Criterion) {
     let mut g = c.benchmark_group("newton_iteration");
     g.sample_size(10);
-    for edge in [1.0 / 50.0, 1.0 / 100.0] {
-        let sc = scene(edge);
-        let p = Pattern::new(&sc.mesh.positions, &sc.mesh.faces, &sc.stencil_extra());
-        let x = curved(&sc);
-        let mut lin = LinearSolver::new(&p).unwrap();
-        let pot = potential(&sc, &p);
-        let mut gr = vec![0.0; p.n];
-        let mut h = vec![0.0; p.nnz()];
-        g.bench_function(BenchmarkId::new("faces", sc.num_faces()), |b| {
-            b.iter(|| {
-                pot.eval(&x, Want::Hessian, &mut gr, &mut h);
+    for model in ["midedge_average", "midedge_sin", "patch_fit"] {
+        for edge in [1.0 / 50.0, 1.0 / 100.0] {
+            let sc = scene_with(edge, model);
+            let p = Pattern::for_scene(&sc);
+            let x = curved(&sc);
+            let phi = vec![0.0; sc.num_edge_dofs()];
+            let mut lin = LinearSolver::new(&p).unwrap();
+            let pot = potential(&sc, &p);
+            let mut gr = vec![0.0; p.n];
+            let mut h = vec![0.0; p.nnz()];
+            let nf = sc.num_faces();
+            g.bench_function(BenchmarkId::new(format!("{model}/total"), nf), |b| {
+                b.iter(|| {
+                    pot.eval(&x, &phi, Want::Hessian, &mut gr, &mut h);
+                    for i in 0..p.n {
+                        h[p.diag(i)] += 1e-6;
+                    }
+                    lin.factor(&h).unwrap();
+                    let mut rhs = gr.clone();
+                    lin.solve_in_place(&mut rhs);
+                    black_box(rhs[0])
+                })
+            });
+            g.bench_function(BenchmarkId::new(format!("{model}/assembly"), nf), |b| {
+                b.iter(|| pot.eval(&x, &phi, Want::Hessian, &mut gr, &mut h))
+            });
+            g.bench_function(BenchmarkId::new(format!("{model}/factor"), nf), |b| {
+                pot.eval(&x, &phi, Want::Hessian, &mut gr, &mut h);
                 for i in 0..p.n {
                     h[p.diag(i)] += 1e-6;
                 }
-                lin.factor(&h).unwrap();
-                let mut rhs = gr.clone();
-                lin.solve_in_place(&mut rhs);
-                black_box(rhs[0])
-            })
-        });
+                b.iter(|| lin.factor(black_box(&h)).unwrap())
+            });
+        }
     }
     g.finish();
 }

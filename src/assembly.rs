@@ -47,6 +47,8 @@ pub struct Pattern {
     offsets: Vec<[u32; SLOTS * SLOTS]>,
     /// Blocks of faces grouped by colour; blocks of one colour share no stencil node.
     colours: Vec<Vec<Vec<usize>>>,
+    /// Positions in the values of every entry in the row or column of a pinned DOF.
+    pinned: Vec<usize>,
 }
 
 /// Faces per block: large enough for cache locality and cheap scheduling, small enough that a
@@ -75,13 +77,32 @@ impl Pattern {
     pub fn for_scene(scene: &crate::scene::Scene) -> Pattern {
         let edges = scene
             .has_edge_dofs()
-            .then(|| (scene.topo.face_edges.as_slice(), scene.topo.edges.len()));
-        Self::with_edges(
+            .then_some((scene.topo.face_edges.as_slice(), scene.topo.edges.len()));
+        let mut p = Self::with_edges(
             &scene.mesh.positions,
             &scene.mesh.faces,
             &scene.stencil_extra(),
             edges,
-        )
+        );
+        p.pin(&scene.pinned_dofs);
+        p
+    }
+
+    /// Records the entries in the rows and columns of `dofs` (see [`Pattern::pinned_entries`]).
+    pub fn pin(&mut self, dofs: &[usize]) {
+        self.pinned.clear();
+        for col in 0..self.n {
+            for k in self.col_ptr[col]..self.col_ptr[col + 1] {
+                if dofs.contains(&col) || dofs.contains(&self.row_idx[k]) {
+                    self.pinned.push(k);
+                }
+            }
+        }
+    }
+
+    /// Positions of the entries in the rows and columns of the pinned DOFs.
+    pub fn pinned_entries(&self) -> &[usize] {
+        &self.pinned
     }
 
     /// As [`Pattern::new`], with one DOF per edge when `edges = Some((face_edges, num_edges))`
@@ -178,6 +199,7 @@ impl Pattern {
             stencil,
             offsets,
             colours,
+            pinned: Vec::new(),
         }
     }
 
@@ -338,7 +360,8 @@ fn morton_blocks(positions: &[Vec3], faces: &[[usize; 3]]) -> Vec<Vec<usize>> {
 fn colour_blocks(
     nv: usize,
     stencil: &[[usize; SLOTS]],
-    blocks: &[Vec<usize>]) -> Vec<Vec<Vec<usize>>> {
+    blocks: &[Vec<usize>],
+) -> Vec<Vec<Vec<usize>>> {
     let mut used: Vec<Vec<u32>> = vec![Vec::new(); nv];
     let mut colours: Vec<Vec<Vec<usize>>> = Vec::new();
     let mut taken: Vec<bool> = Vec::new();

@@ -11,6 +11,26 @@
 //! | `rhombus` | [[2, 1], [1, 2]] | 0 | (F (x, y), 0) with F = √ā |
 //! | `cylinder` | I | diag(1, 0) | (sin x, y, cos x − 1) (radius 1, axis ∥ y) |
 //!
+//! Beyond Table 1 (issue 3's convergence study):
+//!
+//! | case | domain | ā | b̄ | exact surface |
+//! |---|---|---|---|---|
+//! | `gcm_cone` | sector 1 ≤ r ≤ 1.4, 0 ≤ θ ≤ 2π sin α | I | θ̂θ̂ᵀ/(2r) | cone of half-angle α = atan 2 |
+//! | `bilayer_strip` | 1 × 0.1 strip, h = 0.002 | diag(ā11, 1) | diag(3Δε/(2h), 0) | arc of curvature b̄11/ā11 |
+//!
+//! `gcm_cone` is MorphoShell's curvature-programmed cone: ā = I and b̄ = θ̂θ̂ᵀ/(2r) satisfy the
+//! Gauss–Codazzi–Mainardi equations, and the surface is the cone whose circumferential normal
+//! curvature `cot α / r` equals `1/(2r)`, so `tan α = 2`. A flat sector of angle `2π sin α`
+//! (322.0°; the removed wedge is 38.0°) closes into it exactly:
+//! `(r, θ) ↦ (r sin α cos ψ, r sin α sin ψ, −r cos α)`, `ψ = θ / sin α`.
+//!
+//! `bilayer_strip` is a bilayer of two equal layers of total thickness h whose top layer is
+//! stretched by `1 + Δε/2` and bottom by `1 − Δε/2` along x (Δε = 0.002). By the
+//! bilayer–Koiter equivalence (van Rees et al. 2017), `ā = (g⁺ + g⁻)/2` and
+//! `b̄ = 3/(4h)(g⁺ − g⁻)` with `g± = diag((1 ± Δε/2)², 1)`, so `b̄11 = 3Δε/(2h)`: Timoshenko's
+//! bimetal curvature for equal layers (1925), which the exact shape reproduces to
+//! `Δε²/4 = 1e-6` relative (the factor `1/ā11`).
+//!
 //! Signs follow shellsim's convention (positive b̄ bulges toward the normal, +z here). The
 //! hyperboloid's forms are those of the graph `z = (x² − y²)/2`, whose normal-side curvature is
 //! `−∂²f/√(1+|∇f|²)`.
@@ -35,20 +55,71 @@ pub enum Case {
     /// φ = asin(λ_θ/λ_r) = 53.13° (Modes, Bhattacharya & Warner 2011). Use it on an annulus: the
     /// metric is singular at r = 0.
     Cone,
+    /// ā = I, b̄ = θ̂θ̂ᵀ/(2r) on the sector 1 ≤ r ≤ 1.4, 0 ≤ θ ≤ 2π sin α: the
+    /// Gauss–Codazzi–Mainardi cone of half-angle α = atan 2 (MorphoShell).
+    GcmCone,
+    /// A bilayer strip against Timoshenko's formula (see the module doc).
+    BilayerStrip,
+}
+
+/// Half-angle of [`Case::GcmCone`]: `tan α = 2`.
+pub fn gcm_cone_half_angle() -> Real {
+    2.0_f64.atan()
+}
+
+/// Angular extent (rad) of the flat sector that closes into [`Case::GcmCone`]: `2π sin α`.
+pub fn gcm_cone_sweep() -> Real {
+    2.0 * std::f64::consts::PI * gcm_cone_half_angle().sin()
+}
+
+/// Inner and outer radius of [`Case::GcmCone`]'s sector.
+pub const GCM_CONE_RADII: [Real; 2] = [1.0, 1.4];
+
+/// Strain mismatch Δε between the layers of [`Case::BilayerStrip`].
+pub const BILAYER_STRAIN: Real = 0.002;
+/// Total thickness h of [`Case::BilayerStrip`] (m).
+pub const BILAYER_THICKNESS: Real = 0.002;
+/// Length and width of [`Case::BilayerStrip`] (m).
+pub const BILAYER_SIZE: [Real; 2] = [1.0, 0.1];
+
+/// Timoshenko's curvature of a bimetal strip of two equal layers, `3Δε/(2h)` (1/m).
+pub fn timoshenko_curvature(strain: Real, thickness: Real) -> Real {
+    1.5 * strain / thickness
+}
+
+/// `(ā11, b̄11)` of [`Case::BilayerStrip`].
+fn bilayer_forms() -> (Real, Real) {
+    let (gp, gm) = (
+        (1.0 + 0.5 * BILAYER_STRAIN).powi(2),
+        (1.0 - 0.5 * BILAYER_STRAIN).powi(2),
+    );
+    (0.5 * (gp + gm), 0.75 / BILAYER_THICKNESS * (gp - gm))
+}
+
+/// Polar angle in [0, 2π) (a point on the θ = 0 side may round to a tiny negative angle).
+fn polar_angle(x: Real, y: Real) -> Real {
+    let t = y.atan2(x);
+    if t < -1e-12 {
+        t + 2.0 * std::f64::consts::PI
+    } else {
+        t.max(0.0)
+    }
 }
 
 /// Azimuthal stretch of [`Case::Cone`] (its radial stretch is 1).
 pub const CONE_LAMBDA_THETA: Real = 0.8;
 
 impl Case {
-    /// All Table 1 cases.
-    pub const ALL: [Case; 6] = [
+    /// All cases.
+    pub const ALL: [Case; 8] = [
         Case::EnlargedSquare,
         Case::SphericalCap,
         Case::Hyperboloid,
         Case::Rhombus,
         Case::Cylinder,
         Case::Cone,
+        Case::GcmCone,
+        Case::BilayerStrip,
     ];
 
     /// Whether the mirror image (z → −z) of the exact shape is equally exact (b̄ = 0).
@@ -65,6 +136,8 @@ impl Case {
             Case::Rhombus => "rhombus",
             Case::Cylinder => "cylinder",
             Case::Cone => "cone",
+            Case::GcmCone => "gcm_cone",
+            Case::BilayerStrip => "bilayer_strip",
         }
     }
 
@@ -98,6 +171,19 @@ impl Case {
                     Sym2::zeros(),
                 )
             }
+            Case::GcmCone => {
+                let r = (x * x + y * y).sqrt().max(1e-300);
+                let (c, s) = (x / r, y / r);
+                // θ̂θ̂ᵀ / (2r), θ̂ = (−s, c).
+                (
+                    Sym2::new(1.0, 0.0, 1.0),
+                    Sym2::new(s * s, -s * c, c * c) / (2.0 * r),
+                )
+            }
+            Case::BilayerStrip => {
+                let (a11, b11) = bilayer_forms();
+                (Sym2::new(a11, 0.0, 1.0), Sym2::new(b11, 0.0, 0.0))
+            }
         }
     }
 
@@ -119,6 +205,19 @@ impl Case {
                 let r = (x * x + y * y).sqrt();
                 let cos_phi = (1.0 - CONE_LAMBDA_THETA * CONE_LAMBDA_THETA).sqrt();
                 Vec3::new(CONE_LAMBDA_THETA * x, CONE_LAMBDA_THETA * y, -r * cos_phi)
+            }
+            Case::GcmCone => {
+                let r = (x * x + y * y).sqrt();
+                let (sa, ca) = gcm_cone_half_angle().sin_cos();
+                let psi = polar_angle(x, y) / sa;
+                Vec3::new(r * sa * psi.cos(), r * sa * psi.sin(), -r * ca)
+            }
+            Case::BilayerStrip => {
+                // Arc length λx with λ = √ā11, curvature κ = b̄11/ā11 in arc length.
+                let (a11, b11) = bilayer_forms();
+                let (lam, k) = (a11.sqrt(), b11 / a11);
+                let t = k * lam * x;
+                Vec3::new(t.sin() / k, y, (t.cos() - 1.0) / k)
             }
         }
     }
@@ -148,6 +247,13 @@ impl Case {
     /// centroid is only first-order consistent, which leaves an O(ℓ) shape error at corners.
     pub fn program(self, mesh: &mut Mesh) {
         let nf = mesh.faces.len();
+        if self == Case::BilayerStrip {
+            // b̄ depends on the thickness: write it with the forms.
+            mesh.face_fields.insert(
+                "ref_thicknesses".into(),
+                Field::scalar(vec![BILAYER_THICKNESS; nf]),
+            );
+        }
         let mut a = Vec::with_capacity(3 * nf);
         let mut b = Vec::with_capacity(3 * nf);
         for f in 0..nf {

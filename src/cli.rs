@@ -7,7 +7,7 @@
 use crate::cases::{curvature_error, shape_error, Case};
 use crate::integrate::{run, Progress, Quiet};
 use crate::math::{Real, Vec3};
-use crate::mesh::delaunay::delaunay_rectangle;
+use crate::mesh::delaunay::{delaunay_annulus, delaunay_rectangle};
 use crate::mesh::generate::{annulus, rectangle, Spacing};
 use crate::mesh::io::{read_mesh, write_mesh, Format};
 use crate::mesh::Topology;
@@ -124,12 +124,12 @@ struct MeshArgs {
     /// Squares and rectangles: split cells along alternating diagonals instead of the same one.
     #[arg(long)]
     checkerboard: bool,
-    /// Squares and rectangles: Delaunay triangulation of well-spaced random points (seeded by
-    /// --seed) instead of a grid: an irregular mesh.
+    /// Delaunay triangulation of well-spaced random points (seeded by --seed) instead of a
+    /// structured grid: an irregular mesh. Squares, rectangles and annuli.
     #[arg(long, conflicts_with_all = ["checkerboard", "grading"])]
     delaunay: bool,
     /// Write abar_info/bbar_info for an analytic case (enlarged_square, spherical_cap,
-    /// hyperboloid, rhombus, cylinder).
+    /// hyperboloid, rhombus, cylinder, cone, gcm_cone, bilayer_strip).
     #[arg(long)]
     program: Option<String>,
     /// Per-face thickness written as ref_thicknesses (m).
@@ -256,6 +256,12 @@ fn mesh_cmd(a: MeshArgs) -> Result<()> {
         seed: a.seed,
         checkerboard: a.checkerboard,
     };
+    if a.delaunay && a.jitter > 0.0 {
+        bail!("--jitter does not apply to --delaunay meshes (they are irregular already)");
+    }
+    if a.delaunay && matches!(a.shape, Shape::Disk) {
+        bail!("--delaunay supports square, rectangle and annulus");
+    }
     let mut mesh = match a.shape {
         Shape::Square | Shape::Rectangle => {
             let (lx, ly) = match a.shape {
@@ -270,14 +276,7 @@ fn mesh_cmd(a: MeshArgs) -> Result<()> {
                 }
             };
             if a.delaunay {
-                let mut m = delaunay_rectangle(-0.5 * lx, -0.5 * ly, lx, ly, a.edge, sp);
-                if a.jitter > 0.0 {
-                    bail!(
-                        "--jitter does not apply to --delaunay meshes (they are irregular already)"
-                    );
-                }
-                m.source = None;
-                m
+                delaunay_rectangle(-0.5 * lx, -0.5 * ly, lx, ly, a.edge, sp)
             } else {
                 rectangle(-0.5 * lx, -0.5 * ly, lx, ly, a.edge, sp)
             }
@@ -297,13 +296,12 @@ fn mesh_cmd(a: MeshArgs) -> Result<()> {
                     a.radius
                 );
             }
-            annulus(
-                a.inner,
-                a.radius,
-                a.sweep.min(360.0).to_radians(),
-                a.edge,
-                sp,
-            )
+            let sweep = a.sweep.min(360.0).to_radians();
+            if a.delaunay {
+                delaunay_annulus(a.inner, a.radius, sweep, a.edge, sp)
+            } else {
+                annulus(a.inner, a.radius, sweep, a.edge, sp)
+            }
         }
     };
     if let Some(p) = &a.program {

@@ -37,15 +37,26 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
             scene.num_faces()
         )));
     }
-    if let Some(v) = frame.positions.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+    if let Some(v) = frame
+        .positions
+        .iter()
+        .position(|p| !p.iter().all(|c| c.is_finite()))
+    {
         return Err(bad(format!("vertex {v} has a non-finite position")));
     }
     let v = match frame.vertex_field("velocity", 3)? {
         Some(f) => {
             if let Some(i) = f.data.iter().position(|c| !c.is_finite()) {
-                return Err(bad(format!("field 'velocity' is not finite at vertex {}", i / 3)));
+                return Err(bad(format!(
+                    "field 'velocity' is not finite at vertex {}",
+                    i / 3
+                )));
             }
-            Some((0..frame.positions.len()).map(|i| Vec3::from_column_slice(f.get(i))).collect())
+            Some(
+                (0..frame.positions.len())
+                    .map(|i| Vec3::from_column_slice(f.get(i)))
+                    .collect(),
+            )
         }
         None => None,
     };

@@ -45,6 +45,9 @@ pub struct Scene {
     /// free, including on the boundary (the natural free-edge condition, see
     /// [`crate::energy::midedge_angle`]).
     pub node_fixed: Vec<bool>,
+    /// Static mode with nothing fixed: 6 position DOFs held at their current values to remove
+    /// the rigid-body null space of the Hessian (see [`Scene::rigid_pins`]), else empty.
+    pub pinned_dofs: Vec<usize>,
 }
 
 fn positive_face_field(mesh: &Mesh, name: &str) -> Result<Option<Vec<Real>>, MeshError> {
@@ -183,13 +186,26 @@ impl Scene {
                 .face_edges
                 .iter()
                 .enumerate()
-                .map(|(f, fe)| fe.map(|e| if topo.edge_faces[e][0] == f { 1.0 } else { -1.0 }))
+                .map(|(f, fe)| {
+                    fe.map(|e| {
+                        if topo.edge_faces[e][0] == f {
+                            1.0
+                        } else {
+                            -1.0
+                        }
+                    })
+                })
                 .collect();
             let mut nf = fixed.clone();
             nf.resize(nv + topo.edges.len(), false);
             (sign, nf)
         } else {
             (Vec::new(), fixed.clone())
+        };
+        let pinned_dofs = if free && settings.solver.mode == crate::settings::Mode::Static {
+            rigid_pins(&mesh, &fixed)
+        } else {
+            Vec::new()
         };
         let mean_edge = mesh.mean_edge_length();
         let eh = young
@@ -214,6 +230,7 @@ impl Scene {
             patches,
             edge_sign,
             node_fixed,
+            pinned_dofs,
         })
     }
 
@@ -335,6 +352,42 @@ impl Scene {
     pub fn reference_positions(&self) -> &[Vec3] {
         &self.mesh.positions
     }
+}
+
+/// Six position DOFs whose fixing removes the rigid motions of a free sheet without
+/// constraining its shape: all of vertex A (nearest the centroid), the two coordinates of B
+/// (farthest from A) across the dominant direction of AB, and the coordinate of C (farthest from
+/// the line AB) along the dominant direction of the normal of ABC. In statics the energy is
+/// invariant under rigid motions, so the constrained minimum is an equilibrium of the free sheet:
+/// its gradient vanishes on the pinned DOFs too (they are transversal to the rigid motions).
+/// Without them the Hessian is singular and Newton needs a diagonal shift that slows the soft
+/// bending modes of thin shells to linear convergence.
+pub fn rigid_pins(mesh: &Mesh, unused: &[bool]) -> Vec<usize> {
+    let used: Vec<usize> = (0..mesh.positions.len()).filter(|&v| !unused[v]).collect();
+    if used.len() < 3 {
+        return Vec::new();
+    }
+    let p = &mesh.positions;
+    let c = used.iter().map(|&v| p[v]).sum::<Vec3>() / used.len() as Real;
+    let by = |f: &dyn Fn(usize) -> Real| {
+        used.iter()
+            .copied()
+            .max_by(|&u, &v| f(u).total_cmp(&f(v)).then(v.cmp(&u)))
+            .unwrap_or(used[0])
+    };
+    let a = by(&|v| -(p[v] - c).norm());
+    let b = by(&|v| (p[v] - p[a]).norm());
+    let ab = p[b] - p[a];
+    let cc = by(&|v| ab.cross(&(p[v] - p[a])).norm());
+    let n = ab.cross(&(p[cc] - p[a]));
+    if n.norm() <= 1e-12 * ab.norm_squared() {
+        return Vec::new();
+    }
+    let k_ab = ab.iamax();
+    let mut pins = vec![3 * a, 3 * a + 1, 3 * a + 2];
+    pins.extend((0..3).filter(|&k| k != k_ab).map(|k| 3 * b + k));
+    pins.push(3 * cc + n.iamax());
+    pins
 }
 
 fn unused_mask(nv: usize, unused: &[usize]) -> Vec<bool> {

@@ -171,6 +171,81 @@ pub fn delaunay_rectangle(x0: Real, y0: Real, lx: Real, ly: Real, edge: Real, sp
         pts.push(Vec2::new(x0 + lx, y0 + ly * j as Real / ny as Real));
         pts.push(Vec2::new(x0, y0 + ly * (j + 1) as Real / ny as Real));
     }
+    let depth = |p: Vec2| {
+        (p.x - x0)
+            .min(x0 + lx - p.x)
+            .min(p.y - y0)
+            .min(y0 + ly - p.y)
+    };
+    delaunay_domain(pts, depth, [x0, y0], [x0 + lx, y0 + ly], lx * ly, edge, sp)
+}
+
+/// An annulus `r_in ≤ r ≤ r_out`, or its sector `0 ≤ θ ≤ sweep` (rad) when `sweep < 2π`, meshed
+/// like [`delaunay_rectangle`]: boundary points about `edge` apart on the circles (and the two
+/// radial sides of a sector), random interior points at least `0.7 × edge` apart.
+pub fn delaunay_annulus(r_in: Real, r_out: Real, sweep: Real, edge: Real, sp: Spacing) -> Mesh {
+    use std::f64::consts::PI;
+    let full = sweep >= 2.0 * PI - 1e-12;
+    let sweep = sweep.min(2.0 * PI);
+    let mut pts: Vec<Vec2> = Vec::new();
+    for r in [r_in, r_out] {
+        let n = ((sweep * r / edge).round() as usize).max(6);
+        let count = if full { n } else { n + 1 };
+        for k in 0..count {
+            let t = sweep * k as Real / n as Real;
+            pts.push(Vec2::new(r * t.cos(), r * t.sin()));
+        }
+    }
+    if !full {
+        let nr = (((r_out - r_in) / edge).round() as usize).max(1);
+        for j in 1..nr {
+            let r = r_in + (r_out - r_in) * j as Real / nr as Real;
+            pts.push(Vec2::new(r, 0.0));
+            pts.push(Vec2::new(r * sweep.cos(), r * sweep.sin()));
+        }
+    }
+    let depth = move |p: Vec2| {
+        let r = p.norm();
+        let radial = (r - r_in).min(r_out - r);
+        if full {
+            return radial;
+        }
+        // Distance to the two straight sides, negative outside the sector.
+        let mut t = p.y.atan2(p.x);
+        if t < -1e-12 {
+            t += 2.0 * PI;
+        }
+        let side0 = p.y; // side θ = 0 (x > 0)
+        let side1 = -(p.x * sweep.sin() - p.y * sweep.cos()); // side θ = sweep
+        let inside = t <= sweep + 1e-12;
+        let sides = if inside {
+            side0.abs().min(side1.abs()).min(r)
+        } else {
+            -side0.abs().min(side1.abs())
+        };
+        radial.min(sides)
+    };
+    let area = 0.5 * sweep * (r_out * r_out - r_in * r_in);
+    delaunay_domain(pts, depth, [-r_out, -r_out], [r_out, r_out], area, edge, sp)
+}
+
+/// Delaunay mesh of a domain given by its boundary points and `depth(p)` (distance to the
+/// boundary, negative outside) inside the box `[lo, hi]`: interior points by dart throwing
+/// (`0.7 × edge` apart, at least `0.5 × edge` from the boundary) until about
+/// `1.15 area / (√3/2 edge²)` points, then the triangles whose centroid lies outside are dropped
+/// (this carves holes and notches out of the convex hull).
+fn delaunay_domain(
+    mut pts: Vec<Vec2>,
+    depth: impl Fn(Vec2) -> Real,
+    lo: [Real; 2],
+    hi: [Real; 2],
+    area: Real,
+    edge: Real,
+    sp: Spacing,
+) -> Mesh {
+    let (x0, y0) = (lo[0], lo[1]);
+    let (lx, ly) = (hi[0] - lo[0], hi[1] - lo[1]);
+    let nb = pts.len();
     let dmin = 0.7 * edge;
     let cell = dmin / std::f64::consts::SQRT_2;
     let (gx, gy) = (
@@ -179,22 +254,19 @@ pub fn delaunay_rectangle(x0: Real, y0: Real, lx: Real, ly: Real, edge: Real, sp
     );
     let mut grid: Vec<Vec<usize>> = vec![Vec::new(); gx * gy];
     let at = |p: Vec2| {
-        (((p.x - x0) / cell) as usize).min(gx - 1) + gx * (((p.y - y0) / cell) as usize).min(gy - 1)
+        (((p.x - x0) / cell).max(0.0) as usize).min(gx - 1)
+            + gx * (((p.y - y0) / cell).max(0.0) as usize).min(gy - 1)
     };
     for (k, p) in pts.iter().enumerate() {
         grid[at(*p)].push(k);
     }
     let mut rng = Rng::new(sp.seed);
-    let target = (1.15 * lx * ly / (edge * edge * 3f64.sqrt() / 2.0)) as usize;
+    let target = (1.15 * area / (edge * edge * 3f64.sqrt() / 2.0)) as usize;
     let mut misses = 0;
-    while misses < 30 * target.max(1) && pts.len() < target + 2 * (nx + ny) {
+    while misses < 30 * target.max(1) && pts.len() < target + nb {
         let p = Vec2::new(x0 + lx * rng.uniform(), y0 + ly * rng.uniform());
         // Keep away from the boundary by half the spacing, too.
-        if p.x - x0 < 0.5 * edge
-            || x0 + lx - p.x < 0.5 * edge
-            || p.y - y0 < 0.5 * edge
-            || y0 + ly - p.y < 0.5 * edge
-        {
+        if depth(p) < 0.5 * edge {
             misses += 1;
             continue;
         }
@@ -221,9 +293,27 @@ pub fn delaunay_rectangle(x0: Real, y0: Real, lx: Real, ly: Real, edge: Real, sp
             misses += 1;
         }
     }
-    let faces = triangulate(&pts);
+    let faces: Vec<[usize; 3]> = triangulate(&pts)
+        .into_iter()
+        .filter(|t| depth((pts[t[0]] + pts[t[1]] + pts[t[2]]) / 3.0) > 0.0)
+        .collect();
+    // Drop points no kept triangle uses (none for convex domains).
+    let mut map = vec![usize::MAX; pts.len()];
+    let mut positions = Vec::new();
+    let faces = faces
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                if map[v] == usize::MAX {
+                    map[v] = positions.len();
+                    positions.push(Vec3::new(pts[v].x, pts[v].y, 0.0));
+                }
+                map[v]
+            })
+        })
+        .collect();
     Mesh {
-        positions: pts.iter().map(|p| Vec3::new(p.x, p.y, 0.0)).collect(),
+        positions,
         faces,
         ..Default::default()
     }

@@ -151,7 +151,15 @@ impl<'a> Potential<'a> {
                 }
             }
         }
+        if want != Want::Energy {
+            for &d in &sc.pinned_dofs {
+                grad[d] = 0.0;
+            }
+        }
         if want == Want::Hessian {
+            for &k in self.pattern.pinned_entries() {
+                values[k] = 0.0;
+            }
             let n = self.pattern.n;
             let mut sum = 0.0;
             let mut cnt = 0usize;
@@ -170,6 +178,9 @@ impl<'a> Potential<'a> {
                         values[self.pattern.diag(d0 + c)] = scale;
                     }
                 }
+            }
+            for &d in &sc.pinned_dofs {
+                values[self.pattern.diag(d)] = scale;
             }
         }
         e

@@ -142,7 +142,13 @@ fn assembled_derivatives(model: &str) {
     let x = bumpy(&sc);
     let phi = angles(&sc);
     let nx = 3 * sc.num_vertices();
-    let node_of = |k: usize| if k < nx { k / 3 } else { sc.num_vertices() + (k - nx) };
+    let node_of = |k: usize| {
+        if k < nx {
+            k / 3
+        } else {
+            sc.num_vertices() + (k - nx)
+        }
+    };
     let xhat: Vec<Vec3> = x.iter().map(|v| v * 1.01).collect();
     let a_prev = vec![shellsim::math::Sym2::new(0.01, 0.001, 0.012); sc.num_faces()];
     let b_prev = vec![shellsim::math::Sym2::new(0.001, 0.0, -0.001); sc.num_faces()];

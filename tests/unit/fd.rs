@@ -203,10 +203,25 @@ fn midedge_angle_derivatives_match_finite_differences() {
         eval(&v0, Some(&mut g), Some(&mut h));
         let mut ggn = SVec::<21>::zeros();
         let mut hgn = SMat::<21, 21>::zeros();
-        midedge_angle_face::<_, true>(&x, has, &phi, sigma, variant, &d, Some(&mut ggn), Some(&mut hgn));
-        assert!((g - ggn).amax() <= 1e-14 * g.amax(), "trial {trial}: GN gradient differs");
+        midedge_angle_face::<_, true>(
+            &x,
+            has,
+            &phi,
+            sigma,
+            variant,
+            &d,
+            Some(&mut ggn),
+            Some(&mut hgn),
+        );
+        assert!(
+            (g - ggn).amax() <= 1e-14 * g.amax(),
+            "trial {trial}: GN gradient differs"
+        );
         let ev = hgn.symmetric_eigenvalues();
-        assert!(ev.min() >= -1e-12 * ev.amax(), "trial {trial}: GN Hessian not PSD");
+        assert!(
+            ev.min() >= -1e-12 * ev.amax(),
+            "trial {trial}: GN Hessian not PSD"
+        );
         let eps = 1e-6;
         let mut gfd = SVec::<21>::zeros();
         let mut hfd = SMat::<21, 21>::zeros();
@@ -222,14 +237,24 @@ fn midedge_angle_derivatives_match_finite_differences() {
         }
         let ge = (g - gfd).amax() / g.amax();
         let he = (h - hfd).amax() / h.amax();
-        assert!(ge < 1e-6, "trial {trial} {variant:?} {has:?}: gradient rel. error {ge:e}");
-        assert!(he < 1e-6, "trial {trial} {variant:?} {has:?}: Hessian rel. error {he:e}");
+        assert!(
+            ge < 1e-6,
+            "trial {trial} {variant:?} {has:?}: gradient rel. error {ge:e}"
+        );
+        assert!(
+            he < 1e-6,
+            "trial {trial} {variant:?} {has:?}: Hessian rel. error {he:e}"
+        );
         assert!((h - h.transpose()).amax() < 1e-12 * h.amax());
         // The sin variant at φ = 0 is the mid-edge average.
         if variant == AngleVariant::Sin {
-            let e0 = midedge_angle_face::<_, false>(&x, has, &[0.0; 3], sigma, variant, &d, None, None);
+            let e0 =
+                midedge_angle_face::<_, false>(&x, has, &[0.0; 3], sigma, variant, &d, None, None);
             let ea = shell_face(&x, has, &d, None, None);
-            assert!((e0 - ea).abs() <= 1e-12 * ea.abs(), "trial {trial}: {e0} vs {ea}");
+            assert!(
+                (e0 - ea).abs() <= 1e-12 * ea.abs(),
+                "trial {trial}: {e0} vs {ea}"
+            );
         }
     }
 }
