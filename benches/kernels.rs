@@ -134,6 +134,7 @@ fn potential<'a>(sc: &'a Scene, p: &'a Pattern) -> Potential<'a> {
         inertia: None,
         damping: None,
         gravity: Vec3::zeros(),
+        stretch_scale: 1.0,
     }
 }
 

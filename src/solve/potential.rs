@@ -53,6 +53,9 @@ pub struct Potential<'a> {
     pub damping: Option<Damping<'a>>,
     /// Gravitational acceleration (m/s²).
     pub gravity: Vec3,
+    /// Multiplier on the elastic stretching weight (1 except during the static solver's
+    /// membrane continuation).
+    pub stretch_scale: Real,
 }
 
 impl<'a> Potential<'a> {
@@ -62,6 +65,7 @@ impl<'a> Potential<'a> {
         let sc = self.scene;
         let (abar, bbar) = sc.rest.at(f, self.dial);
         let (ws, wb) = KoiterDensity::weights(&abar, sc.thickness[f], sc.stretch_factor);
+        let ws = ws * self.stretch_scale;
         let mut d = KoiterDensity {
             c: sv_matrix(&abar, sc.lame[f]),
             stretch: [(ws, abar), (0.0, Sym2::zeros())],

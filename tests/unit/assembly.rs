@@ -76,6 +76,7 @@ fn rest_state_has_zero_energy_and_gradient() {
         inertia: None,
         damping: None,
         gravity: Vec3::zeros(),
+        stretch_scale: 1.0,
     };
     let mut g = vec![0.0; p.n];
     let phi = vec![0.0; sc.num_edge_dofs()];
@@ -113,6 +114,7 @@ fn bitwise_identical(model: &str) {
                 inertia: None,
                 damping: None,
                 gravity: Vec3::new(0.0, 0.0, -9.81),
+                stretch_scale: 1.0,
             };
             let mut g = vec![0.0; p.n];
             let mut h = vec![0.0; p.nnz()];
@@ -166,6 +168,7 @@ fn assembled_derivatives(model: &str) {
             b_prev: &b_prev,
         }),
         gravity: Vec3::new(0.0, 0.0, -9.81),
+        stretch_scale: 1.0,
     };
     let mut g = vec![0.0; p.n];
     let mut h = vec![0.0; p.nnz()];
