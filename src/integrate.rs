@@ -2,10 +2,11 @@
 //! dynamics with adaptive time steps.
 //!
 //! Membrane continuation (statics): the dial continuation runs with the stretching weight
-//! divided by `solver.membrane_continuation` (default 100), which makes the sheet effectively
-//! √100 = 10× thicker relative to its bending; then the weight is raised back to 1 by warm-started
-//! solves at dial 1 (×10, then ×100 after an easy solve; a failed solve takes the square root of
-//! the ratio). Newton's quadratic model is poor for thin sheets making large rotations (stiff
+//! divided by c (`solver.membrane_continuation`, by default c = (L/10h)² with L the mesh's
+//! bounding-box diagonal), which makes the sheet effectively √c times thicker relative to its
+//! bending, as stiff as a plate of thickness L/10; then the weight is raised back to 1 by
+//! warm-started solves at dial 1 (×10, then ×100 after an easy solve; a failed solve takes the
+//! square root of the ratio). Newton's quadratic model is poor for thin sheets making large rotations (stiff
 //! stretching, soft bending): measured on the 13.5k-face Gauss–Codazzi–Mainardi cone, 269 Newton
 //! iterations without it, 17 with it, the same equilibrium to 1e-7. Both call Newton on a [`Potential`] and write frames
 //! through an [`output::Writer`](crate::output::Writer).
@@ -305,7 +306,16 @@ fn run_static(
     let mut step = st.continuation_step;
     // Membrane continuation: the stretching weight starts at 1/softening and grows ×ratio per
     // solve once the dial is at 1 (see the module doc).
-    let mut scale = 1.0 / st.membrane_continuation.max(1.0);
+    let h_min = s
+        .scene
+        .thickness
+        .iter()
+        .copied()
+        .fold(Real::INFINITY, Real::min);
+    let softening = st
+        .membrane_continuation
+        .factor(s.scene.mesh.bbox_diagonal(), h_min);
+    let mut scale = 1.0 / softening.max(1.0);
     let mut ratio: Real = 10.0;
     let mut trial = x.clone();
     let mut trial_phi = phi.clone();

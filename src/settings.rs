@@ -111,6 +111,34 @@ pub enum BendingModel {
     MidedgeTan,
 }
 
+/// The softening factor of the static solver's membrane continuation.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Softening {
+    /// A factor ≥ 1 (1 disables the continuation).
+    Factor(Real),
+    /// `"auto"`: chosen from the mesh size and thickness.
+    Auto(Auto),
+}
+
+/// The word `"auto"`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Auto {
+    /// Automatic.
+    Auto,
+}
+
+impl Softening {
+    /// The factor for a sheet of size `size` (m) and smallest thickness `h` (m).
+    pub fn factor(self, size: Real, h: Real) -> Real {
+        match self {
+            Softening::Factor(c) => c,
+            Softening::Auto(_) => ((size / (10.0 * h)).powi(2)).clamp(1.0, 1e8),
+        }
+    }
+}
+
 impl BendingModel {
     /// The edge-DOF variant, if this model has edge DOFs.
     pub fn angle_variant(self) -> Option<crate::energy::midedge_angle::AngleVariant> {
@@ -212,12 +240,14 @@ pub struct Solver {
     /// Static mode: the increment below which continuation gives up (default: `1e-4`).
     pub min_continuation_step: Real,
     /// Static mode: membrane continuation. The dial continuation runs with the stretching
-    /// weight divided by this factor (a sheet √factor times thicker, relative to bending), then
-    /// the weight is raised to its true value in warm-started solves (×10, ×100, … per solve).
-    /// Thin sheets that roll or fold take far fewer Newton iterations this way, and the final
-    /// state is a converged, stability-checked equilibrium of the true energy. 1 disables it
-    /// (dimensionless, ≥ 1, default: `100`).
-    pub membrane_continuation: Real,
+    /// weight divided by a factor c (a sheet √c times thicker, relative to bending), then the
+    /// weight is raised to its true value in warm-started solves (×10, ×100, … per solve). Thin
+    /// sheets that roll or fold take far fewer Newton iterations this way, and the final state is
+    /// a converged, stability-checked equilibrium of the true energy. `"auto"` (default): c =
+    /// (L / 10 h)², L the reference mesh's bounding-box diagonal and h its smallest thickness, so
+    /// that the softened sheet is as stiff as one of thickness L/10; a number ≥ 1 sets c; 1
+    /// disables it.
+    pub membrane_continuation: Softening,
     /// Out-of-plane perturbation that breaks the symmetry of a flat start, as a fraction of the
     /// mean edge length (dimensionless, default: `1e-3`; 0 disables). Applied when the sheet is
     /// exactly planar, and again (×10 each time) when a converged state is found to be a saddle.
@@ -240,7 +270,7 @@ impl Default for Solver {
             hessian_projection: HessianProjection::Adaptive,
             continuation_step: 1.0,
             min_continuation_step: 1e-4,
-            membrane_continuation: 100.0,
+            membrane_continuation: Softening::Auto(Auto::Auto),
             symmetry_breaking: 1e-3,
             seed: 1,
             check_stability: true,
@@ -489,14 +519,13 @@ impl Settings {
             );
         }
         pos("solver.min_continuation_step", s.min_continuation_step)?;
-        if !(s.membrane_continuation >= 1.0 && s.membrane_continuation.is_finite()) {
-            return inv(
-                "solver.membrane_continuation",
-                format!(
-                    "must be a finite number ≥ 1, got {}",
-                    s.membrane_continuation
-                ),
-            );
+        if let Softening::Factor(c) = s.membrane_continuation {
+            if !(c >= 1.0 && c.is_finite()) {
+                return inv(
+                    "solver.membrane_continuation",
+                    format!("must be \"auto\" or a finite number ≥ 1, got {c}"),
+                );
+            }
         }
         nonneg("solver.symmetry_breaking", s.symmetry_breaking)?;
         let t = &self.time;

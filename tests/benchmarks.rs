@@ -1,6 +1,9 @@
 //! Seed 000 Table 1 through the real pipeline: generate a programmed unit-square mesh, run the
 //! binary to static equilibrium, measure the frame with `shellsim error`. Coarse (edge 0.1),
 //! fine (0.05) and non-uniform (graded 2.5× and jittered 20%, edge 0.05) meshes; thickness 0.05.
+//! The Table 1 test pins seed 000's own bending model (the mid-edge average); issue 3's
+//! convergence study (`bending_models_converge_on_irregular_meshes` and the cone and bilayer
+//! tests) covers the others.
 //!
 //! Bounds are the errors measured when the test was written plus about 20%; the flat cases are
 //! exact up to the solver tolerance. The curved cases converge at first order on uniform meshes:
@@ -50,7 +53,7 @@ fn run_case(case: &str, mesh_args: &[&str], dir: &Path, tag: &str) -> Row {
     let out = format!("out_{case}_{tag}");
     std::fs::write(
         dir.join("s.toml"),
-        "[material]\nthickness = 0.05\n[rest]\ntarget = \"mesh\"\n",
+        "[material]\nthickness = 0.05\nbending = \"midedge_average\"\n[rest]\ntarget = \"mesh\"\n",
     )
     .unwrap();
     shellsim(&["s.toml", &mesh, "--out", &out, "-q"], dir);
@@ -457,4 +460,197 @@ fn patch_fit_converges_on_delaunay_meshes() {
         assert!(errs[1] < errs[0], "{case}: {errs:?}");
         assert!(errs[1] < 0.0012, "{case}: {errs:?}");
     }
+}
+
+/// Runs `case` on a generated mesh with one bending model; returns (max error rel, RMS rel,
+/// faces, Newton iterations).
+fn study_run(
+    dir: &Path,
+    model: &str,
+    case: &str,
+    mesh_args: &[&str],
+    tag: &str,
+) -> (f64, f64, u64, u64) {
+    let mesh = format!("{case}_{tag}.vtk");
+    let mut args = vec!["mesh"];
+    args.extend_from_slice(mesh_args);
+    args.extend_from_slice(&["--program", case, "-o", &mesh]);
+    shellsim(&args, dir);
+    let settings = format!("{model}.toml");
+    std::fs::write(
+        dir.join(&settings),
+        format!("[material]\nthickness = 0.01\nbending = \"{model}\"\n[rest]\ntarget = \"mesh\"\n"),
+    )
+    .unwrap();
+    let out = format!("o_{model}_{case}_{tag}");
+    shellsim(&[&settings, &mesh, "--out", &out, "-q"], dir);
+    let s = summary(dir, &out);
+    assert_eq!(
+        s["converged"], true,
+        "{model} {case} {tag}: {}",
+        s["reason"]
+    );
+    let frame = format!("{out}/{}", s["final_frame"].as_str().unwrap());
+    let e = measure(dir, case, &frame);
+    (
+        e["max_error_rel"].as_f64().unwrap(),
+        e["rms_error_rel"].as_f64().unwrap(),
+        s["faces"].as_u64().unwrap(),
+        s["newton_iterations"].as_u64().unwrap(),
+    )
+}
+
+/// Observed order of a pair of (error, faces) with h ∝ 1/√faces.
+fn order(coarse: (f64, u64), fine: (f64, u64)) -> f64 {
+    (coarse.0 / fine.0).ln() / (0.5 * (fine.1 as f64 / coarse.1 as f64).ln())
+}
+
+/// Issue 3's study at small size: the cylinder (ā = I, b̄ = diag(1, 0)) on meshes jittered by
+/// 25% of the edge and on Delaunay meshes of random points, 200–256 and 800–1016 faces, h = 0.01.
+/// The models that claim convergence (edge DOFs sin/tan, patch fit) must show order ≥ 1.5 and a
+/// max material-point error ≤ 1e-4 of the size at the finer mesh (measured 5.3e-5 to 8.2e-5,
+/// order 2.1–3.1); the mid-edge average must show its floor (measured 1.9% and 1.2% at 800–1016
+/// faces, observed order 0.55 and 0.18, and 1.5% and 1.1% at 12.8k–16k faces in the study),
+/// honestly, so that a change that silently alters it is noticed.
+#[test]
+fn bending_models_converge_on_irregular_meshes() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let kinds: [(&str, &[&str]); 2] = [
+        ("jittered", &["--jitter", "0.25", "--seed", "7"]),
+        ("delaunay", &["--delaunay", "--seed", "7"]),
+    ];
+    for (kind, extra) in kinds {
+        for model in ["midedge_sin", "midedge_tan", "patch_fit", "midedge_average"] {
+            let mut rows = Vec::new();
+            for edge in ["0.1", "0.05"] {
+                let mut args = vec!["square", "--edge", edge];
+                args.extend_from_slice(extra);
+                rows.push(study_run(
+                    dir,
+                    model,
+                    "cylinder",
+                    &args,
+                    &format!("{kind}{edge}"),
+                ));
+            }
+            let (c, f) = (rows[0], rows[1]);
+            let p = order((c.0, c.2), (f.0, f.2));
+            println!(
+                "cylinder {kind:<9} {model:<16} faces {}/{}: max {:.3e} -> {:.3e} (order {p:.2}), \
+                 Newton {}/{}",
+                c.2, f.2, c.0, f.0, c.3, f.3
+            );
+            if model == "midedge_average" {
+                assert!(
+                    p < 1.0 && f.0 > 5e-3,
+                    "{kind}: the floor moved: {c:?} {f:?}"
+                );
+            } else {
+                assert!(p >= 1.5, "{kind} {model}: order {p:.2} ({c:?} -> {f:?})");
+                assert!(
+                    f.0 <= 1e-4,
+                    "{kind} {model}: max error {:.3e} at {} faces",
+                    f.0,
+                    f.2
+                );
+            }
+        }
+    }
+}
+
+/// MorphoShell's Gauss–Codazzi–Mainardi cone (ā = I, b̄ = θ̂θ̂ᵀ/(2r) on the sector 1 ≤ r ≤ 1.4 of
+/// angle 2π sin(atan 2)) on meshes jittered by 25%, 842 and 3371 faces, h = 0.01. The edge-DOF
+/// model meets issue 3's numbers: ≤ 0.05% at ~1k faces (measured 0.0077%), order ≥ 1.5
+/// (measured 1.73), and ≤ 3e-5 at 3.4k (measured 2.3e-5; the issue asks ≤ 0.005% at ~12k, where
+/// the study measures 7.2e-6). The mid-edge average stays near 3% (its floor).
+#[test]
+fn gcm_cone_converges_with_edge_dofs() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let sweep = format!("{}", 360.0 * 2.0 / 5f64.sqrt());
+    let mesh = |edge: &'static str| -> Vec<String> {
+        [
+            "annulus", "--inner", "1", "--radius", "1.4", "--sweep", &sweep, "--edge", edge,
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain(["--jitter", "0.25", "--seed", "7"].map(String::from))
+        .collect()
+    };
+    let run = |model: &str, edge: &'static str| {
+        let args = mesh(edge);
+        let args: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
+        study_run(dir, model, "gcm_cone", &args, edge)
+    };
+    let (c, f) = (run("midedge_sin", "0.08"), run("midedge_sin", "0.04"));
+    let p = order((c.0, c.2), (f.0, f.2));
+    println!(
+        "gcm cone, midedge_sin, faces {}/{}: max {:.3e} -> {:.3e} (order {p:.2}), rms {:.3e} -> {:.3e}",
+        c.2, f.2, c.0, f.0, c.1, f.1
+    );
+    assert!(c.0 <= 1e-4, "coarse cone error {:.3e}", c.0);
+    assert!(f.0 <= 3e-5, "fine cone error {:.3e}", f.0);
+    assert!(p >= 1.5, "order {p:.2}");
+    let a = run("midedge_average", "0.08");
+    assert!(
+        a.0 > 1e-2,
+        "mid-edge average on the jittered cone: {:.3e}",
+        a.0
+    );
+}
+
+/// A bilayer strip (1 × 0.1 m, h = 2 mm, layers stretched by 1 ± Δε/2 along x, Δε = 0.002) against
+/// Timoshenko's bimetal formula for equal layers, κ = 3Δε/(2h) = 1.5 /m (the case's forms come from
+/// the bilayer–Koiter equivalence). Regular meshes of 500 and 2000 faces, edge-DOF bending: the
+/// circle through three centre-line vertices (both ends and the middle) has Timoshenko's
+/// curvature to 1e-3 (measured 7e-7 relative, within the model's Δε²/4 = 1e-6 difference), and the
+/// material-point error against the exact arc falls at order ≥ 1.5 (measured 1.76e-5 → 4.4e-6).
+#[test]
+fn bilayer_strip_matches_timoshenko() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let kappa_t = shellsim::cases::timoshenko_curvature(
+        shellsim::cases::BILAYER_STRAIN,
+        shellsim::cases::BILAYER_THICKNESS,
+    );
+    let mut rows = Vec::new();
+    for edge in ["0.02", "0.01"] {
+        let args = ["rectangle", "--lx", "1", "--ly", "0.1", "--edge", edge];
+        let r = study_run(dir, "midedge_sin", "bilayer_strip", &args, edge);
+        // Curvature of the circle through the centre-line vertices at x = −0.5, 0, 0.5.
+        let mesh =
+            shellsim::mesh::io::read_mesh(&dir.join(format!("bilayer_strip_{edge}.vtk"))).unwrap();
+        let out = format!("o_midedge_sin_bilayer_strip_{edge}");
+        let frame = summary(dir, &out)["final_frame"]
+            .as_str()
+            .unwrap()
+            .to_string();
+        let x = read_positions(&dir.join(&out).join(frame));
+        let pick = |px: f64| {
+            let v = (0..mesh.positions.len())
+                .min_by(|&a, &b| {
+                    let da = (mesh.positions[a].x - px).abs() + mesh.positions[a].y.abs();
+                    let db = (mesh.positions[b].x - px).abs() + mesh.positions[b].y.abs();
+                    da.total_cmp(&db)
+                })
+                .unwrap();
+            shellsim::math::Vec3::from(x[v])
+        };
+        let (p, q, w) = (pick(-0.5), pick(0.0), pick(0.5));
+        let (a, b, c) = ((q - p).norm(), (w - q).norm(), (w - p).norm());
+        let kappa = 2.0 * (q - p).cross(&(w - p)).norm() / (a * b * c);
+        println!(
+            "bilayer strip, {} faces: curvature {kappa:.6} (Timoshenko {kappa_t}), max error {:.3e}",
+            r.2, r.0
+        );
+        assert!(
+            (kappa / kappa_t - 1.0).abs() < 1e-3,
+            "κ = {kappa}, Timoshenko {kappa_t}"
+        );
+        rows.push(r);
+    }
+    let p = order((rows[0].0, rows[0].2), (rows[1].0, rows[1].2));
+    assert!(p >= 1.5, "order {p:.2}: {rows:?}");
+    assert!(rows[1].0 < 1e-5, "max error {:.3e}", rows[1].0);
 }

@@ -378,6 +378,22 @@ fn mesh_generator_and_error_command() {
             "annulus",
             vec!["--edge", "0.1", "--inner", "0.5", "--sweep", "300"],
         ),
+        (
+            "annulus",
+            vec![
+                "--edge",
+                "0.1",
+                "--inner",
+                "0.5",
+                "--sweep",
+                "300",
+                "--delaunay",
+            ],
+        ),
+        (
+            "annulus",
+            vec!["--edge", "0.1", "--inner", "0.5", "--delaunay"],
+        ),
     ] {
         let mut args = vec!["mesh", shape, "-o", "g.vtu"];
         args.extend(extra);
@@ -461,4 +477,157 @@ fn fixed_tags_hold_and_continuation_frames_are_written() {
     }
     // The free vertices moved: ā = 1.2 I asks for edges √1.2 ≈ 9.5% longer.
     assert!(disp.get(0).iter().any(|c| c.abs() > 1e-3));
+}
+
+fn final_frame(dir: &Path, out: &str) -> String {
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join(out).join("summary.json")).unwrap())
+            .unwrap();
+    format!("{out}/{}", s["final_frame"].as_str().unwrap())
+}
+
+fn summary_of(dir: &Path, out: &str) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join(out).join("summary.json")).unwrap())
+        .unwrap()
+}
+
+/// Restart: a static run from the final frame of an earlier run reads the positions and edge
+/// angles back and is converged at once, on the same shape; a dynamic restart resumes at the
+/// frame's time. Edge angles that disagree between an edge's two faces, and a frame of another
+/// mesh, are bad input.
+#[test]
+fn restart_carries_positions_edge_dofs_and_time() {
+    let d = tmp();
+    let p = d.path();
+    let r = run(
+        &[
+            "mesh",
+            "square",
+            "--edge",
+            "0.25",
+            "--program",
+            "cylinder",
+            "-o",
+            "m.vtk",
+        ],
+        p,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let settings = "[material]\nthickness = 0.05\nbending = \"midedge_sin\"\n[rest]\ntarget = \"mesh\"\n[output]\nformat = \"vtk_ascii\"\n";
+    write(p, "s.toml", settings);
+    let r = run(&["s.toml", "m.vtk", "--out", "a", "-q"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let fa = final_frame(p, "a");
+    let text = std::fs::read_to_string(p.join(&fa)).unwrap();
+    assert!(text.contains("edge_angles"), "frames carry the edge DOFs");
+    let r = run(
+        &["s.toml", "m.vtk", "--out", "b", "-q", "--restart", &fa],
+        p,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let sb = summary_of(p, "b");
+    assert!(sb["newton_iterations"].as_u64().unwrap() <= 1, "{sb}");
+    let err = |frame: &str| -> f64 {
+        let r = run(&["error", "cylinder", frame], p);
+        let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+        v["max_error_rel"].as_f64().unwrap()
+    };
+    let (ea, eb) = (err(&fa), err(&final_frame(p, "b")));
+    assert!(
+        (ea - eb).abs() <= 1e-9,
+        "restart moved the shape: {ea} vs {eb}"
+    );
+
+    // Tampered edge angles: the first face's three values no longer match its neighbours'.
+    let i = text.find("edge_angles").unwrap();
+    let line_start = i + text[i..].find('\n').unwrap() + 1;
+    let line_end = line_start + text[line_start..].find('\n').unwrap();
+    let mut vals: Vec<String> = text[line_start..line_end]
+        .split_whitespace()
+        .map(String::from)
+        .collect();
+    for (k, v) in vals.iter_mut().take(3).enumerate() {
+        *v = format!("0.{}", 5 + k);
+    }
+    let bad = format!(
+        "{}{}{}",
+        &text[..line_start],
+        vals.join(" "),
+        &text[line_end..]
+    );
+    write(p, "bad.vtk", &bad);
+    let r = run(
+        &[
+            "s.toml",
+            "m.vtk",
+            "--out",
+            "c",
+            "-q",
+            "--restart",
+            "bad.vtk",
+        ],
+        p,
+    );
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("edge_angles"), "{}", r.stderr);
+    // A frame of another mesh.
+    let r = run(&["mesh", "square", "--edge", "0.5", "-o", "other.vtk"], p);
+    assert_eq!(r.code, 0);
+    let r = run(
+        &[
+            "s.toml",
+            "m.vtk",
+            "--out",
+            "c",
+            "-q",
+            "--restart",
+            "other.vtk",
+        ],
+        p,
+    );
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("same mesh"), "{}", r.stderr);
+
+    // Dynamic: 4 steps to t = 0.02 with frames every 0.01; restart from t = 0.01.
+    let dynamic = "[material]\nthickness = 0.05\n[rest]\ntarget = \"mesh\"\n[solver]\nmode = \"dynamic\"\n[time]\nend = 0.02\ndt = 0.005\noutput_interval = 0.01\n";
+    write(p, "dyn.toml", dynamic);
+    let r = run(&["dyn.toml", "m.vtk", "--out", "d", "-q"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let r = run(
+        &[
+            "dyn.toml",
+            "m.vtk",
+            "--out",
+            "e",
+            "-q",
+            "--restart",
+            "d/frame_00001.vtu",
+        ],
+        p,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let se = summary_of(p, "e");
+    assert!((se["time"].as_f64().unwrap() - 0.02).abs() < 1e-12, "{se}");
+    let series = std::fs::read_to_string(p.join("e/series.pvd")).unwrap();
+    assert!(
+        series.contains("timestep=\"1.000000000000e-2\""),
+        "{series}"
+    );
+    // Same trajectory as the uninterrupted run (velocities and edge angles carried over).
+    let (ed, ee) = (err(&final_frame(p, "d")), err(&final_frame(p, "e")));
+    assert!((ed - ee).abs() <= 1e-12 * ed.abs(), "{ed} vs {ee}");
+}
+
+/// The membrane-continuation setting is validated.
+#[test]
+fn membrane_continuation_below_one_is_bad_input() {
+    let d = tmp();
+    let p = d.path();
+    write(p, "m.vtk", TWO_TRIANGLES);
+    write(
+        p,
+        "s.toml",
+        &format!("{STATIC}membrane_continuation = 0.5\n"),
+    );
+    expect_bad(&["s.toml", "m.vtk"], p, "solver.membrane_continuation");
 }
