@@ -3,7 +3,10 @@
 # resolutions on uniform meshes, plus graded + jittered ("nonuniform") meshes, through the real
 # pipeline (mesh generator -> static solve -> `shellsim error`). Writes a CSV.
 #
-#   scripts/speed_vs_error.sh [OUT.csv] [THREADS]
+#   scripts/speed_vs_error.sh [OUT.csv] [THREADS] [BENDING]
+#
+# BENDING is the bending model (default: midedge_average, seed 000's own, which the README's
+# Table 1 section documents; scripts/convergence_study.py compares all models).
 #
 # Columns: case, mesh, edge, vertices, faces, threads, wall_seconds, newton_iterations,
 # hausdorff_rel, max_error_rel, rms_error_rel, mean_curvature_rms_error.
@@ -11,12 +14,13 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 out=${1:-$root/scripts/results/speed_vs_error.csv}
 threads=${2:-$(nproc)}
+bending=${3:-midedge_average}
 mkdir -p "$(dirname "$out")"
 cargo build --release --quiet --manifest-path "$root/Cargo.toml"
 bin=$root/target/release/shellsim
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-printf '[material]\nthickness = 0.05\n[rest]\ntarget = "mesh"\n' > "$work/s.toml"
+printf '[material]\nthickness = 0.05\nbending = "%s"\n[rest]\ntarget = "mesh"\n' "$bending" > "$work/s.toml"
 echo "case,mesh,edge,vertices,faces,threads,wall_seconds,newton_iterations,hausdorff_rel,max_error_rel,rms_error_rel,mean_curvature_rms_error" > "$out"
 json() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(','.join(str(d[k]) for k in sys.argv[2:]))" "$@"; }
 for case in enlarged_square spherical_cap hyperboloid rhombus cylinder cone; do

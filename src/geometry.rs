@@ -268,6 +268,86 @@ pub fn midedge_average_q(
     (EdgeQ { q, grad }, f_nf)
 }
 
+/// The mid-edge-average `q_i` of a face's three edges, from its 6 stencil positions
+/// `[v0, v1, v2, p0, p1, p2]` (`has[i]`: edge `i` has a neighbour; otherwise `q_i = 0`).
+#[derive(Clone, Copy, Debug)]
+pub struct AverageQs {
+    /// `q_i` (m).
+    pub q: [Real; 3],
+    /// `∇q_i` over the local slots [`edge_slots`]`(i)` (12 entries each).
+    pub grad: [SVec<12>; 3],
+    /// `∇²q_i` without the `N_f` second-derivative part (filled only when asked).
+    pub hess: [SMat<12, 12>; 3],
+    /// `∂q_i/∂N_f`, contracted once per face by [`AverageQs::add_hessians`].
+    pub dnf: [Vec3; 3],
+}
+
+/// The 4 face-local vertex slots of edge `i`'s quantity: `[v_i, v_j, v_k, p_i]`.
+#[inline(always)]
+pub fn edge_slots(i: usize) -> [usize; 4] {
+    [i, (i + 1) % 3, (i + 2) % 3, 3 + i]
+}
+
+impl AverageQs {
+    /// Evaluates every edge of a face; Hessians only with `hess`.
+    #[inline]
+    pub fn new(nf: &UnitNormal, x: &[Vec3; 6], has: [bool; 3], hess: bool) -> Self {
+        let mut out = AverageQs {
+            q: [0.0; 3],
+            grad: [SVec::<12>::zeros(); 3],
+            hess: [SMat::<12, 12>::zeros(); 3],
+            dnf: [Vec3::zeros(); 3],
+        };
+        for i in 0..3 {
+            if !has[i] {
+                continue;
+            }
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            let (eq, f) = midedge_average_q(
+                nf,
+                [i, j, k],
+                &[x[i], x[j], x[k]],
+                &x[3 + i],
+                hess.then_some(&mut out.hess[i]),
+            );
+            out.q[i] = eq.q;
+            out.grad[i] = eq.grad;
+            out.dnf[i] = f;
+        }
+        out
+    }
+
+    /// Adds `Σ_i μ_i ∇²q_i` to the position block (the first 18 rows and columns) of an element
+    /// Hessian, the face-normal part contracted once with `Σ_i μ_i ∂q_i/∂N_f`.
+    #[inline]
+    pub fn add_hessians<const N: usize>(
+        &self,
+        nf: &UnitNormal,
+        has: [bool; 3],
+        mu: [Real; 3],
+        h: &mut SMat<N, N>,
+    ) {
+        let mut lam_f = Vec3::zeros();
+        for i in 0..3 {
+            if !has[i] || mu[i] == 0.0 {
+                continue;
+            }
+            lam_f += self.dnf[i] * mu[i];
+            let sl = edge_slots(i);
+            for (la, &sa) in sl.iter().enumerate() {
+                for (lb, &sb) in sl.iter().enumerate() {
+                    let blk = self.hess[i].fixed_view::<3, 3>(3 * la, 3 * lb) * mu[i];
+                    let mut dst = h.fixed_view_mut::<3, 3>(3 * sa, 3 * sb);
+                    dst += blk;
+                }
+            }
+        }
+        let hn = nf.hessian_contract(&lam_f);
+        let mut dst = h.fixed_view_mut::<9, 9>(0, 0);
+        dst += hn;
+    }
+}
+
 /// `b = 2 [q0 + q1, q0; q0, q0 + q2]` as `[b11, b12, b22]` (1/m · m² = m).
 #[inline]
 pub fn b_from_q(q: &SVec<3>) -> Sym2 {

@@ -39,8 +39,8 @@
 
 use super::material::{DensityDerivs, FaceDensity};
 use crate::geometry::{
-    b_from_q, b_from_q_matrix, first_fundamental_form, first_fundamental_form_hessian_pattern,
-    first_fundamental_form_jacobian, midedge_average_q, UnitNormal,
+    b_from_q, b_from_q_matrix, edge_slots, first_fundamental_form,
+    first_fundamental_form_hessian_pattern, first_fundamental_form_jacobian, AverageQs, UnitNormal,
 };
 use crate::math::{Mat3, Real, SMat, SVec, Sym2, Vec3};
 
@@ -166,30 +166,8 @@ pub fn midedge_angle_face<D: FaceDensity, const GN: bool>(
     let want_h = hess.is_some();
     let want_g = grad.is_some() || want_h;
     let nf = UnitNormal::new(&xf);
-    let mut qt = [0.0; 3];
-    let mut gqt = [SVec::<12>::zeros(); 3];
-    let mut hqt = [SMat::<12, 12>::zeros(); 3];
-    let mut fnf = [Vec3::zeros(); 3];
-    for i in 0..3 {
-        if !has[i] {
-            continue;
-        }
-        let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-        let (eq, f) = midedge_average_q(
-            &nf,
-            [i, j, k],
-            &[xf[i], xf[j], xf[k]],
-            &x[3 + i],
-            if want_h && !GN {
-                Some(&mut hqt[i])
-            } else {
-                None
-            },
-        );
-        qt[i] = eq.q;
-        gqt[i] = if want_g { eq.grad } else { SVec::zeros() };
-        fnf[i] = f;
-    }
+    let qs = AverageQs::new(&nf, x, has, want_h && !GN);
+    let qt = qs.q;
     let mut q = SVec::<3>::zeros();
     let mut dh = [(SVec::<3>::zeros(), Mat3::zeros()); 3];
     let mut df = [(SVec::<3>::zeros(), Mat3::zeros()); 3];
@@ -224,14 +202,13 @@ pub fn midedge_angle_face<D: FaceDensity, const GN: bool>(
     }
     // J = ∂y/∂x (9×21).
     let ja = first_fundamental_form_jacobian(&xf);
-    let slots = |i: usize| [i, (i + 1) % 3, (i + 2) % 3, 3 + i];
     let mut jy = SMat::<9, 21>::zeros();
     jy.fixed_view_mut::<3, 9>(0, 0).copy_from(&ja);
     for i in 0..3 {
         if has[i] {
-            for (l, &s) in slots(i).iter().enumerate() {
+            for (l, &s) in edge_slots(i).iter().enumerate() {
                 for c in 0..3 {
-                    jy[(3 + i, 3 * s + c)] = gqt[i][3 * l + c];
+                    jy[(3 + i, 3 * s + c)] = qs.grad[i][3 * l + c];
                 }
             }
         }
@@ -274,25 +251,7 @@ pub fn midedge_angle_face<D: FaceDensity, const GN: bool>(
                 }
             }
             // Σ_i ∂Ẽ/∂q̃_i ∇²q̃_i, the N_f part contracted once.
-            let mut lam_f = Vec3::zeros();
-            for i in 0..3 {
-                let mu = gy[3 + i];
-                if !has[i] || mu == 0.0 {
-                    continue;
-                }
-                lam_f += fnf[i] * mu;
-                let sl = slots(i);
-                for (la, &sa) in sl.iter().enumerate() {
-                    for (lb, &sb) in sl.iter().enumerate() {
-                        let blk = hqt[i].fixed_view::<3, 3>(3 * la, 3 * lb) * mu;
-                        let mut dst = h.fixed_view_mut::<3, 3>(3 * sa, 3 * sb);
-                        dst += blk;
-                    }
-                }
-            }
-            let hn = nf.hessian_contract(&lam_f);
-            let mut dst = h.fixed_view_mut::<9, 9>(0, 0);
-            dst += hn;
+            qs.add_hessians(&nf, has, [gy[3], gy[4], gy[5]], &mut h);
         }
         *hout = h;
     }

@@ -7,8 +7,8 @@
 
 use super::material::{DensityDerivs, FaceDensity};
 use crate::geometry::{
-    b_from_q, b_from_q_matrix, first_fundamental_form, first_fundamental_form_hessian_pattern,
-    first_fundamental_form_jacobian, midedge_average_q, UnitNormal,
+    b_from_q, b_from_q_matrix, edge_slots, first_fundamental_form,
+    first_fundamental_form_hessian_pattern, first_fundamental_form_jacobian, AverageQs, UnitNormal,
 };
 use crate::math::{Real, SMat, SVec, Sym2, Vec3};
 
@@ -67,32 +67,8 @@ fn shell_face_impl<D: FaceDensity, const GN: bool>(
     let want_h = hess.is_some();
     let want_g = grad.is_some() || want_h;
     let nf = UnitNormal::new(&xf);
-    let mut q = SVec::<3>::zeros();
-    let mut gq = [SVec::<12>::zeros(); 3];
-    let mut hq = [SMat::<12, 12>::zeros(); 3];
-    let mut fnf = [Vec3::zeros(); 3];
-    if bending {
-        for i in 0..3 {
-            if !has[i] {
-                continue;
-            }
-            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-            let (eq, f) = midedge_average_q(
-                &nf,
-                [i, j, k],
-                &[xf[i], xf[j], xf[k]],
-                &x[3 + i],
-                if want_h && !GN {
-                    Some(&mut hq[i])
-                } else {
-                    None
-                },
-            );
-            q[i] = eq.q;
-            gq[i] = eq.grad;
-            fnf[i] = f;
-        }
-    }
+    let qs = bending.then(|| AverageQs::new(&nf, x, has, want_h && !GN));
+    let q = SVec::<3>::from(qs.map_or([0.0; 3], |qs| qs.q));
     let b = b_from_q(&q);
     let mut d = DensityDerivs::default();
     let e = dens.eval(&a, &b, &mut d);
@@ -102,17 +78,13 @@ fn shell_face_impl<D: FaceDensity, const GN: bool>(
     let ja = first_fundamental_form_jacobian(&xf);
     let bq = b_from_q_matrix();
     let gqv = bq.transpose() * d.gb; // ∂E/∂q
-    let slots = |i: usize| [i, (i + 1) % 3, (i + 2) % 3, 3 + i];
     let mut g = SVec::<18>::zeros();
     g.fixed_rows_mut::<9>(0).copy_from(&(ja.transpose() * d.ga));
-    if bending {
-        for i in 0..3 {
-            if !has[i] {
-                continue;
-            }
-            for (l, &s) in slots(i).iter().enumerate() {
+    if let Some(qs) = &qs {
+        for i in (0..3).filter(|&i| has[i]) {
+            for (l, &s) in edge_slots(i).iter().enumerate() {
                 for c in 0..3 {
-                    g[3 * s + c] += gqv[i] * gq[i][3 * l + c];
+                    g[3 * s + c] += gqv[i] * qs.grad[i][3 * l + c];
                 }
             }
         }
@@ -131,41 +103,20 @@ fn shell_face_impl<D: FaceDensity, const GN: bool>(
                 }
             }
         }
-        if bending {
+        if let Some(qs) = &qs {
             let hqq = bq.transpose() * d.hbb * bq;
             let mut gmat = SMat::<18, 3>::zeros();
-            for i in 0..3 {
-                if !has[i] {
-                    continue;
-                }
-                for (l, &s) in slots(i).iter().enumerate() {
+            for i in (0..3).filter(|&i| has[i]) {
+                for (l, &s) in edge_slots(i).iter().enumerate() {
                     for c in 0..3 {
-                        gmat[(3 * s + c, i)] = gq[i][3 * l + c];
+                        gmat[(3 * s + c, i)] = qs.grad[i][3 * l + c];
                     }
                 }
             }
             *h += gmat * hqq * gmat.transpose();
-            if GN {
-                return e_and_grad(e, g, grad);
+            if !GN {
+                qs.add_hessians(&nf, has, [gqv[0], gqv[1], gqv[2]], h);
             }
-            let mut lam_f = Vec3::zeros();
-            for i in 0..3 {
-                if !has[i] || gqv[i] == 0.0 {
-                    continue;
-                }
-                lam_f += fnf[i] * gqv[i];
-                let sl = slots(i);
-                for (la, &sa) in sl.iter().enumerate() {
-                    for (lb, &sb) in sl.iter().enumerate() {
-                        let blk = hq[i].fixed_view::<3, 3>(3 * la, 3 * lb) * gqv[i];
-                        let mut dst = h.fixed_view_mut::<3, 3>(3 * sa, 3 * sb);
-                        dst += blk;
-                    }
-                }
-            }
-            let hn = nf.hessian_contract(&lam_f);
-            let mut dst = h.fixed_view_mut::<9, 9>(0, 0);
-            dst += hn;
         }
     }
     e_and_grad(e, g, grad)
