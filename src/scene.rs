@@ -46,7 +46,7 @@ pub struct Scene {
     /// [`crate::energy::midedge_angle`]).
     pub node_fixed: Vec<bool>,
     /// Static mode with nothing fixed: 6 position DOFs held at their current values to remove
-    /// the rigid-body null space of the Hessian (see [`Scene::rigid_pins`]), else empty.
+    /// the rigid-body null space of the Hessian (see [`rigid_pins`]), else empty.
     pub pinned_dofs: Vec<usize>,
 }
 
