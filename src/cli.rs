@@ -238,6 +238,12 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
     }
 }
 
+/// Prints a line on stdout; a closed pipe (`shellsim error … | head`) is not an error.
+fn print_out(text: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stdout(), "{text}");
+}
+
 fn mesh_cmd(a: MeshArgs) -> Result<()> {
     let pos = |name: &str, v: Real| -> Result<()> {
         if !(v.is_finite() && v > 0.0) {
@@ -335,12 +341,12 @@ fn mesh_cmd(a: MeshArgs) -> Result<()> {
         ),
     };
     write_mesh(&a.out, &mesh, format, "shellsim generated mesh")?;
-    println!(
+    print_out(&format!(
         "{}: {} vertices, {} faces",
         a.out.display(),
         mesh.positions.len(),
         mesh.faces.len()
-    );
+    ));
     Ok(())
 }
 
@@ -387,6 +393,6 @@ fn error_cmd(a: ErrorArgs) -> Result<()> {
         "mean_curvature_rms_error": eh,
         "gauss_curvature_rms_error": ek,
     });
-    println!("{}", serde_json::to_string_pretty(&out)?);
+    print_out(&serde_json::to_string_pretty(&out)?);
     Ok(())
 }

@@ -42,6 +42,7 @@ pub mod cases;
 pub mod cli;
 pub mod energy;
 pub mod geometry;
+pub mod growth;
 pub mod integrate;
 pub mod math;
 pub mod mesh;

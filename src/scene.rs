@@ -100,6 +100,27 @@ impl Scene {
             .collect();
 
         let mut rest = RestForms::no_growth(&mesh, &topo);
+        if let Some(variant) = m.bending.angle_variant() {
+            // The reference curvature in the edge-DOF model's own terms (φ = 0), so that a curved
+            // input mesh is stress-free under "no growth" for the tan variant too (sin at φ = 0
+            // is the average).
+            let sign = edge_signs(&topo);
+            for (f, face) in mesh.faces.iter().enumerate() {
+                let o = topo.opposite_vertex[f];
+                let has = o.map(|v| v != crate::mesh::topology::NONE);
+                let p = &mesh.positions;
+                let xs = [0, 1, 2, 3, 4, 5].map(|k| match k {
+                    0..=2 => p[face[k]],
+                    _ if has[k - 3] => p[o[k - 3]],
+                    _ => p[face[0]],
+                });
+                let b = crate::energy::midedge_angle::midedge_angle_b(
+                    &xs, has, &[0.0; 3], sign[f], variant,
+                );
+                rest.bbar0[f] = b;
+                rest.bbar1[f] = b;
+            }
+        }
         match settings.rest.target {
             TargetForms::None => {}
             TargetForms::Uniform => {
@@ -130,6 +151,12 @@ impl Scene {
                 rest.abar1 = a1;
                 rest.bbar1 = b1;
             }
+        }
+
+        if settings.growth.law != crate::settings::GrowthLaw::None {
+            let (a1, b1) = growth_targets(&mesh, &settings, &rest, &thickness)?;
+            rest.abar1 = a1;
+            rest.bbar1 = b1;
         }
 
         let mut mass = vec![0.0; nv];
@@ -352,6 +379,136 @@ impl Scene {
     pub fn reference_positions(&self) -> &[Vec3] {
         &self.mesh.positions
     }
+}
+
+/// Each face's orientation sign on its three edges: +1 for the edge's first face, −1 for its
+/// second.
+fn edge_signs(topo: &Topology) -> Vec<[Real; 3]> {
+    topo.face_edges
+        .iter()
+        .enumerate()
+        .map(|(f, fe)| {
+            fe.map(|e| {
+                if topo.edge_faces[e][0] == f {
+                    1.0
+                } else {
+                    -1.0
+                }
+            })
+        })
+        .collect()
+}
+
+/// A per-face scalar field with a uniform fallback, checked finite (naming the face).
+fn face_values(mesh: &Mesh, name: &str, uniform: Real) -> Result<Vec<Real>, MeshError> {
+    match mesh.face_field(name, 1)? {
+        Some(f) => {
+            if let Some(i) = f.data.iter().position(|v| !v.is_finite()) {
+                return Err(mesh.invalid(format!("face field '{name}' is not finite at face {i}")));
+            }
+            Ok(f.data.clone())
+        }
+        None => Ok(vec![uniform; mesh.faces.len()]),
+    }
+}
+
+/// The target forms of `growth.law` from the reference forms (dial 0) and the per-face fields
+/// (see [`crate::growth`]). Errors name the face and field: non-finite values, a machine
+/// direction that is zero or normal to its face, and swelling that makes ā non-positive.
+fn growth_targets(
+    mesh: &Mesh,
+    settings: &Settings,
+    rest: &RestForms,
+    thickness: &[Real],
+) -> Result<(Vec<Sym2>, Vec<Sym2>), MeshError> {
+    use crate::settings::GrowthLaw;
+    let g = &settings.growth;
+    let nf = mesh.faces.len();
+    let mt = face_values(mesh, "moisture_top", g.moisture_top)?;
+    let mb = face_values(mesh, "moisture_bottom", g.moisture_bottom)?;
+    let s = face_values(mesh, "growth_factor", g.s)?;
+    let dirs = mesh.face_field("machine_direction", 3)?;
+    let mut a1 = Vec::with_capacity(nf);
+    let mut b1 = Vec::with_capacity(nf);
+    // (coefficient, applies to the top moisture, applies to the bottom moisture).
+    let coefficients: &[(Real, bool, bool)] = match g.law {
+        GrowthLaw::LinearSwelling => &[(g.mu, true, true)],
+        GrowthLaw::Bilayer => &[(g.mu_top, true, false), (g.mu_bottom, false, true)],
+        GrowthLaw::MachineDirection => &[(g.mu, true, true), (g.mu_perp, true, true)],
+        _ => &[],
+    };
+    for f in 0..nf {
+        let (a0, b0) = (rest.abar0[f], rest.bbar0[f]);
+        let h = thickness[f];
+        for &(mu, top, bottom) in coefficients {
+            let worst = match (top, bottom) {
+                (true, true) => (mu * mt[f]).min(mu * mb[f]),
+                (true, false) => mu * mt[f],
+                _ => mu * mb[f],
+            };
+            if 1.0 + worst <= 0.0 {
+                return Err(mesh.invalid(format!(
+                    "growth: the stretch 1 + mu m = 1 + {worst} is not positive at face {f} \
+                     (mu {mu}, moisture_top {}, moisture_bottom {}): a length cannot become ≤ 0",
+                    mt[f], mb[f]
+                )));
+            }
+        }
+        let (a, b) = match g.law {
+            GrowthLaw::None => (a0, b0),
+            GrowthLaw::Isotropic => crate::growth::isotropic(&a0, &b0, s[f]),
+            GrowthLaw::LinearSwelling => {
+                crate::growth::linear_swelling(&a0, &b0, h, mt[f], mb[f], g.mu)
+            }
+            GrowthLaw::Bilayer => {
+                crate::growth::bilayer(&a0, &b0, h, mt[f], mb[f], g.mu_top, g.mu_bottom)
+            }
+            GrowthLaw::MachineDirection => {
+                let (d, what) = match dirs {
+                    Some(df) => (
+                        Vec3::from_column_slice(df.get(f)),
+                        "face field 'machine_direction'",
+                    ),
+                    None => (Vec3::from(g.machine_direction), "growth.machine_direction"),
+                };
+                let d2 = barycentric_direction(mesh, f, &d).ok_or_else(|| {
+                    mesh.invalid(format!(
+                        "{what} at face {f} is [{}, {}, {}]: it must be finite, non-zero and not \
+                         normal to the face",
+                        d.x, d.y, d.z
+                    ))
+                })?;
+                crate::growth::machine_direction(&a0, &b0, h, mt[f], mb[f], g.mu, g.mu_perp, d2)
+            }
+        };
+        if !(a[0] > 0.0 && crate::math::sym_det(&a) > 0.0 && b.iter().all(|v| v.is_finite())) {
+            return Err(mesh.invalid(format!(
+                "growth.law {:?} makes abar non-positive-definite at face {f} (moisture top {}, \
+                 bottom {}, s {}): the swelling factor 1 + mu m must stay positive",
+                g.law, mt[f], mb[f], s[f]
+            )));
+        }
+        a1.push(a);
+        b1.push(b);
+    }
+    Ok((a1, b1))
+}
+
+/// A reference-Cartesian direction as barycentric coordinates of face `f`: its projection on the
+/// face plane written in the basis `e1, e2`. `None` if it is zero, non-finite or normal to the
+/// face (projection below 1e-6 of its length).
+fn barycentric_direction(mesh: &Mesh, f: usize, d: &Vec3) -> Option<[Real; 2]> {
+    let n = d.norm();
+    if !(n.is_finite() && n > 0.0) {
+        return None;
+    }
+    let [p0, p1, p2] = mesh.face_positions(f);
+    let (e1, e2) = (p1 - p0, p2 - p0);
+    let gram = crate::math::Mat2::new(e1.dot(&e1), e1.dot(&e2), e1.dot(&e2), e2.dot(&e2));
+    let rhs = crate::math::Vec2::new(e1.dot(d), e2.dot(d));
+    let c = gram.try_inverse()? * rhs;
+    let proj = e1 * c.x + e2 * c.y;
+    (proj.norm() > 1e-6 * n).then_some([c.x, c.y])
 }
 
 /// Six position DOFs whose fixing removes the rigid motions of a free sheet without

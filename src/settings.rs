@@ -56,6 +56,8 @@ pub struct Settings {
     pub material: Material,
     /// Rest (programmed) fundamental forms and how they are dialled.
     pub rest: Rest,
+    /// Growth and swelling laws that compute the target rest forms (seed 000 §3).
+    pub growth: Growth,
     /// What is solved: statics or dynamics, and the Newton solver's controls.
     pub solver: Solver,
     /// Time stepping (dynamic mode).
@@ -204,6 +206,66 @@ impl Default for Rest {
             abar: [1.0, 0.0, 1.0],
             bbar: [0.0; 3],
             dial_time: 0.0,
+        }
+    }
+}
+
+/// Which rest-form law computes the target forms (see [`crate::growth`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GrowthLaw {
+    /// No growth law: the targets come from `[rest]`.
+    #[default]
+    None,
+    /// `ā = e^{2s} a⁰`, `b̄ = e^{2s} b⁰`, s from the face field `growth_factor` or `growth.s`.
+    Isotropic,
+    /// Linear differential swelling from the top and bottom moisture, coefficient `mu`.
+    LinearSwelling,
+    /// Piecewise-constant bilayer, coefficients `mu_top` and `mu_bottom`.
+    Bilayer,
+    /// Linear swelling with a machine direction: `mu` along it, `mu_perp` across it.
+    MachineDirection,
+}
+
+/// `[growth]`: the rest-form laws of seed 000 §3. Per-face mesh fields take precedence over the
+/// uniform values here: `moisture_top`, `moisture_bottom` (dimensionless moisture fractions),
+/// `growth_factor` (s), `machine_direction` (3 components, reference Cartesian coordinates).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Growth {
+    /// The law (default: `"none"`).
+    pub law: GrowthLaw,
+    /// Moisture–length coefficient μ along the machine direction, or isotropic (per unit
+    /// moisture, default `0`).
+    pub mu: Real,
+    /// Moisture–length coefficient μ⊥ across the machine direction (default `0`).
+    pub mu_perp: Real,
+    /// Bilayer: coefficient of the top layer (default `0`).
+    pub mu_top: Real,
+    /// Bilayer: coefficient of the bottom layer (default `0`).
+    pub mu_bottom: Real,
+    /// Uniform moisture at the top surface (dimensionless fraction, default `0`).
+    pub moisture_top: Real,
+    /// Uniform moisture at the bottom surface (default `0`).
+    pub moisture_bottom: Real,
+    /// Uniform conformal growth factor s of the isotropic law (default `0`).
+    pub s: Real,
+    /// Uniform machine direction in reference Cartesian coordinates (default `[1, 0, 0]`).
+    pub machine_direction: [Real; 3],
+}
+
+impl Default for Growth {
+    fn default() -> Self {
+        Growth {
+            law: GrowthLaw::None,
+            mu: 0.0,
+            mu_perp: 0.0,
+            mu_top: 0.0,
+            mu_bottom: 0.0,
+            moisture_top: 0.0,
+            moisture_bottom: 0.0,
+            s: 0.0,
+            machine_direction: [1.0, 0.0, 0.0],
         }
     }
 }
@@ -528,6 +590,30 @@ impl Settings {
             }
         }
         nonneg("solver.symmetry_breaking", s.symmetry_breaking)?;
+        let g = &self.growth;
+        for (k, v) in [
+            ("growth.mu", g.mu),
+            ("growth.mu_perp", g.mu_perp),
+            ("growth.mu_top", g.mu_top),
+            ("growth.mu_bottom", g.mu_bottom),
+            ("growth.moisture_top", g.moisture_top),
+            ("growth.moisture_bottom", g.moisture_bottom),
+            ("growth.s", g.s),
+        ] {
+            if !v.is_finite() {
+                return inv(k, format!("must be a finite number, got {v}"));
+            }
+        }
+        if g.law != GrowthLaw::None && self.rest.target != TargetForms::None {
+            return inv(
+                "growth.law",
+                format!(
+                    "a growth law computes the target forms, so rest.target must be \"none\" \
+                     (it is {:?}); use one or the other",
+                    self.rest.target
+                ),
+            );
+        }
         let t = &self.time;
         pos("time.end", t.end)?;
         pos("time.dt", t.dt)?;

@@ -631,3 +631,76 @@ fn membrane_continuation_below_one_is_bad_input() {
     );
     expect_bad(&["s.toml", "m.vtk"], p, "solver.membrane_continuation");
 }
+
+/// Growth laws end to end: a strip wetted on top (linear swelling) curls with its middle above
+/// its ends (b̄ > 0 bulges toward the +z normal, i.e. away from the water), a dry top curls the
+/// other way, equal moisture stays flat; bad growth input is exit 2 naming the face or key.
+#[test]
+fn growth_laws_curl_strips_and_reject_bad_input() {
+    let d = tmp();
+    let p = d.path();
+    let r = run(
+        &[
+            "mesh",
+            "rectangle",
+            "--lx",
+            "0.2",
+            "--ly",
+            "0.02",
+            "--edge",
+            "0.01",
+            "-o",
+            "s.vtk",
+        ],
+        p,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let middle_minus_ends = |toml: &str, out: &str| -> f64 {
+        write(p, "g.toml", toml);
+        let r = run(&["g.toml", "s.vtk", "--out", out, "-q"], p);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        let frame = final_frame(p, out);
+        let m = shellsim::mesh::io::read_mesh(&p.join(frame)).unwrap();
+        let reference = shellsim::mesh::io::read_mesh(&p.join("s.vtk")).unwrap();
+        let z = |pick: &dyn Fn(f64) -> bool| {
+            let v: Vec<f64> = reference
+                .positions
+                .iter()
+                .zip(&m.positions)
+                .filter(|(r, _)| pick(r.x))
+                .map(|(_, x)| x.z)
+                .collect();
+            v.iter().sum::<f64>() / v.len() as f64
+        };
+        z(&|x| x.abs() < 1e-9) - z(&|x| (x.abs() - 0.1).abs() < 1e-9)
+    };
+    let law = |top: f64, bottom: f64| {
+        format!(
+            "[material]\nthickness = 0.001\n[growth]\nlaw = \"linear_swelling\"\nmu = 0.01\nmoisture_top = {top}\nmoisture_bottom = {bottom}\n"
+        )
+    };
+    let wet_top = middle_minus_ends(&law(0.1, 0.0), "a");
+    let wet_bottom = middle_minus_ends(&law(0.0, 0.1), "b");
+    let even = middle_minus_ends(&law(0.1, 0.1), "c");
+    assert!(wet_top > 1e-4, "wet top: {wet_top}");
+    assert!(wet_bottom < -1e-4, "wet bottom: {wet_bottom}");
+    assert!(even.abs() < 1e-9, "even moisture: {even}");
+
+    write(
+        p,
+        "neg.toml",
+        &law(0.1, 0.0).replace("mu = 0.01", "mu = -20"),
+    );
+    expect_bad(&["neg.toml", "s.vtk"], p, "face 0");
+    let md = "[material]\nthickness = 0.001\n[growth]\nlaw = \"machine_direction\"\nmu = 0.01\nmachine_direction = [0, 0, 1]\nmoisture_top = 0.1\n";
+    write(p, "md.toml", md);
+    expect_bad(&["md.toml", "s.vtk"], p, "machine_direction");
+    write(
+        p,
+        "both.toml",
+        "[rest]\ntarget = \"uniform\"\n[growth]\nlaw = \"isotropic\"\n",
+    );
+    expect_bad(&["both.toml", "s.vtk"], p, "growth.law");
+    write(p, "nan.toml", "[growth]\nlaw = \"isotropic\"\ns = nan\n");
+    expect_bad(&["nan.toml", "s.vtk"], p, "growth.s");
+}

@@ -246,3 +246,49 @@ fn colouring_separates_stencils() {
     assert!(p.colours().iter().map(|c| c.len()).sum::<usize>() >= 16);
     assert!(p.num_colours() < 16, "{} colours", p.num_colours());
 }
+
+/// "No growth" on a curved reference mesh is stress-free for every mid-edge model at φ = 0 (the
+/// reference curvature is computed in each model's own terms).
+#[test]
+fn curved_reference_is_at_rest_for_every_midedge_model() {
+    for model in [MODELS[0], MODELS[2], MODELS[3]] {
+        let mut m = rectangle(
+            -0.5,
+            -0.5,
+            1.0,
+            1.0,
+            0.125,
+            Spacing {
+                jitter: 0.2,
+                seed: 4,
+                ..Default::default()
+            },
+        );
+        for p in &mut m.positions {
+            p.z = 0.3 * (p.x * p.x - 0.5 * p.y * p.y);
+        }
+        let sc = Scene::build(
+            m,
+            Settings::from_str_with(&format!("[material]\n{model}\n"), "test", &[]).unwrap(),
+        )
+        .unwrap();
+        let p = pattern(&sc);
+        let pot = Potential {
+            scene: &sc,
+            pattern: &p,
+            dial: 1.0,
+            inertia: None,
+            damping: None,
+            gravity: Vec3::zeros(),
+            stretch_scale: 1.0,
+        };
+        let mut g = vec![0.0; p.n];
+        let phi = vec![0.0; sc.num_edge_dofs()];
+        let e = pot.eval(&sc.mesh.positions, &phi, Want::Gradient, &mut g, &mut []);
+        assert!(e.abs() < 1e-20, "{model}: E = {e}");
+        assert!(
+            g.iter().all(|v: &f64| v.abs() < 1e-12),
+            "{model}: gradient not zero"
+        );
+    }
+}
