@@ -40,6 +40,7 @@
 pub mod assembly;
 pub mod cases;
 pub mod cli;
+pub mod diffusion;
 pub mod energy;
 pub mod geometry;
 pub mod growth;

@@ -41,8 +41,16 @@ pub struct LinearSolver {
 impl LinearSolver {
     /// Symbolic analysis of the pattern, done once.
     pub fn new(p: &Pattern) -> Result<Self, LinearError> {
-        let pattern =
-            SymbolicSparseColMat::new_checked(p.n, p.n, p.col_ptr.clone(), None, p.row_idx.clone());
+        Self::from_csc(p.n, p.col_ptr.clone(), p.row_idx.clone())
+    }
+
+    /// Symbolic analysis of any lower-triangular CSC pattern (sorted rows, diagonal first).
+    pub fn from_csc(
+        n: usize,
+        col_ptr: Vec<usize>,
+        row_idx: Vec<usize>,
+    ) -> Result<Self, LinearError> {
+        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         let symbolic = factorize_symbolic_cholesky(
             pattern.as_ref(),
             Side::Lower,

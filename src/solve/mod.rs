@@ -6,6 +6,6 @@ pub mod linear;
 pub mod newton;
 pub mod potential;
 
-pub use linear::LinearSolver;
+pub use linear::{LinearError, LinearSolver};
 pub use newton::{newton, NewtonOptions, NewtonReport};
 pub use potential::Potential;
