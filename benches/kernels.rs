@@ -135,6 +135,7 @@ fn potential<'a>(sc: &'a Scene, p: &'a Pattern) -> Potential<'a> {
         damping: None,
         gravity: Vec3::zeros(),
         stretch_scale: 1.0,
+        rest_override: None,
     }
 }
 

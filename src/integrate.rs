@@ -20,7 +20,7 @@
 //! (amplitude ×10 each time) and re-solved. A saddle is never reported as an equilibrium.
 
 use crate::assembly::{Pattern, Want};
-use crate::math::{Real, Vec3};
+use crate::math::{Real, Sym2, Vec3};
 use crate::mesh::generate::Rng;
 use crate::output::{LogRow, OutputError, Summary, Writer};
 use crate::scene::Scene;
@@ -41,6 +41,106 @@ pub enum RunError {
     /// The linear solver could not be set up.
     #[error(transparent)]
     Linear(#[from] LinearError),
+    /// The moisture state made the rest forms invalid.
+    #[error("moisture: {0}")]
+    Moisture(String),
+}
+
+/// The moisture diffusion of a dynamic run and the rest forms it drives.
+struct Moisture {
+    diffusion: crate::diffusion::Diffusion,
+    /// Nodal moisture at the last accepted step, and the trial of the current one.
+    u: Vec<Real>,
+    trial: Vec<Real>,
+}
+
+impl Moisture {
+    /// Builds the diffusion system of a scene with `moisture.enabled` (None otherwise).
+    fn new(sc: &Scene) -> Result<Option<Self>, RunError> {
+        use crate::diffusion::{Diffusion, Diffusivity, Side, SurfaceBc};
+        use crate::settings::{SurfaceKind, SurfaceSide};
+        let mo = &sc.settings.moisture;
+        if !mo.enabled {
+            return Ok(None);
+        }
+        let dirs: Vec<Vec3> = sc.growth.direction.iter().map(|d| d.1).collect();
+        let mut diffusion = Diffusion::new(
+            &sc.mesh.positions,
+            &sc.mesh.faces,
+            &sc.thickness,
+            &dirs,
+            Diffusivity {
+                along: mo.diffusivity_along,
+                across: mo.diffusivity_across,
+                through: mo.diffusivity_through,
+            },
+            mo.layers,
+        )?;
+        for b in &mo.boundary {
+            let side = match b.side {
+                SurfaceSide::Top => Side::Top,
+                SurfaceSide::Bottom => Side::Bottom,
+            };
+            let bc = match b.kind {
+                SurfaceKind::Sealed => SurfaceBc::Sealed,
+                SurfaceKind::Value => SurfaceBc::Value(b.value),
+                SurfaceKind::Flux => SurfaceBc::Flux(b.value),
+                SurfaceKind::Robin => SurfaceBc::Robin {
+                    k: b.k,
+                    ambient: b.ambient,
+                },
+            };
+            let faces = crate::scene::region_faces(&sc.mesh, &b.tags)
+                .map_err(|e| RunError::Moisture(e.to_string()))?;
+            for f in faces {
+                diffusion
+                    .set_surface(f, side, bc)
+                    .map_err(RunError::Moisture)?;
+            }
+        }
+        let u = vec![mo.initial; diffusion.num_nodes()];
+        Ok(Some(Moisture {
+            trial: u.clone(),
+            u,
+            diffusion,
+        }))
+    }
+
+    /// Rest forms of every face from the moisture `u`.
+    fn targets_of(&self, sc: &Scene, u: &[Real]) -> Result<Vec<(Sym2, Sym2)>, String> {
+        (0..sc.num_faces())
+            .map(|f| {
+                let m = self.diffusion.surface_moisture(u, f);
+                let reference = (sc.rest.abar0[f], sc.rest.bbar0[f]);
+                crate::scene::growth_face(
+                    &sc.settings,
+                    &sc.growth,
+                    f,
+                    reference,
+                    sc.thickness[f],
+                    m,
+                )
+                .map_err(|e| format!("growth at face {f}: {e}"))
+            })
+            .collect()
+    }
+
+    fn targets(&self, sc: &Scene) -> Result<Vec<(Sym2, Sym2)>, String> {
+        self.targets_of(sc, &self.u)
+    }
+
+    /// Hands the surface moisture of the accepted state to the writer for the next frame.
+    fn publish(&self, writer: &mut Writer) {
+        let nf = writer.num_faces();
+        let (mut top, mut bottom) = (Vec::with_capacity(nf), Vec::with_capacity(nf));
+        for f in 0..nf {
+            let (a, b) = self.diffusion.surface_moisture(&self.u, f);
+            top.push(a);
+            bottom.push(b);
+        }
+        writer.set_face_field("moisture_top", top);
+        writer.set_face_field("moisture_bottom", bottom);
+    }
 }
 
 /// Receives progress updates (a terminal progress bar, or nothing).
@@ -178,6 +278,7 @@ impl<'a> Solver<'a> {
             damping: None,
             gravity: self.gravity,
             stretch_scale,
+            rest_override: None,
         }
     }
 
@@ -466,8 +567,19 @@ fn run_dynamic(
     } else {
         (Vec::new(), Vec::new())
     };
+    // Moisture: the diffusion state and the rest forms it sets (None without diffusion).
+    let mut moisture = Moisture::new(sc)?;
+    let mut targets: Vec<(Sym2, Sym2)> = Vec::new();
+    let mut trial_targets: Vec<(Sym2, Sym2)> = Vec::new();
+    if let Some(m) = &moisture {
+        targets = m.targets(sc).map_err(RunError::Moisture)?;
+        m.publish(writer);
+    }
     {
-        let pot = s.potential(dial_at(t0));
+        let pot = Potential {
+            rest_override: moisture.as_ref().map(|_| &targets[..]),
+            ..s.potential(dial_at(t0))
+        };
         s.frame(writer, &pot, &x, &phi, &v, t0)?;
     }
     let mut t = t0;
@@ -486,6 +598,21 @@ fn run_dynamic(
         }
         trial.copy_from_slice(&xhat);
         trial_phi.copy_from_slice(&phi);
+        if let Some(m) = &mut moisture {
+            // Diffuse over the step, then set the rest forms from the new surface moisture.
+            m.trial.copy_from_slice(&m.u);
+            if let Err(e) = m.diffusion.step(&mut m.trial, h) {
+                failure = Some(format!("moisture diffusion at t = {t:.6e}: {e}"));
+                break;
+            }
+            match m.targets_of(sc, &m.trial) {
+                Ok(tt) => trial_targets = tt,
+                Err(e) => {
+                    failure = Some(format!("at t = {t:.6e}: {e}"));
+                    break;
+                }
+            }
+        }
         let pot = Potential {
             scene: sc,
             pattern: s.pattern,
@@ -501,6 +628,7 @@ fn run_dynamic(
             }),
             gravity: s.gravity,
             stretch_scale: 1.0,
+            rest_override: moisture.as_ref().map(|_| &trial_targets[..]),
         };
         let rep = newton(
             &pot,
@@ -529,6 +657,10 @@ fn run_dynamic(
         }
         x.copy_from_slice(&trial);
         phi.copy_from_slice(&trial_phi);
+        if let Some(m) = &mut moisture {
+            m.u.copy_from_slice(&m.trial);
+            std::mem::swap(&mut targets, &mut trial_targets);
+        }
         t += h;
         s.summary.steps += 1;
         if damping {
@@ -552,7 +684,10 @@ fn run_dynamic(
         let at_output = t >= next_out - 1e-9 * h.max(eps_t);
         let mut stop = false;
         if tm.stop_at_equilibrium {
-            let pot = s.potential(dial);
+            let pot = Potential {
+                rest_override: moisture.as_ref().map(|_| &targets[..]),
+                ..s.potential(dial)
+            };
             let mut g = vec![0.0; s.pattern.n];
             pot.eval(&x, &phi, Want::Gradient, &mut g, &mut []);
             let r = pot.residual(&g);
@@ -564,7 +699,13 @@ fn run_dynamic(
                         * (en.stretching + en.bending).max(Real::MIN_POSITIVE);
         }
         if at_output || stop || t >= tm.end - eps_t {
-            let pot = s.potential(dial);
+            if let Some(m) = &moisture {
+                m.publish(writer);
+            }
+            let pot = Potential {
+                rest_override: moisture.as_ref().map(|_| &targets[..]),
+                ..s.potential(dial)
+            };
             s.frame(writer, &pot, &x, &phi, &v, t)?;
             while next_out <= t + eps_t {
                 next_out += tm.output_interval;
@@ -579,7 +720,10 @@ fn run_dynamic(
     s.summary.dial = dial_at(t);
     s.summary.converged = failure.is_none();
     s.summary.reason = failure.unwrap_or_default();
-    let pot = s.potential(dial_at(t));
+    let pot = Potential {
+        rest_override: moisture.as_ref().map(|_| &targets[..]),
+        ..s.potential(dial_at(t))
+    };
     s.summary.energy = Writer::energies(&pot, &x, &phi, &v);
     if s.summary.reason.is_empty() {
         return Ok(());

@@ -26,6 +26,7 @@
 //!     damping: None,
 //!     gravity: Vec3::zeros(),
 //!     stretch_scale: 1.0,
+//!     rest_override: None,
 //! };
 //! // The flat sheet is not at rest under the programmed curvature: positive bending energy and
 //! // a non-zero gradient.

@@ -145,6 +145,8 @@ pub struct Writer {
     log: Vec<LogRow>,
     frame_mesh: Mesh,
     frames_t: Vec<Mat2>,
+    /// Extra per-face fields written into every following frame (moisture).
+    extra: std::collections::BTreeMap<String, Vec<Real>>,
 }
 
 fn ioerr(path: &Path, e: impl ToString) -> OutputError {
@@ -215,7 +217,18 @@ impl Writer {
             log: Vec::new(),
             frames_t: output_frames(mesh),
             frame_mesh,
+            extra: Default::default(),
         })
+    }
+
+    /// Sets an extra per-face scalar field written into the following frames.
+    pub fn set_face_field(&mut self, name: &str, data: Vec<Real>) {
+        self.extra.insert(name.to_string(), data);
+    }
+
+    /// Number of faces of the frames.
+    pub fn num_faces(&self) -> usize {
+        self.frame_mesh.faces.len()
     }
 
     /// Number of frames written.
@@ -317,6 +330,9 @@ impl Writer {
         ff.insert("stretching_energy_density".into(), Field::scalar(es));
         ff.insert("bending_energy_density".into(), Field::scalar(eb));
         ff.insert("thickness".into(), Field::scalar(sc.thickness.clone()));
+        for (name, data) in &self.extra {
+            ff.insert(name.clone(), Field::scalar(data.clone()));
+        }
         if sc.has_edge_dofs() {
             let ea = sc.topo.face_edges.iter().flat_map(|fe| fe.map(|e| phi[e]));
             ff.insert("edge_angles".into(), vec3(ea.collect()));

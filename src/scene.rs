@@ -48,6 +48,8 @@ pub struct Scene {
     /// Static mode with nothing fixed: 6 position DOFs held at their current values to remove
     /// the rigid-body null space of the Hessian (see [`rigid_pins`]), else empty.
     pub pinned_dofs: Vec<usize>,
+    /// Per-face inputs of the growth law.
+    pub growth: GrowthInputs,
 }
 
 fn positive_face_field(mesh: &Mesh, name: &str) -> Result<Option<Vec<Real>>, MeshError> {
@@ -153,10 +155,23 @@ impl Scene {
             }
         }
 
+        let growth = GrowthInputs::read(&mesh, &settings)?;
         if settings.growth.law != crate::settings::GrowthLaw::None {
-            let (a1, b1) = growth_targets(&mesh, &settings, &rest, &thickness)?;
-            rest.abar1 = a1;
-            rest.bbar1 = b1;
+            for (f, &h) in thickness.iter().enumerate() {
+                let m = if settings.moisture.enabled {
+                    (settings.moisture.initial, settings.moisture.initial)
+                } else {
+                    (growth.moisture_top[f], growth.moisture_bottom[f])
+                };
+                let reference = (rest.abar0[f], rest.bbar0[f]);
+                let (a, b) = growth_face(&settings, &growth, f, reference, h, m)
+                    .map_err(|e| mesh.invalid(format!("growth at face {f}: {e}")))?;
+                rest.abar1[f] = a;
+                rest.bbar1[f] = b;
+            }
+        }
+        if settings.moisture.enabled {
+            check_moisture_regions(&mesh, &settings)?;
         }
 
         let mut mass = vec![0.0; nv];
@@ -258,6 +273,7 @@ impl Scene {
             edge_sign,
             node_fixed,
             pinned_dofs,
+            growth,
         })
     }
 
@@ -399,6 +415,43 @@ fn edge_signs(topo: &Topology) -> Vec<[Real; 3]> {
         .collect()
 }
 
+/// The faces of a moisture boundary region: `tri_tags` in `tags`, or every face.
+pub fn region_faces(mesh: &Mesh, tags: &[i64]) -> Result<Vec<usize>, MeshError> {
+    if tags.is_empty() {
+        return Ok((0..mesh.faces.len()).collect());
+    }
+    let t = mesh.face_field("tri_tags", 1)?.ok_or_else(|| {
+        mesh.invalid(
+            "moisture.boundary selects faces by tags, which needs the face field 'tri_tags'",
+        )
+    })?;
+    Ok((0..mesh.faces.len())
+        .filter(|&f| tags.contains(&(t.data[f].round() as i64)))
+        .collect())
+}
+
+/// Rejects moisture boundary regions that give one face side two different conditions.
+fn check_moisture_regions(mesh: &Mesh, settings: &Settings) -> Result<(), MeshError> {
+    let mut seen: std::collections::HashMap<(usize, crate::settings::SurfaceSide), usize> =
+        Default::default();
+    for (i, b) in settings.moisture.boundary.iter().enumerate() {
+        for f in region_faces(mesh, &b.tags)? {
+            if let Some(&j) = seen.get(&(f, b.side)) {
+                let o = &settings.moisture.boundary[j];
+                if (o.kind, o.value, o.k, o.ambient) != (b.kind, b.value, b.k, b.ambient) {
+                    return Err(mesh.invalid(format!(
+                        "moisture.boundary[{j}] and moisture.boundary[{i}] both set the {:?} \
+                         surface of face {f} to different conditions",
+                        b.side
+                    )));
+                }
+            }
+            seen.insert((f, b.side), i);
+        }
+    }
+    Ok(())
+}
+
 /// A per-face scalar field with a uniform fallback, checked finite (naming the face).
 fn face_values(mesh: &Mesh, name: &str, uniform: Real) -> Result<Vec<Real>, MeshError> {
     match mesh.face_field(name, 1)? {
@@ -412,58 +465,33 @@ fn face_values(mesh: &Mesh, name: &str, uniform: Real) -> Result<Vec<Real>, Mesh
     }
 }
 
-/// The target forms of `growth.law` from the reference forms (dial 0) and the per-face fields
-/// (see [`crate::growth`]). Errors name the face and field: non-finite values, a machine
-/// direction that is zero or normal to its face, and swelling that makes ā non-positive.
-fn growth_targets(
-    mesh: &Mesh,
-    settings: &Settings,
-    rest: &RestForms,
-    thickness: &[Real],
-) -> Result<(Vec<Sym2>, Vec<Sym2>), MeshError> {
-    use crate::settings::GrowthLaw;
-    let g = &settings.growth;
-    let nf = mesh.faces.len();
-    let mt = face_values(mesh, "moisture_top", g.moisture_top)?;
-    let mb = face_values(mesh, "moisture_bottom", g.moisture_bottom)?;
-    let s = face_values(mesh, "growth_factor", g.s)?;
-    let dirs = mesh.face_field("machine_direction", 3)?;
-    let mut a1 = Vec::with_capacity(nf);
-    let mut b1 = Vec::with_capacity(nf);
-    // (coefficient, applies to the top moisture, applies to the bottom moisture).
-    let coefficients: &[(Real, bool, bool)] = match g.law {
-        GrowthLaw::LinearSwelling => &[(g.mu, true, true)],
-        GrowthLaw::Bilayer => &[(g.mu_top, true, false), (g.mu_bottom, false, true)],
-        GrowthLaw::MachineDirection => &[(g.mu, true, true), (g.mu_perp, true, true)],
-        _ => &[],
-    };
-    for f in 0..nf {
-        let (a0, b0) = (rest.abar0[f], rest.bbar0[f]);
-        let h = thickness[f];
-        for &(mu, top, bottom) in coefficients {
-            let worst = match (top, bottom) {
-                (true, true) => (mu * mt[f]).min(mu * mb[f]),
-                (true, false) => mu * mt[f],
-                _ => mu * mb[f],
-            };
-            if 1.0 + worst <= 0.0 {
-                return Err(mesh.invalid(format!(
-                    "growth: the stretch 1 + mu m = 1 + {worst} is not positive at face {f} \
-                     (mu {mu}, moisture_top {}, moisture_bottom {}): a length cannot become ≤ 0",
-                    mt[f], mb[f]
-                )));
-            }
-        }
-        let (a, b) = match g.law {
-            GrowthLaw::None => (a0, b0),
-            GrowthLaw::Isotropic => crate::growth::isotropic(&a0, &b0, s[f]),
-            GrowthLaw::LinearSwelling => {
-                crate::growth::linear_swelling(&a0, &b0, h, mt[f], mb[f], g.mu)
-            }
-            GrowthLaw::Bilayer => {
-                crate::growth::bilayer(&a0, &b0, h, mt[f], mb[f], g.mu_top, g.mu_bottom)
-            }
-            GrowthLaw::MachineDirection => {
+/// Per-face inputs of the growth laws, read once from the mesh fields and settings.
+#[derive(Clone, Debug, Default)]
+pub struct GrowthInputs {
+    /// Moisture at the top surface.
+    pub moisture_top: Vec<Real>,
+    /// Moisture at the bottom surface.
+    pub moisture_bottom: Vec<Real>,
+    /// Conformal factor s of the isotropic law.
+    pub s: Vec<Real>,
+    /// Machine direction per face: barycentric coordinates, and the unit 3D vector in the face
+    /// plane (for the diffusivity). Empty unless the law or the diffusion needs it.
+    pub direction: Vec<([Real; 2], Vec3)>,
+}
+
+impl GrowthInputs {
+    fn read(mesh: &Mesh, settings: &Settings) -> Result<Self, MeshError> {
+        use crate::settings::GrowthLaw;
+        let g = &settings.growth;
+        let mut out = GrowthInputs {
+            moisture_top: face_values(mesh, "moisture_top", g.moisture_top)?,
+            moisture_bottom: face_values(mesh, "moisture_bottom", g.moisture_bottom)?,
+            s: face_values(mesh, "growth_factor", g.s)?,
+            direction: Vec::new(),
+        };
+        if g.law == GrowthLaw::MachineDirection || settings.moisture.enabled {
+            let dirs = mesh.face_field("machine_direction", 3)?;
+            for f in 0..mesh.faces.len() {
                 let (d, what) = match dirs {
                     Some(df) => (
                         Vec3::from_column_slice(df.get(f)),
@@ -478,20 +506,73 @@ fn growth_targets(
                         d.x, d.y, d.z
                     ))
                 })?;
-                crate::growth::machine_direction(&a0, &b0, h, mt[f], mb[f], g.mu, g.mu_perp, d2)
+                let [p0, p1, p2] = mesh.face_positions(f);
+                let d3 = ((p1 - p0) * d2[0] + (p2 - p0) * d2[1]).normalize();
+                out.direction.push((d2, d3));
             }
-        };
-        if !(a[0] > 0.0 && crate::math::sym_det(&a) > 0.0 && b.iter().all(|v| v.is_finite())) {
-            return Err(mesh.invalid(format!(
-                "growth.law {:?} makes abar non-positive-definite at face {f} (moisture top {}, \
-                 bottom {}, s {}): the swelling factor 1 + mu m must stay positive",
-                g.law, mt[f], mb[f], s[f]
-            )));
         }
-        a1.push(a);
-        b1.push(b);
+        Ok(out)
     }
-    Ok((a1, b1))
+}
+
+/// The rest forms of face `f` under `settings.growth.law`, from its reference forms, thickness
+/// and surface moisture `(m_top, m_bottom)`. Errors (without the face, which the caller names):
+/// a stretch `1 + μ m ≤ 0`, or an ā that is not positive definite.
+pub fn growth_face(
+    settings: &Settings,
+    inputs: &GrowthInputs,
+    f: usize,
+    reference: (Sym2, Sym2),
+    h: Real,
+    moisture: (Real, Real),
+) -> Result<(Sym2, Sym2), String> {
+    use crate::settings::GrowthLaw;
+    let g = &settings.growth;
+    let (a0, b0) = reference;
+    let (mt, mb) = moisture;
+    // (coefficient, applies to the top moisture, applies to the bottom moisture).
+    let coefficients: &[(Real, bool, bool)] = match g.law {
+        GrowthLaw::LinearSwelling => &[(g.mu, true, true)],
+        GrowthLaw::Bilayer => &[(g.mu_top, true, false), (g.mu_bottom, false, true)],
+        GrowthLaw::MachineDirection => &[(g.mu, true, true), (g.mu_perp, true, true)],
+        _ => &[],
+    };
+    for &(mu, top, bottom) in coefficients {
+        let worst = match (top, bottom) {
+            (true, true) => (mu * mt).min(mu * mb),
+            (true, false) => mu * mt,
+            _ => mu * mb,
+        };
+        if 1.0 + worst <= 0.0 || worst.is_nan() {
+            return Err(format!(
+                "the stretch 1 + mu m = 1 + {worst} is not positive (mu {mu}, moisture top \
+                 {mt}, bottom {mb}): a length cannot become ≤ 0"
+            ));
+        }
+    }
+    let (a, b) = match g.law {
+        GrowthLaw::None => (a0, b0),
+        GrowthLaw::Isotropic => crate::growth::isotropic(&a0, &b0, inputs.s[f]),
+        GrowthLaw::LinearSwelling => crate::growth::linear_swelling(&a0, &b0, h, mt, mb, g.mu),
+        GrowthLaw::Bilayer => crate::growth::bilayer(&a0, &b0, h, mt, mb, g.mu_top, g.mu_bottom),
+        GrowthLaw::MachineDirection => crate::growth::machine_direction(
+            &a0,
+            &b0,
+            h,
+            mt,
+            mb,
+            g.mu,
+            g.mu_perp,
+            inputs.direction[f].0,
+        ),
+    };
+    if !(a[0] > 0.0 && crate::math::sym_det(&a) > 0.0 && b.iter().all(|v| v.is_finite())) {
+        return Err(format!(
+            "growth.law {:?} makes abar non-positive-definite (moisture top {mt}, bottom {mb})",
+            g.law
+        ));
+    }
+    Ok((a, b))
 }
 
 /// A reference-Cartesian direction as barycentric coordinates of face `f`: its projection on the

@@ -58,6 +58,8 @@ pub struct Settings {
     pub rest: Rest,
     /// Growth and swelling laws that compute the target rest forms (seed 000 §3).
     pub growth: Growth,
+    /// Moisture diffusion that drives the swelling laws in time (seed 000 §4).
+    pub moisture: Moisture,
     /// What is solved: statics or dynamics, and the Newton solver's controls.
     pub solver: Solver,
     /// Time stepping (dynamic mode).
@@ -268,6 +270,99 @@ impl Default for Growth {
             machine_direction: [1.0, 0.0, 0.0],
         }
     }
+}
+
+/// `[moisture]`: prism-FEM diffusion through the sheet (see [`crate::diffusion`]); each time
+/// step diffuses, then sets the rest forms from the surface moisture with `growth.law`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Moisture {
+    /// Solve the diffusion (dynamic mode with a moisture-driven growth law; default `false`).
+    pub enabled: bool,
+    /// Diffusivity along the machine direction (m²/s, default `1e-10`).
+    pub diffusivity_along: Real,
+    /// Diffusivity across it, in the plane (m²/s, default `1e-10`).
+    pub diffusivity_across: Real,
+    /// Diffusivity through the thickness (m²/s, default `1e-10`).
+    pub diffusivity_through: Real,
+    /// Element layers through the thickness (default `4`).
+    pub layers: usize,
+    /// Initial moisture everywhere (default `0`).
+    pub initial: Real,
+    /// Surface conditions by region; faces without one are sealed.
+    pub boundary: Vec<MoistureBoundary>,
+}
+
+impl Default for Moisture {
+    fn default() -> Self {
+        Moisture {
+            enabled: false,
+            diffusivity_along: 1e-10,
+            diffusivity_across: 1e-10,
+            diffusivity_through: 1e-10,
+            layers: 4,
+            initial: 0.0,
+            boundary: Vec::new(),
+        }
+    }
+}
+
+/// One surface condition on a region of faces.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MoistureBoundary {
+    /// Faces whose `tri_tags` is one of these (empty: every face).
+    pub tags: Vec<i64>,
+    /// `"top"` (the normal side) or `"bottom"`.
+    pub side: SurfaceSide,
+    /// `"value"` (prescribed moisture), `"flux"` (inward flux), `"robin"` (exchange with an
+    /// ambient moisture) or `"sealed"`.
+    pub kind: SurfaceKind,
+    /// Moisture for `"value"`, inward flux (m/s) for `"flux"`.
+    pub value: Real,
+    /// Transfer coefficient k (m/s) for `"robin"`.
+    pub k: Real,
+    /// Ambient moisture for `"robin"`.
+    pub ambient: Real,
+}
+
+impl Default for MoistureBoundary {
+    fn default() -> Self {
+        MoistureBoundary {
+            tags: Vec::new(),
+            side: SurfaceSide::Top,
+            kind: SurfaceKind::Sealed,
+            value: 0.0,
+            k: 0.0,
+            ambient: 0.0,
+        }
+    }
+}
+
+/// Top or bottom surface.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SurfaceSide {
+    /// `z = +h/2`.
+    #[default]
+    Top,
+    /// `z = −h/2`.
+    Bottom,
+}
+
+/// Kind of surface condition.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SurfaceKind {
+    /// No flux.
+    #[default]
+    Sealed,
+    /// Prescribed moisture.
+    Value,
+    /// Prescribed inward flux.
+    Flux,
+    /// Exchange with the ambient.
+    Robin,
 }
 
 /// Static equilibrium or dynamics.
@@ -613,6 +708,60 @@ impl Settings {
                     self.rest.target
                 ),
             );
+        }
+        let mo = &self.moisture;
+        if mo.enabled {
+            for (k, v) in [
+                ("moisture.diffusivity_along", mo.diffusivity_along),
+                ("moisture.diffusivity_across", mo.diffusivity_across),
+                ("moisture.diffusivity_through", mo.diffusivity_through),
+            ] {
+                pos(k, v)?;
+            }
+            if mo.layers == 0 {
+                return inv("moisture.layers", "must be at least 1".into());
+            }
+            if !mo.initial.is_finite() {
+                return inv(
+                    "moisture.initial",
+                    format!("must be finite, got {}", mo.initial),
+                );
+            }
+            if self.solver.mode != Mode::Dynamic {
+                return inv(
+                    "moisture.enabled",
+                    "moisture diffusion runs in time: set solver.mode = \"dynamic\"".into(),
+                );
+            }
+            if !matches!(
+                g.law,
+                GrowthLaw::LinearSwelling | GrowthLaw::Bilayer | GrowthLaw::MachineDirection
+            ) {
+                return inv(
+                    "moisture.enabled",
+                    format!(
+                        "moisture drives the rest forms through a swelling law; growth.law is \
+                         {:?} (use linear_swelling, bilayer or machine_direction)",
+                        g.law
+                    ),
+                );
+            }
+            for (i, b) in mo.boundary.iter().enumerate() {
+                for v in [b.value, b.k, b.ambient] {
+                    if !v.is_finite() {
+                        return inv(
+                            &format!("moisture.boundary[{i}]"),
+                            format!("non-finite value {v}"),
+                        );
+                    }
+                }
+                if b.kind == SurfaceKind::Robin && b.k < 0.0 {
+                    return inv(
+                        &format!("moisture.boundary[{i}].k"),
+                        format!("must be ≥ 0, got {}", b.k),
+                    );
+                }
+            }
         }
         let t = &self.time;
         pos("time.end", t.end)?;

@@ -704,3 +704,71 @@ fn growth_laws_curl_strips_and_reject_bad_input() {
     write(p, "nan.toml", "[growth]\nlaw = \"isotropic\"\ns = nan\n");
     expect_bad(&["nan.toml", "s.vtk"], p, "growth.s");
 }
+
+/// Moisture coupling end to end: a strip wetted on top (prescribed moisture 0.2, bottom sealed)
+/// curls away from the water while the moisture crosses the thickness, then flattens as it
+/// evens out: the mean curvature rises, peaks and falls, with the right sign, and every frame
+/// carries finite moisture fields. Contradictory regions and moisture in static mode are exit 2.
+#[test]
+fn wetted_strip_curls_then_flattens() {
+    let d = tmp();
+    let p = d.path();
+    let r = run(
+        &[
+            "mesh",
+            "rectangle",
+            "--lx",
+            "0.1",
+            "--ly",
+            "0.02",
+            "--edge",
+            "0.01",
+            "-o",
+            "s.vtk",
+        ],
+        p,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let scene = "[material]\nyoung = 3.0e9\ndensity = 800.0\nthickness = 1.0e-4\n[growth]\nlaw = \"linear_swelling\"\nmu = 0.01\n[moisture]\nenabled = true\ndiffusivity_along = 1e-9\ndiffusivity_across = 1e-9\ndiffusivity_through = 1e-9\nlayers = 4\n[[moisture.boundary]]\nside = \"top\"\nkind = \"value\"\nvalue = 0.2\n[solver]\nmode = \"dynamic\"\n[time]\nend = 12.0\ndt = 0.01\ndt_max = 0.5\noutput_interval = 1.0\ndamping = 0.1\n[output]\nformat = \"vtk_ascii\"\n";
+    write(p, "w.toml", scene);
+    let r = run(&["w.toml", "s.vtk", "--out", "o", "-q"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let mut curvature = Vec::new();
+    for k in 0..=12 {
+        let m = shellsim::mesh::io::read_mesh(&p.join(format!("o/frame_{k:05}.vtk"))).unwrap();
+        let h = &m.face_fields["mean_curvature"].data;
+        let top = &m.face_fields["moisture_top"].data;
+        let bottom = &m.face_fields["moisture_bottom"].data;
+        assert!(top
+            .iter()
+            .chain(bottom)
+            .all(|v| v.is_finite() && *v >= -1e-12 && *v <= 0.2 + 1e-12));
+        curvature.push(h.iter().sum::<f64>() / h.len() as f64);
+    }
+    println!("mean curvature per second: {curvature:.3?}");
+    let (peak, at) =
+        curvature.iter().enumerate().fold(
+            (0.0f64, 0),
+            |(m, i), (k, &c)| if c > m { (c, k) } else { (m, i) },
+        );
+    assert!(
+        peak > 5.0,
+        "the strip should curl away from the water: {curvature:?}"
+    );
+    assert!((1..=3).contains(&at), "peak at {at} s");
+    assert!(
+        curvature[12] < 0.2 * peak,
+        "it should flatten as the moisture evens out"
+    );
+
+    let contradictory =
+        format!("{scene}[[moisture.boundary]]\nside = \"top\"\nkind = \"flux\"\nvalue = 1e-6\n");
+    write(p, "c.toml", &contradictory);
+    expect_bad(&["c.toml", "s.vtk"], p, "face 0");
+    write(
+        p,
+        "st.toml",
+        &scene.replace("mode = \"dynamic\"", "mode = \"static\""),
+    );
+    expect_bad(&["st.toml", "s.vtk"], p, "moisture.enabled");
+}

@@ -56,6 +56,8 @@ pub struct Potential<'a> {
     /// Multiplier on the elastic stretching weight (1 except during the static solver's
     /// membrane continuation).
     pub stretch_scale: Real,
+    /// Per-face rest forms `(ā, b̄)` that replace the dialled ones (moisture-driven growth).
+    pub rest_override: Option<&'a [(Sym2, Sym2)]>,
 }
 
 impl<'a> Potential<'a> {
@@ -63,7 +65,10 @@ impl<'a> Potential<'a> {
     #[inline]
     pub fn density(&self, f: usize) -> KoiterDensity {
         let sc = self.scene;
-        let (abar, bbar) = sc.rest.at(f, self.dial);
+        let (abar, bbar) = match self.rest_override {
+            Some(r) => r[f],
+            None => sc.rest.at(f, self.dial),
+        };
         let (ws, wb) = KoiterDensity::weights(&abar, sc.thickness[f], sc.stretch_factor);
         let ws = ws * self.stretch_scale;
         let mut d = KoiterDensity {

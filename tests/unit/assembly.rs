@@ -77,6 +77,7 @@ fn rest_state_has_zero_energy_and_gradient() {
         damping: None,
         gravity: Vec3::zeros(),
         stretch_scale: 1.0,
+        rest_override: None,
     };
     let mut g = vec![0.0; p.n];
     let phi = vec![0.0; sc.num_edge_dofs()];
@@ -115,6 +116,7 @@ fn bitwise_identical(model: &str) {
                 damping: None,
                 gravity: Vec3::new(0.0, 0.0, -9.81),
                 stretch_scale: 1.0,
+                rest_override: None,
             };
             let mut g = vec![0.0; p.n];
             let mut h = vec![0.0; p.nnz()];
@@ -169,6 +171,7 @@ fn assembled_derivatives(model: &str) {
         }),
         gravity: Vec3::new(0.0, 0.0, -9.81),
         stretch_scale: 1.0,
+        rest_override: None,
     };
     let mut g = vec![0.0; p.n];
     let mut h = vec![0.0; p.nnz()];
@@ -281,6 +284,7 @@ fn curved_reference_is_at_rest_for_every_midedge_model() {
             damping: None,
             gravity: Vec3::zeros(),
             stretch_scale: 1.0,
+            rest_override: None,
         };
         let mut g = vec![0.0; p.n];
         let phi = vec![0.0; sc.num_edge_dofs()];
