@@ -246,5 +246,58 @@ fn newton_iteration(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, kernel, assembly, newton_iteration);
+/// One moisture-diffusion step (4 layers, 5k faces; the factorisation is cached for a fixed Δt)
+/// plus the rest forms of every face from the new surface moisture: the extra cost of a coupled
+/// time step, to set against `newton_iteration` on the same mesh.
+fn moisture_step(c: &mut Criterion) {
+    use shellsim::diffusion::{Diffusion, Diffusivity, Side, SurfaceBc};
+    let mut g = c.benchmark_group("moisture_step");
+    g.sample_size(20);
+    let sc = scene(1.0 / 50.0);
+    let nf = sc.num_faces();
+    let dirs = vec![Vec3::new(1.0, 0.0, 0.0); nf];
+    let d = Diffusivity {
+        along: 1e-9,
+        across: 5e-10,
+        through: 1e-9,
+    };
+    let mut diff = Diffusion::new(
+        &sc.mesh.positions,
+        &sc.mesh.faces,
+        &sc.thickness,
+        &dirs,
+        d,
+        4,
+    )
+    .unwrap();
+    for f in 0..nf {
+        diff.set_surface(f, Side::Top, SurfaceBc::Value(0.2))
+            .unwrap();
+    }
+    let mut u = vec![0.0; diff.num_nodes()];
+    g.bench_function(BenchmarkId::new("diffuse", nf), |b| {
+        b.iter(|| diff.step(black_box(&mut u), 0.05).unwrap())
+    });
+    g.bench_function(BenchmarkId::new("rest_forms", nf), |b| {
+        b.iter(|| {
+            (0..nf)
+                .map(|f| {
+                    let (mt, mb) = diff.surface_moisture(&u, f);
+                    let r = shellsim::growth::linear_swelling(
+                        &sc.rest.abar0[f],
+                        &sc.rest.bbar0[f],
+                        sc.thickness[f],
+                        mt,
+                        mb,
+                        0.01,
+                    );
+                    r.0[0] + r.1[0]
+                })
+                .sum::<f64>()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, kernel, assembly, newton_iteration, moisture_step);
 criterion_main!(benches);

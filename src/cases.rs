@@ -17,6 +17,7 @@
 //! |---|---|---|---|---|
 //! | `gcm_cone` | sector 1 ≤ r ≤ 1.4, 0 ≤ θ ≤ 2π sin α | I | θ̂θ̂ᵀ/(2r) | cone of half-angle α = atan 2 |
 //! | `bilayer_strip` | 1 × 0.1 strip, h = 0.002 | diag(ā11, 1) | diag(3Δε/(2h), 0) | arc of curvature b̄11/ā11 |
+//! | `conformal_cap` | unit disk | η² I, η = 1/(1 + ρ²/4) | = ā | the unit sphere by inverse stereographic projection |
 //!
 //! `gcm_cone` is MorphoShell's curvature-programmed cone: ā = I and b̄ = θ̂θ̂ᵀ/(2r) satisfy the
 //! Gauss–Codazzi–Mainardi equations, and the surface is the cone whose circumferential normal
@@ -60,6 +61,10 @@ pub enum Case {
     GcmCone,
     /// A bilayer strip against Timoshenko's formula (see the module doc).
     BilayerStrip,
+    /// Isotropic (conformal) growth of the unit disk toward a spherical cap: ā = η² I with
+    /// η = 1/(1 + ρ²/4) (Gauss curvature 1, Klein, Efrati & Sharon 2007) and b̄ = ā (the unit
+    /// sphere's curvature, b̄ = ā/R with R = 1).
+    ConformalCap,
 }
 
 /// Half-angle of [`Case::GcmCone`]: `tan α = 2`.
@@ -111,7 +116,7 @@ pub const CONE_LAMBDA_THETA: Real = 0.8;
 
 impl Case {
     /// All cases.
-    pub const ALL: [Case; 8] = [
+    pub const ALL: [Case; 9] = [
         Case::EnlargedSquare,
         Case::SphericalCap,
         Case::Hyperboloid,
@@ -120,6 +125,7 @@ impl Case {
         Case::Cone,
         Case::GcmCone,
         Case::BilayerStrip,
+        Case::ConformalCap,
     ];
 
     /// Whether the mirror image (z → −z) of the exact shape is equally exact (b̄ = 0).
@@ -138,6 +144,7 @@ impl Case {
             Case::Cone => "cone",
             Case::GcmCone => "gcm_cone",
             Case::BilayerStrip => "bilayer_strip",
+            Case::ConformalCap => "conformal_cap",
         }
     }
 
@@ -184,6 +191,11 @@ impl Case {
                 let (a11, b11) = bilayer_forms();
                 (Sym2::new(a11, 0.0, 1.0), Sym2::new(b11, 0.0, 0.0))
             }
+            Case::ConformalCap => {
+                let eta = 1.0 / (1.0 + 0.25 * (x * x + y * y));
+                let a = Sym2::new(1.0, 0.0, 1.0) * (eta * eta);
+                (a, a)
+            }
         }
     }
 
@@ -211,6 +223,12 @@ impl Case {
                 let (sa, ca) = gcm_cone_half_angle().sin_cos();
                 let psi = polar_angle(x, y) / sa;
                 Vec3::new(r * sa * psi.cos(), r * sa * psi.sin(), -r * ca)
+            }
+            Case::ConformalCap => {
+                // Inverse stereographic projection from the south pole, scaled so that the
+                // metric is (1 + ρ²/4)⁻² |dx|²: the unit sphere, the centre at the north pole.
+                let q = 1.0 + 0.25 * (x * x + y * y);
+                Vec3::new(x / q, y / q, (1.0 - 0.25 * (x * x + y * y)) / q)
             }
             Case::BilayerStrip => {
                 // Arc length λx with λ = √ā11, curvature κ = b̄11/ā11 in arc length.
