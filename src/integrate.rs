@@ -52,6 +52,8 @@ struct Moisture {
     /// Nodal moisture at the last accepted step, and the trial of the current one.
     u: Vec<Real>,
     trial: Vec<Real>,
+    /// Largest nodal change of the last trial step.
+    change: Real,
 }
 
 impl Moisture {
@@ -103,6 +105,7 @@ impl Moisture {
             trial: u.clone(),
             u,
             diffusion,
+            change: 0.0,
         }))
     }
 
@@ -605,6 +608,18 @@ fn run_dynamic(
                 failure = Some(format!("moisture diffusion at t = {t:.6e}: {e}"));
                 break;
             }
+            // The step control sees the diffusion too: a step that changes the computed moisture
+            // (prescribed nodes excluded: their jump is imposed) by more than
+            // moisture.max_change anywhere is cut before the mechanical solve.
+            m.change = (0..m.u.len())
+                .filter(|&i| !m.diffusion.is_prescribed(i))
+                .fold(0.0, |c: Real, i| c.max((m.trial[i] - m.u[i]).abs()));
+            if m.change > sc.settings.moisture.max_change && h > tm.dt_min {
+                s.summary.rejected_steps += 1;
+                dt = (h * 0.5).max(tm.dt_min);
+                easy = 0;
+                continue;
+            }
             match m.targets_of(sc, &m.trial) {
                 Ok(tt) => trial_targets = tt,
                 Err(e) => {
@@ -668,7 +683,10 @@ fn run_dynamic(
             a_prev = a;
             b_prev = b;
         }
-        if rep.iterations <= 3 {
+        let calm = moisture
+            .as_ref()
+            .is_none_or(|m| m.change <= 0.5 * sc.settings.moisture.max_change);
+        if rep.iterations <= 3 && calm {
             easy += 1;
             if easy >= 3 {
                 dt = (dt * 1.5).min(tm.dt_max);

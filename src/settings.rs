@@ -289,6 +289,10 @@ pub struct Moisture {
     pub layers: usize,
     /// Initial moisture everywhere (default `0`).
     pub initial: Real,
+    /// Largest change of the nodal moisture allowed in one time step; a step that exceeds it
+    /// is cut (halved) before the mechanical solve, and Δt grows only while changes stay below
+    /// half of it (default `0.02`).
+    pub max_change: Real,
     /// Surface conditions by region; faces without one are sealed.
     pub boundary: Vec<MoistureBoundary>,
 }
@@ -302,6 +306,7 @@ impl Default for Moisture {
             diffusivity_through: 1e-10,
             layers: 4,
             initial: 0.0,
+            max_change: 0.02,
             boundary: Vec::new(),
         }
     }
@@ -718,6 +723,7 @@ impl Settings {
             ] {
                 pos(k, v)?;
             }
+            pos("moisture.max_change", mo.max_change)?;
             if mo.layers == 0 {
                 return inv("moisture.layers", "must be at least 1".into());
             }
