@@ -102,11 +102,15 @@ impl Scene {
             .collect();
 
         let mut rest = RestForms::no_growth(&mesh, &topo);
+        let edge_sign = if m.bending.angle_variant().is_some() {
+            edge_signs(&topo)
+        } else {
+            Vec::new()
+        };
         if let Some(variant) = m.bending.angle_variant() {
             // The reference curvature in the edge-DOF model's own terms (φ = 0), so that a curved
             // input mesh is stress-free under "no growth" for the tan variant too (sin at φ = 0
             // is the average).
-            let sign = edge_signs(&topo);
             for (f, face) in mesh.faces.iter().enumerate() {
                 let o = topo.opposite_vertex[f];
                 let has = o.map(|v| v != crate::mesh::topology::NONE);
@@ -117,7 +121,11 @@ impl Scene {
                     _ => p[face[0]],
                 });
                 let b = crate::energy::midedge_angle::midedge_angle_b(
-                    &xs, has, &[0.0; 3], sign[f], variant,
+                    &xs,
+                    has,
+                    &[0.0; 3],
+                    edge_sign[f],
+                    variant,
                 );
                 rest.bbar0[f] = b;
                 rest.bbar1[f] = b;
@@ -223,27 +231,11 @@ impl Scene {
         } else {
             Vec::new()
         };
-        let (edge_sign, node_fixed) = if m.bending.angle_variant().is_some() {
-            let sign = topo
-                .face_edges
-                .iter()
-                .enumerate()
-                .map(|(f, fe)| {
-                    fe.map(|e| {
-                        if topo.edge_faces[e][0] == f {
-                            1.0
-                        } else {
-                            -1.0
-                        }
-                    })
-                })
-                .collect();
-            let mut nf = fixed.clone();
-            nf.resize(nv + topo.edges.len(), false);
-            (sign, nf)
-        } else {
-            (Vec::new(), fixed.clone())
-        };
+        let mut node_fixed = fixed.clone();
+        if !edge_sign.is_empty() {
+            // Edge DOFs are free (see the field's doc).
+            node_fixed.resize(nv + topo.edges.len(), false);
+        }
         let pinned_dofs = if free && settings.solver.mode == crate::settings::Mode::Static {
             rigid_pins(&mesh, &fixed)
         } else {
