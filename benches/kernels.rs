@@ -202,6 +202,26 @@ fn assembly(c: &mut Criterion) {
             b.iter(|| pool.install(|| pot.eval(&x, &[], Want::Hessian, &mut gr, &mut h)))
         });
     }
+    // The same Hessian assembly with edge DOFs (the default bending model).
+    let sc = scene_with(1.0 / 224.0, "midedge_sin");
+    let p = Pattern::for_scene(&sc);
+    let phi = vec![0.0; sc.num_edge_dofs()];
+    for threads in [1usize, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        g.bench_with_input(
+            BenchmarkId::new("midedge_sin_hessian", threads),
+            &threads,
+            |b, _| {
+                let pot = potential(&sc, &p);
+                let mut gr = vec![0.0; p.n];
+                let mut h = vec![0.0; p.nnz()];
+                b.iter(|| pool.install(|| pot.eval(&x, &phi, Want::Hessian, &mut gr, &mut h)))
+            },
+        );
+    }
     g.finish();
 }
 
