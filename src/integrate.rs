@@ -128,10 +128,6 @@ impl Moisture {
             .collect()
     }
 
-    fn targets(&self, sc: &Scene) -> Result<Vec<(Sym2, Sym2)>, String> {
-        self.targets_of(sc, &self.u)
-    }
-
     /// Hands the surface moisture of the accepted state to the writer for the next frame.
     fn publish(&self, writer: &mut Writer) {
         let nf = writer.num_faces();
@@ -575,7 +571,7 @@ fn run_dynamic(
     let mut targets: Vec<(Sym2, Sym2)> = Vec::new();
     let mut trial_targets: Vec<(Sym2, Sym2)> = Vec::new();
     if let Some(m) = &moisture {
-        targets = m.targets(sc).map_err(RunError::Moisture)?;
+        targets = m.targets_of(sc, &m.u).map_err(RunError::Moisture)?;
         m.publish(writer);
     }
     {

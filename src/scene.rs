@@ -111,25 +111,11 @@ impl Scene {
             // The reference curvature in the edge-DOF model's own terms (φ = 0), so that a curved
             // input mesh is stress-free under "no growth" for the tan variant too (sin at φ = 0
             // is the average).
-            for (f, face) in mesh.faces.iter().enumerate() {
-                let o = topo.opposite_vertex[f];
-                let has = o.map(|v| v != crate::mesh::topology::NONE);
-                let p = &mesh.positions;
-                let xs = [0, 1, 2, 3, 4, 5].map(|k| match k {
-                    0..=2 => p[face[k]],
-                    _ if has[k - 3] => p[o[k - 3]],
-                    _ => p[face[0]],
-                });
-                let b = crate::energy::midedge_angle::midedge_angle_b(
-                    &xs,
-                    has,
-                    &[0.0; 3],
-                    edge_sign[f],
-                    variant,
-                );
-                rest.bbar0[f] = b;
-                rest.bbar1[f] = b;
-            }
+            let zeros = vec![0.0; topo.edges.len()];
+            let (_, b0) =
+                midedge_angle_forms(&mesh, &topo, &edge_sign, variant, &mesh.positions, &zeros);
+            rest.bbar1.clone_from(&b0);
+            rest.bbar0 = b0;
         }
         match settings.rest.target {
             TargetForms::None => {}
@@ -320,39 +306,7 @@ impl Scene {
     /// them), with this scene's bending model.
     pub fn forms(&self, x: &[Vec3], phi: &[Real]) -> (Vec<Sym2>, Vec<Sym2>) {
         if let Some(variant) = self.settings.material.bending.angle_variant() {
-            let t = &self.topo;
-            let ab = self
-                .mesh
-                .faces
-                .iter()
-                .enumerate()
-                .map(|(f, face)| {
-                    let xf = face.map(|v| x[v]);
-                    let o = t.opposite_vertex[f];
-                    let has = o.map(|v| v != crate::mesh::topology::NONE);
-                    let xs = [0, 1, 2, 3, 4, 5].map(|s| {
-                        if s < 3 {
-                            xf[s]
-                        } else if has[s - 3] {
-                            x[o[s - 3]]
-                        } else {
-                            xf[0]
-                        }
-                    });
-                    let ph = t.face_edges[f].map(|e| phi[e]);
-                    (
-                        crate::geometry::first_fundamental_form(&xf),
-                        crate::energy::midedge_angle::midedge_angle_b(
-                            &xs,
-                            has,
-                            &ph,
-                            self.edge_sign[f],
-                            variant,
-                        ),
-                    )
-                })
-                .unzip();
-            return ab;
+            return midedge_angle_forms(&self.mesh, &self.topo, &self.edge_sign, variant, x, phi);
         }
         if self.patches.is_empty() {
             return crate::rest::mesh_forms(x, &self.mesh, &self.topo);
@@ -387,6 +341,37 @@ impl Scene {
     pub fn reference_positions(&self) -> &[Vec3] {
         &self.mesh.positions
     }
+}
+
+/// First and second fundamental forms of every face under an edge-DOF bending model, at
+/// positions `x` and edge DOFs `phi`.
+fn midedge_angle_forms(
+    mesh: &Mesh,
+    topo: &Topology,
+    edge_sign: &[[Real; 3]],
+    variant: crate::energy::midedge_angle::AngleVariant,
+    x: &[Vec3],
+    phi: &[Real],
+) -> (Vec<Sym2>, Vec<Sym2>) {
+    mesh.faces
+        .iter()
+        .enumerate()
+        .map(|(f, face)| {
+            let o = topo.opposite_vertex[f];
+            let has = o.map(|v| v != crate::mesh::topology::NONE);
+            let xs = [0, 1, 2, 3, 4, 5].map(|k| match k {
+                0..=2 => x[face[k]],
+                _ if has[k - 3] => x[o[k - 3]],
+                _ => x[face[0]],
+            });
+            let xf = [xs[0], xs[1], xs[2]];
+            let ph = topo.face_edges[f].map(|e| phi[e]);
+            (
+                crate::geometry::first_fundamental_form(&xf),
+                crate::energy::midedge_angle::midedge_angle_b(&xs, has, &ph, edge_sign[f], variant),
+            )
+        })
+        .unzip()
 }
 
 /// Each face's orientation sign on its three edges: +1 for the edge's first face, −1 for its
