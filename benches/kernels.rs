@@ -128,14 +128,7 @@ fn curved(sc: &Scene) -> Vec<Vec3> {
 
 fn potential<'a>(sc: &'a Scene, p: &'a Pattern) -> Potential<'a> {
     Potential {
-        scene: sc,
-        pattern: p,
-        dial: 1.0,
-        inertia: None,
-        damping: None,
-        gravity: Vec3::zeros(),
-        stretch_scale: 1.0,
-        rest_override: None,
+        ..Potential::new(sc, p)
     }
 }
 

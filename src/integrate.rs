@@ -27,9 +27,15 @@ use crate::scene::Scene;
 use crate::settings::Mode;
 use crate::solve::linear::LinearError;
 use crate::solve::newton::{factor_with_shift_upto, Workspace};
-use crate::solve::potential::{Damping, Inertia};
+use crate::solve::potential::{Damping, Friction, Inertia};
 use crate::solve::{newton, LinearSolver, NewtonOptions, NewtonReport, Potential};
 use std::time::Instant;
+
+/// Friction lag: a step is re-solved with the updated normal forces until they change by at
+/// most this fraction of the largest one ...
+const FRICTION_LAG_TOL: Real = 1e-3;
+/// ... or this many solves were made (the last one is accepted).
+const FRICTION_LAG_MAX: usize = 6;
 
 /// Errors that stop a run (as opposed to non-convergence, which is reported in the summary).
 #[derive(Debug, thiserror::Error)]
@@ -54,6 +60,10 @@ struct Moisture {
     trial: Vec<Real>,
     /// Largest nodal change of the last trial step.
     change: Real,
+    /// Lumped vertex masses with the absorbed water, at `u` and at `trial` (empty when
+    /// `moisture.water_density = 0`).
+    mass: Vec<Real>,
+    trial_mass: Vec<Real>,
 }
 
 impl Moisture {
@@ -101,12 +111,46 @@ impl Moisture {
             }
         }
         let u = vec![mo.initial; diffusion.num_nodes()];
-        Ok(Some(Moisture {
+        let mut m = Moisture {
             trial: u.clone(),
             u,
             diffusion,
             change: 0.0,
-        }))
+            mass: Vec::new(),
+            trial_mass: Vec::new(),
+        };
+        m.mass = m.masses_of(sc, &m.u);
+        m.trial_mass = m.mass.clone();
+        Ok(Some(m))
+    }
+
+    /// Lumped vertex masses with face densities ρ_shell + (m⁺ + m⁻)/2 · ρ_water (seed 000 §3,
+    /// "Mass Matrix"); empty when the water density is 0 (the scene's masses apply).
+    fn masses_of(&self, sc: &Scene, u: &[Real]) -> Vec<Real> {
+        let rho_w = sc.settings.moisture.water_density;
+        if rho_w == 0.0 {
+            return Vec::new();
+        }
+        let mut mass = sc.mass.clone();
+        for (f, face) in sc.mesh.faces.iter().enumerate() {
+            let (top, bottom) = self.diffusion.surface_moisture(u, f);
+            let [p0, p1, p2] = sc.mesh.face_positions(f);
+            let area = 0.5 * (p1 - p0).cross(&(p2 - p0)).norm();
+            let dm = 0.5 * (top + bottom) * rho_w * sc.thickness[f] * area / 3.0;
+            for &v in face {
+                mass[v] += dm;
+            }
+        }
+        mass
+    }
+
+    /// The masses at the accepted state (the scene's without water density).
+    fn mass<'s>(&'s self, sc: &'s Scene) -> &'s [Real] {
+        if self.mass.is_empty() {
+            &sc.mass
+        } else {
+            &self.mass
+        }
     }
 
     /// Rest forms of every face from the moisture `u`.
@@ -270,14 +314,10 @@ impl<'a> Solver<'a> {
 
     fn potential_scaled(&self, dial: Real, stretch_scale: Real) -> Potential<'a> {
         Potential {
-            scene: self.scene,
-            pattern: self.pattern,
             dial,
-            inertia: None,
-            damping: None,
             gravity: self.gravity,
             stretch_scale,
-            rest_override: None,
+            ..Potential::new(self.scene, self.pattern)
         }
     }
 
@@ -577,10 +617,17 @@ fn run_dynamic(
     {
         let pot = Potential {
             rest_override: moisture.as_ref().map(|_| &targets[..]),
+            mass: moisture.as_ref().map_or(&sc.mass[..], |m| m.mass(sc)),
             ..s.potential(dial_at(t0))
         };
         s.frame(writer, &pot, &x, &phi, &v, t0)?;
     }
+    // Friction: the lagged normal forces, carried from step to step.
+    let friction = sc.ground.as_ref().is_some_and(|g| g.friction > 0.0);
+    let mut lambda = match &sc.ground {
+        Some(g) if friction => g.normal_forces(&x),
+        _ => Vec::new(),
+    };
     let mut t = t0;
     let mut dt = tm.dt;
     // The next output time after the start (a restart resumes the output grid).
@@ -623,33 +670,62 @@ fn run_dynamic(
                     break;
                 }
             }
+            m.trial_mass = m.masses_of(sc, &m.trial);
         }
-        let pot = Potential {
-            scene: sc,
-            pattern: s.pattern,
-            dial,
-            inertia: Some(Inertia {
-                inv_dt2: 1.0 / (h * h),
-                xhat: &xhat,
-            }),
-            damping: damping.then_some(Damping {
-                eta_over_dt: tm.damping / h,
-                a_prev: &a_prev,
-                b_prev: &b_prev,
-            }),
-            gravity: s.gravity,
-            stretch_scale: 1.0,
-            rest_override: moisture.as_ref().map(|_| &trial_targets[..]),
+        let trial_mass: &[Real] = match &moisture {
+            Some(m) if !m.trial_mass.is_empty() => &m.trial_mass,
+            _ => &sc.mass,
         };
-        let rep = newton(
-            &pot,
-            &mut s.lin,
-            &mut s.ws,
-            &mut trial,
-            &mut trial_phi,
-            NewtonOptions { tol, max_iter },
-        );
-        s.record(&rep);
+        // Friction lags the normal force: solve with λ, update λ from the solution, and re-solve
+        // until it agrees (see solve::contact).
+        let mut rep;
+        let mut lag = 0;
+        loop {
+            let pot = Potential {
+                dial,
+                inertia: Some(Inertia {
+                    inv_dt2: 1.0 / (h * h),
+                    xhat: &xhat,
+                }),
+                damping: damping.then_some(Damping {
+                    eta_over_dt: tm.damping / h,
+                    a_prev: &a_prev,
+                    b_prev: &b_prev,
+                }),
+                gravity: s.gravity,
+                rest_override: moisture.as_ref().map(|_| &trial_targets[..]),
+                mass: trial_mass,
+                friction: friction.then_some(Friction {
+                    x_prev: &x,
+                    normal_force: &lambda,
+                    eps: sc.settings.contact.slip_speed * h,
+                }),
+                ..Potential::new(sc, s.pattern)
+            };
+            rep = newton(
+                &pot,
+                &mut s.lin,
+                &mut s.ws,
+                &mut trial,
+                &mut trial_phi,
+                NewtonOptions { tol, max_iter },
+            );
+            s.record(&rep);
+            let Some(ground) = sc.ground.as_ref().filter(|_| friction && rep.converged) else {
+                break;
+            };
+            let new = ground.normal_forces(&trial);
+            let scale = new.iter().fold(0.0, |m: Real, v| m.max(*v));
+            let diff = new
+                .iter()
+                .zip(&lambda)
+                .fold(0.0, |m: Real, (a, b)| m.max((a - b).abs()));
+            lambda.copy_from_slice(&new);
+            lag += 1;
+            if diff <= FRICTION_LAG_TOL * scale || lag >= FRICTION_LAG_MAX {
+                break;
+            }
+        }
         if !rep.converged {
             s.summary.rejected_steps += 1;
             dt = h * 0.5;
@@ -671,6 +747,7 @@ fn run_dynamic(
         if let Some(m) = &mut moisture {
             m.u.copy_from_slice(&m.trial);
             std::mem::swap(&mut targets, &mut trial_targets);
+            std::mem::swap(&mut m.mass, &mut m.trial_mass);
         }
         t += h;
         s.summary.steps += 1;
@@ -700,6 +777,7 @@ fn run_dynamic(
         if tm.stop_at_equilibrium {
             let pot = Potential {
                 rest_override: moisture.as_ref().map(|_| &targets[..]),
+                mass: moisture.as_ref().map_or(&sc.mass[..], |m| m.mass(sc)),
                 ..s.potential(dial)
             };
             let mut g = vec![0.0; s.pattern.n];
@@ -718,6 +796,7 @@ fn run_dynamic(
             }
             let pot = Potential {
                 rest_override: moisture.as_ref().map(|_| &targets[..]),
+                mass: moisture.as_ref().map_or(&sc.mass[..], |m| m.mass(sc)),
                 ..s.potential(dial)
             };
             s.frame(writer, &pot, &x, &phi, &v, t)?;
@@ -736,6 +815,7 @@ fn run_dynamic(
     s.summary.reason = failure.unwrap_or_default();
     let pot = Potential {
         rest_override: moisture.as_ref().map(|_| &targets[..]),
+        mass: moisture.as_ref().map_or(&sc.mass[..], |m| m.mass(sc)),
         ..s.potential(dial_at(t))
     };
     s.summary.energy = Writer::energies(&pot, &x, &phi, &v);

@@ -18,16 +18,7 @@
 //! let settings = Settings::from_str_with("[rest]\ntarget = \"mesh\"\n", "example", &[]).unwrap();
 //! let scene = Scene::build(mesh, settings).unwrap();
 //! let pattern = Pattern::for_scene(&scene);
-//! let pot = Potential {
-//!     scene: &scene,
-//!     pattern: &pattern,
-//!     dial: 1.0,
-//!     inertia: None,
-//!     damping: None,
-//!     gravity: Vec3::zeros(),
-//!     stretch_scale: 1.0,
-//!     rest_override: None,
-//! };
+//! let pot = Potential::new(&scene, &pattern);
 //! // The flat sheet is not at rest under the programmed curvature: positive bending energy and
 //! // a non-zero gradient.
 //! let mut grad = vec![0.0; pattern.n];

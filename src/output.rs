@@ -60,6 +60,8 @@ pub struct Energies {
     pub gravity: Real,
     /// Kinetic energy ½ Σ m |v|².
     pub kinetic: Real,
+    /// Ground-contact penalty energy Σ k A ψ(p) (0 without a ground).
+    pub contact: Real,
 }
 
 /// One row of the per-frame log.
@@ -257,10 +259,15 @@ impl Writer {
             en.bending += b;
         }
         for (i, xv) in x.iter().enumerate() {
-            en.gravity -= sc.mass[i] * pot.gravity.dot(xv);
-            en.kinetic += 0.5 * sc.mass[i] * v[i].norm_squared();
+            en.gravity -= pot.mass[i] * pot.gravity.dot(xv);
+            en.kinetic += 0.5 * pot.mass[i] * v[i].norm_squared();
+            if let Some(g) = &sc.ground {
+                if let Some((e, _, _)) = g.normal_term(i, xv) {
+                    en.contact += e;
+                }
+            }
         }
-        en.total = en.stretching + en.bending + en.gravity + en.kinetic;
+        en.total = en.stretching + en.bending + en.gravity + en.kinetic + en.contact;
         en
     }
 
@@ -411,13 +418,13 @@ impl Writer {
     fn write_log(&self) -> Result<(), OutputError> {
         let mut s = String::from(
             "frame,time,dial,energy_total,energy_stretching,energy_bending,energy_gravity,\
-             energy_kinetic,residual,newton_iterations,steps,shifted_iterations,\
+             energy_kinetic,energy_contact,residual,newton_iterations,steps,shifted_iterations,\
              gauss_newton_iterations,rejected_steps,wall_seconds\n",
         );
         for r in &self.log {
             let e = &r.energy;
             s.push_str(&format!(
-                "{},{:.12e},{:.6},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{},{},{},{},{},{:.6}\n",
+                "{},{:.12e},{:.6},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{},{},{},{},{},{:.6}\n",
                 r.frame,
                 r.time,
                 r.dial,
@@ -426,6 +433,7 @@ impl Writer {
                 e.bending,
                 e.gravity,
                 e.kinetic,
+                e.contact,
                 r.residual,
                 r.newton_iterations,
                 r.steps,

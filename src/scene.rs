@@ -50,6 +50,8 @@ pub struct Scene {
     pub pinned_dofs: Vec<usize>,
     /// Per-face inputs of the growth law.
     pub growth: GrowthInputs,
+    /// The ground plane (`contact.enabled`), else `None`.
+    pub ground: Option<crate::solve::contact::Ground>,
 }
 
 fn positive_face_field(mesh: &Mesh, name: &str) -> Result<Option<Vec<Real>>, MeshError> {
@@ -210,6 +212,18 @@ impl Scene {
                  constraints.fix_boxes) or use solver.mode = \"dynamic\"",
             ));
         }
+        if settings.contact.enabled && free && settings.solver.mode == crate::settings::Mode::Static
+        {
+            return Err(mesh.invalid(
+                "static mode with a ground (contact.enabled) needs fixed vertices: a free sheet on \
+                 a frictionless plane slides and spins freely. Fix some vertices or use \
+                 solver.mode = \"dynamic\"",
+            ));
+        }
+        let ground = settings
+            .contact
+            .enabled
+            .then(|| build_ground(&mesh, &settings.contact, &thickness, &young));
         let patches = if m.bending == crate::settings::BendingModel::PatchFit {
             let (p, w) = crate::energy::patch::build_patches(&mesh)?;
             warnings.extend(w);
@@ -252,6 +266,7 @@ impl Scene {
             node_fixed,
             pinned_dofs,
             growth,
+            ground,
         })
     }
 
@@ -603,6 +618,52 @@ pub fn rigid_pins(mesh: &Mesh, unused: &[bool]) -> Vec<usize> {
     pins.extend((0..3).filter(|&k| k != k_ab).map(|k| 3 * b + k));
     pins.push(3 * cc + n.iamax());
     pins
+}
+
+/// The ground of `[contact]` with the per-vertex areas and half thicknesses it needs (see
+/// [`crate::solve::contact`]); `"auto"` stiffness is the area-weighted mean of E/h, `"auto"`
+/// smoothing is the area-weighted mean h over 100.
+fn build_ground(
+    mesh: &Mesh,
+    c: &crate::settings::Contact,
+    thickness: &[Real],
+    young: &[Real],
+) -> crate::solve::contact::Ground {
+    let nv = mesh.positions.len();
+    let mut area = vec![0.0; nv];
+    let mut h_area = vec![0.0; nv];
+    let (mut total, mut e_over_h, mut h_mean) = (0.0, 0.0, 0.0);
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let [p0, p1, p2] = mesh.face_positions(f);
+        let a = 0.5 * (p1 - p0).cross(&(p2 - p0)).norm();
+        total += a;
+        e_over_h += a * young[f] / thickness[f];
+        h_mean += a * thickness[f];
+        for &v in face {
+            area[v] += a / 3.0;
+            h_area[v] += a / 3.0 * thickness[f];
+        }
+    }
+    let total = total.max(Real::MIN_POSITIVE);
+    let half_thickness = (0..nv)
+        .map(|v| {
+            if area[v] > 0.0 {
+                0.5 * h_area[v] / area[v]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    crate::solve::contact::Ground {
+        point: Vec3::from(c.point),
+        normal: Vec3::from(c.normal).normalize(),
+        stiffness: c.stiffness.or(e_over_h / total),
+        smoothing: c.smoothing.or(h_mean / total / 100.0),
+        friction: c.friction,
+        slip_speed: c.slip_speed,
+        area,
+        half_thickness,
+    }
 }
 
 fn unused_mask(nv: usize, unused: &[usize]) -> Vec<bool> {

@@ -66,6 +66,8 @@ pub struct Settings {
     pub time: Time,
     /// External loads.
     pub loads: Loads,
+    /// Ground contact with friction.
+    pub contact: Contact,
     /// Fixed vertices.
     pub constraints: Constraints,
     /// Output files.
@@ -289,6 +291,10 @@ pub struct Moisture {
     pub layers: usize,
     /// Initial moisture everywhere (default `0`).
     pub initial: Real,
+    /// Density of the absorbed water (kg/m³, default `1000`): each face's density is
+    /// ρ = ρ_shell + (m⁺ + m⁻)/2 · ρ_water (seed 000 §3, mass matrix), with the moisture m a
+    /// volume fraction. `0` keeps the density constant.
+    pub water_density: Real,
     /// Largest change of the nodal moisture allowed in one time step; a step that exceeds it
     /// is cut (halved) before the mechanical solve, and Δt grows only while changes stay below
     /// half of it (default `0.02`).
@@ -306,6 +312,7 @@ impl Default for Moisture {
             diffusivity_through: 1e-10,
             layers: 4,
             initial: 0.0,
+            water_density: 1000.0,
             max_change: 0.02,
             boundary: Vec::new(),
         }
@@ -485,6 +492,64 @@ impl Default for Time {
 pub struct Loads {
     /// Gravitational acceleration (m/s², default: `[0, 0, 0]`; Earth: `[0, 0, -9.81]`).
     pub gravity: [Real; 3],
+}
+
+/// A number or the word `"auto"`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum AutoOr {
+    /// A value.
+    Value(Real),
+    /// `"auto"`: chosen by the solver (each use documents how).
+    Auto(Auto),
+}
+
+impl AutoOr {
+    /// The value, or `auto` when automatic.
+    pub fn or(self, auto: Real) -> Real {
+        match self {
+            AutoOr::Value(v) => v,
+            AutoOr::Auto(_) => auto,
+        }
+    }
+}
+
+/// `[contact]`: a rigid ground plane the sheet rests on and lifts off from, with Coulomb
+/// friction, inside the Newton solve (see [`crate::solve::contact`]).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Contact {
+    /// Build the ground (default `false`).
+    pub enabled: bool,
+    /// A point on the plane (m, default `[0, 0, 0]`).
+    pub point: [Real; 3],
+    /// The plane's normal, pointing to the side the sheet is on (default `[0, 0, 1]`).
+    pub normal: [Real; 3],
+    /// Penalty stiffness k: contact pressure per unit penetration (Pa/m). `"auto"`: E/h, the
+    /// sheet's own through-thickness stiffness (default).
+    pub stiffness: AutoOr,
+    /// Smoothing length δ of the penalty (m): the pressure grows as k p²/(2δ) for a penetration
+    /// p < δ, and as k (p − δ/2) beyond. `"auto"`: h/100 (default).
+    pub smoothing: AutoOr,
+    /// Coulomb friction coefficient μ (default `0`; dynamics only).
+    pub friction: Real,
+    /// Slip speed ε_v (m/s) below which friction is smoothed (sticking creeps at most this fast;
+    /// default `1e-5`).
+    pub slip_speed: Real,
+}
+
+impl Default for Contact {
+    fn default() -> Self {
+        Contact {
+            enabled: false,
+            point: [0.0; 3],
+            normal: [0.0, 0.0, 1.0],
+            stiffness: AutoOr::Auto(Auto::Auto),
+            smoothing: AutoOr::Auto(Auto::Auto),
+            friction: 0.0,
+            slip_speed: 1e-5,
+        }
+    }
 }
 
 /// An axis-aligned box of vertices to hold fixed.
@@ -724,6 +789,7 @@ impl Settings {
                 pos(k, v)?;
             }
             pos("moisture.max_change", mo.max_change)?;
+            nonneg("moisture.water_density", mo.water_density)?;
             if mo.layers == 0 {
                 return inv("moisture.layers", "must be at least 1".into());
             }
@@ -788,6 +854,27 @@ impl Settings {
         }
         if self.loads.gravity.iter().any(|g| !g.is_finite()) {
             return inv("loads.gravity", "must be finite".into());
+        }
+        let c = &self.contact;
+        if c.enabled {
+            if c.point.iter().any(|v| !v.is_finite()) {
+                return inv("contact.point", "must be finite".into());
+            }
+            let n2: Real = c.normal.iter().map(|v| v * v).sum();
+            if !(n2.is_finite() && n2 > 0.0) {
+                return inv(
+                    "contact.normal",
+                    format!("must be a finite non-zero vector, got {:?}", c.normal),
+                );
+            }
+            if let AutoOr::Value(k) = c.stiffness {
+                pos("contact.stiffness", k)?;
+            }
+            if let AutoOr::Value(d) = c.smoothing {
+                pos("contact.smoothing", d)?;
+            }
+            nonneg("contact.friction", c.friction)?;
+            pos("contact.slip_speed", c.slip_speed)?;
         }
         for (i, b) in self.constraints.fix_boxes.iter().enumerate() {
             if b.min.iter().chain(b.max.iter()).any(|v| !v.is_finite())

@@ -675,3 +675,49 @@ fn conformal_growth_reaches_the_spherical_cap() {
     assert!(rows[0].0 < 1e-3 && rows[1].0 < 2e-4, "{rows:?}");
     assert!(p >= 1.5, "order {p:.2}");
 }
+
+/// Coulomb friction on an incline (ground contact, issue 4): a free sheet resting on the ground
+/// under gravity tilted by θ = 30° slides with a = g (sin θ − μ cos θ) when tan θ > μ, and
+/// implicit Euler gives v = a t exactly for a constant force (measured: 2e-5 relative, from the
+/// first step settling the sheet onto the ground by √(2δσ/k) ≈ 13 µm). With μ > tan θ it sticks:
+/// the smoothed friction balances the slope where f₁(s/ε) = 2r − r² = tan θ / μ, so the sheet
+/// creeps at exactly r ε_v, r = 1 − √(1 − tan θ/μ) (measured to 1e-4 relative).
+#[test]
+fn friction_on_an_incline_follows_coulomb() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    shellsim(&["mesh", "square", "--edge", "0.25", "-o", "s.vtk"], dir);
+    let (g, theta) = (9.81_f64, 30f64.to_radians());
+    for mu in [0.3, 0.7] {
+        std::fs::write(
+            dir.join("f.toml"),
+            format!(
+                "[loads]\ngravity = [{}, 0.0, {}]\n[solver]\nmode = \"dynamic\"\nsymmetry_breaking = 0.0\n\
+                 [contact]\nenabled = true\npoint = [0.0, 0.0, -0.005]\nfriction = {mu}\nslip_speed = 1e-5\n\
+                 [time]\nend = 0.2\ndt = 0.01\ndt_max = 0.01\noutput_interval = 0.2\n",
+                g * theta.sin(),
+                -g * theta.cos()
+            ),
+        )
+        .unwrap();
+        shellsim(&["f.toml", "s.vtk", "--out", "of", "-q"], dir);
+        let m = shellsim::mesh::io::read_mesh(&dir.join("of/frame_00001.vtu")).unwrap();
+        let vel = &m.vertex_fields["velocity"];
+        let disp = &m.vertex_fields["displacement"];
+        let n = m.positions.len();
+        let vx = (0..n).map(|i| vel.get(i)[0]).sum::<f64>() / n as f64;
+        let depth = (0..n).map(|i| -disp.get(i)[2]).fold(0.0, f64::max);
+        if mu < theta.tan() {
+            let a = g * (theta.sin() - mu * theta.cos());
+            println!("μ = {mu}: v = {vx:.6} m/s vs a t = {:.6}", a * 0.2);
+            assert!((vx / (a * 0.2) - 1.0).abs() < 1e-3, "{vx} vs {}", a * 0.2);
+        } else {
+            let creep = (1.0 - (1.0 - theta.tan() / mu).sqrt()) * 1e-5;
+            println!("μ = {mu}: creeping at {vx:.4e} m/s vs {creep:.4e}");
+            assert!((vx / creep - 1.0).abs() < 1e-3, "{vx} vs {creep}");
+        }
+        // Resting on the ground: penetration far below the thickness, never lifting off.
+        assert!(depth > 0.0 && depth < 1e-4, "penetration {depth}");
+        assert!((0..n).all(|i| vel.get(i)[2].abs() < 1e-3));
+    }
+}

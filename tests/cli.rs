@@ -772,3 +772,33 @@ fn wetted_strip_curls_then_flattens() {
     );
     expect_bad(&["st.toml", "s.vtk"], p, "moisture.enabled");
 }
+
+/// Moisture adds the water's mass (seed 000 §3): each face's density is ρ + (m⁺ + m⁻)/2 ρ_w. A
+/// sealed sheet at uniform moisture 0.25 in free fall has kinetic energy ½ M (g t)² with
+/// M = (ρ + 0.25 ρ_w) h A; `water_density = 0` keeps M = ρ h A.
+#[test]
+fn absorbed_water_adds_mass() {
+    let d = tmp();
+    let p = d.path();
+    let r = run(&["mesh", "square", "--edge", "0.25", "-o", "s.vtk"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let (rho, h, g, t) = (800.0, 1e-3, 9.81, 0.05);
+    for rho_w in [1000.0, 0.0] {
+        let scene = format!(
+            "[material]\ndensity = {rho}\nthickness = {h}\n[growth]\nlaw = \"linear_swelling\"\nmu = 0.0\n\
+             [moisture]\nenabled = true\ninitial = 0.25\nwater_density = {rho_w}\n[loads]\ngravity = [0.0, 0.0, -{g}]\n\
+             [solver]\nmode = \"dynamic\"\nsymmetry_breaking = 0.0\n[time]\nend = {t}\ndt = 0.01\ndt_max = 0.01\noutput_interval = {t}\n"
+        );
+        write(p, "m.toml", &scene);
+        let r = run(&["m.toml", "s.vtk", "--out", "o", "-q"], p);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        let s = summary_of(p, "o");
+        let kinetic = s["energy"]["kinetic"].as_f64().unwrap();
+        let mass = (rho + 0.25 * rho_w) * h * 1.0;
+        let expect = 0.5 * mass * (g * t) * (g * t);
+        assert!(
+            (kinetic / expect - 1.0).abs() < 1e-9,
+            "ρ_w = {rho_w}: {kinetic} vs {expect}"
+        );
+    }
+}

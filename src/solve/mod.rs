@@ -1,7 +1,9 @@
-//! Nonlinear solves: the incremental potential of a step ([`potential`]), Newton's method with a
+//! Nonlinear solves: the incremental potential of a step ([`potential`]) with its ground contact
+//! ([`contact`]), Newton's method with a
 //! backtracking line search and a growing diagonal shift ([`mod@newton`]), and the sparse Cholesky
 //! it uses ([`linear`]).
 
+pub mod contact;
 pub mod linear;
 pub mod newton;
 pub mod potential;

@@ -1,9 +1,9 @@
 //! The potential minimised by one Newton solve:
 //!
 //! `Φ(x) = E_elastic(x; ā(s), b̄(s)) + E_damp(x; a_prev, b_prev) + Σ_i m_i/(2Δt²)|x_i − x̂_i|²
-//!        − Σ_i m_i g·x_i`
+//!        − Σ_i m_i g·x_i + E_ground(x) + D_friction(x; x_n, λ)`
 //!
-//! Statics use only the elastic and gravity terms. Dynamics (implicit Euler, seed 000 §3) add
+//! Statics use only the elastic, gravity and (frictionless) ground terms. Dynamics (implicit Euler, seed 000 §3) add
 //! inertia with `x̂ = x_n + Δt v_n` (its minimiser satisfies `M(v_{n+1} − v_n)/Δt = F(x_{n+1})`)
 //! and the Kelvin–Voigt damping potential. Only the terms a scene enables are assembled.
 //!
@@ -38,6 +38,17 @@ pub struct Damping<'a> {
     pub b_prev: &'a [Sym2],
 }
 
+/// Friction over one step (dynamics with `contact.friction > 0`; see [`super::contact`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Friction<'a> {
+    /// Positions at the start of the step (m).
+    pub x_prev: &'a [Vec3],
+    /// Lagged normal force per vertex (N).
+    pub normal_force: &'a [Real],
+    /// Slip smoothing ε = ε_v Δt (m).
+    pub eps: Real,
+}
+
 /// The potential of one solve.
 #[derive(Clone, Copy)]
 pub struct Potential<'a> {
@@ -58,9 +69,31 @@ pub struct Potential<'a> {
     pub stretch_scale: Real,
     /// Per-face rest forms `(ā, b̄)` that replace the dialled ones (moisture-driven growth).
     pub rest_override: Option<&'a [(Sym2, Sym2)]>,
+    /// Lumped vertex masses (kg): the scene's, or moisture-dependent ones.
+    pub mass: &'a [Real],
+    /// Friction against the ground (the normal contact term is on whenever the scene has a
+    /// ground).
+    pub friction: Option<Friction<'a>>,
 }
 
 impl<'a> Potential<'a> {
+    /// The static potential at dial 1 with the scene's masses and no inertia, damping, gravity
+    /// or friction; set the other fields with struct-update syntax.
+    pub fn new(scene: &'a Scene, pattern: &'a Pattern) -> Self {
+        Potential {
+            scene,
+            pattern,
+            dial: 1.0,
+            inertia: None,
+            damping: None,
+            gravity: Vec3::zeros(),
+            stretch_scale: 1.0,
+            rest_override: None,
+            mass: &scene.mass,
+            friction: None,
+        }
+    }
+
     /// Elastic (+ damping) density of face `f`.
     #[inline]
     pub fn density(&self, f: usize) -> KoiterDensity {
@@ -95,6 +128,32 @@ impl<'a> Potential<'a> {
         values: &mut [Real],
     ) -> Real {
         self.eval_projected(x, phi, want, HessianProjection::None, grad, values)
+    }
+
+    /// Adds a per-vertex gradient and 3×3 Hessian block (lower triangle) of vertex `v`.
+    #[inline]
+    fn add_vertex_term(
+        &self,
+        v: usize,
+        want: Want,
+        g: &Vec3,
+        h: &[[Real; 3]; 3],
+        grad: &mut [Real],
+        values: &mut [Real],
+    ) {
+        if want != Want::Energy {
+            for c in 0..3 {
+                grad[3 * v + c] += g[c];
+            }
+        }
+        if want == Want::Hessian {
+            for a in 0..3 {
+                let col = 3 * v + a;
+                for (b, hb) in h.iter().enumerate().skip(a) {
+                    values[self.pattern.diag(col) + (b - a)] += hb[a];
+                }
+            }
+        }
     }
 
     /// The relative residual of a gradient: `max(‖g_x‖∞, ‖g_φ‖∞ / ℓ) / F`, with `F` the scene's
@@ -136,7 +195,21 @@ impl<'a> Potential<'a> {
             if sc.fixed[v] {
                 continue;
             }
-            let m = sc.mass[v];
+            let m = self.mass[v];
+            if let Some(ground) = &sc.ground {
+                if let Some((ec, gc, hc)) = ground.normal_term(v, xv) {
+                    e += ec;
+                    self.add_vertex_term(v, want, &gc, &hc, grad, values);
+                }
+                if let Some(fr) = &self.friction {
+                    let lambda = fr.normal_force[v];
+                    if lambda > 0.0 && ground.friction > 0.0 {
+                        let (ef, gf, hf) = ground.friction_term(lambda, xv, &fr.x_prev[v], fr.eps);
+                        e += ef;
+                        self.add_vertex_term(v, want, &gf, &hf, grad, values);
+                    }
+                }
+            }
             if let Some(inr) = &self.inertia {
                 let dx = xv - inr.xhat[v];
                 e += 0.5 * inr.inv_dt2 * m * dx.norm_squared();

@@ -69,16 +69,7 @@ fn bumpy(sc: &Scene) -> Vec<Vec3> {
 fn rest_state_has_zero_energy_and_gradient() {
     let sc = scene("", None);
     let p = pattern(&sc);
-    let pot = Potential {
-        scene: &sc,
-        pattern: &p,
-        dial: 1.0,
-        inertia: None,
-        damping: None,
-        gravity: Vec3::zeros(),
-        stretch_scale: 1.0,
-        rest_override: None,
-    };
+    let pot = Potential::new(&sc, &p);
     let mut g = vec![0.0; p.n];
     let phi = vec![0.0; sc.num_edge_dofs()];
     let e = pot.eval(&sc.mesh.positions, &phi, Want::Gradient, &mut g, &mut []);
@@ -109,14 +100,9 @@ fn bitwise_identical(model: &str) {
             .unwrap();
         pool.install(|| {
             let pot = Potential {
-                scene: &sc,
-                pattern: &p,
                 dial: 0.7,
-                inertia: None,
-                damping: None,
                 gravity: Vec3::new(0.0, 0.0, -9.81),
-                stretch_scale: 1.0,
-                rest_override: None,
+                ..Potential::new(&sc, &p)
             };
             let mut g = vec![0.0; p.n];
             let mut h = vec![0.0; p.nnz()];
@@ -145,20 +131,10 @@ fn assembled_derivatives(model: &str) {
     let p = pattern(&sc);
     let x = bumpy(&sc);
     let phi = angles(&sc);
-    let nx = 3 * sc.num_vertices();
-    let node_of = |k: usize| {
-        if k < nx {
-            k / 3
-        } else {
-            sc.num_vertices() + (k - nx)
-        }
-    };
     let xhat: Vec<Vec3> = x.iter().map(|v| v * 1.01).collect();
     let a_prev = vec![shellsim::math::Sym2::new(0.01, 0.001, 0.012); sc.num_faces()];
     let b_prev = vec![shellsim::math::Sym2::new(0.001, 0.0, -0.001); sc.num_faces()];
     let pot = Potential {
-        scene: &sc,
-        pattern: &p,
         dial: 0.6,
         inertia: Some(shellsim::solve::potential::Inertia {
             inv_dt2: 1e4,
@@ -170,20 +146,42 @@ fn assembled_derivatives(model: &str) {
             b_prev: &b_prev,
         }),
         gravity: Vec3::new(0.0, 0.0, -9.81),
-        stretch_scale: 1.0,
-        rest_override: None,
+        ..Potential::new(&sc, &p)
+    };
+    check_fd(&sc, &p, &pot, &x, &phi, model, 7);
+}
+
+/// The assembled gradient and Hessian of `pot` at `(x, phi)` against central differences of
+/// the assembled energy and gradient (every `stride`-th DOF).
+fn check_fd(
+    sc: &Scene,
+    p: &Pattern,
+    pot: &Potential,
+    x: &[Vec3],
+    phi: &[f64],
+    label: &str,
+    stride: usize,
+) {
+    let nx = 3 * sc.num_vertices();
+    let node_of = |k: usize| {
+        if k < nx {
+            k / 3
+        } else {
+            sc.num_vertices() + (k - nx)
+        }
     };
     let mut g = vec![0.0; p.n];
     let mut h = vec![0.0; p.nnz()];
-    pot.eval(&x, &phi, Want::Hessian, &mut g, &mut h);
+    pot.eval(x, phi, Want::Hessian, &mut g, &mut h);
     let eps = 1e-6;
     let gmax = g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let hmax = h.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    for k in (0..p.n).step_by(7) {
+    for k in (0..p.n).step_by(stride) {
         if sc.node_fixed[node_of(k)] {
             continue;
         }
-        let (mut xp, mut xm, mut pp, mut pm) = (x.clone(), x.clone(), phi.clone(), phi.clone());
+        let (mut xp, mut xm) = (x.to_vec(), x.to_vec());
+        let (mut pp, mut pm) = (phi.to_vec(), phi.to_vec());
         if k < nx {
             xp[k / 3][k % 3] += eps;
             xm[k / 3][k % 3] -= eps;
@@ -198,7 +196,7 @@ fn assembled_derivatives(model: &str) {
         let fd = (ep - em) / (2.0 * eps);
         assert!(
             (fd - g[k]).abs() < 1e-6 * gmax,
-            "{model}: grad {k}: {} vs {fd}",
+            "{label}: grad {k}: {} vs {fd}",
             g[k]
         );
         // Column k of the Hessian (lower part stored in column k, upper part in rows).
@@ -210,9 +208,51 @@ fn assembled_derivatives(model: &str) {
             }
             assert!(
                 (fd - val).abs() < 1e-6 * hmax,
-                "{model}: H({row},{k}): {val} vs {fd}"
+                "{label}: H({row},{k}): {val} vs {fd}"
             );
         }
+    }
+}
+
+#[test]
+fn ground_contact_and_friction_match_finite_differences() {
+    // Half the bumpy sheet below the ground plane z = 0, penetrations on both sides of the
+    // smoothing length, slips on both sides of ε.
+    let sc = scene(
+        "[rest]\ntarget = \"mesh\"\n[solver]\nmode = \"dynamic\"\n\
+         [contact]\nenabled = true\nstiffness = 1e7\nsmoothing = 0.01\nfriction = 0.4\n\
+         [constraints]\nfix_boxes = [{ min = [-1, -1, -1], max = [-0.45, 1, 1] }]\n",
+        Some(Case::Hyperboloid),
+    );
+    let g = sc.ground.as_ref().unwrap();
+    assert_eq!((g.stiffness, g.smoothing, g.friction), (1e7, 0.01, 0.4));
+    let p = pattern(&sc);
+    let x = bumpy(&sc);
+    let phi = angles(&sc);
+    let pen: Vec<f64> = (0..x.len()).map(|v| g.penetration(v, &x[v])).collect();
+    assert!(pen.iter().any(|&q| q > 0.0 && q < 0.01) && pen.iter().any(|&q| q > 0.01));
+    assert!(pen.iter().filter(|&&q| q == 0.0).count() > x.len() / 4);
+    let mut rng = Rng::new(3);
+    let x_prev: Vec<Vec3> = x
+        .iter()
+        .map(|v| v + Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * 0.004)
+        .collect();
+    let lambda: Vec<f64> = (0..x.len()).map(|v| 1.0 + (v % 5) as f64).collect();
+    let pot = Potential {
+        friction: Some(shellsim::solve::potential::Friction {
+            x_prev: &x_prev,
+            normal_force: &lambda,
+            eps: 0.003,
+        }),
+        ..Potential::new(&sc, &p)
+    };
+    check_fd(&sc, &p, &pot, &x, &phi, "contact", 1);
+    // The normal forces are k A ψ′(p): ψ′ = p²/(2δ) below δ, p − δ/2 beyond.
+    let lam = g.normal_forces(&x);
+    for v in 0..x.len() {
+        let q = pen[v];
+        let psi1 = if q <= 0.01 { q * q / 0.02 } else { q - 0.005 };
+        assert!((lam[v] - 1e7 * g.area[v] * psi1).abs() <= 1e-9 * lam[v].max(1e-300));
     }
 }
 
@@ -277,14 +317,7 @@ fn curved_reference_is_at_rest_for_every_midedge_model() {
         .unwrap();
         let p = pattern(&sc);
         let pot = Potential {
-            scene: &sc,
-            pattern: &p,
-            dial: 1.0,
-            inertia: None,
-            damping: None,
-            gravity: Vec3::zeros(),
-            stretch_scale: 1.0,
-            rest_override: None,
+            ..Potential::new(&sc, &p)
         };
         let mut g = vec![0.0; p.n];
         let phi = vec![0.0; sc.num_edge_dofs()];
