@@ -275,30 +275,16 @@ impl Case {
         let mut a = Vec::with_capacity(3 * nf);
         let mut b = Vec::with_capacity(3 * nf);
         for f in 0..nf {
-            let [p0, p1, p2] = mesh.face_positions(f);
             let t = crate::rest::reference_frame(mesh, f);
-            let e1 = crate::math::Vec2::new(t[(0, 0)], t[(1, 0)]);
-            let e2 = crate::math::Vec2::new(t[(0, 1)], t[(1, 1)]);
-            let e3 = e2 - e1;
-            let m01 = (p0 + p1) / 2.0;
-            let m02 = (p0 + p2) / 2.0;
-            let m12 = (p1 + p2) / 2.0;
-            let quad =
-                |m: &Sym2, e: &crate::math::Vec2| (e.transpose() * sym_to_mat(m) * e)[(0, 0)];
-            let bary = |k: usize| -> Sym2 {
-                let pick = |p: &Vec3| {
-                    let (fa, fb) = self.forms(p.x, p.y);
+            let bary = |k: usize| {
+                crate::rest::sample_on_edges(mesh, f, |x, y| {
+                    let (fa, fb) = self.forms(x, y);
                     if k == 0 {
                         fa
                     } else {
                         fb
                     }
-                };
-                let m11 = quad(&pick(&m01), &e1);
-                let m22 = quad(&pick(&m02), &e2);
-                let m33 = quad(&pick(&m12), &e3);
-                // M(e2 − e1, e2 − e1) = m11 + m22 − 2 m12.
-                Sym2::new(m11, 0.5 * (m11 + m22 - m33), m22)
+                })
             };
             a.extend_from_slice(crate::rest::push_forward(&t, &bary(0)).as_slice());
             b.extend_from_slice(crate::rest::push_forward(&t, &bary(1)).as_slice());

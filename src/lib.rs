@@ -34,6 +34,7 @@ pub mod cases;
 pub mod cli;
 pub mod diffusion;
 pub mod energy;
+pub mod expr;
 pub mod geometry;
 pub mod growth;
 pub mod integrate;

@@ -91,6 +91,28 @@ pub fn push_forward(t: &Mat2, m: &Sym2) -> Sym2 {
     crate::math::mat_to_sym(&(ti.transpose() * crate::math::sym_to_mat(m) * ti))
 }
 
+/// The barycentric form of face `f` of a tensor field `m(x, y)` given in reference Cartesian
+/// coordinates, sampled edge by edge: each edge vector `e` gets `eᵀ m(x_e) e` with `x_e` the
+/// edge's midpoint (the discrete metric's squared edge lengths when `m` is ā), and the form is
+/// the one with these three values on `e1`, `e2` and `e2 − e1`. Exact for constant `m`, second
+/// order otherwise.
+pub fn sample_on_edges(mesh: &Mesh, f: usize, m: impl Fn(Real, Real) -> Sym2) -> Sym2 {
+    let [p0, p1, p2] = mesh.face_positions(f);
+    let t = reference_frame(mesh, f);
+    let e1 = crate::math::Vec2::new(t[(0, 0)], t[(1, 0)]);
+    let e2 = crate::math::Vec2::new(t[(0, 1)], t[(1, 1)]);
+    let e3 = e2 - e1;
+    let quad = |p: Vec3, e: &crate::math::Vec2| {
+        let s = m(p.x, p.y);
+        e.x * e.x * s[0] + 2.0 * e.x * e.y * s[1] + e.y * e.y * s[2]
+    };
+    let m11 = quad((p0 + p1) / 2.0, &e1);
+    let m22 = quad((p0 + p2) / 2.0, &e2);
+    let m33 = quad((p1 + p2) / 2.0, &e3);
+    // M(e2 − e1, e2 − e1) = m11 + m22 − 2 m12.
+    Sym2::new(m11, 0.5 * (m11 + m22 - m33), m22)
+}
+
 /// Target forms given per face in reference Cartesian coordinates (e.g. the `abar_info` and
 /// `bbar_info` fields), pulled back. Requires a flat reference mesh; checks ā > 0 per face.
 pub fn pulled_back_targets(

@@ -122,10 +122,10 @@ impl Scene {
         match settings.rest.target {
             TargetForms::None => {}
             TargetForms::Uniform => {
-                let a = Sym2::from(settings.rest.abar);
-                let b = Sym2::from(settings.rest.bbar);
+                let a = settings_form(&mesh, &settings.rest.abar, "rest.abar")?;
+                let b = settings_form(&mesh, &settings.rest.bbar, "rest.bbar")?;
                 let (a1, b1) =
-                    pulled_back_targets(&mesh, |_| a, |_| b, "rest.target = \"uniform\"")?;
+                    pulled_back_targets(&mesh, |f| a[f], |f| b[f], "rest.target = \"uniform\"")?;
                 rest.abar1 = a1;
                 rest.bbar1 = b1;
             }
@@ -445,6 +445,66 @@ fn check_moisture_regions(mesh: &Mesh, settings: &Settings) -> Result<(), MeshEr
 }
 
 /// A per-face scalar field with a uniform fallback, checked finite (naming the face).
+/// A settings field (number or expression of x, y) at every face's reference centroid; a
+/// non-finite value is an error naming the face.
+pub fn settings_field(
+    mesh: &Mesh,
+    field: &crate::settings::Field,
+    key: &str,
+) -> Result<Vec<Real>, MeshError> {
+    let e = field
+        .compile()
+        .map_err(|e| mesh.invalid(format!("{key}: {e}")))?;
+    (0..mesh.faces.len())
+        .map(|f| {
+            let [p0, p1, p2] = mesh.face_positions(f);
+            let c = (p0 + p1 + p2) / 3.0;
+            let v = e.eval(c.x, c.y);
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(mesh.invalid(format!(
+                    "{key} is {v} at face {f} (centroid x = {}, y = {})",
+                    c.x, c.y
+                )))
+            }
+        })
+        .collect()
+}
+
+/// A symmetric 2×2 form `[xx, xy, yy]` of settings fields (numbers or expressions of x, y) at
+/// every face, in reference Cartesian coordinates, sampled on the edges as
+/// [`crate::rest::sample_on_edges`] does; a non-finite value is an error naming the face.
+fn settings_form(
+    mesh: &Mesh,
+    form: &[crate::settings::Field; 3],
+    key: &str,
+) -> Result<Vec<Sym2>, MeshError> {
+    let e = form
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            c.compile()
+                .map_err(|e| mesh.invalid(format!("{key}[{i}]: {e}")))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    (0..mesh.faces.len())
+        .map(|f| {
+            let at =
+                |x: Real, y: Real| Sym2::new(e[0].eval(x, y), e[1].eval(x, y), e[2].eval(x, y));
+            let m = crate::rest::sample_on_edges(mesh, f, at);
+            if m.iter().all(|v| v.is_finite()) {
+                Ok(crate::rest::push_forward(
+                    &crate::rest::reference_frame(mesh, f),
+                    &m,
+                ))
+            } else {
+                Err(mesh.invalid(format!("{key} is not finite on an edge of face {f}")))
+            }
+        })
+        .collect()
+}
+
 fn face_values(mesh: &Mesh, name: &str, uniform: Real) -> Result<Vec<Real>, MeshError> {
     match mesh.face_field(name, 1)? {
         Some(f) => {
@@ -478,7 +538,10 @@ impl GrowthInputs {
         let mut out = GrowthInputs {
             moisture_top: face_values(mesh, "moisture_top", g.moisture_top)?,
             moisture_bottom: face_values(mesh, "moisture_bottom", g.moisture_bottom)?,
-            s: face_values(mesh, "growth_factor", g.s)?,
+            s: match mesh.face_field("growth_factor", 1)? {
+                Some(_) => face_values(mesh, "growth_factor", 0.0)?,
+                None => settings_field(mesh, &g.s, "growth.s")?,
+            },
             direction: Vec::new(),
         };
         if g.law == GrowthLaw::MachineDirection || settings.moisture.enabled {

@@ -179,7 +179,8 @@ pub enum TargetForms {
     /// No growth: ā = a⁰, b̄ = b⁰ of the input mesh (seed 000 "No Growth").
     #[default]
     None,
-    /// Uniform `abar`, `bbar` from these settings, in reference Cartesian coordinates.
+    /// `abar`, `bbar` from these settings (numbers or expressions of x, y), in reference
+    /// Cartesian coordinates.
     Uniform,
     /// Per-face `abar_info` (required) and `bbar_info` (optional, default 0) mesh fields, in
     /// reference Cartesian coordinates (MorphoShell's files).
@@ -192,12 +193,12 @@ pub enum TargetForms {
 pub struct Rest {
     /// Target forms: `"none"`, `"uniform"` or `"mesh"` (default: `"none"`).
     pub target: TargetForms,
-    /// Uniform target ā as `[xx, xy, yy]` in reference Cartesian coordinates (dimensionless,
-    /// default: `[1, 0, 1]`).
-    pub abar: [Real; 3],
-    /// Uniform target b̄ as `[xx, xy, yy]` in reference Cartesian coordinates (1/m, default:
-    /// `[0, 0, 0]`).
-    pub bbar: [Real; 3],
+    /// Target ā as `[xx, xy, yy]` in reference Cartesian coordinates, each a number or an
+    /// expression of x, y (dimensionless, default: `[1, 0, 1]`).
+    pub abar: [Field; 3],
+    /// Target b̄ as `[xx, xy, yy]` in reference Cartesian coordinates, numbers or expressions
+    /// (1/m, default: `[0, 0, 0]`).
+    pub bbar: [Field; 3],
     /// Dynamic mode: time over which the forms are dialled linearly from the input mesh's forms to
     /// the target (s, default: `0` = target from the start).
     pub dial_time: Real,
@@ -207,8 +208,8 @@ impl Default for Rest {
     fn default() -> Self {
         Rest {
             target: TargetForms::None,
-            abar: [1.0, 0.0, 1.0],
-            bbar: [0.0; 3],
+            abar: [1.0.into(), 0.0.into(), 1.0.into()],
+            bbar: [0.0.into(), 0.0.into(), 0.0.into()],
             dial_time: 0.0,
         }
     }
@@ -252,8 +253,9 @@ pub struct Growth {
     pub moisture_top: Real,
     /// Uniform moisture at the bottom surface (default `0`).
     pub moisture_bottom: Real,
-    /// Uniform conformal growth factor s of the isotropic law (default `0`).
-    pub s: Real,
+    /// Conformal growth factor s of the isotropic law: a number or an expression of the
+    /// reference x, y (default `0`).
+    pub s: Field,
     /// Uniform machine direction in reference Cartesian coordinates (default `[1, 0, 0]`).
     pub machine_direction: [Real; 3],
 }
@@ -268,7 +270,7 @@ impl Default for Growth {
             mu_bottom: 0.0,
             moisture_top: 0.0,
             moisture_bottom: 0.0,
-            s: 0.0,
+            s: Field::Value(0.0),
             machine_direction: [1.0, 0.0, 0.0],
         }
     }
@@ -492,6 +494,41 @@ impl Default for Time {
 pub struct Loads {
     /// Gravitational acceleration (m/s², default: `[0, 0, 0]`; Earth: `[0, 0, -9.81]`).
     pub gravity: [Real; 3],
+}
+
+/// A number, or an expression of the reference coordinates x, y (m) as a string (see
+/// [`crate::expr`]), evaluated at each face's reference centroid.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Field {
+    /// A constant.
+    Value(Real),
+    /// An expression of x and y.
+    Expr(String),
+}
+
+impl Field {
+    /// The parsed expression (a constant for a number).
+    pub fn compile(&self) -> Result<crate::expr::Expr, String> {
+        match self {
+            Field::Value(v) => Ok(crate::expr::Expr::Num(*v)),
+            Field::Expr(s) => crate::expr::Expr::parse(s),
+        }
+    }
+
+    /// The constant, if this is one.
+    pub fn constant(&self) -> Option<Real> {
+        match self {
+            Field::Value(v) => Some(*v),
+            Field::Expr(_) => None,
+        }
+    }
+}
+
+impl From<Real> for Field {
+    fn from(v: Real) -> Self {
+        Field::Value(v)
+    }
 }
 
 /// A number or the word `"auto"`.
@@ -722,16 +759,29 @@ impl Settings {
             );
         }
         let r = &self.rest;
-        if r.abar.iter().chain(r.bbar.iter()).any(|v| !v.is_finite()) {
-            return inv("rest.abar/bbar", "must be finite".into());
+        for (name, form) in [("abar", &r.abar), ("bbar", &r.bbar)] {
+            for (i, v) in form.iter().enumerate() {
+                let key = format!("rest.{name}[{i}]");
+                match v {
+                    Field::Value(v) if !v.is_finite() => {
+                        return inv(&key, format!("must be finite, got {v}"))
+                    }
+                    Field::Expr(_) => {
+                        if let Err(e) = v.compile() {
+                            return inv(&key, e);
+                        }
+                    }
+                    _ => {}
+                }
+            }
         }
-        if r.target == TargetForms::Uniform
-            && !(r.abar[0] > 0.0 && r.abar[0] * r.abar[2] - r.abar[1] * r.abar[1] > 0.0)
-        {
-            return inv(
-                "rest.abar",
-                format!("must be positive definite, got {:?}", r.abar),
-            );
+        if let [Some(a0), Some(a1), Some(a2)] = r.abar.clone().map(|f| f.constant()) {
+            if r.target == TargetForms::Uniform && !(a0 > 0.0 && a0 * a2 - a1 * a1 > 0.0) {
+                return inv(
+                    "rest.abar",
+                    format!("must be positive definite, got [{a0}, {a1}, {a2}]"),
+                );
+            }
         }
         nonneg("rest.dial_time", r.dial_time)?;
         let s = &self.solver;
@@ -763,11 +813,21 @@ impl Settings {
             ("growth.mu_bottom", g.mu_bottom),
             ("growth.moisture_top", g.moisture_top),
             ("growth.moisture_bottom", g.moisture_bottom),
-            ("growth.s", g.s),
         ] {
             if !v.is_finite() {
                 return inv(k, format!("must be a finite number, got {v}"));
             }
+        }
+        match &g.s {
+            Field::Value(v) if !v.is_finite() => {
+                return inv("growth.s", format!("must be finite, got {v}"))
+            }
+            Field::Expr(_) => {
+                if let Err(e) = g.s.compile() {
+                    return inv("growth.s", e);
+                }
+            }
+            _ => {}
         }
         if g.law != GrowthLaw::None && self.rest.target != TargetForms::None {
             return inv(

@@ -41,3 +41,71 @@ fn override_syntax_errors() {
     assert!(apply_overrides(&mut t, &["a..b=1".into()]).is_err());
     assert!(apply_overrides(&mut t, &["novalue".into()]).is_err());
 }
+
+/// Pullback forms as settings expressions of x, y equal the same forms given per face (seed
+/// 000 Table 1's hyperboloid, programmed by `Case::program` at the face centroids), and the
+/// isotropic law's `growth.s` expression equals the conformal cap's metric e^{2s} I.
+#[test]
+fn expressions_of_x_y_give_the_per_face_forms() {
+    use shellsim::cases::Case;
+    use shellsim::mesh::generate::{rectangle, Spacing};
+    use shellsim::scene::Scene;
+    let mesh = || rectangle(-0.5, -0.5, 1.0, 1.0, 0.125, Spacing::default());
+    let mut programmed = mesh();
+    Case::Hyperboloid.program(&mut programmed);
+    let by_fields = Scene::build(
+        programmed,
+        Settings::from_str_with("[rest]\ntarget = \"mesh\"\n", "t", &[]).unwrap(),
+    )
+    .unwrap();
+    let text = "[rest]\ntarget = \"uniform\"\nabar = [\"1 + x^2\", \"-x*y\", \"1 + y^2\"]\n\
+                bbar = [\"-1/sqrt(1 + x^2 + y^2)\", 0, \"1/sqrt(1 + x^2 + y^2)\"]\n";
+    let by_expr = Scene::build(mesh(), Settings::from_str_with(text, "t", &[]).unwrap()).unwrap();
+    for f in 0..by_expr.num_faces() {
+        assert!((by_expr.rest.abar1[f] - by_fields.rest.abar1[f]).norm() < 1e-14);
+        assert!((by_expr.rest.bbar1[f] - by_fields.rest.bbar1[f]).norm() < 1e-14);
+    }
+    // Isotropic growth with s(x, y): ā = e^{2s} a⁰ at each centroid.
+    let text = "[growth]\nlaw = \"isotropic\"\ns = \"-log(1 + (x^2 + y^2)/4)\"\n";
+    let sc = Scene::build(mesh(), Settings::from_str_with(text, "t", &[]).unwrap()).unwrap();
+    for f in 0..sc.num_faces() {
+        let [p0, p1, p2] = sc.mesh.face_positions(f);
+        let c = (p0 + p1 + p2) / 3.0;
+        let eta = 1.0 / (1.0 + 0.25 * (c.x * c.x + c.y * c.y));
+        let want = sc.rest.abar0[f] * (eta * eta);
+        assert!((sc.rest.abar1[f] - want).norm() < 1e-13 * want.norm());
+    }
+    // Bad expressions name the key; values that are not finite or not positive definite name
+    // the face.
+    for (text, needle) in [
+        (
+            "[rest]\ntarget = \"uniform\"\nabar = [\"1 + \", 0, 1]\n",
+            "rest.abar[0]",
+        ),
+        (
+            "[growth]\nlaw = \"isotropic\"\ns = \"foo(x)\"\n",
+            "growth.s",
+        ),
+    ] {
+        let e = Settings::from_str_with(text, "t", &[]).unwrap_err();
+        assert!(format!("{e:#}").contains(needle), "{e:#}");
+    }
+    for (text, needle) in [
+        (
+            "[rest]\ntarget = \"uniform\"\nabar = [\"x\", 0, 1]\n",
+            "not positive definite",
+        ),
+        (
+            "[rest]\ntarget = \"uniform\"\nabar = [\"1/x\", 0, 1]\n",
+            "rest.abar is not finite on an edge of face",
+        ),
+        (
+            "[growth]\nlaw = \"isotropic\"\ns = \"log(x)\"\n",
+            "growth.s is NaN at face",
+        ),
+    ] {
+        let s = Settings::from_str_with(text, "t", &[]).unwrap();
+        let e = Scene::build(mesh(), s).unwrap_err();
+        assert!(format!("{e:#}").contains(needle), "{e:#}");
+    }
+}
