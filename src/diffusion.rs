@@ -271,13 +271,44 @@ impl Diffusion {
                 "face {f} {side:?}: conditions {old:?} and {bc:?} contradict each other"
             ));
         }
-        self.bcs[f][s] = bc;
+        if old != bc {
+            self.bcs[f][s] = bc;
+            self.apply(f, side, bc, 1.0);
+        }
+        Ok(())
+    }
+
+    /// The condition on one face side.
+    pub fn surface(&self, f: usize, side: Side) -> SurfaceBc {
+        self.bcs[f][side as usize]
+    }
+
+    /// Replaces the flux or Robin condition of one face side by another (or by sealed), e.g. a
+    /// surface that touches or leaves a moist ground. Prescribed values cannot be replaced.
+    pub fn replace_surface(&mut self, f: usize, side: Side, bc: SurfaceBc) -> Result<(), String> {
+        let s = side as usize;
+        let old = self.bcs[f][s];
+        if matches!(old, SurfaceBc::Value(_)) || matches!(bc, SurfaceBc::Value(_)) {
+            return Err(format!(
+                "face {f} {side:?}: a prescribed moisture cannot be switched"
+            ));
+        }
+        if old != bc {
+            self.apply(f, side, old, -1.0);
+            self.bcs[f][s] = bc;
+            self.apply(f, side, bc, 1.0);
+        }
+        Ok(())
+    }
+
+    /// Adds (`sign = 1`) or removes (`−1`) the contributions of a condition.
+    fn apply(&mut self, f: usize, side: Side, bc: SurfaceBc, sign: Real) {
         let k = match side {
             Side::Top => self.layers,
             Side::Bottom => 0,
         };
         let ns = self.faces[f].map(|v| self.node(v, k));
-        let area = self.areas[f];
+        let area = self.areas[f] * sign;
         match bc {
             SurfaceBc::Sealed => {}
             SurfaceBc::Flux(q) => {
@@ -305,7 +336,6 @@ impl Diffusion {
                 self.factored_dt = None;
             }
         }
-        Ok(())
     }
 
     /// Prescribes the moisture at one node (e.g. on the sheet's rim).

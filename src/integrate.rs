@@ -64,6 +64,12 @@ struct Moisture {
     /// `moisture.water_density = 0`).
     mass: Vec<Real>,
     trial_mass: Vec<Real>,
+    /// `[moisture.ground]`: each face's own conditions (top, bottom), the ground's
+    /// `(k, value, distance)`, and which sides currently touch it.
+    base: Vec<[crate::diffusion::SurfaceBc; 2]>,
+    taped: Vec<[bool; 2]>,
+    ground: Option<(Real, Real, Real)>,
+    touching: Vec<[bool; 2]>,
 }
 
 impl Moisture {
@@ -88,6 +94,8 @@ impl Moisture {
             },
             mo.layers,
         )?;
+        // Sides sealed on purpose (tape): the ground exchange leaves them sealed.
+        let mut taped = vec![[false; 2]; sc.num_faces()];
         for b in &mo.boundary {
             let side = match b.side {
                 SurfaceSide::Top => Side::Top,
@@ -102,15 +110,32 @@ impl Moisture {
                     ambient: b.ambient,
                 },
             };
-            let faces = crate::scene::region_faces(&sc.mesh, &b.tags)
+            let faces = crate::scene::region_faces(&sc.mesh, b)
                 .map_err(|e| RunError::Moisture(e.to_string()))?;
             for f in faces {
                 diffusion
                     .set_surface(f, side, bc)
                     .map_err(RunError::Moisture)?;
+                if bc == SurfaceBc::Sealed {
+                    taped[f][side as usize] = true;
+                }
             }
         }
         let u = vec![mo.initial; diffusion.num_nodes()];
+        let nf = sc.num_faces();
+        let base = (0..nf)
+            .map(|f| {
+                [
+                    diffusion.surface(f, Side::Top),
+                    diffusion.surface(f, Side::Bottom),
+                ]
+            })
+            .collect();
+        let h_mean = sc.thickness.iter().sum::<Real>() / nf.max(1) as Real;
+        let ground = mo
+            .ground
+            .as_ref()
+            .map(|g| (g.k, g.value, g.distance.or(h_mean)));
         let mut m = Moisture {
             trial: u.clone(),
             u,
@@ -118,10 +143,51 @@ impl Moisture {
             change: 0.0,
             mass: Vec::new(),
             trial_mass: Vec::new(),
+            base,
+            taped,
+            ground,
+            touching: vec![[false; 2]; nf],
         };
         m.mass = m.masses_of(sc, &m.u);
         m.trial_mass = m.mass.clone();
         Ok(Some(m))
+    }
+
+    /// Switches the ground exchange of every face side on or off from the positions `x`: a side
+    /// touches when it faces the ground (its outward normal within 60° of the ground's inward
+    /// one) and the face's centroid is within `distance` of the ground, thickness included.
+    fn update_ground(&mut self, sc: &Scene, x: &[Vec3]) -> Result<(), String> {
+        use crate::diffusion::{Side, SurfaceBc};
+        let (Some((k, value, distance)), Some(g)) = (self.ground, &sc.ground) else {
+            return Ok(());
+        };
+        for (f, face) in sc.mesh.faces.iter().enumerate() {
+            let [p0, p1, p2] = face.map(|v| x[v]);
+            let n = (p1 - p0).cross(&(p2 - p0)).normalize();
+            let c = (p0 + p1 + p2) / 3.0;
+            let facing = n.dot(&g.normal);
+            let gap = g.normal.dot(&(c - g.point)) - 0.5 * sc.thickness[f] * facing.abs();
+            let near = gap <= distance && facing.abs() >= 0.5;
+            // The top (+n) faces the ground when n points into it.
+            let touch = [near && facing < 0.0, near && facing > 0.0];
+            for (s, side) in [Side::Top, Side::Bottom].into_iter().enumerate() {
+                if touch[s] == self.touching[f][s] {
+                    continue;
+                }
+                let base = self.base[f][s];
+                if self.taped[f][s] || matches!(base, SurfaceBc::Value(_)) {
+                    continue;
+                }
+                let bc = if touch[s] {
+                    SurfaceBc::Robin { k, ambient: value }
+                } else {
+                    base
+                };
+                self.diffusion.replace_surface(f, side, bc)?;
+                self.touching[f][s] = touch[s];
+            }
+        }
+        Ok(())
     }
 
     /// Lumped vertex masses with face densities ρ_shell + (m⁺ + m⁻)/2 · ρ_water (seed 000 §3,
@@ -646,6 +712,10 @@ fn run_dynamic(
         trial_phi.copy_from_slice(&phi);
         if let Some(m) = &mut moisture {
             // Diffuse over the step, then set the rest forms from the new surface moisture.
+            if let Err(e) = m.update_ground(sc, &x) {
+                failure = Some(format!("moisture at t = {t:.6e}: {e}"));
+                break;
+            }
             m.trial.copy_from_slice(&m.u);
             if let Err(e) = m.diffusion.step(&mut m.trial, h) {
                 failure = Some(format!("moisture diffusion at t = {t:.6e}: {e}"));

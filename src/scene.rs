@@ -407,18 +407,30 @@ fn edge_signs(topo: &Topology) -> Vec<[Real; 3]> {
         .collect()
 }
 
-/// The faces of a moisture boundary region: `tri_tags` in `tags`, or every face.
-pub fn region_faces(mesh: &Mesh, tags: &[i64]) -> Result<Vec<usize>, MeshError> {
-    if tags.is_empty() {
-        return Ok((0..mesh.faces.len()).collect());
-    }
-    let t = mesh.face_field("tri_tags", 1)?.ok_or_else(|| {
-        mesh.invalid(
-            "moisture.boundary selects faces by tags, which needs the face field 'tri_tags'",
-        )
-    })?;
+/// The faces of a moisture boundary region: those whose `tri_tags` value is in `b.tags` (all
+/// faces when empty) and, if `b.inside` is given, whose reference centroid lies in that box.
+pub fn region_faces(
+    mesh: &Mesh,
+    b: &crate::settings::MoistureBoundary,
+) -> Result<Vec<usize>, MeshError> {
+    let tags = if b.tags.is_empty() {
+        None
+    } else {
+        Some(mesh.face_field("tri_tags", 1)?.ok_or_else(|| {
+            mesh.invalid(
+                "moisture.boundary selects faces by tags, which needs the face field 'tri_tags'",
+            )
+        })?)
+    };
     Ok((0..mesh.faces.len())
-        .filter(|&f| tags.contains(&(t.data[f].round() as i64)))
+        .filter(|&f| tags.is_none_or(|t| b.tags.contains(&(t.data[f].round() as i64))))
+        .filter(|&f| {
+            b.inside.as_ref().is_none_or(|bx| {
+                let [p0, p1, p2] = mesh.face_positions(f);
+                let c = (p0 + p1 + p2) / 3.0;
+                (0..3).all(|k| c[k] >= bx.min[k] && c[k] <= bx.max[k])
+            })
+        })
         .collect())
 }
 
@@ -427,7 +439,7 @@ fn check_moisture_regions(mesh: &Mesh, settings: &Settings) -> Result<(), MeshEr
     let mut seen: std::collections::HashMap<(usize, crate::settings::SurfaceSide), usize> =
         Default::default();
     for (i, b) in settings.moisture.boundary.iter().enumerate() {
-        for f in region_faces(mesh, &b.tags)? {
+        for f in region_faces(mesh, b)? {
             if let Some(&j) = seen.get(&(f, b.side)) {
                 let o = &settings.moisture.boundary[j];
                 if (o.kind, o.value, o.k, o.ambient) != (b.kind, b.value, b.k, b.ambient) {
@@ -444,7 +456,6 @@ fn check_moisture_regions(mesh: &Mesh, settings: &Settings) -> Result<(), MeshEr
     Ok(())
 }
 
-/// A per-face scalar field with a uniform fallback, checked finite (naming the face).
 /// A settings field (number or expression of x, y) at every face's reference centroid; a
 /// non-finite value is an error naming the face.
 pub fn settings_field(
@@ -505,6 +516,7 @@ fn settings_form(
         .collect()
 }
 
+/// A per-face scalar field with a uniform fallback, checked finite (naming the face).
 fn face_values(mesh: &Mesh, name: &str, uniform: Real) -> Result<Vec<Real>, MeshError> {
     match mesh.face_field(name, 1)? {
         Some(f) => {

@@ -303,6 +303,34 @@ pub struct Moisture {
     pub max_change: Real,
     /// Surface conditions by region; faces without one are sealed.
     pub boundary: Vec<MoistureBoundary>,
+    /// Exchange with a moist ground (`[moisture.ground]`, needs `[contact]`), else none.
+    pub ground: Option<GroundMoisture>,
+}
+
+/// `[moisture.ground]`: a face side that faces the ground (`[contact]`) and is within
+/// `distance` of it exchanges moisture with it, `−D∂u/∂n = k (u − value)`, instead of its own
+/// condition; sealed sides (tape) and prescribed values stay as they are. Re-evaluated every
+/// time step from the current positions.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GroundMoisture {
+    /// Transfer coefficient k (m/s, default `1e-5`).
+    pub k: Real,
+    /// Moisture of the ground (default `0.3`).
+    pub value: Real,
+    /// Largest gap between the sheet's surface and the ground that counts as touching (m;
+    /// `"auto"`: the thickness, default).
+    pub distance: AutoOr,
+}
+
+impl Default for GroundMoisture {
+    fn default() -> Self {
+        GroundMoisture {
+            k: 1e-5,
+            value: 0.3,
+            distance: AutoOr::Auto(Auto::Auto),
+        }
+    }
 }
 
 impl Default for Moisture {
@@ -317,6 +345,7 @@ impl Default for Moisture {
             water_density: 1000.0,
             max_change: 0.02,
             boundary: Vec::new(),
+            ground: None,
         }
     }
 }
@@ -327,6 +356,8 @@ impl Default for Moisture {
 pub struct MoistureBoundary {
     /// Faces whose `tri_tags` is one of these (empty: every face).
     pub tags: Vec<i64>,
+    /// Only faces whose reference centroid lies in this box (m), e.g. a taped end.
+    pub inside: Option<FixBox>,
     /// `"top"` (the normal side) or `"bottom"`.
     pub side: SurfaceSide,
     /// `"value"` (prescribed moisture), `"flux"` (inward flux), `"robin"` (exchange with an
@@ -344,6 +375,7 @@ impl Default for MoistureBoundary {
     fn default() -> Self {
         MoistureBoundary {
             tags: Vec::new(),
+            inside: None,
             side: SurfaceSide::Top,
             kind: SurfaceKind::Sealed,
             value: 0.0,
@@ -850,6 +882,24 @@ impl Settings {
             }
             pos("moisture.max_change", mo.max_change)?;
             nonneg("moisture.water_density", mo.water_density)?;
+            if let Some(g) = &mo.ground {
+                nonneg("moisture.ground.k", g.k)?;
+                if !g.value.is_finite() {
+                    return inv(
+                        "moisture.ground.value",
+                        format!("must be finite, got {}", g.value),
+                    );
+                }
+                if let AutoOr::Value(d) = g.distance {
+                    nonneg("moisture.ground.distance", d)?;
+                }
+                if !self.contact.enabled {
+                    return inv(
+                        "moisture.ground",
+                        "needs a ground: set contact.enabled = true".into(),
+                    );
+                }
+            }
             if mo.layers == 0 {
                 return inv("moisture.layers", "must be at least 1".into());
             }

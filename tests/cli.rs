@@ -802,3 +802,98 @@ fn absorbed_water_adds_mass() {
         );
     }
 }
+
+/// Bad growth and moisture input (issue 4): per-face fields of the wrong length, NaN (the reader
+/// names the line), a zero
+/// machine direction, swelling that makes ā non-positive, a ground exchange without a ground,
+/// a broken expression, a zero contact normal. Each is exit 2 naming the field or the face.
+#[test]
+fn bad_growth_and_moisture_fields_are_rejected() {
+    let d = tmp();
+    let p = d.path();
+    let with_fields = |fields: &str| {
+        TWO_TRIANGLES.replace(
+            "CELL_DATA 2\nFIELD FieldData 5\n",
+            &format!(
+                "CELL_DATA 2\nFIELD FieldData {}\n{fields}",
+                5 + fields.matches(" double\n").count()
+            ),
+        )
+    };
+    let swell = "[growth]\nlaw = \"linear_swelling\"\nmu = 0.01\n";
+    write(p, "swell.toml", swell);
+    for (name, mesh, needle) in [
+        (
+            "len.vtk",
+            with_fields("moisture_top 1 3 double\n0.1 0.1 0.1\n"),
+            "moisture_top",
+        ),
+        (
+            "nan.vtk",
+            with_fields("moisture_top 1 2 double\n0.1 nan\n"),
+            "line 19: non-finite",
+        ),
+        (
+            "nan2.vtk",
+            with_fields("moisture_bottom 1 2 double\ninf 0.1\n"),
+            "line 19: non-finite",
+        ),
+        (
+            "neg.vtk",
+            with_fields("moisture_top 1 2 double\n0.1 -200\n"),
+            "face 1",
+        ),
+    ] {
+        write(p, name, &mesh);
+        expect_bad(&["swell.toml", name], p, needle);
+    }
+    let md = "[growth]\nlaw = \"machine_direction\"\nmu = 0.01\nmu_perp = 0.03\n";
+    write(p, "md.toml", md);
+    for (name, field, needle) in [
+        (
+            "zero.vtk",
+            "machine_direction 3 2 double\n1 0 0 0 0 0\n",
+            "face 1",
+        ),
+        (
+            "mdlen.vtk",
+            "machine_direction 2 2 double\n1 0 1 0\n",
+            "machine_direction",
+        ),
+        (
+            "mdnan.vtk",
+            "machine_direction 3 2 double\n1 0 0 nan 1 0\n",
+            "line 19: non-finite",
+        ),
+    ] {
+        write(p, name, &with_fields(field));
+        expect_bad(&["md.toml", name], p, needle);
+    }
+    write(
+        p,
+        "iso_len.vtk",
+        &with_fields("growth_factor 1 1 double\n0.1\n"),
+    );
+    write(p, "iso.toml", "[growth]\nlaw = \"isotropic\"\n");
+    expect_bad(&["iso.toml", "iso_len.vtk"], p, "growth_factor");
+    write(p, "ok.vtk", TWO_TRIANGLES);
+    let dynamic = "[solver]\nmode = \"dynamic\"\n[growth]\nlaw = \"linear_swelling\"\nmu = 0.01\n[moisture]\nenabled = true\n";
+    write(
+        p,
+        "ground.toml",
+        &format!("{dynamic}[moisture.ground]\nk = 1e-5\n"),
+    );
+    expect_bad(&["ground.toml", "ok.vtk"], p, "moisture.ground");
+    write(
+        p,
+        "normal.toml",
+        &format!("{dynamic}[contact]\nenabled = true\nnormal = [0, 0, 0]\n"),
+    );
+    expect_bad(&["normal.toml", "ok.vtk"], p, "contact.normal");
+    write(
+        p,
+        "expr.toml",
+        "[growth]\nlaw = \"isotropic\"\ns = \"sqrt(x\"\n",
+    );
+    expect_bad(&["expr.toml", "ok.vtk"], p, "growth.s");
+}
