@@ -312,5 +312,68 @@ fn moisture_step(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, kernel, assembly, newton_iteration, moisture_step);
+/// The whole coupled loop (issue 4): the first 0.2 s of the wetted paper strip
+/// (settings/paper_strip_cd.toml, 1 200 faces, edge DOFs; Δt ≤ 0.05 s, cut by
+/// `moisture.max_change` to about 16 steps): diffusion, rest forms, moisture masses and the
+/// Newton solve, on 1 and 2 threads. The summary's `moisture_seconds` splits the
+/// step into its diffusion and mechanics parts; the ratio is printed once per thread count.
+fn coupled_step(c: &mut Criterion) {
+    let mut g = c.benchmark_group("coupled_step");
+    g.sample_size(10);
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/settings/paper_strip_cd.toml"
+    ))
+    .unwrap();
+    let overrides: Vec<String> = [
+        "time.end=0.2",
+        "time.dt=0.05",
+        "time.dt_max=0.05",
+        "time.output_interval=0.2",
+        "output.format=\"vtu\"",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let settings = Settings::from_str_with(&text, "paper_strip_cd", &overrides).unwrap();
+    let mesh = rectangle(-0.03, -0.005, 0.06, 0.01, 0.001, Spacing::default());
+    let sc = Scene::build(mesh, settings).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let once = || {
+            let mut w = shellsim::output::Writer::new(dir.path(), &sc).unwrap();
+            shellsim::integrate::run(&sc, &mut w, &mut shellsim::integrate::Quiet, threads, None)
+                .unwrap()
+        };
+        let s = pool.install(once);
+        eprintln!(
+            "coupled_step {threads} thread(s): {} faces, {} steps, {} Newton iterations; \
+             diffusion + rest forms {:.1} of {:.1} ms ({:.1}%), coupled / mechanics = {:.3}",
+            s.faces,
+            s.steps,
+            s.newton_iterations,
+            1e3 * s.moisture_seconds,
+            1e3 * s.wall_seconds,
+            100.0 * s.moisture_seconds / s.wall_seconds,
+            s.wall_seconds / (s.wall_seconds - s.moisture_seconds)
+        );
+        g.bench_function(BenchmarkId::new("paper_strip_0.2s", threads), |b| {
+            b.iter(|| pool.install(once))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    kernel,
+    assembly,
+    newton_iteration,
+    moisture_step,
+    coupled_step
+);
 criterion_main!(benches);

@@ -710,6 +710,7 @@ fn run_dynamic(
         }
         trial.copy_from_slice(&xhat);
         trial_phi.copy_from_slice(&phi);
+        let moisture_clock = Instant::now();
         if let Some(m) = &mut moisture {
             // Diffuse over the step, then set the rest forms from the new surface moisture.
             if let Err(e) = m.update_ground(sc, &x) {
@@ -728,6 +729,7 @@ fn run_dynamic(
                 .filter(|&i| !m.diffusion.is_prescribed(i))
                 .fold(0.0, |c: Real, i| c.max((m.trial[i] - m.u[i]).abs()));
             if m.change > sc.settings.moisture.max_change && h > tm.dt_min {
+                s.summary.moisture_seconds += moisture_clock.elapsed().as_secs_f64();
                 s.summary.rejected_steps += 1;
                 dt = (h * 0.5).max(tm.dt_min);
                 easy = 0;
@@ -741,6 +743,7 @@ fn run_dynamic(
                 }
             }
             m.trial_mass = m.masses_of(sc, &m.trial);
+            s.summary.moisture_seconds += moisture_clock.elapsed().as_secs_f64();
         }
         let trial_mass: &[Real] = match &moisture {
             Some(m) if !m.trial_mass.is_empty() => &m.trial_mass,

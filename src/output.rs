@@ -134,6 +134,10 @@ pub struct Summary {
     pub residual: Real,
     /// Final energies.
     pub energy: Energies,
+    /// Wall time spent in the moisture diffusion and the rest forms it sets (s; 0 without
+    /// `[moisture]`): the coupled step's cost over the mechanics alone is
+    /// `wall / (wall − moisture_seconds)`.
+    pub moisture_seconds: Real,
     /// Warnings raised while loading.
     pub warnings: Vec<String>,
 }
