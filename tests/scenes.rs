@@ -337,13 +337,13 @@ fn paper_walker_curls_on_the_moist_surface() {
     let last = frames.last().unwrap();
     let bottom = &last.face_fields["moisture_bottom"].data;
     let (mut low, mut high) = (Vec::new(), Vec::new());
-    for f in 0..last.faces.len() {
+    for (f, &m) in bottom.iter().enumerate() {
         let [a, b, c] = last.face_positions(f);
         let z = (a.z + b.z + c.z) / 3.0;
         if z < 0.001 {
-            low.push(bottom[f]);
+            low.push(m);
         } else if z > 0.01 {
-            high.push(bottom[f]);
+            high.push(m);
         }
     }
     assert!(!low.is_empty() && !high.is_empty());
