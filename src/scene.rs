@@ -224,6 +224,19 @@ impl Scene {
             .contact
             .enabled
             .then(|| build_ground(&mesh, &settings.contact, &thickness, &young));
+        if let Some(g) = &ground {
+            // A start deep inside the ground would be thrown out by the penalty's full force.
+            for (v, x) in mesh.positions.iter().enumerate() {
+                let p = g.penetration(v, x);
+                if g.area[v] > 0.0 && p > g.smoothing {
+                    return Err(mesh.invalid(format!(
+                        "vertex {v} starts {p:.3e} m inside the ground (its surface, mid-surface \
+                         − h/2, is below the plane through contact.point with contact.normal); \
+                         move the plane or the mesh"
+                    )));
+                }
+            }
+        }
         let patches = if m.bending == crate::settings::BendingModel::PatchFit {
             let (p, w) = crate::energy::patch::build_patches(&mesh)?;
             warnings.extend(w);

@@ -806,7 +806,8 @@ fn absorbed_water_adds_mass() {
 /// Bad growth and moisture input (issue 4): per-face fields of the wrong length, NaN (the reader
 /// names the line), a zero
 /// machine direction, swelling that makes ā non-positive, a ground exchange without a ground,
-/// a broken expression, a zero contact normal. Each is exit 2 naming the field or the face.
+/// a broken expression, a zero contact normal, a mesh that starts inside the ground. Each is
+/// exit 2 naming the field, the face or the vertex.
 #[test]
 fn bad_growth_and_moisture_fields_are_rejected() {
     let d = tmp();
@@ -890,6 +891,12 @@ fn bad_growth_and_moisture_fields_are_rejected() {
         &format!("{dynamic}[contact]\nenabled = true\nnormal = [0, 0, 0]\n"),
     );
     expect_bad(&["normal.toml", "ok.vtk"], p, "contact.normal");
+    write(
+        p,
+        "inside.toml",
+        &format!("{dynamic}[contact]\nenabled = true\npoint = [0, 0, 0.01]\n"),
+    );
+    expect_bad(&["inside.toml", "ok.vtk"], p, "inside the ground");
     write(
         p,
         "expr.toml",
