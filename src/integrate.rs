@@ -68,6 +68,8 @@ struct Moisture {
     /// `(k, value, distance)`, and which sides currently touch it.
     base: Vec<[crate::diffusion::SurfaceBc; 2]>,
     taped: Vec<[bool; 2]>,
+    /// Sides covered by tape (top, bottom): the growth law sees moisture 0 there.
+    tape: Vec<[bool; 2]>,
     ground: Option<(Real, Real, Real)>,
     touching: Vec<[bool; 2]>,
 }
@@ -96,6 +98,8 @@ impl Moisture {
         )?;
         // Sides sealed on purpose (tape): the ground exchange leaves them sealed.
         let mut taped = vec![[false; 2]; sc.num_faces()];
+        // Sides covered by tape (`tape = true`): a non-swelling layer for the growth law.
+        let mut tape = vec![[false; 2]; sc.num_faces()];
         for b in &mo.boundary {
             let side = match b.side {
                 SurfaceSide::Top => Side::Top,
@@ -118,6 +122,9 @@ impl Moisture {
                     .map_err(RunError::Moisture)?;
                 if bc == SurfaceBc::Sealed {
                     taped[f][side as usize] = true;
+                }
+                if b.tape {
+                    tape[f][side as usize] = true;
                 }
             }
         }
@@ -145,6 +152,7 @@ impl Moisture {
             trial_mass: Vec::new(),
             base,
             taped,
+            tape,
             ground,
             touching: vec![[false; 2]; nf],
         };
@@ -220,10 +228,20 @@ impl Moisture {
     }
 
     /// Rest forms of every face from the moisture `u`.
+    ///
+    /// A taped side (`moisture.boundary.tape`) is a layer that does not swell: the law sees
+    /// moisture 0 there, so wet paper under tape curls away from it as a bilayer does.
     fn targets_of(&self, sc: &Scene, u: &[Real]) -> Result<Vec<(Sym2, Sym2)>, String> {
         (0..sc.num_faces())
             .map(|f| {
-                let m = self.diffusion.surface_moisture(u, f);
+                let (mut top, mut bottom) = self.diffusion.surface_moisture(u, f);
+                if self.tape[f][0] {
+                    top = 0.0;
+                }
+                if self.tape[f][1] {
+                    bottom = 0.0;
+                }
+                let m = (top, bottom);
                 let reference = (sc.rest.abar0[f], sc.rest.bbar0[f]);
                 crate::scene::growth_face(
                     &sc.settings,

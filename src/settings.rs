@@ -358,6 +358,9 @@ pub struct MoistureBoundary {
     pub tags: Vec<i64>,
     /// Only faces whose reference centroid lies in this box (m), e.g. a taped end.
     pub inside: Option<FixBox>,
+    /// With `kind = "sealed"`: the side is covered by tape, a layer that neither lets water
+    /// through nor swells; the growth law sees moisture 0 on it (default `false`).
+    pub tape: bool,
     /// `"top"` (the normal side) or `"bottom"`.
     pub side: SurfaceSide,
     /// `"value"` (prescribed moisture), `"flux"` (inward flux), `"robin"` (exchange with an
@@ -376,6 +379,7 @@ impl Default for MoistureBoundary {
         MoistureBoundary {
             tags: Vec::new(),
             inside: None,
+            tape: false,
             side: SurfaceSide::Top,
             kind: SurfaceKind::Sealed,
             value: 0.0,
@@ -936,6 +940,12 @@ impl Settings {
                             format!("non-finite value {v}"),
                         );
                     }
+                }
+                if b.tape && b.kind != SurfaceKind::Sealed {
+                    return inv(
+                        &format!("moisture.boundary[{i}].tape"),
+                        "tape is a sealed surface: needs kind = \"sealed\"".into(),
+                    );
                 }
                 if b.kind == SurfaceKind::Robin && b.k < 0.0 {
                     return inv(
