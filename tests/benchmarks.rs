@@ -10,22 +10,9 @@
 //! their error sits at the corners and comes from seed 000's boundary rule (the mid-edge normal
 //! of a boundary edge is the face normal), the mid-edge average's known limit.
 
+mod common;
+use common::shellsim;
 use std::path::Path;
-use std::process::Command;
-
-fn shellsim(args: &[&str], dir: &Path) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_shellsim"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "shellsim {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
 
 /// The `summary.json` of the run written to `dir/out`.
 fn summary(dir: &Path, out: &str) -> serde_json::Value {

@@ -27,6 +27,26 @@ fn run(args: &[&str], dir: &Path) -> Run {
     }
 }
 
+/// Writes a generated strip mesh `lx × ly` with target edge `edge` to `dir/name`.
+fn strip_mesh(dir: &Path, lx: &str, ly: &str, edge: &str, name: &str) {
+    let r = run(
+        &[
+            "mesh",
+            "rectangle",
+            "--lx",
+            lx,
+            "--ly",
+            ly,
+            "--edge",
+            edge,
+            "-o",
+            name,
+        ],
+        dir,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+}
+
 fn tmp() -> tempfile::TempDir {
     tempfile::tempdir().unwrap()
 }
@@ -639,22 +659,7 @@ fn membrane_continuation_below_one_is_bad_input() {
 fn growth_laws_curl_strips_and_reject_bad_input() {
     let d = tmp();
     let p = d.path();
-    let r = run(
-        &[
-            "mesh",
-            "rectangle",
-            "--lx",
-            "0.2",
-            "--ly",
-            "0.02",
-            "--edge",
-            "0.01",
-            "-o",
-            "s.vtk",
-        ],
-        p,
-    );
-    assert_eq!(r.code, 0, "{}", r.stderr);
+    strip_mesh(p, "0.2", "0.02", "0.01", "s.vtk");
     let middle_minus_ends = |toml: &str, out: &str| -> f64 {
         write(p, "g.toml", toml);
         let r = run(&["g.toml", "s.vtk", "--out", out, "-q"], p);
@@ -713,22 +718,7 @@ fn growth_laws_curl_strips_and_reject_bad_input() {
 fn wetted_strip_curls_then_flattens() {
     let d = tmp();
     let p = d.path();
-    let r = run(
-        &[
-            "mesh",
-            "rectangle",
-            "--lx",
-            "0.1",
-            "--ly",
-            "0.02",
-            "--edge",
-            "0.01",
-            "-o",
-            "s.vtk",
-        ],
-        p,
-    );
-    assert_eq!(r.code, 0, "{}", r.stderr);
+    strip_mesh(p, "0.1", "0.02", "0.01", "s.vtk");
     let scene = "[material]\nyoung = 3.0e9\ndensity = 800.0\nthickness = 1.0e-4\n[growth]\nlaw = \"linear_swelling\"\nmu = 0.01\n[moisture]\nenabled = true\ndiffusivity_along = 1e-9\ndiffusivity_across = 1e-9\ndiffusivity_through = 1e-9\nlayers = 4\n[[moisture.boundary]]\nside = \"top\"\nkind = \"value\"\nvalue = 0.2\n[solver]\nmode = \"dynamic\"\n[time]\nend = 12.0\ndt = 0.01\ndt_max = 0.5\noutput_interval = 1.0\ndamping = 0.1\n[output]\nformat = \"vtk_ascii\"\n";
     write(p, "w.toml", scene);
     let r = run(&["w.toml", "s.vtk", "--out", "o", "-q"], p);
@@ -913,22 +903,7 @@ fn bad_growth_and_moisture_fields_are_rejected() {
 fn taped_side_does_not_swell() {
     let d = tmp();
     let p = d.path();
-    let r = run(
-        &[
-            "mesh",
-            "rectangle",
-            "--lx",
-            "0.06",
-            "--ly",
-            "0.01",
-            "--edge",
-            "0.005",
-            "-o",
-            "s.vtk",
-        ],
-        p,
-    );
-    assert_eq!(r.code, 0, "{}", r.stderr);
+    strip_mesh(p, "0.06", "0.01", "0.005", "s.vtk");
     let mut end = Vec::new();
     for tape in [false, true] {
         let scene = format!(

@@ -3,6 +3,8 @@
 //! outcome and, where there is one, a closed-form number checked. `scripts/paper_scenes.py` runs
 //! them at full size and prints the README's numbers.
 
+mod common;
+use common::shellsim;
 use shellsim::mesh::io::read_mesh;
 use shellsim::mesh::Mesh;
 use std::path::{Path, PathBuf};
@@ -10,19 +12,6 @@ use std::process::Command;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn shellsim(args: &[&str], dir: &Path) {
-    let out = Command::new(env!("CARGO_BIN_EXE_shellsim"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "shellsim {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
 }
 
 /// Runs `settings/<scene>.toml` on `mesh` with overrides; returns the frames in order.
