@@ -208,8 +208,7 @@ impl Moisture {
         let mut mass = sc.mass.clone();
         for (f, face) in sc.mesh.faces.iter().enumerate() {
             let (top, bottom) = self.diffusion.surface_moisture(u, f);
-            let [p0, p1, p2] = sc.mesh.face_positions(f);
-            let area = 0.5 * (p1 - p0).cross(&(p2 - p0)).norm();
+            let area = sc.mesh.face_area(f);
             let dm = 0.5 * (top + bottom) * rho_w * sc.thickness[f] * area / 3.0;
             for &v in face {
                 mass[v] += dm;

@@ -172,8 +172,7 @@ impl Scene {
 
         let mut mass = vec![0.0; nv];
         for (f, face) in mesh.faces.iter().enumerate() {
-            let [p0, p1, p2] = mesh.face_positions(f);
-            let area = 0.5 * (p1 - p0).cross(&(p2 - p0)).norm();
+            let area = mesh.face_area(f);
             let mf = m.density * thickness[f] * area / 3.0;
             for &v in face {
                 mass[v] += mf;
@@ -722,8 +721,7 @@ fn build_ground(
     let mut h_area = vec![0.0; nv];
     let (mut total, mut e_over_h, mut h_mean) = (0.0, 0.0, 0.0);
     for (f, face) in mesh.faces.iter().enumerate() {
-        let [p0, p1, p2] = mesh.face_positions(f);
-        let a = 0.5 * (p1 - p0).cross(&(p2 - p0)).norm();
+        let a = mesh.face_area(f);
         total += a;
         e_over_h += a * young[f] / thickness[f];
         h_mean += a * thickness[f];

@@ -114,6 +114,13 @@ impl Mesh {
         [self.positions[i], self.positions[j], self.positions[k]]
     }
 
+    /// Area of face `f` in these (reference) positions (m²).
+    #[inline]
+    pub fn face_area(&self, f: usize) -> Real {
+        let [p0, p1, p2] = self.face_positions(f);
+        0.5 * (p1 - p0).cross(&(p2 - p0)).norm()
+    }
+
     /// Checks coordinates, faces and fields; returns the unused vertices (a warning, not an
     /// error). Topological checks (manifoldness, orientation) live in [`Topology::build`].
     pub fn validate(&self) -> Result<Vec<usize>, MeshError> {
