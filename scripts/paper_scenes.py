@@ -140,6 +140,19 @@ def cap(out):
     print("conformal cap (b̄ = 0): " + ", ".join(f"h = {r[0]}: Hausdorff {100 * r[1]:.2f}%" for r in rows))
 
 
+def tips_of(rows):
+    """Tips of the walker: the centre (column 2) first swinging past ±12 mm (a fifth of the
+    length), then past 5 mm on the other side, alternately. Returns (time, centre mm) pairs."""
+    tips, side = [], None
+    for r in rows:
+        x = r[2] - rows[0][2]
+        bound = 0.012 if side is None else 0.005
+        if abs(x) > bound and (side is None or (x > 0) != side):
+            side = x > 0
+            tips.append((r[0], round(1e3 * x, 1)))
+    return tips
+
+
 def walker(out):
     o = os.path.join(out, "walker")
     wall = run("paper_walker", "meshes/paper_walker.vtk", o)
@@ -154,9 +167,9 @@ def walker(out):
                      mean(a[0] for a in cf["moisture_bottom"]), mean(a[0] for a in cf["moisture_top"])))
     write_csv("paper_walker.csv", ["time", "z_max", "x_mean", "turned_over", "m_bottom", "m_top"], rows)
     peak = max(rows, key=lambda r: r[3])
+    tips = tips_of(rows)
     print(f"walker: highest point {max(r[1] for r in rows) * 1e3:.1f} mm; most faces turned over "
-          f"{100 * peak[3]:.0f}% at {peak[0]} s; at the end {100 * rows[-1][3]:.0f}%; "
-          f"centre moved {1e3 * (rows[-1][2] - rows[0][2]):.2f} mm; wall {wall:.1f} s")
+          f"{100 * peak[3]:.0f}% at {peak[0]} s; tips (time s, centre mm) {tips}; wall {wall:.1f} s")
 
 
 def main():
