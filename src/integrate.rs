@@ -217,12 +217,14 @@ impl Moisture {
         mass
     }
 
-    /// The masses at the accepted state (the scene's without water density).
-    fn mass<'s>(&'s self, sc: &'s Scene) -> &'s [Real] {
-        if self.mass.is_empty() {
+    /// The masses at the accepted state (`trial = false`) or the trial one (the scene's without
+    /// water density).
+    fn mass<'s>(&'s self, sc: &'s Scene, trial: bool) -> &'s [Real] {
+        let m = if trial { &self.trial_mass } else { &self.mass };
+        if m.is_empty() {
             &sc.mass
         } else {
-            &self.mass
+            m
         }
     }
 
@@ -266,6 +268,23 @@ impl Moisture {
         }
         writer.set_face_field("moisture_top", top);
         writer.set_face_field("moisture_bottom", bottom);
+    }
+}
+
+/// The potential of the accepted state of a dynamic run: with moisture, its rest forms
+/// `targets` and its wet masses.
+fn accepted<'a>(
+    base: Potential<'a>,
+    moisture: Option<&'a Moisture>,
+    targets: &'a [(Sym2, Sym2)],
+) -> Potential<'a> {
+    match moisture {
+        Some(m) => Potential {
+            rest_override: Some(targets),
+            mass: m.mass(base.scene, false),
+            ..base
+        },
+        None => base,
     }
 }
 
@@ -698,11 +717,7 @@ fn run_dynamic(
         m.publish(writer);
     }
     {
-        let pot = Potential {
-            rest_override: moisture.as_ref().map(|_| &targets[..]),
-            mass: moisture.as_ref().map_or(&sc.mass[..], |m| m.mass(sc)),
-            ..s.potential(dial_at(t0))
-        };
+        let pot = accepted(s.potential(dial_at(t0)), moisture.as_ref(), &targets);
         s.frame(writer, &pot, &x, &phi, &v, t0)?;
     }
     // Friction: the lagged normal forces, carried from step to step.
@@ -762,10 +777,7 @@ fn run_dynamic(
             m.trial_mass = m.masses_of(sc, &m.trial);
             s.summary.moisture_seconds += moisture_clock.elapsed().as_secs_f64();
         }
-        let trial_mass: &[Real] = match &moisture {
-            Some(m) if !m.trial_mass.is_empty() => &m.trial_mass,
-            _ => &sc.mass,
-        };
+        let trial_mass = moisture.as_ref().map_or(&sc.mass[..], |m| m.mass(sc, true));
         // Friction lags the normal force: solve with λ, update λ from the solution, and re-solve
         // until it agrees (see solve::contact).
         let mut rep;
@@ -865,11 +877,7 @@ fn run_dynamic(
         let at_output = t >= next_out - 1e-9 * h.max(eps_t);
         let mut stop = false;
         if tm.stop_at_equilibrium {
-            let pot = Potential {
-                rest_override: moisture.as_ref().map(|_| &targets[..]),
-                mass: moisture.as_ref().map_or(&sc.mass[..], |m| m.mass(sc)),
-                ..s.potential(dial)
-            };
+            let pot = accepted(s.potential(dial), moisture.as_ref(), &targets);
             let mut g = vec![0.0; s.pattern.n];
             pot.eval(&x, &phi, Want::Gradient, &mut g, &mut []);
             let r = pot.residual(&g);
@@ -884,11 +892,7 @@ fn run_dynamic(
             if let Some(m) = &moisture {
                 m.publish(writer);
             }
-            let pot = Potential {
-                rest_override: moisture.as_ref().map(|_| &targets[..]),
-                mass: moisture.as_ref().map_or(&sc.mass[..], |m| m.mass(sc)),
-                ..s.potential(dial)
-            };
+            let pot = accepted(s.potential(dial), moisture.as_ref(), &targets);
             s.frame(writer, &pot, &x, &phi, &v, t)?;
             while next_out <= t + eps_t {
                 next_out += tm.output_interval;
@@ -903,11 +907,7 @@ fn run_dynamic(
     s.summary.dial = dial_at(t);
     s.summary.converged = failure.is_none();
     s.summary.reason = failure.unwrap_or_default();
-    let pot = Potential {
-        rest_override: moisture.as_ref().map(|_| &targets[..]),
-        mass: moisture.as_ref().map_or(&sc.mass[..], |m| m.mass(sc)),
-        ..s.potential(dial_at(t))
-    };
+    let pot = accepted(s.potential(dial_at(t)), moisture.as_ref(), &targets);
     s.summary.energy = Writer::energies(&pot, &x, &phi, &v);
     if s.summary.reason.is_empty() {
         return Ok(());
