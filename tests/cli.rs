@@ -500,10 +500,10 @@ fn fixed_tags_hold_and_continuation_frames_are_written() {
 }
 
 fn final_frame(dir: &Path, out: &str) -> String {
-    let s: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join(out).join("summary.json")).unwrap())
-            .unwrap();
-    format!("{out}/{}", s["final_frame"].as_str().unwrap())
+    format!(
+        "{out}/{}",
+        summary_of(dir, out)["final_frame"].as_str().unwrap()
+    )
 }
 
 fn summary_of(dir: &Path, out: &str) -> serde_json::Value {
@@ -537,13 +537,17 @@ fn restart_carries_positions_edge_dofs_and_time() {
     write(p, "s.toml", settings);
     let r = run(&["s.toml", "m.vtk", "--out", "a", "-q"], p);
     assert_eq!(r.code, 0, "{}", r.stderr);
+    // `settings` run into `out`, restarted from `frame`.
+    let restart = |settings: &str, out: &str, frame: &str| {
+        run(
+            &[settings, "m.vtk", "--out", out, "-q", "--restart", frame],
+            p,
+        )
+    };
     let fa = final_frame(p, "a");
     let text = std::fs::read_to_string(p.join(&fa)).unwrap();
     assert!(text.contains("edge_angles"), "frames carry the edge DOFs");
-    let r = run(
-        &["s.toml", "m.vtk", "--out", "b", "-q", "--restart", &fa],
-        p,
-    );
+    let r = restart("s.toml", "b", &fa);
     assert_eq!(r.code, 0, "{}", r.stderr);
     let sb = summary_of(p, "b");
     assert!(sb["newton_iterations"].as_u64().unwrap() <= 1, "{sb}");
@@ -576,35 +580,13 @@ fn restart_carries_positions_edge_dofs_and_time() {
         &text[line_end..]
     );
     write(p, "bad.vtk", &bad);
-    let r = run(
-        &[
-            "s.toml",
-            "m.vtk",
-            "--out",
-            "c",
-            "-q",
-            "--restart",
-            "bad.vtk",
-        ],
-        p,
-    );
+    let r = restart("s.toml", "c", "bad.vtk");
     assert_eq!(r.code, 2, "{}", r.stderr);
     assert!(r.stderr.contains("edge_angles"), "{}", r.stderr);
     // A frame of another mesh.
     let r = run(&["mesh", "square", "--edge", "0.5", "-o", "other.vtk"], p);
     assert_eq!(r.code, 0);
-    let r = run(
-        &[
-            "s.toml",
-            "m.vtk",
-            "--out",
-            "c",
-            "-q",
-            "--restart",
-            "other.vtk",
-        ],
-        p,
-    );
+    let r = restart("s.toml", "c", "other.vtk");
     assert_eq!(r.code, 2, "{}", r.stderr);
     assert!(r.stderr.contains("same mesh"), "{}", r.stderr);
 
@@ -613,18 +595,7 @@ fn restart_carries_positions_edge_dofs_and_time() {
     write(p, "dyn.toml", dynamic);
     let r = run(&["dyn.toml", "m.vtk", "--out", "d", "-q"], p);
     assert_eq!(r.code, 0, "{}", r.stderr);
-    let r = run(
-        &[
-            "dyn.toml",
-            "m.vtk",
-            "--out",
-            "e",
-            "-q",
-            "--restart",
-            "d/frame_00001.vtu",
-        ],
-        p,
-    );
+    let r = restart("dyn.toml", "e", "d/frame_00001.vtu");
     assert_eq!(r.code, 0, "{}", r.stderr);
     let se = summary_of(p, "e");
     assert!((se["time"].as_f64().unwrap() - 0.02).abs() < 1e-12, "{se}");
