@@ -165,7 +165,7 @@ fn assembly(c: &mut Criterion) {
                         (0..sc.num_faces())
                             .into_par_iter()
                             .map(|f| {
-                                let st = p.stencil[f];
+                                let st = p.faces().element(f);
                                 let has = [
                                     st[3] != usize::MAX,
                                     st[4] != usize::MAX,

@@ -1,138 +1,98 @@
-//! Global assembly of energy, gradient and sparse Hessian.
+//! Global assembly of energy, gradient and sparse Hessian over the terms of a scene.
 //!
-//! The sparsity pattern (lower triangle, compressed sparse columns, 3 DOFs per vertex in the
-//! order `x, y, z`, then one DOF per edge when the bending model has edge DOFs) is built once per
-//! mesh from each face's stencil (6 vertices, plus its 3 edges), together with a greedy colouring
-//! of the faces in which no two faces of a colour share a stencil node.
-//! Colours are processed in order; within a colour, faces are evaluated in parallel (rayon) and
-//! each scatters its gradient and Hessian directly into entries no other face of that colour
-//! touches. Every entry therefore receives its contributions in a fixed order (colour by colour)
-//! that does not depend on the threads: no floating-point atomics, no per-thread accumulators,
-//! results bitwise identical for any number of threads. Energies are stored per face and summed
-//! in face order.
+//! DOFs are grouped in *nodes*: vertex `v` (node `v`) owns the 3 DOFs `3v..3v+3` (`x, y, z`);
+//! with edge DOFs, edge `e` (node `nv + e`) owns the single DOF `3 nv + e`. The sparsity pattern
+//! (lower triangle, compressed sparse columns) is the union of every term's stencil
+//! ([`crate::energy::term::Stencil`]) and is built once per mesh, together with one
+//! [`ElementMap`] per term: where each element's entries go, and a greedy colouring of blocks of
+//! elements in which no two blocks of a colour share a stencil node.
+//!
+//! Terms are assembled in their registry order; within a term, colours are processed in order,
+//! and within a colour, blocks are evaluated in parallel (rayon), each scattering its gradient and
+//! Hessian directly into entries no other block of that colour touches. Every entry therefore
+//! receives its contributions in a fixed order that does not depend on the threads: no
+//! floating-point atomics, no per-thread accumulators, results bitwise identical for any number
+//! of threads. Energies are stored per element and summed in element order.
 
-use crate::energy::midedge_angle::{midedge_angle_face, AngleVariant};
-use crate::energy::patch::{patch_face, Patch};
 use crate::energy::projection::{project, HessianProjection};
-use crate::energy::shell::{shell_face, shell_face_gauss_newton};
-use crate::energy::KoiterDensity;
+use crate::energy::term::Stencil;
 use crate::math::{Real, SMat, SVec, Vec3};
 use crate::mesh::topology::NONE;
 use rayon::prelude::*;
 
-/// Stencil slots per face: 6 vertices, then up to 3 edge-DOF nodes.
-const SLOTS: usize = 9;
-
-/// The Hessian's sparsity pattern and, per face, where its entries go.
-///
-/// DOFs are grouped in *nodes*: vertex `v` (node `v`) owns the 3 DOFs `3v..3v+3`; with edge DOFs,
-/// edge `e` (node `nv + e`) owns the single DOF `3 nv + e`.
+/// The Hessian's sparsity pattern and, per term, where its elements' entries go.
 #[derive(Clone, Debug)]
 pub struct Pattern {
     /// Number of DOFs (3 × vertices + edge DOFs).
     pub n: usize,
     /// Number of vertices.
     pub num_vertices: usize,
-    /// Number of edge DOFs (0 unless the bending model has them).
+    /// Number of edge DOFs (0 unless a term declares them).
     pub num_edge_dofs: usize,
     /// CSC column pointers (lower triangle).
     pub col_ptr: Vec<usize>,
     /// CSC row indices.
     pub row_idx: Vec<usize>,
-    /// Per face: node ids of its stencil `[v0, v1, v2, p0, p1, p2, e0, e1, e2]` (`NONE` if
-    /// absent; the edge slots are `NONE` without edge DOFs).
-    pub stencil: Vec<[usize; SLOTS]>,
-    /// Per face and slot pair (s, t) with node `u_s > u_t`: offset of `u_s`'s rows among the
-    /// rows of `u_t`'s columns below its own diagonal block.
-    offsets: Vec<[u32; SLOTS * SLOTS]>,
-    /// Blocks of faces grouped by colour; blocks of one colour share no stencil node.
-    colours: Vec<Vec<Vec<usize>>>,
+    /// One element map per term, in the scene's term order.
+    pub maps: Vec<ElementMap>,
     /// Positions in the values of every entry in the row or column of a pinned DOF.
     pinned: Vec<usize>,
 }
 
-/// Faces per block: large enough for cache locality and cheap scheduling, small enough that a
-/// colour holds many blocks.
+/// Where one term's element entries go in the global pattern, and its colouring.
+#[derive(Clone, Debug)]
+pub struct ElementMap {
+    /// Slots per element.
+    pub slots: usize,
+    /// Local DOF offset of each slot in the element vector.
+    pub local: Vec<usize>,
+    /// Node ids, `elements × slots` (`NONE` where absent).
+    pub nodes: Vec<usize>,
+    /// Number of vertices (nodes below it are vertices with 3 DOFs, above it edges with 1).
+    num_vertices: usize,
+    /// Per element and slot pair (s, t) with node `u_s > u_t`: offset of `u_s`'s rows among the
+    /// rows of `u_t`'s columns below its own diagonal block.
+    offsets: Vec<u32>,
+    /// Blocks of elements grouped by colour; blocks of one colour share no stencil node.
+    colours: Vec<Vec<Vec<usize>>>,
+}
+
+/// Elements per block: large enough for cache locality and cheap scheduling, small enough that
+/// a colour holds many blocks.
 pub const BLOCK: usize = 256;
 
-/// Local DOF offset of stencil slot `s` in an element vector (vertices 3 each, then edges).
+/// First DOF and number of DOFs of node `u` when nodes below `nv` are vertices.
 #[inline(always)]
-fn local(s: usize) -> usize {
-    if s < 6 {
-        3 * s
+fn node_dofs(nv: usize, u: usize) -> (usize, usize) {
+    if u < nv {
+        (3 * u, 3)
     } else {
-        12 + s
+        (3 * nv + (u - nv), 1)
     }
 }
 
 impl Pattern {
-    /// Builds the pattern for faces and their extra bending vertices, without edge DOFs;
-    /// `positions` (any configuration, usually the reference one) only orders the faces into
-    /// spatially coherent blocks.
-    pub fn new(positions: &[Vec3], faces: &[[usize; 3]], extra: &[[usize; 3]]) -> Pattern {
-        Self::with_edges(positions, faces, extra, None)
-    }
-
-    /// The pattern of a scene (with edge DOFs when its bending model has them).
+    /// The pattern of a scene: the union of its terms' stencils, edge DOFs when a term has them.
     pub fn for_scene(scene: &crate::scene::Scene) -> Pattern {
-        let edges = scene
-            .has_edge_dofs()
-            .then_some((scene.topo.face_edges.as_slice(), scene.topo.edges.len()));
-        let mut p = Self::with_edges(
-            &scene.mesh.positions,
-            &scene.mesh.faces,
-            &scene.stencil_extra(),
-            edges,
-        );
+        let stencils: Vec<Stencil> = scene.terms.iter().map(|t| t.stencil(scene)).collect();
+        let mut p = Self::build(&scene.mesh.positions, scene.num_edge_dofs(), &stencils);
         p.pin(&scene.pinned_dofs);
         p
     }
 
-    /// Records the entries in the rows and columns of `dofs` (see [`Pattern::pinned_entries`]).
-    pub fn pin(&mut self, dofs: &[usize]) {
-        self.pinned.clear();
-        for col in 0..self.n {
-            for k in self.col_ptr[col]..self.col_ptr[col + 1] {
-                if dofs.contains(&col) || dofs.contains(&self.row_idx[k]) {
-                    self.pinned.push(k);
-                }
-            }
-        }
-    }
-
-    /// Positions of the entries in the rows and columns of the pinned DOFs.
-    pub fn pinned_entries(&self) -> &[usize] {
-        &self.pinned
-    }
-
-    /// As [`Pattern::new`], with one DOF per edge when `edges = Some((face_edges, num_edges))`
-    /// (`face_edges[f][i]` the edge opposite vertex `i` of face `f`).
-    pub fn with_edges(
-        positions: &[Vec3],
-        faces: &[[usize; 3]],
-        extra: &[[usize; 3]],
-        edges: Option<(&[[usize; 3]], usize)>,
-    ) -> Pattern {
+    /// Builds the pattern of the vertices at `positions` (which only order the elements into
+    /// spatially coherent blocks) and `ne` edge nodes from the stencils.
+    pub fn build(positions: &[Vec3], ne: usize, stencils: &[Stencil]) -> Pattern {
         let nv = positions.len();
-        let ne = edges.map_or(0, |e| e.1);
         let nodes = nv + ne;
-        let stencil: Vec<[usize; SLOTS]> = faces
-            .iter()
-            .zip(extra)
-            .enumerate()
-            .map(|(fi, (f, o))| {
-                let e = edges.map_or([NONE; 3], |(fe, _)| fe[fi].map(|e| nv + e));
-                [f[0], f[1], f[2], o[0], o[1], o[2], e[0], e[1], e[2]]
-            })
-            .collect();
-        let size = |u: usize| if u < nv { 3 } else { 1 };
-        let dof = |u: usize| if u < nv { 3 * u } else { 3 * nv + (u - nv) };
         let mut hi: Vec<Vec<usize>> = vec![Vec::new(); nodes];
-        for st in &stencil {
-            for &u in st {
-                for &v in st {
-                    if u != NONE && v != NONE && u > v {
-                        hi[v].push(u);
+        for st in stencils {
+            for el in st.nodes.chunks(st.slots().max(1)) {
+                for &u in el {
+                    for &v in el {
+                        if u != NONE && v != NONE && u > v {
+                            hi[v].push(u);
+                        }
                     }
                 }
             }
@@ -141,6 +101,7 @@ impl Pattern {
             h.sort_unstable();
             h.dedup();
         }
+        let size = |u: usize| node_dofs(nv, u).1;
         // prefix[v][r]: DOFs of v's higher neighbours before the r-th.
         let prefix: Vec<Vec<u32>> = hi
             .iter()
@@ -160,57 +121,77 @@ impl Pattern {
         let mut row_idx = Vec::new();
         col_ptr.push(0);
         for (v, hv) in hi.iter().enumerate() {
-            let kv = size(v);
+            let (d0, kv) = node_dofs(nv, v);
             for d in 0..kv {
                 for c in d..kv {
-                    row_idx.push(dof(v) + c);
+                    row_idx.push(d0 + c);
                 }
                 for &u in hv {
-                    for c in 0..size(u) {
-                        row_idx.push(dof(u) + c);
-                    }
+                    let (du, ku) = node_dofs(nv, u);
+                    row_idx.extend(du..du + ku);
                 }
                 col_ptr.push(row_idx.len());
             }
         }
-        let offsets = stencil
+        let maps = stencils
             .iter()
             .map(|st| {
-                let mut r = [0u32; SLOTS * SLOTS];
-                for s in 0..SLOTS {
-                    for t in 0..SLOTS {
-                        let (u, v) = (st[s], st[t]);
-                        if u != NONE && v != NONE && u > v {
-                            let rank = hi[v].binary_search(&u).unwrap_or(0);
-                            r[SLOTS * s + t] = prefix[v][rank];
+                let s = st.slots();
+                let mut local = Vec::with_capacity(s);
+                let mut acc = 0;
+                for &k in &st.slot_dofs {
+                    local.push(acc);
+                    acc += k;
+                }
+                let mut offsets = vec![0u32; st.len() * s * s];
+                for (e, el) in st.nodes.chunks(s.max(1)).enumerate() {
+                    for a in 0..s {
+                        for b in 0..s {
+                            let (u, v) = (el[a], el[b]);
+                            if u != NONE && v != NONE && u > v {
+                                let rank = hi[v].binary_search(&u).unwrap_or(0);
+                                offsets[e * s * s + s * a + b] = prefix[v][rank];
+                            }
                         }
                     }
                 }
-                r
+                let colours = colour_blocks(nodes, st, &morton_blocks(&st.anchors, positions));
+                ElementMap {
+                    slots: s,
+                    local,
+                    nodes: st.nodes.clone(),
+                    num_vertices: nv,
+                    offsets,
+                    colours,
+                }
             })
             .collect();
-        let colours = colour_blocks(nodes, &stencil, &morton_blocks(positions, faces));
         Pattern {
             n,
             num_vertices: nv,
             num_edge_dofs: ne,
             col_ptr,
             row_idx,
-            stencil,
-            offsets,
-            colours,
+            maps,
             pinned: Vec::new(),
         }
     }
 
-    /// Number of block colours.
-    pub fn num_colours(&self) -> usize {
-        self.colours.len()
+    /// Records the entries in the rows and columns of `dofs` (see [`Pattern::pinned_entries`]).
+    pub fn pin(&mut self, dofs: &[usize]) {
+        self.pinned.clear();
+        for col in 0..self.n {
+            for k in self.col_ptr[col]..self.col_ptr[col + 1] {
+                if dofs.contains(&col) || dofs.contains(&self.row_idx[k]) {
+                    self.pinned.push(k);
+                }
+            }
+        }
     }
 
-    /// Blocks of faces by colour (no two blocks of a colour share a stencil node).
-    pub fn colours(&self) -> &[Vec<Vec<usize>>] {
-        &self.colours
+    /// Positions of the entries in the rows and columns of the pinned DOFs.
+    pub fn pinned_entries(&self) -> &[usize] {
+        &self.pinned
     }
 
     /// Number of stored entries.
@@ -227,33 +208,67 @@ impl Pattern {
     /// First DOF and number of DOFs of node `u`.
     #[inline]
     pub fn node_dofs(&self, u: usize) -> (usize, usize) {
-        let nv = self.num_vertices;
-        if u < nv {
-            (3 * u, 3)
-        } else {
-            (3 * nv + (u - nv), 1)
-        }
+        node_dofs(self.num_vertices, u)
+    }
+
+    /// The first term's map (the shell faces in every scene).
+    pub fn faces(&self) -> &ElementMap {
+        &self.maps[0]
+    }
+
+    /// Number of block colours of the shell faces.
+    pub fn num_colours(&self) -> usize {
+        self.faces().colours.len()
+    }
+
+    /// Blocks of shell faces by colour (no two blocks of a colour share a stencil node).
+    pub fn colours(&self) -> &[Vec<Vec<usize>>] {
+        &self.faces().colours
+    }
+}
+
+impl ElementMap {
+    /// The nodes of element `e`.
+    #[inline]
+    pub fn element(&self, e: usize) -> &[usize] {
+        &self.nodes[e * self.slots..(e + 1) * self.slots]
+    }
+
+    /// Number of elements.
+    pub fn len(&self) -> usize {
+        self.nodes.len() / self.slots.max(1)
+    }
+
+    /// Whether the map has no elements.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Number of block colours.
+    pub fn num_colours(&self) -> usize {
+        self.colours.len()
     }
 
     /// Adds an element gradient into `grad`, skipping fixed nodes.
     ///
     /// # Safety
-    /// No other thread writes the gradient entries of face `f`'s stencil nodes concurrently.
+    /// No other thread writes the gradient entries of element `e`'s nodes concurrently.
     #[inline]
     unsafe fn scatter_gradient<const N: usize>(
         &self,
-        f: usize,
+        e: usize,
         g: &SVec<N>,
         fixed: &[bool],
         grad: Shared,
     ) {
-        for (s, &u) in self.stencil[f].iter().enumerate() {
+        for (s, &u) in self.element(e).iter().enumerate() {
             if u == NONE || fixed[u] {
                 continue;
             }
-            let (d0, k) = self.node_dofs(u);
+            let (d0, k) = node_dofs(self.num_vertices, u);
+            let l = self.local[s];
             for c in 0..k {
-                unsafe { grad.add(d0 + c, g[local(s) + c]) };
+                unsafe { grad.add(d0 + c, g[l + c]) };
             }
         }
     }
@@ -261,39 +276,43 @@ impl Pattern {
     /// Adds an element Hessian (lower parts) into the values, skipping fixed nodes.
     ///
     /// # Safety
-    /// No other thread writes the Hessian columns of face `f`'s stencil nodes concurrently.
+    /// No other thread writes the Hessian columns of element `e`'s nodes concurrently.
     #[inline]
     unsafe fn scatter_hessian<const N: usize>(
         &self,
-        f: usize,
+        pattern_col_ptr: &[usize],
+        e: usize,
         h: &SMat<N, N>,
         fixed: &[bool],
         values: Shared,
     ) {
-        let st = &self.stencil[f];
-        let off = &self.offsets[f];
-        for t in 0..SLOTS {
+        let sl = self.slots;
+        let st = self.element(e);
+        let off = &self.offsets[e * sl * sl..(e + 1) * sl * sl];
+        for t in 0..sl {
             let v = st[t];
             if v == NONE || fixed[v] {
                 continue;
             }
-            let (dv, kv) = self.node_dofs(v);
-            let lt = local(t);
-            for s in 0..SLOTS {
+            let (dv, kv) = node_dofs(self.num_vertices, v);
+            let lt = self.local[t];
+            for s in 0..sl {
                 let u = st[s];
                 if u == NONE || fixed[u] || u < v {
                     continue;
                 }
-                let ls = local(s);
-                let ku = self.node_dofs(u).1;
+                let ls = self.local[s];
+                let ku = node_dofs(self.num_vertices, u).1;
                 for d in 0..kv {
-                    let base = self.col_ptr[dv + d];
+                    let base = pattern_col_ptr[dv + d];
                     if u == v {
+                        // A node in two slots (s ≠ t) gets both cross blocks' lower triangles:
+                        // the lower part of H_st + H_ts, as the symmetric sum requires.
                         for c in d..kv {
                             unsafe { values.add(base + c - d, h[(ls + c, lt + d)]) };
                         }
                     } else {
-                        let o = base + (kv - d) + off[SLOTS * s + t] as usize;
+                        let o = base + (kv - d) + off[sl * s + t] as usize;
                         for c in 0..ku {
                             unsafe { values.add(o + c, h[(ls + c, lt + d)]) };
                         }
@@ -315,12 +334,13 @@ pub enum Want {
     Hessian,
 }
 
-/// Splits the faces into blocks of [`BLOCK`] consecutive faces along the Morton curve of their
-/// centroids (ties by face index), each block sorted by face index.
-fn morton_blocks(positions: &[Vec3], faces: &[[usize; 3]]) -> Vec<Vec<usize>> {
+/// Splits elements into blocks of [`BLOCK`] consecutive elements along the Morton curve of their
+/// anchors (ties by element index) in the bounding box of `bounds`, each block sorted by
+/// element index.
+fn morton_blocks(anchors: &[Vec3], bounds: &[Vec3]) -> Vec<Vec<usize>> {
     let mut lo = Vec3::repeat(Real::INFINITY);
     let mut hi = Vec3::repeat(Real::NEG_INFINITY);
-    for p in positions {
+    for p in bounds {
         lo = lo.inf(p);
         hi = hi.sup(p);
     }
@@ -334,11 +354,10 @@ fn morton_blocks(positions: &[Vec3], faces: &[[usize; 3]]) -> Vec<Vec<usize>> {
         v = (v | (v << 4)) & 0x10c30c30c30c30c3;
         (v | (v << 2)) & 0x1249249249249249
     };
-    let mut keyed: Vec<(u64, usize)> = faces
+    let mut keyed: Vec<(u64, usize)> = anchors
         .iter()
         .enumerate()
-        .map(|(f, t)| {
-            let c = (positions[t[0]] + positions[t[1]] + positions[t[2]]) / 3.0;
+        .map(|(f, c)| {
             let q = (c - lo).component_div(&ext) * ((1u64 << 21) - 1) as Real;
             let k = spread(q.x as u64) | (spread(q.y as u64) << 1) | (spread(q.z as u64) << 2);
             (k, f)
@@ -357,11 +376,8 @@ fn morton_blocks(positions: &[Vec3], faces: &[[usize; 3]]) -> Vec<Vec<usize>> {
 
 /// Greedy colouring of blocks: each takes the smallest colour not used by a block sharing one of
 /// its stencil vertices. Deterministic.
-fn colour_blocks(
-    nv: usize,
-    stencil: &[[usize; SLOTS]],
-    blocks: &[Vec<usize>],
-) -> Vec<Vec<Vec<usize>>> {
+fn colour_blocks(nv: usize, stencil: &Stencil, blocks: &[Vec<usize>]) -> Vec<Vec<Vec<usize>>> {
+    let s = stencil.slots().max(1);
     let mut used: Vec<Vec<u32>> = vec![Vec::new(); nv];
     let mut colours: Vec<Vec<Vec<usize>>> = Vec::new();
     let mut taken: Vec<bool> = Vec::new();
@@ -369,7 +385,12 @@ fn colour_blocks(
     for block in blocks {
         verts.clear();
         for &f in block {
-            verts.extend(stencil[f].iter().copied().filter(|&v| v != NONE));
+            verts.extend(
+                stencil.nodes[f * s..(f + 1) * s]
+                    .iter()
+                    .copied()
+                    .filter(|&v| v != NONE),
+            );
         }
         verts.sort_unstable();
         verts.dedup();
@@ -419,159 +440,52 @@ impl Shared {
     }
 }
 
-/// The bending model of the face kernel, with its per-face data.
-#[derive(Clone, Copy, Debug)]
-pub enum Bending<'a> {
-    /// Seed 000's mid-edge average ([`shell_face`]), 18 DOFs.
-    MidedgeAverage,
-    /// MorphoShell's patch fit ([`patch_face`]), 18 DOFs, one patch per face.
-    PatchFit(&'a [Patch]),
-    /// Mid-edge normals with edge DOFs ([`midedge_angle_face`]), 21 DOFs; `sigma[f][i]` is face
-    /// `f`'s orientation sign on its edge `i`.
-    MidedgeAngle {
-        /// `sin` or `tan`.
-        variant: AngleVariant,
-        /// Orientation signs per face and edge.
-        sigma: &'a [[Real; 3]],
-    },
-}
-
-/// Assembles face terms. `density(f)` gives the face's energy density; `fixed` is per node
-/// (vertices, then edge DOFs); `phi` holds the edge DOFs (empty without them). Returns the total
-/// face energy; fills `grad` (len n) and `values` (len nnz) when wanted (they are overwritten,
-/// not accumulated).
+/// Accumulates one element term into `grad` (len n) and `values` (len nnz) as `want` says and
+/// returns its energy, summed in element order. `kernel(e, nodes, grad, hess)` evaluates
+/// element `e` with `N` local DOFs (slot `s` at `map.local[s]`); `fixed` is per node.
 #[allow(clippy::too_many_arguments)]
-pub fn assemble_faces<F>(
-    pattern: &Pattern,
-    x: &[Vec3],
-    phi: &[Real],
-    bending: Bending,
-    density: F,
-    fixed: &[bool],
-    projection: HessianProjection,
-    want: Want,
-    grad: &mut [Real],
-    values: &mut [Real],
-) -> Real
-where
-    F: Fn(usize) -> KoiterDensity + Sync,
-{
-    let gn = projection == HessianProjection::GaussNewton;
-    match bending {
-        Bending::MidedgeAverage => assemble_generic::<18, _>(
-            pattern,
-            |f, g, h| {
-                let (xs, has) = gather(pattern, x, f);
-                if gn {
-                    shell_face_gauss_newton(&xs, has, &density(f), g, h)
-                } else {
-                    shell_face(&xs, has, &density(f), g, h)
-                }
-            },
-            fixed,
-            projection,
-            want,
-            grad,
-            values,
-        ),
-        Bending::PatchFit(patches) => assemble_generic::<18, _>(
-            pattern,
-            |f, g, h| {
-                let (xs, _) = gather(pattern, x, f);
-                let w = &patches[f].weights;
-                if gn {
-                    patch_face::<_, true>(&xs, w, &density(f), g, h)
-                } else {
-                    patch_face::<_, false>(&xs, w, &density(f), g, h)
-                }
-            },
-            fixed,
-            projection,
-            want,
-            grad,
-            values,
-        ),
-        Bending::MidedgeAngle { variant, sigma } => {
-            let nv = pattern.num_vertices;
-            assemble_generic::<21, _>(
-                pattern,
-                |f, g, h| {
-                    let (xs, has) = gather(pattern, x, f);
-                    let st = &pattern.stencil[f];
-                    let ph = [phi[st[6] - nv], phi[st[7] - nv], phi[st[8] - nv]];
-                    let d = density(f);
-                    if gn {
-                        midedge_angle_face::<_, true>(&xs, has, &ph, sigma[f], variant, &d, g, h)
-                    } else {
-                        midedge_angle_face::<_, false>(&xs, has, &ph, sigma[f], variant, &d, g, h)
-                    }
-                },
-                fixed,
-                projection,
-                want,
-                grad,
-                values,
-            )
-        }
-    }
-}
-
-/// The colour-by-colour assembly loop for a kernel with `N` local DOFs.
-#[allow(clippy::too_many_arguments)]
-fn assemble_generic<const N: usize, K>(
-    pattern: &Pattern,
+pub fn assemble_elements<const N: usize, K>(
+    map: &ElementMap,
     kernel: K,
     fixed: &[bool],
     projection: HessianProjection,
     want: Want,
     grad: &mut [Real],
     values: &mut [Real],
+    col_ptr: &[usize],
 ) -> Real
 where
-    K: Fn(usize, Option<&mut SVec<N>>, Option<&mut SMat<N, N>>) -> Real + Sync,
+    K: Fn(usize, &[usize], Option<&mut SVec<N>>, Option<&mut SMat<N, N>>) -> Real + Sync,
 {
-    let nf = pattern.stencil.len();
+    let ne = map.len();
     if want == Want::Energy {
-        let es: Vec<Real> = (0..nf)
+        let es: Vec<Real> = (0..ne)
             .into_par_iter()
-            .map(|f| kernel(f, None, None))
+            .map(|e| kernel(e, map.element(e), None, None))
             .collect();
         return es.iter().sum();
     }
-    grad.par_chunks_mut(1 << 14).for_each(|c| c.fill(0.0));
-    if want == Want::Hessian {
-        values.par_chunks_mut(1 << 14).for_each(|c| c.fill(0.0));
-    }
-    let mut energies = vec![0.0; nf];
+    let mut energies = vec![0.0; ne];
     let (ep, gp) = (Shared::new(&mut energies), Shared::new(grad));
     let vp = Shared::new(values);
-    for blocks in &pattern.colours {
+    for blocks in &map.colours {
         blocks.par_iter().for_each(|block| {
             let mut g = SVec::<N>::zeros();
             let mut h = SMat::<N, N>::zeros();
-            for &f in block {
+            for &e in block {
                 let hout = (want == Want::Hessian).then_some(&mut h);
-                let e = kernel(f, Some(&mut g), hout);
-                // SAFETY: see `Shared`: faces of one colour touch disjoint entries.
+                let en = kernel(e, map.element(e), Some(&mut g), hout);
+                // SAFETY: see `Shared`: blocks of one colour touch disjoint entries.
                 unsafe {
-                    ep.add(f, e);
-                    pattern.scatter_gradient(f, &g, fixed, gp);
+                    ep.add(e, en);
+                    map.scatter_gradient(e, &g, fixed, gp);
                     if want == Want::Hessian {
                         project(&mut h, projection);
-                        pattern.scatter_hessian(f, &h, fixed, vp);
+                        map.scatter_hessian(col_ptr, e, &h, fixed, vp);
                     }
                 }
             }
         });
     }
     energies.iter().sum()
-}
-
-/// The face's 6 stencil positions (absent neighbours get the face's own first vertex, unused).
-#[inline]
-fn gather(pattern: &Pattern, x: &[Vec3], f: usize) -> ([Vec3; 6], [bool; 3]) {
-    let st = &pattern.stencil[f];
-    let has = [st[3] != NONE, st[4] != NONE, st[5] != NONE];
-    let xs = std::array::from_fn(|s| if st[s] == NONE { x[st[0]] } else { x[st[s]] });
-    (xs, has)
 }

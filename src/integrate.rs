@@ -886,7 +886,8 @@ fn run_dynamic(
                 && r <= tol
                 && en.kinetic
                     <= tm.equilibrium_kinetic
-                        * (en.stretching + en.bending).max(Real::MIN_POSITIVE);
+                        * (en.get("stretching").unwrap_or(0.0) + en.get("bending").unwrap_or(0.0))
+                            .max(Real::MIN_POSITIVE);
         }
         if at_output || stop || t >= tm.end - eps_t {
             if let Some(m) = &moisture {

@@ -47,21 +47,47 @@ pub enum OutputError {
     },
 }
 
-/// Energies of a state, by term (J).
-#[derive(Clone, Copy, Debug, Default, Serialize)]
+/// Energies of a state by term (J): `total`, then each reported term under its own name (in
+/// the scene's term order), then `kinetic` (½ Σ m |v|²).
+#[derive(Clone, Debug, Default)]
 pub struct Energies {
-    /// Sum of the terms below.
+    /// Sum of the terms and the kinetic energy.
     pub total: Real,
-    /// Stretching (membrane) energy.
-    pub stretching: Real,
-    /// Bending energy.
-    pub bending: Real,
-    /// Gravitational potential energy.
-    pub gravity: Real,
+    /// The terms' energies by name.
+    pub terms: Vec<(&'static str, Real)>,
     /// Kinetic energy ½ Σ m |v|².
     pub kinetic: Real,
-    /// Ground-contact penalty energy Σ k A ψ(p) (0 without a ground).
-    pub contact: Real,
+}
+
+impl Energies {
+    /// The energy reported under `name` (`"total"`, a term's name, `"kinetic"`).
+    pub fn get(&self, name: &str) -> Option<Real> {
+        match name {
+            "total" => Some(self.total),
+            "kinetic" => Some(self.kinetic),
+            _ => self.terms.iter().find(|t| t.0 == name).map(|t| t.1),
+        }
+    }
+
+    /// `(name, value)` pairs in column order.
+    pub fn columns(&self) -> Vec<(&str, Real)> {
+        let mut c = vec![("total", self.total)];
+        c.extend(self.terms.iter().copied());
+        c.push(("kinetic", self.kinetic));
+        c
+    }
+}
+
+impl Serialize for Energies {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let cols = self.columns();
+        let mut m = s.serialize_map(Some(cols.len()))?;
+        for (k, v) in cols {
+            m.serialize_entry(k, &v)?;
+        }
+        m.end()
+    }
 }
 
 /// One row of the per-frame log.
@@ -162,19 +188,6 @@ fn ioerr(path: &Path, e: impl ToString) -> OutputError {
     }
 }
 
-/// Elastic (stretching, bending) energy of each face at forms `a`, `b` (J), without damping.
-fn face_energies(pot: &Potential, a: &[Sym2], b: &[Sym2]) -> Vec<(Real, Real)> {
-    (0..a.len())
-        .map(|f| {
-            let d = pot.density(f);
-            let (ws, ta) = d.stretch[0];
-            let (wb, tb) = d.bend[0];
-            let (da, db) = (a[f] - ta, b[f] - tb);
-            (ws * da.dot(&(d.c * da)), wb * db.dot(&(d.c * db)))
-        })
-        .collect()
-}
-
 /// Per-face frames mapping barycentric to reference Cartesian coordinates (see module doc).
 fn output_frames(mesh: &Mesh) -> Vec<Mat2> {
     let flat = mesh.is_flat_xy();
@@ -249,30 +262,18 @@ impl Writer {
 
     /// Energies of a state by term.
     pub fn energies(pot: &Potential, x: &[Vec3], phi: &[Real], v: &[Vec3]) -> Energies {
-        let sc = pot.scene;
-        let (a, b) = sc.forms(x, phi);
-        Self::energies_of(pot, x, v, &face_energies(pot, &a, &b))
-    }
-
-    /// Totals from per-face (stretching, bending) energies, plus gravity and kinetic energy.
-    fn energies_of(pot: &Potential, x: &[Vec3], v: &[Vec3], faces: &[(Real, Real)]) -> Energies {
-        let sc = pot.scene;
-        let mut en = Energies::default();
-        for (s, b) in faces {
-            en.stretching += s;
-            en.bending += b;
+        let terms = pot.energies(x, phi);
+        let kinetic: Real = v
+            .iter()
+            .zip(pot.mass)
+            .map(|(v, m)| 0.5 * m * v.norm_squared())
+            .sum();
+        let total = terms.iter().map(|t| t.1).sum::<Real>() + kinetic;
+        Energies {
+            total,
+            terms,
+            kinetic,
         }
-        for (i, xv) in x.iter().enumerate() {
-            en.gravity -= pot.mass[i] * pot.gravity.dot(xv);
-            en.kinetic += 0.5 * pot.mass[i] * v[i].norm_squared();
-            if let Some(g) = &sc.ground {
-                if let Some((e, _, _)) = g.normal_term(i, xv) {
-                    en.contact += e;
-                }
-            }
-        }
-        en.total = en.stretching + en.bending + en.gravity + en.kinetic + en.contact;
-        en
     }
 
     /// Writes one frame and appends its log row; rewrites the series and the log.
@@ -289,15 +290,12 @@ impl Writer {
         row.frame = index;
         let nf = sc.num_faces();
         let (a, b) = sc.forms(x, phi);
-        let fe = face_energies(pot, &a, &b);
-        row.energy = Self::energies_of(pot, x, v, &fe);
+        row.energy = Self::energies(pot, x, phi, v);
         let mut fa = Vec::with_capacity(3 * nf);
         let mut fb = Vec::with_capacity(3 * nf);
         let mut fab = Vec::with_capacity(3 * nf);
         let mut fbb = Vec::with_capacity(3 * nf);
-        let (mut hh, mut kk, mut k1s, mut k2s, mut es, mut eb) = (
-            Vec::with_capacity(nf),
-            Vec::with_capacity(nf),
+        let (mut hh, mut kk, mut k1s, mut k2s) = (
             Vec::with_capacity(nf),
             Vec::with_capacity(nf),
             Vec::with_capacity(nf),
@@ -305,8 +303,7 @@ impl Writer {
         );
         for f in 0..nf {
             let t = &self.frames_t[f];
-            let d = pot.density(f);
-            let (abar, bbar) = (d.stretch[0].1, d.bend[0].1);
+            let (abar, bbar) = pot.rest_forms(f);
             let push = |out: &mut Vec<Real>, s: &Sym2| {
                 out.extend_from_slice(push_forward(t, s).as_slice())
             };
@@ -319,9 +316,6 @@ impl Writer {
             kk.push(k);
             k1s.push(k1);
             k2s.push(k2);
-            let area = 0.5 * crate::math::sym_det(&abar).max(0.0).sqrt();
-            es.push(fe[f].0 / area);
-            eb.push(fe[f].1 / area);
         }
         let m = &mut self.frame_mesh;
         m.positions.copy_from_slice(x);
@@ -338,8 +332,11 @@ impl Writer {
         ff.insert("gauss_curvature".into(), Field::scalar(kk));
         ff.insert("k1".into(), Field::scalar(k1s));
         ff.insert("k2".into(), Field::scalar(k2s));
-        ff.insert("stretching_energy_density".into(), Field::scalar(es));
-        ff.insert("bending_energy_density".into(), Field::scalar(eb));
+        for t in sc.terms.iter() {
+            for (name, data) in t.face_fields(pot, x, phi) {
+                ff.insert(name, Field::scalar(data));
+            }
+        }
         ff.insert("thickness".into(), Field::scalar(sc.thickness.clone()));
         for (name, data) in &self.extra {
             ff.insert(name.clone(), Field::scalar(data.clone()));
@@ -420,24 +417,23 @@ impl Writer {
     }
 
     fn write_log(&self) -> Result<(), OutputError> {
-        let mut s = String::from(
-            "frame,time,dial,energy_total,energy_stretching,energy_bending,energy_gravity,\
-             energy_kinetic,energy_contact,residual,newton_iterations,steps,shifted_iterations,\
-             gauss_newton_iterations,rejected_steps,wall_seconds\n",
+        let mut s = String::from("frame,time,dial,");
+        if let Some(r) = self.log.first() {
+            for (name, _) in r.energy.columns() {
+                s.push_str(&format!("energy_{name},"));
+            }
+        }
+        s.push_str(
+            "residual,newton_iterations,steps,shifted_iterations,gauss_newton_iterations,\
+             rejected_steps,wall_seconds\n",
         );
         for r in &self.log {
-            let e = &r.energy;
+            s.push_str(&format!("{},{:.12e},{:.6},", r.frame, r.time, r.dial));
+            for (_, e) in r.energy.columns() {
+                s.push_str(&format!("{e:.12e},"));
+            }
             s.push_str(&format!(
-                "{},{:.12e},{:.6},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{},{},{},{},{},{:.6}\n",
-                r.frame,
-                r.time,
-                r.dial,
-                e.total,
-                e.stretching,
-                e.bending,
-                e.gravity,
-                e.kinetic,
-                e.contact,
+                "{:.6e},{},{},{},{},{},{:.6}\n",
                 r.residual,
                 r.newton_iterations,
                 r.steps,

@@ -52,6 +52,8 @@ pub struct Scene {
     pub growth: GrowthInputs,
     /// The ground plane (`contact.enabled`), else `None`.
     pub ground: Option<crate::solve::contact::Ground>,
+    /// The energy terms the settings enable, in assembly order ([`crate::energy::registry`]).
+    pub terms: crate::energy::term::Terms,
 }
 
 fn positive_face_field(mesh: &Mesh, name: &str) -> Result<Option<Vec<Real>>, MeshError> {
@@ -259,7 +261,7 @@ impl Scene {
             .zip(&thickness)
             .map(|(e, h)| e * h)
             .fold(0.0, Real::max);
-        Ok(Scene {
+        let mut scene = Scene {
             stretch_factor: m.stretch_convention.factor(),
             force_scale: eh * mean_edge,
             mean_edge,
@@ -279,7 +281,12 @@ impl Scene {
             pinned_dofs,
             growth,
             ground,
-        })
+            terms: Default::default(),
+        };
+        scene.terms = crate::energy::term::Terms(std::sync::Arc::new(
+            crate::energy::registry::terms(&scene)?,
+        ));
+        Ok(scene)
     }
 
     /// Number of vertices.
@@ -313,19 +320,6 @@ impl Scene {
             self.topo.edges.len()
         } else {
             0
-        }
-    }
-
-    /// The bending model for the assembly.
-    pub fn bending(&self) -> crate::assembly::Bending<'_> {
-        use crate::assembly::Bending;
-        match self.settings.material.bending.angle_variant() {
-            Some(variant) => Bending::MidedgeAngle {
-                variant,
-                sigma: &self.edge_sign,
-            },
-            None if !self.patches.is_empty() => Bending::PatchFit(&self.patches),
-            None => Bending::MidedgeAverage,
         }
     }
 
@@ -657,7 +651,7 @@ pub fn growth_face(
 /// A reference-Cartesian direction as barycentric coordinates of face `f`: its projection on the
 /// face plane written in the basis `e1, e2`. `None` if it is zero, non-finite or normal to the
 /// face (projection below 1e-6 of its length).
-fn barycentric_direction(mesh: &Mesh, f: usize, d: &Vec3) -> Option<[Real; 2]> {
+pub(crate) fn barycentric_direction(mesh: &Mesh, f: usize, d: &Vec3) -> Option<[Real; 2]> {
     let n = d.norm();
     if !(n.is_finite() && n > 0.0) {
         return None;

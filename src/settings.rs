@@ -97,9 +97,60 @@ pub struct Material {
     pub stretch_convention: StretchConvention,
     /// Discrete second fundamental form: `"midedge_average"` (seed 000), `"patch_fit"`
     /// (MorphoShell's quadratic patch fit, flat reference meshes only), `"midedge_sin"` or
-    /// `"midedge_tan"` (mid-edge normals with one rotation DOF per edge) (default:
-    /// `"midedge_sin"`).
+    /// `"midedge_tan"` (mid-edge normals with one rotation DOF per edge), or `"none"` (a pure
+    /// membrane: no bending energy) (default: `"midedge_sin"`).
     pub bending: BendingModel,
+    /// Membrane material: `"koiter"` (St Venant–Kirchhoff, seed 000), `"neo_hookean"` or
+    /// `"mooney_rivlin"` (incompressible rubber), `"baraff_witkin"` (strain-limiting cloth,
+    /// seed 003) (default: `"koiter"`).
+    pub model: MaterialModel,
+    /// Mooney–Rivlin `c₁` (Pa, default: `0`; required > 0 with `model = "mooney_rivlin"`).
+    pub c1: Real,
+    /// Mooney–Rivlin `c₂` (Pa, default: `0`, ≥ 0).
+    pub c2: Real,
+    /// Baraff–Witkin constants and warp direction.
+    pub baraff_witkin: BaraffWitkinSettings,
+}
+
+/// The membrane material.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MaterialModel {
+    /// St Venant–Kirchhoff / Koiter.
+    #[default]
+    Koiter,
+    /// Incompressible neo-Hookean, μ = E/(2(1+ν)).
+    NeoHookean,
+    /// Incompressible Mooney–Rivlin with `c1`, `c2`.
+    MooneyRivlin,
+    /// Strain-limiting Baraff–Witkin (seed 003).
+    BaraffWitkin,
+}
+
+/// `[material.baraff_witkin]`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BaraffWitkinSettings {
+    /// Stretch stiffness λ (Pa, default: `E/2`).
+    pub lambda: Option<Real>,
+    /// Shear stiffness μ (Pa, default: `E/(4(1+ν))`).
+    pub mu: Option<Real>,
+    /// Cubic strain-limiting coefficient r (dimensionless, ≥ 0, default: `100`).
+    pub r: Real,
+    /// Warp direction in reference Cartesian coordinates, projected on each rest face; the
+    /// face field `warp_direction` overrides it (default: `[1, 0, 0]`).
+    pub direction: [Real; 3],
+}
+
+impl Default for BaraffWitkinSettings {
+    fn default() -> Self {
+        BaraffWitkinSettings {
+            lambda: None,
+            mu: None,
+            r: 100.0,
+            direction: [1.0, 0.0, 0.0],
+        }
+    }
 }
 
 /// The discrete second fundamental form.
@@ -115,6 +166,8 @@ pub enum BendingModel {
     MidedgeSin,
     /// As `MidedgeSin` with `q = h tan(θ/2 + σφ)`.
     MidedgeTan,
+    /// No bending energy (a pure membrane).
+    None,
 }
 
 /// The softening factor of the static solver's membrane continuation.
@@ -168,6 +221,10 @@ impl Default for Material {
             use_mesh_shear_modulus: true,
             stretch_convention: StretchConvention::Koiter,
             bending: BendingModel::default(),
+            model: MaterialModel::default(),
+            c1: 0.0,
+            c2: 0.0,
+            baraff_witkin: BaraffWitkinSettings::default(),
         }
     }
 }
@@ -764,6 +821,58 @@ impl Settings {
     }
 
     /// Checks ranges and consistency.
+    /// Validates `[material]`'s membrane model and its constants.
+    pub fn validate_material(&self, name: &str) -> Result<(), SettingsError> {
+        let inv = |key: &str, reason: String| {
+            Err(SettingsError::Invalid {
+                path: name.to_string(),
+                key: key.into(),
+                reason,
+            })
+        };
+        let m = &self.material;
+        if m.model == MaterialModel::MooneyRivlin {
+            if !(m.c1.is_finite() && m.c1 > 0.0) {
+                return inv(
+                    "material.c1",
+                    format!("model = \"mooney_rivlin\" needs c1 > 0 (Pa), got {}", m.c1),
+                );
+            }
+            if !(m.c2.is_finite() && m.c2 >= 0.0) {
+                return inv("material.c2", format!("must be ≥ 0 (Pa), got {}", m.c2));
+            }
+        }
+        let bw = &m.baraff_witkin;
+        if !(bw.r.is_finite() && bw.r >= 0.0) {
+            return inv(
+                "material.baraff_witkin.r",
+                format!(
+                    "must be ≥ 0 (a negative cubic term softens the strain limit), got {}",
+                    bw.r
+                ),
+            );
+        }
+        for (key, v) in [("lambda", bw.lambda), ("mu", bw.mu)] {
+            if let Some(v) = v {
+                if !(v.is_finite() && v > 0.0) {
+                    return inv(
+                        &format!("material.baraff_witkin.{key}"),
+                        format!("must be a positive number (Pa), got {v}"),
+                    );
+                }
+            }
+        }
+        let d = bw.direction;
+        if !d.iter().all(|c| c.is_finite()) || d.iter().all(|&c| c == 0.0) {
+            return inv(
+                "material.baraff_witkin.direction",
+                format!("must be a finite non-zero vector, got {d:?}"),
+            );
+        }
+        Ok(())
+    }
+
+    /// Validates every section (see the per-section validators).
     pub fn validate(&self, name: &str) -> Result<(), SettingsError> {
         let inv = |key: &str, reason: String| {
             Err(SettingsError::Invalid {
@@ -794,6 +903,7 @@ impl Settings {
                 format!("must lie in (-1, 0.5], got {}", m.poisson),
             );
         }
+        self.validate_material(name)?;
         let r = &self.rest;
         for (name, form) in [("abar", &r.abar), ("bbar", &r.bbar)] {
             for (i, v) in form.iter().enumerate() {

@@ -83,6 +83,15 @@ pub trait FaceDensity {
     fn uses_b(&self) -> bool;
     /// Energy and derivatives.
     fn eval(&self, a: &Sym2, b: &Sym2, d: &mut DensityDerivs) -> Real;
+    /// Replaces the derivatives of [`FaceDensity::eval`] by those of the Gauss–Newton Hessian:
+    /// `haa` and `hbb` positive semi-definite, and `ga_psd` the part of `ga` kept in the term
+    /// `Σ_k ga_k ∇²a_k` (positive semi-definite as a 2×2 form). The default keeps `haa` and
+    /// `hbb` (positive semi-definite for quadratic wells) and drops that term.
+    fn gauss_newton(&self, _a: &Sym2, _b: &Sym2, d: &mut DensityDerivs) {
+        d.ga_psd = Sym2::zeros();
+    }
+    /// The elastic (stretching, bending) energies without damping (J).
+    fn elastic_parts(&self, a: &Sym2, b: &Sym2) -> (Real, Real);
 }
 
 /// Derivatives filled by [`FaceDensity::eval`].
@@ -96,6 +105,8 @@ pub struct DensityDerivs {
     pub haa: Mat3,
     /// `∂²W/∂b²`.
     pub hbb: Mat3,
+    /// Gauss–Newton only: the coefficient of `Σ_k ∇²a_k` kept (see [`FaceDensity::gauss_newton`]).
+    pub ga_psd: Sym2,
 }
 
 /// The discrete Koiter density of seed 000 §3 (eq. for `E_elastic`), plus optional Kelvin–Voigt
@@ -161,5 +172,13 @@ impl FaceDensity for KoiterDensity {
         d.haa = self.c * (2.0 * ws);
         d.hbb = self.c * (2.0 * wb);
         e
+    }
+
+    #[inline]
+    fn elastic_parts(&self, a: &Sym2, b: &Sym2) -> (Real, Real) {
+        let (ws, ta) = self.stretch[0];
+        let (wb, tb) = self.bend[0];
+        let (da, db) = (a - ta, b - tb);
+        (ws * da.dot(&(self.c * da)), wb * db.dot(&(self.c * db)))
     }
 }

@@ -1,19 +1,30 @@
-//! Energy terms. Each kernel is a pure function of one element's vertices and its rest data,
+//! Energy terms. Every energy is a [`term::Term`] in its own file, built by [`registry`] from
+//! the validated settings; kernels are pure functions of one element's DOFs and its rest data,
 //! returning the energy and, optionally, the gradient (+∂E/∂x, i.e. minus the force) and the
-//! Hessian, with fixed sizes and the DOF order written in its doc comment.
+//! Hessian, with fixed sizes and the DOF order written in their doc comments.
 //!
-//! * [`material`]: plane-stress Lamé parameters and the Koiter (St Venant–Kirchhoff) density.
-//! * [`shell`]: the discrete Koiter shell face (stretching + mid-edge bending), seed 000 §3.
-//! * [`midedge_angle`]: the mid-edge shell with one rotation DOF per edge (sin/tan variants).
-//! * [`patch`]: MorphoShell's quadratic patch-fit curvature (seed 001 §2).
+//! * [`term`]: the contracts (element, vertex and low-rank global terms).
+//! * [`registry`]: settings → the list of terms.
+//! * [`shell`]: membrane material × bending model, composed by one chain rule.
+//! * [`membrane`]: the membrane materials (Koiter, neo-Hookean, Mooney–Rivlin, Baraff–Witkin).
+//! * [`bending`]: the bending models (mid-edge average, patch fit, edge-DOF sin/tan, none).
+//! * [`material`]: plane-stress Lamé parameters and the Koiter density (stretching, bending and
+//!   Kelvin–Voigt damping wells).
+//! * [`gravity`], [`inertia`], [`ground`]: vertex terms.
 //! * [`projection`]: optional per-element projection of a Hessian to positive semi-definite.
 
+pub mod bending;
+pub mod gravity;
+pub mod ground;
+pub mod inertia;
 pub mod material;
-pub mod midedge_angle;
-pub mod patch;
+pub mod membrane;
 pub mod projection;
+pub mod registry;
 pub mod shell;
+pub mod term;
 
+pub use bending::{midedge_angle, patch};
 pub use material::{FaceDensity, KoiterDensity, Lame2d, StretchConvention};
 pub use projection::HessianProjection;
 pub use shell::{shell_face, shell_face_gauss_newton};

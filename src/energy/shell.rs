@@ -1,18 +1,34 @@
-//! The discrete Koiter shell face of seed 000 §3: stretching from the face's first fundamental
-//! form, bending from the mid-edge-average second fundamental form (see [`crate::geometry`]).
+//! The shell face term: a membrane material × a bending model, composed by one chain rule.
 //!
-//! DOF order (18): `x[v0], x[v1], x[v2], x[p0], x[p1], x[p2]`, where `p_i` is the far vertex of
-//! the neighbour across the edge opposite `v_i`. On a boundary edge (`has[i] = false`) `q_i = 0`
-//! and the `p_i` entries of the gradient and Hessian are zero.
+//! A face's energy is `E = W(a(x), b(x))`, with `a` the first fundamental form of the face's
+//! own vertices (local DOFs 0..9) and `b` the bending model's second fundamental form over the
+//! model's stencil ([`super::bending`]). With `Ja = ∂a/∂x` and `G = ∂b/∂x`:
+//!
+//! `∇E = Jaᵀ W_a + G W_b`,
+//! `∇²E = Jaᵀ W_aa Ja + Σ_k (W_a)_k ∇²a_k + G W_bb Gᵀ + Σ_q (W_b)_q ∇²b_q`
+//!
+//! (stretching and bending are uncoupled: no `W_ab`). The Gauss–Newton Hessian keeps
+//! `Jaᵀ W_aa⁺ Ja + Σ_k (W_a⁺)_k ∇²a_k + G W_bb Gᵀ` with the density's positive semi-definite
+//! parts ([`FaceDensity::gauss_newton`]).
+//!
+//! Units: energy J, gradient N (positions) and N·m (edge angles), Hessian N/m. DOF order: that
+//! of the bending model (`x[v0], x[v1], x[v2]` first).
 
+use super::bending::average::MidedgeAverage;
+use super::bending::BendingModel;
 use super::material::{DensityDerivs, FaceDensity};
+use super::membrane::Membrane;
+use super::term::{ElementKernel, Stencil};
 use crate::geometry::{
-    b_from_q, b_from_q_matrix, edge_slots, first_fundamental_form,
-    first_fundamental_form_hessian_pattern, first_fundamental_form_jacobian, AverageQs, UnitNormal,
+    first_fundamental_form, first_fundamental_form_hessian_pattern, first_fundamental_form_jacobian,
 };
 use crate::math::{Real, SMat, SVec, Sym2, Vec3};
+use crate::mesh::topology::NONE;
+use crate::scene::Scene;
+use crate::solve::Potential;
 
-/// Fundamental forms of one face (for output and the damping term's previous state).
+/// Fundamental forms of one face under the mid-edge average (for output and the damping term's
+/// previous state).
 pub fn face_forms(x: &[Vec3; 6], has: [bool; 3]) -> (Sym2, Sym2) {
     let xf = [x[0], x[1], x[2]];
     let opp = [0, 1, 2].map(|i| has[i].then_some(x[3 + i]));
@@ -22,13 +38,70 @@ pub fn face_forms(x: &[Vec3; 6], has: [bool; 3]) -> (Sym2, Sym2) {
     )
 }
 
-/// Energy (J) of one shell face under density `dens`, with optional gradient (+∂E/∂x, N) and
-/// Hessian (N/m), 18 DOFs in the order of the module doc.
-///
-/// `E = W(a(x), b(x))` with `b = B q`; chain rule:
-/// `∇E = Jaᵀ ∂W/∂a + Σ_i (Bᵀ∂W/∂b)_i ∇q_i`,
-/// `∇²E = Jaᵀ W_aa Ja + Σ_k (∂W/∂a_k) ∇²a_k + G (Bᵀ W_bb B) Gᵀ + Σ_i (Bᵀ∂W/∂b)_i ∇²q_i`,
-/// with `G = [∇q_0 ∇q_1 ∇q_2]`.
+/// The one shell chain rule (module doc): energy (J) of a face under density `dens` with
+/// bending model `model` (per-face input `face`), stencil positions `x`, optional gradient and
+/// Hessian over the model's `N` DOFs. `GN` selects the Gauss–Newton Hessian.
+#[inline(always)]
+pub fn shell_element<D: FaceDensity, B: BendingModel<N>, const N: usize, const GN: bool>(
+    model: &B,
+    face: &B::Face,
+    x: &[Vec3; 6],
+    dens: &D,
+    grad: Option<&mut SVec<N>>,
+    hess: Option<&mut SMat<N, N>>,
+) -> Real {
+    let xf = [x[0], x[1], x[2]];
+    let a = first_fundamental_form(&xf);
+    let want_h = hess.is_some();
+    let want_g = grad.is_some() || want_h;
+    let bending = N > 9 && dens.uses_b();
+    let ev = bending.then(|| model.eval(face, x, want_g, want_h && !GN));
+    let b = ev.as_ref().map_or(Sym2::zeros(), |ev| ev.b);
+    let mut d = DensityDerivs::default();
+    let e = dens.eval(&a, &b, &mut d);
+    if !want_g {
+        return e;
+    }
+    if GN && want_h {
+        dens.gauss_newton(&a, &b, &mut d);
+    }
+    let ja = first_fundamental_form_jacobian(&xf);
+    let mut g = SVec::<N>::zeros();
+    g.fixed_rows_mut::<9>(0).copy_from(&(ja.transpose() * d.ga));
+    if let Some(ev) = &ev {
+        g += ev.jac * d.gb;
+    }
+    if let Some(h) = hess {
+        h.fill(0.0);
+        h.fixed_view_mut::<9, 9>(0, 0)
+            .copy_from(&(ja.transpose() * d.haa * ja));
+        let coef = if GN { d.ga_psd } else { d.ga };
+        if coef != Sym2::zeros() {
+            let pat = first_fundamental_form_hessian_pattern(&coef);
+            for r in 0..3 {
+                for s in 0..3 {
+                    for c in 0..3 {
+                        h[(3 * r + c, 3 * s + c)] += pat[(r, s)];
+                    }
+                }
+            }
+        }
+        if let Some(ev) = &ev {
+            *h += ev.jac * d.hbb * ev.jac.transpose();
+            if !GN {
+                model.add_hessian(face, x, ev, &d.gb, h);
+            }
+        }
+    }
+    if let Some(gout) = grad {
+        *gout = g;
+    }
+    e
+}
+
+/// Energy (J) of one shell face with the mid-edge average (seed 000 §3) under density `dens`,
+/// with optional gradient (+∂E/∂x, N) and Hessian (N/m), 18 DOFs in the order of
+/// [`super::bending::average`].
 pub fn shell_face<D: FaceDensity>(
     x: &[Vec3; 6],
     has: [bool; 3],
@@ -36,11 +109,11 @@ pub fn shell_face<D: FaceDensity>(
     grad: Option<&mut SVec<18>>,
     hess: Option<&mut SMat<18, 18>>,
 ) -> Real {
-    shell_face_impl::<D, false>(x, has, dens, grad, hess)
+    shell_element::<D, MidedgeAverage, 18, false>(&MidedgeAverage, &has, x, dens, grad, hess)
 }
 
 /// As [`shell_face`], but the Hessian is the Gauss–Newton part only,
-/// `Jaᵀ W_aa Ja + G (Bᵀ W_bb B) Gᵀ`, dropping the terms with second derivatives of `a` and `q`.
+/// `Jaᵀ W_aa Ja + G W_bb Gᵀ`, dropping the terms with second derivatives of `a` and `b`.
 /// For the Koiter density (`W_aa`, `W_bb` multiples of the positive semi-definite `C`) it is
 /// positive semi-definite by construction: a descent direction without an eigendecomposition.
 pub fn shell_face_gauss_newton<D: FaceDensity>(
@@ -50,82 +123,169 @@ pub fn shell_face_gauss_newton<D: FaceDensity>(
     grad: Option<&mut SVec<18>>,
     hess: Option<&mut SMat<18, 18>>,
 ) -> Real {
-    shell_face_impl::<D, true>(x, has, dens, grad, hess)
+    shell_element::<D, MidedgeAverage, 18, true>(&MidedgeAverage, &has, x, dens, grad, hess)
 }
 
-#[inline(always)]
-fn shell_face_impl<D: FaceDensity, const GN: bool>(
-    x: &[Vec3; 6],
-    has: [bool; 3],
-    dens: &D,
-    grad: Option<&mut SVec<18>>,
-    hess: Option<&mut SMat<18, 18>>,
-) -> Real {
-    let xf = [x[0], x[1], x[2]];
-    let a = first_fundamental_form(&xf);
-    let bending = dens.uses_b();
-    let want_h = hess.is_some();
-    let want_g = grad.is_some() || want_h;
-    let nf = UnitNormal::new(&xf);
-    let qs = bending.then(|| AverageQs::new(&nf, x, has, want_h && !GN));
-    let q = SVec::<3>::from(qs.map_or([0.0; 3], |qs| qs.q));
-    let b = b_from_q(&q);
-    let mut d = DensityDerivs::default();
-    let e = dens.eval(&a, &b, &mut d);
-    if !want_g {
-        return e;
-    }
-    let ja = first_fundamental_form_jacobian(&xf);
-    let bq = b_from_q_matrix();
-    let gqv = bq.transpose() * d.gb; // ∂E/∂q
-    let mut g = SVec::<18>::zeros();
-    g.fixed_rows_mut::<9>(0).copy_from(&(ja.transpose() * d.ga));
-    if let Some(qs) = &qs {
-        for i in (0..3).filter(|&i| has[i]) {
-            for (l, &s) in edge_slots(i).iter().enumerate() {
-                for c in 0..3 {
-                    g[3 * s + c] += gqv[i] * qs.grad[i][3 * l + c];
-                }
-            }
-        }
-    }
-    if let Some(h) = hess {
-        h.fill(0.0);
-        let hm = ja.transpose() * d.haa * ja;
-        h.fixed_view_mut::<9, 9>(0, 0).copy_from(&hm);
-        if !GN {
-            let pat = first_fundamental_form_hessian_pattern(&d.ga);
-            for r in 0..3 {
-                for s in 0..3 {
-                    for c in 0..3 {
-                        h[(3 * r + c, 3 * s + c)] += pat[(r, s)];
-                    }
-                }
-            }
-        }
-        if let Some(qs) = &qs {
-            let hqq = bq.transpose() * d.hbb * bq;
-            let mut gmat = SMat::<18, 3>::zeros();
-            for i in (0..3).filter(|&i| has[i]) {
-                for (l, &s) in edge_slots(i).iter().enumerate() {
-                    for c in 0..3 {
-                        gmat[(3 * s + c, i)] = qs.grad[i][3 * l + c];
-                    }
-                }
-            }
-            *h += gmat * hqq * gmat.transpose();
-            if !GN {
-                qs.add_hessians(&nf, has, [gqv[0], gqv[1], gqv[2]], h);
-            }
-        }
-    }
-    e_and_grad(e, g, grad)
+/// The shell face term of a membrane material `M` and a bending model `B` with `N` local DOFs.
+pub struct Shell<M, B, const N: usize> {
+    /// The membrane material.
+    pub membrane: M,
+    /// The bending model.
+    pub bending: B,
 }
 
+/// A face's 6 stencil positions (absent slots get the face's own first vertex, unused).
 #[inline(always)]
-fn e_and_grad(e: Real, g: SVec<18>, grad: Option<&mut SVec<18>>) -> Real {
-    if let Some(gout) = grad {
-        *gout = g;
+pub fn gather(nodes: &[usize], x: &[Vec3]) -> [Vec3; 6] {
+    std::array::from_fn(|s| match nodes.get(s) {
+        Some(&u) if u != NONE => x[u],
+        _ => x[nodes[0]],
+    })
+}
+
+impl<M: Membrane, B: BendingModel<N>, const N: usize> ElementKernel<N> for Shell<M, B, N> {
+    const SLOTS: usize = B::SLOTS;
+
+    #[inline]
+    fn eval(
+        &self,
+        pot: &Potential,
+        f: usize,
+        nodes: &[usize],
+        x: &[Vec3],
+        phi: &[Real],
+        gauss_newton: bool,
+        grad: Option<&mut SVec<N>>,
+        hess: Option<&mut SMat<N, N>>,
+    ) -> Real {
+        let xs = gather(nodes, x);
+        let face = self.bending.face(pot.scene, f, nodes, phi);
+        let dens = self.membrane.density(pot, f);
+        if gauss_newton {
+            shell_element::<_, B, N, true>(&self.bending, &face, &xs, &dens, grad, hess)
+        } else {
+            shell_element::<_, B, N, false>(&self.bending, &face, &xs, &dens, grad, hess)
+        }
     }
-    e
+}
+
+impl<M: Membrane, B: BendingModel<N>, const N: usize> Shell<M, B, N> {
+    /// The stencil `[v0, v1, v2, p0, p1, p2, e0, e1, e2]` truncated to the model's slots.
+    pub fn stencil(scene: &Scene, _: &Self) -> Stencil {
+        let slots = B::SLOTS;
+        let extra = scene.stencil_extra();
+        let nv = scene.num_vertices();
+        let mut nodes = Vec::with_capacity(slots * scene.num_faces());
+        let mut anchors = Vec::with_capacity(scene.num_faces());
+        for (f, face) in scene.mesh.faces.iter().enumerate() {
+            let o = extra[f];
+            let e = if slots > 6 {
+                scene.topo.face_edges[f].map(|e| nv + e)
+            } else {
+                [NONE; 3]
+            };
+            let all = [
+                face[0], face[1], face[2], o[0], o[1], o[2], e[0], e[1], e[2],
+            ];
+            nodes.extend_from_slice(&all[..slots]);
+            let p = &scene.mesh.positions;
+            anchors.push((p[face[0]] + p[face[1]] + p[face[2]]) / 3.0);
+        }
+        let slot_dofs = (0..slots).map(|s| if s < 6 { 3 } else { 1 }).collect();
+        Stencil {
+            slot_dofs,
+            nodes,
+            anchors,
+        }
+    }
+
+    /// Per-face elastic (stretching, bending) energies (J) at `x`, `phi`, without damping.
+    pub fn face_energies(&self, pot: &Potential, x: &[Vec3], phi: &[Real]) -> Vec<(Real, Real)> {
+        use rayon::prelude::*;
+        let pattern = pot.pattern.faces();
+        (0..pot.scene.num_faces())
+            .into_par_iter()
+            .map(|f| {
+                let nodes = pattern.element(f);
+                let xs = gather(nodes, x);
+                let face = self.bending.face(pot.scene, f, nodes, phi);
+                let dens = self.membrane.density(pot, f);
+                let a = first_fundamental_form(&[xs[0], xs[1], xs[2]]);
+                let b = if N > 9 {
+                    self.bending.eval(&face, &xs, false, false).b
+                } else {
+                    Sym2::zeros()
+                };
+                dens.elastic_parts(&a, &b)
+            })
+            .collect()
+    }
+}
+
+impl<M: Membrane, B: BendingModel<N>, const N: usize> super::term::Term for Shell<M, B, N> {
+    fn name(&self) -> &'static str {
+        "shell"
+    }
+
+    fn stencil(&self, scene: &Scene) -> Stencil {
+        Self::stencil(scene, self)
+    }
+
+    fn eval(
+        &self,
+        pot: &Potential,
+        map: &crate::assembly::ElementMap,
+        x: &[Vec3],
+        phi: &[Real],
+        want: crate::assembly::Want,
+        projection: super::HessianProjection,
+        grad: &mut [Real],
+        values: &mut [Real],
+    ) -> Real {
+        let gn = projection == super::HessianProjection::GaussNewton;
+        crate::assembly::assemble_elements::<N, _>(
+            map,
+            |e, nodes, g, h| ElementKernel::<N>::eval(self, pot, e, nodes, x, phi, gn, g, h),
+            &pot.scene.node_fixed,
+            projection,
+            want,
+            grad,
+            values,
+            &pot.pattern.col_ptr,
+        )
+    }
+
+    /// Stretching and bending, elastic parts only (Kelvin–Voigt damping is dissipation, not
+    /// stored energy).
+    fn energies(
+        &self,
+        pot: &Potential,
+        _: &crate::assembly::ElementMap,
+        x: &[Vec3],
+        phi: &[Real],
+    ) -> Vec<(&'static str, Real)> {
+        let fe = self.face_energies(pot, x, phi);
+        let (s, b) = fe
+            .iter()
+            .fold((0.0, 0.0), |(s, b), (fs, fb)| (s + fs, b + fb));
+        vec![("stretching", s), ("bending", b)]
+    }
+
+    /// `stretching_energy_density` and `bending_energy_density` (J/m² of rest area).
+    fn face_fields(&self, pot: &Potential, x: &[Vec3], phi: &[Real]) -> Vec<(String, Vec<Real>)> {
+        let fe = self.face_energies(pot, x, phi);
+        let area: Vec<Real> = (0..fe.len())
+            .map(|f| 0.5 * crate::math::sym_det(&pot.rest_forms(f).0).max(0.0).sqrt())
+            .collect();
+        vec![
+            (
+                "stretching_energy_density".into(),
+                fe.iter().zip(&area).map(|(e, a)| e.0 / a).collect(),
+            ),
+            (
+                "bending_energy_density".into(),
+                fe.iter().zip(&area).map(|(e, a)| e.1 / a).collect(),
+            ),
+        ]
+    }
 }

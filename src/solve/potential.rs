@@ -11,11 +11,13 @@
 //! inertia, so each implicit step sets them quasi-statically, as the bending they describe is a
 //! through-thickness rotation whose inertia is O(h²) smaller than the translational one).
 
-use crate::assembly::{assemble_faces, Pattern, Want};
+use crate::assembly::{Pattern, Want};
 use crate::energy::material::sv_matrix;
+use crate::energy::term::LowRank;
 use crate::energy::{HessianProjection, KoiterDensity};
 use crate::math::{Real, Sym2, Vec3};
 use crate::scene::Scene;
+use rayon::prelude::*;
 
 /// Inertia of an implicit-Euler step.
 #[derive(Clone, Copy, Debug)]
@@ -94,14 +96,20 @@ impl<'a> Potential<'a> {
         }
     }
 
-    /// Elastic (+ damping) density of face `f`.
+    /// The rest forms `(ā, b̄)` of face `f` at this potential's dial (or override).
+    #[inline]
+    pub fn rest_forms(&self, f: usize) -> (Sym2, Sym2) {
+        match self.rest_override {
+            Some(r) => r[f],
+            None => self.scene.rest.at(f, self.dial),
+        }
+    }
+
+    /// Koiter elastic (+ damping) density of face `f`.
     #[inline]
     pub fn density(&self, f: usize) -> KoiterDensity {
         let sc = self.scene;
-        let (abar, bbar) = match self.rest_override {
-            Some(r) => r[f],
-            None => sc.rest.at(f, self.dial),
-        };
+        let (abar, bbar) = self.rest_forms(f);
         let (ws, wb) = KoiterDensity::weights(&abar, sc.thickness[f], sc.stretch_factor);
         let ws = ws * self.stretch_scale;
         let mut d = KoiterDensity {
@@ -130,32 +138,6 @@ impl<'a> Potential<'a> {
         self.eval_projected(x, phi, want, HessianProjection::None, grad, values)
     }
 
-    /// Adds a per-vertex gradient and 3×3 Hessian block (lower triangle) of vertex `v`.
-    #[inline]
-    fn add_vertex_term(
-        &self,
-        v: usize,
-        want: Want,
-        g: &Vec3,
-        h: &[[Real; 3]; 3],
-        grad: &mut [Real],
-        values: &mut [Real],
-    ) {
-        if want != Want::Energy {
-            for c in 0..3 {
-                grad[3 * v + c] += g[c];
-            }
-        }
-        if want == Want::Hessian {
-            for a in 0..3 {
-                let col = 3 * v + a;
-                for (b, hb) in h.iter().enumerate().skip(a) {
-                    values[self.pattern.diag(col) + (b - a)] += hb[a];
-                }
-            }
-        }
-    }
-
     /// The relative residual of a gradient: `max(‖g_x‖∞, ‖g_φ‖∞ / ℓ) / F`, with `F` the scene's
     /// force scale and `ℓ` its mean edge length (an edge DOF's gradient is a moment, N·m).
     pub fn residual(&self, grad: &[Real]) -> Real {
@@ -177,61 +159,15 @@ impl<'a> Potential<'a> {
         values: &mut [Real],
     ) -> Real {
         let sc = self.scene;
-        let mut e = assemble_faces(
-            self.pattern,
-            x,
-            phi,
-            sc.bending(),
-            |f| self.density(f),
-            &sc.node_fixed,
-            projection,
-            want,
-            grad,
-            values,
-        );
-        let g = self.gravity;
-        let has_g = g != Vec3::zeros();
-        for (v, xv) in x.iter().enumerate() {
-            if sc.fixed[v] {
-                continue;
-            }
-            let m = self.mass[v];
-            if let Some(ground) = &sc.ground {
-                if let Some((ec, gc, hc)) = ground.normal_term(v, xv) {
-                    e += ec;
-                    self.add_vertex_term(v, want, &gc, &hc, grad, values);
-                }
-                if let Some(fr) = &self.friction {
-                    let lambda = fr.normal_force[v];
-                    if lambda > 0.0 && ground.friction > 0.0 {
-                        let (ef, gf, hf) = ground.friction_term(lambda, xv, &fr.x_prev[v], fr.eps);
-                        e += ef;
-                        self.add_vertex_term(v, want, &gf, &hf, grad, values);
-                    }
-                }
-            }
-            if let Some(inr) = &self.inertia {
-                let dx = xv - inr.xhat[v];
-                e += 0.5 * inr.inv_dt2 * m * dx.norm_squared();
-                if want != Want::Energy {
-                    for c in 0..3 {
-                        grad[3 * v + c] += inr.inv_dt2 * m * dx[c];
-                    }
-                }
-                if want == Want::Hessian {
-                    for c in 0..3 {
-                        values[self.pattern.diag(3 * v + c)] += inr.inv_dt2 * m;
-                    }
-                }
-            }
-            if has_g {
-                e -= m * g.dot(xv);
-                if want != Want::Energy {
-                    for c in 0..3 {
-                        grad[3 * v + c] -= m * g[c];
-                    }
-                }
-            }
+        if want != Want::Energy {
+            grad.par_chunks_mut(1 << 14).for_each(|c| c.fill(0.0));
+        }
+        if want == Want::Hessian {
+            values.par_chunks_mut(1 << 14).for_each(|c| c.fill(0.0));
+        }
+        let mut e = 0.0;
+        for (term, map) in sc.terms.iter().zip(&self.pattern.maps) {
+            e += term.eval(self, map, x, phi, want, projection, grad, values);
         }
         if want != Want::Energy {
             for &d in &sc.pinned_dofs {
@@ -266,5 +202,35 @@ impl<'a> Potential<'a> {
             }
         }
         e
+    }
+
+    /// The dense low-rank Hessian parts of every term at `(x, phi)`, zero on fixed nodes and
+    /// pinned DOFs.
+    pub fn low_rank(&self, x: &[Vec3], phi: &[Real]) -> Vec<LowRank> {
+        let mut out = Vec::new();
+        for t in self.scene.terms.iter() {
+            t.low_rank(self, x, phi, &mut out);
+        }
+        for lr in &mut out {
+            for (u, &fx) in self.scene.node_fixed.iter().enumerate() {
+                if fx {
+                    let (d0, k) = self.pattern.node_dofs(u);
+                    lr.u[d0..d0 + k].fill(0.0);
+                }
+            }
+            for &d in &self.scene.pinned_dofs {
+                lr.u[d] = 0.0;
+            }
+        }
+        out
+    }
+
+    /// Energies by term name at `(x, phi)` (each term's [`crate::energy::term::Term::energies`]).
+    pub fn energies(&self, x: &[Vec3], phi: &[Real]) -> Vec<(&'static str, Real)> {
+        let mut out = Vec::new();
+        for (t, map) in self.scene.terms.iter().zip(&self.pattern.maps) {
+            out.extend(t.energies(self, map, x, phi));
+        }
+        out
     }
 }

@@ -267,7 +267,9 @@ fn colouring_separates_stencils() {
             let tag = c * 100_000 + b;
             for &f in block {
                 total += 1;
-                let mut st: Vec<usize> = p.stencil[f]
+                let mut st: Vec<usize> = p
+                    .faces()
+                    .element(f)
                     .iter()
                     .copied()
                     .filter(|&v| v != usize::MAX)

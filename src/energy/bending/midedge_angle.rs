@@ -37,12 +37,14 @@
 //! `φ_{e0}, φ_{e1}, φ_{e2}` (rad), the DOFs of the edges opposite `v0, v1, v2`. Units: energy J,
 //! gradient N (positions) and N·m (angles).
 
-use super::material::{DensityDerivs, FaceDensity};
+use super::{BendingEval, BendingModel};
+use crate::energy::material::FaceDensity;
 use crate::geometry::{
     b_from_q, b_from_q_matrix, edge_slots, first_fundamental_form,
     first_fundamental_form_hessian_pattern, first_fundamental_form_jacobian, AverageQs, UnitNormal,
 };
 use crate::math::{Mat3, Real, SMat, SVec, Sym2, Vec3};
+use crate::scene::Scene;
 
 /// The function `g` of `q = h g(θ/2 + σφ)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -146,7 +148,8 @@ pub fn midedge_angle_b(
 }
 
 /// Energy (J) of one face of the mid-edge shell with edge DOFs, with optional gradient and
-/// Hessian in the 21-DOF order of the module doc. `GN` selects the Gauss–Newton Hessian
+/// Hessian in the 21-DOF order of the module doc, through the one shell chain rule
+/// ([`crate::energy::shell::shell_element`]). `GN` selects the Gauss–Newton Hessian
 /// `Jᵀ W'' J` (positive semi-definite for the Koiter density), dropping second derivatives of
 /// `a`, `q̃`, `h` and `F`.
 #[allow(clippy::too_many_arguments)]
@@ -161,102 +164,170 @@ pub fn midedge_angle_face<D: FaceDensity, const GN: bool>(
     grad: Option<&mut SVec<21>>,
     hess: Option<&mut SMat<21, 21>>,
 ) -> Real {
-    let xf = [x[0], x[1], x[2]];
-    let a = first_fundamental_form(&xf);
-    let want_h = hess.is_some();
-    let want_g = grad.is_some() || want_h;
-    let nf = UnitNormal::new(&xf);
-    let qs = AverageQs::new(&nf, x, has, want_h && !GN);
-    let qt = qs.q;
-    let mut q = SVec::<3>::zeros();
-    let mut dh = [(SVec::<3>::zeros(), Mat3::zeros()); 3];
-    let mut df = [(SVec::<3>::zeros(), Mat3::zeros()); 3];
-    for i in 0..3 {
-        let (h, gh, hh) = height_from_a(&a, i);
-        let (f, gf, hf) = edge_q(variant, qt[i], h, sigma[i] * phi[i]);
-        q[i] = f;
-        dh[i] = (gh, hh);
-        df[i] = (gf, hf);
-    }
-    let b = b_from_q(&q);
-    let mut d = DensityDerivs::default();
-    let e = dens.eval(&a, &b, &mut d);
-    if !want_g {
-        return e;
-    }
-    // Intermediate variables y = (a[0..3], q̃[3..6], φ[6..9]); Jq = ∂q/∂y (3×9).
-    let mut jq = SMat::<3, 9>::zeros();
-    for i in 0..3 {
-        let (gf, _) = df[i];
-        for c in 0..3 {
-            jq[(i, c)] = gf[1] * dh[i].0[c];
+    let face = AngleFace {
+        has,
+        phi: *phi,
+        sigma,
+    };
+    crate::energy::shell::shell_element::<D, MidedgeAngle, 21, GN>(
+        &MidedgeAngle(variant),
+        &face,
+        x,
+        dens,
+        grad,
+        hess,
+    )
+}
+
+/// The edge-DOF model (`sin` or `tan`).
+#[derive(Clone, Copy, Debug)]
+pub struct MidedgeAngle(pub AngleVariant);
+
+/// Per-face input: boundary flags, the three edge DOFs (rad) and the face's orientation signs.
+#[derive(Clone, Copy, Debug)]
+pub struct AngleFace {
+    /// Whether edge `i` has a neighbour.
+    pub has: [bool; 3],
+    /// `φ` of the edges opposite `v0, v1, v2` (rad).
+    pub phi: [Real; 3],
+    /// The face's orientation sign `σ` on each edge.
+    pub sigma: [Real; 3],
+}
+
+/// Intermediate-variable derivatives kept for the Hessian contraction.
+pub struct AngleCache {
+    nf: UnitNormal,
+    qs: AverageQs,
+    /// `∂q/∂y` (3×9), `y = (a, q̃, φ)`.
+    jq: SMat<3, 9>,
+    /// `∂y/∂x` (9×21).
+    jy: SMat<9, 21>,
+    /// `(∇_a h_i, ∇²_a h_i)`.
+    dh: [(SVec<3>, Mat3); 3],
+    /// `(∇F_i, ∇²F_i)` in `(q̃, h, ψ)`.
+    df: [(SVec<3>, Mat3); 3],
+}
+
+impl BendingModel<21> for MidedgeAngle {
+    type Face = AngleFace;
+    type Cache = AngleCache;
+    const SLOTS: usize = 9;
+    const NAME: &'static str = "midedge_angle";
+
+    #[inline]
+    fn face(&self, scene: &Scene, f: usize, nodes: &[usize], phi: &[Real]) -> AngleFace {
+        let nv = scene.num_vertices();
+        AngleFace {
+            has: super::has_extra(nodes),
+            phi: [phi[nodes[6] - nv], phi[nodes[7] - nv], phi[nodes[8] - nv]],
+            sigma: scene.edge_sign[f],
         }
-        jq[(i, 3 + i)] = if has[i] { gf[0] } else { 0.0 };
-        jq[(i, 6 + i)] = gf[2] * sigma[i];
     }
-    let bq = b_from_q_matrix();
-    let lam = bq.transpose() * d.gb; // ∂E/∂q
-    let mut gy = jq.transpose() * lam;
-    for c in 0..3 {
-        gy[c] += d.ga[c];
-    }
-    // J = ∂y/∂x (9×21).
-    let ja = first_fundamental_form_jacobian(&xf);
-    let mut jy = SMat::<9, 21>::zeros();
-    jy.fixed_view_mut::<3, 9>(0, 0).copy_from(&ja);
-    for i in 0..3 {
-        if has[i] {
-            for (l, &s) in edge_slots(i).iter().enumerate() {
-                for c in 0..3 {
-                    jy[(3 + i, 3 * s + c)] = qs.grad[i][3 * l + c];
-                }
-            }
+
+    /// `G = Jyᵀ Jqᵀ Bᵀ` through the 9 intermediate variables of the module doc.
+    #[inline]
+    fn eval(
+        &self,
+        face: &AngleFace,
+        x: &[Vec3; 6],
+        grad: bool,
+        hess: bool,
+    ) -> BendingEval<21, AngleCache> {
+        let AngleFace { has, phi, sigma } = *face;
+        let xf = [x[0], x[1], x[2]];
+        let a = first_fundamental_form(&xf);
+        let nf = UnitNormal::new(&xf);
+        let qs = AverageQs::new(&nf, x, has, hess);
+        let mut q = SVec::<3>::zeros();
+        let mut dh = [(SVec::<3>::zeros(), Mat3::zeros()); 3];
+        let mut df = [(SVec::<3>::zeros(), Mat3::zeros()); 3];
+        for i in 0..3 {
+            let (h, gh, hh) = height_from_a(&a, i);
+            let (f, gf, hf) = edge_q(self.0, qs.q[i], h, sigma[i] * phi[i]);
+            q[i] = f;
+            dh[i] = (gh, hh);
+            df[i] = (gf, hf);
         }
-        jy[(6 + i, 18 + i)] = 1.0;
-    }
-    let g: SVec<21> = jy.transpose() * gy;
-    if let Some(hout) = hess {
-        // Hessian of Ẽ in y.
-        let mut hy = jq.transpose() * (bq.transpose() * d.hbb * bq) * jq;
-        {
-            let mut aa = hy.fixed_view_mut::<3, 3>(0, 0);
-            aa += d.haa;
-        }
-        if !GN {
+        let b = b_from_q(&q);
+        let mut jq = SMat::<3, 9>::zeros();
+        let mut jy = SMat::<9, 21>::zeros();
+        let mut jac = SMat::<21, 3>::zeros();
+        if grad {
             for i in 0..3 {
-                // λ_i ∇²_y q_i = λ_i (Kᵀ F'' K + F_h ∇²_a h).
-                let (gf, hf) = df[i];
-                let mut kmat = SMat::<3, 9>::zeros();
-                if has[i] {
-                    kmat[(0, 3 + i)] = 1.0;
-                }
+                let (gf, _) = df[i];
                 for c in 0..3 {
-                    kmat[(1, c)] = dh[i].0[c];
+                    jq[(i, c)] = gf[1] * dh[i].0[c];
                 }
-                kmat[(2, 6 + i)] = sigma[i];
-                hy += kmat.transpose() * hf * kmat * lam[i];
-                let mut aa = hy.fixed_view_mut::<3, 3>(0, 0);
-                aa += dh[i].1 * (lam[i] * gf[1]);
+                jq[(i, 3 + i)] = if has[i] { gf[0] } else { 0.0 };
+                jq[(i, 6 + i)] = gf[2] * sigma[i];
             }
-        }
-        let mut h: SMat<21, 21> = jy.transpose() * hy * jy;
-        if !GN {
-            // Σ_k ∂Ẽ/∂a_k ∇²a_k.
-            let pat = first_fundamental_form_hessian_pattern(&Sym2::new(gy[0], gy[1], gy[2]));
-            for r in 0..3 {
-                for s in 0..3 {
-                    for c in 0..3 {
-                        h[(3 * r + c, 3 * s + c)] += pat[(r, s)];
+            jy.fixed_view_mut::<3, 9>(0, 0)
+                .copy_from(&first_fundamental_form_jacobian(&xf));
+            for i in 0..3 {
+                if has[i] {
+                    for (l, &s) in edge_slots(i).iter().enumerate() {
+                        for c in 0..3 {
+                            jy[(3 + i, 3 * s + c)] = qs.grad[i][3 * l + c];
+                        }
                     }
                 }
+                jy[(6 + i, 18 + i)] = 1.0;
             }
-            // Σ_i ∂Ẽ/∂q̃_i ∇²q̃_i, the N_f part contracted once.
-            qs.add_hessians(&nf, has, [gy[3], gy[4], gy[5]], &mut h);
+            jac = jy.transpose() * (jq.transpose() * b_from_q_matrix().transpose());
         }
-        *hout = h;
+        BendingEval {
+            b,
+            jac,
+            cache: AngleCache {
+                nf,
+                qs,
+                jq,
+                jy,
+                dh,
+                df,
+            },
+        }
     }
-    if let Some(gout) = grad {
-        *gout = g;
+
+    /// With `μ = Bᵀλ`: `Σ_i μ_i ∇²q_i = Jyᵀ [Σ_i μ_i (Kᵢᵀ F_i'' Kᵢ + F_i,h ∇²_a h_i)] Jy`
+    /// `+ Σ_k (Jqᵀμ)_{a_k} ∇²a_k + Σ_i (Jqᵀμ)_{q̃_i} ∇²q̃_i`.
+    #[inline]
+    fn add_hessian(
+        &self,
+        face: &AngleFace,
+        _: &[Vec3; 6],
+        ev: &BendingEval<21, AngleCache>,
+        lambda: &Sym2,
+        h: &mut SMat<21, 21>,
+    ) {
+        let AngleFace { has, sigma, .. } = *face;
+        let c = &ev.cache;
+        let mu = b_from_q_matrix().transpose() * lambda;
+        let mut hy = SMat::<9, 9>::zeros();
+        for i in 0..3 {
+            let (gf, hf) = c.df[i];
+            let mut kmat = SMat::<3, 9>::zeros();
+            if has[i] {
+                kmat[(0, 3 + i)] = 1.0;
+            }
+            for k in 0..3 {
+                kmat[(1, k)] = c.dh[i].0[k];
+            }
+            kmat[(2, 6 + i)] = sigma[i];
+            hy += kmat.transpose() * hf * kmat * mu[i];
+            let mut aa = hy.fixed_view_mut::<3, 3>(0, 0);
+            aa += c.dh[i].1 * (mu[i] * gf[1]);
+        }
+        *h += c.jy.transpose() * hy * c.jy;
+        let gy = c.jq.transpose() * mu;
+        let pat = first_fundamental_form_hessian_pattern(&Sym2::new(gy[0], gy[1], gy[2]));
+        for r in 0..3 {
+            for s in 0..3 {
+                for k in 0..3 {
+                    h[(3 * r + k, 3 * s + k)] += pat[(r, s)];
+                }
+            }
+        }
+        c.qs.add_hessians(&c.nf, has, [gy[3], gy[4], gy[5]], h);
     }
-    e
 }

@@ -9,12 +9,11 @@
 //!
 //! DOF order (18): `x[v0], x[v1], x[v2], x[n0], x[n1], x[n2]` (face vertices, patch nodes).
 
-use super::material::{DensityDerivs, FaceDensity};
-use crate::geometry::{
-    first_fundamental_form, first_fundamental_form_hessian_pattern,
-    first_fundamental_form_jacobian, UnitNormal,
-};
+use super::{BendingEval, BendingModel};
+use crate::energy::material::FaceDensity;
+use crate::geometry::UnitNormal;
 use crate::math::{Mat3, Real, SMat, SVec, Sym2, Vec3};
+use crate::scene::Scene;
 
 /// Barycentric patch weights `Ŵ` (rows: b11, b12, b22; columns: the 6 stencil nodes), 1/m².
 pub type PatchWeights = SMat<3, 6>;
@@ -25,12 +24,9 @@ pub fn patch_b(x: &[Vec3; 6], w: &PatchWeights) -> Sym2 {
     Sym2::from_fn(|q, _| -n.dot(&(0..6).map(|k| x[k] * w[(q, k)]).sum::<Vec3>()))
 }
 
-/// Energy (J) of one face with patch-fit bending, optional gradient (N) and Hessian (N/m) in the
-/// DOF order of the module doc. With `GN`, the Hessian is the Gauss–Newton part only (PSD).
-///
-/// `∇b_q`: node k gets `−Ŵ_qk N`; face vertex a also gets `−(∂N/∂x_a)ᵀ s_q`.
-/// `∇²b_q`: the cross blocks `−Ŵ_qk ∂N/∂x_a` (node k, face vertex a) and their transposes, and
-/// `−∇²(s_q·N)` with `s_q` fixed on the face vertices.
+/// Energy (J) of one face with patch-fit bending under density `dens`, optional gradient (N)
+/// and Hessian (N/m) in the DOF order of the module doc, through the one shell chain rule
+/// ([`crate::energy::shell::shell_element`]). With `GN`, the Hessian is the Gauss–Newton part.
 pub fn patch_face<D: FaceDensity, const GN: bool>(
     x: &[Vec3; 6],
     w: &PatchWeights,
@@ -38,77 +34,95 @@ pub fn patch_face<D: FaceDensity, const GN: bool>(
     grad: Option<&mut SVec<18>>,
     hess: Option<&mut SMat<18, 18>>,
 ) -> Real {
-    let xf = [x[0], x[1], x[2]];
-    let a = first_fundamental_form(&xf);
-    let nf = UnitNormal::new(&xf);
-    let s: [Vec3; 3] = std::array::from_fn(|q| (0..6).map(|k| x[k] * w[(q, k)]).sum());
-    let b = Sym2::from_fn(|q, _| -nf.n.dot(&s[q]));
-    let mut d = DensityDerivs::default();
-    let e = dens.eval(&a, &b, &mut d);
-    if grad.is_none() && hess.is_none() {
-        return e;
+    crate::energy::shell::shell_element::<D, PatchFit, 18, GN>(&PatchFit, w, x, dens, grad, hess)
+}
+
+/// MorphoShell's patch-fit model; the per-face input is the face's weights `Ŵ`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PatchFit;
+
+/// The face normal and the weighted sums `s_q` kept for the Hessian contraction.
+pub struct PatchCache {
+    nf: UnitNormal,
+    s: [Vec3; 3],
+}
+
+impl BendingModel<18> for PatchFit {
+    type Face = PatchWeights;
+    type Cache = PatchCache;
+    const SLOTS: usize = 6;
+    const NAME: &'static str = "patch_fit";
+
+    #[inline]
+    fn face(&self, scene: &Scene, f: usize, _: &[usize], _: &[Real]) -> PatchWeights {
+        scene.patches[f].weights
     }
-    // G: columns ∇b_q (18×3).
-    let mut gmat = SMat::<18, 3>::zeros();
-    for q in 0..3 {
-        for k in 0..6 {
-            for c in 0..3 {
-                gmat[(3 * k + c, q)] -= w[(q, k)] * nf.n[c];
-            }
-        }
-        for av in 0..3 {
-            let v = nf.dn[av].transpose() * s[q];
-            for c in 0..3 {
-                gmat[(3 * av + c, q)] -= v[c];
-            }
-        }
-    }
-    let ja = first_fundamental_form_jacobian(&xf);
-    let mut g = gmat * d.gb;
-    {
-        let ga = ja.transpose() * d.ga;
-        for i in 0..9 {
-            g[i] += ga[i];
-        }
-    }
-    if let Some(h) = hess {
-        h.fill(0.0);
-        h.fixed_view_mut::<9, 9>(0, 0)
-            .copy_from(&(ja.transpose() * d.haa * ja));
-        *h += gmat * d.hbb * gmat.transpose();
-        if !GN {
-            let pat = first_fundamental_form_hessian_pattern(&d.ga);
-            for r in 0..3 {
-                for t in 0..3 {
+
+    /// `∇b_q`: node k gets `−Ŵ_qk N`; face vertex a also gets `−(∂N/∂x_a)ᵀ s_q`.
+    #[inline]
+    fn eval(
+        &self,
+        w: &PatchWeights,
+        x: &[Vec3; 6],
+        grad: bool,
+        _hess: bool,
+    ) -> BendingEval<18, PatchCache> {
+        let nf = UnitNormal::new(&[x[0], x[1], x[2]]);
+        let s: [Vec3; 3] = std::array::from_fn(|q| (0..6).map(|k| x[k] * w[(q, k)]).sum());
+        let b = Sym2::from_fn(|q, _| -nf.n.dot(&s[q]));
+        let mut jac = SMat::<18, 3>::zeros();
+        if grad {
+            for q in 0..3 {
+                for k in 0..6 {
                     for c in 0..3 {
-                        h[(3 * r + c, 3 * t + c)] += pat[(r, t)];
+                        jac[(3 * k + c, q)] -= w[(q, k)] * nf.n[c];
+                    }
+                }
+                for av in 0..3 {
+                    let v = nf.dn[av].transpose() * s[q];
+                    for c in 0..3 {
+                        jac[(3 * av + c, q)] -= v[c];
                     }
                 }
             }
-            // Σ_q gb_q ∇²b_q.
-            let lam: Vec3 = s.iter().zip(d.gb.iter()).map(|(sq, g)| sq * *g).sum();
-            let hn = nf.hessian_contract(&lam);
-            let mut top = h.fixed_view_mut::<9, 9>(0, 0);
-            top -= hn;
-            for k in 0..6 {
-                let wk: Real = (0..3).map(|q| d.gb[q] * w[(q, k)]).sum();
-                if wk == 0.0 {
-                    continue;
-                }
-                for av in 0..3 {
-                    let blk: Mat3 = -nf.dn[av] * wk; // ∂²/∂x_k ∂x_a
-                    let mut dst = h.fixed_view_mut::<3, 3>(3 * k, 3 * av);
-                    dst += blk;
-                    let mut dst_t = h.fixed_view_mut::<3, 3>(3 * av, 3 * k);
-                    dst_t += blk.transpose();
-                }
+        }
+        BendingEval {
+            b,
+            jac,
+            cache: PatchCache { nf, s },
+        }
+    }
+
+    /// `∇²b_q`: the cross blocks `−Ŵ_qk ∂N/∂x_a` (node k, face vertex a) and their transposes,
+    /// and `−∇²(s_q·N)` with `s_q` fixed on the face vertices.
+    #[inline]
+    fn add_hessian(
+        &self,
+        w: &PatchWeights,
+        _: &[Vec3; 6],
+        ev: &BendingEval<18, PatchCache>,
+        lambda: &Sym2,
+        h: &mut SMat<18, 18>,
+    ) {
+        let PatchCache { nf, s } = &ev.cache;
+        let lam: Vec3 = s.iter().zip(lambda.iter()).map(|(sq, g)| sq * *g).sum();
+        let hn = nf.hessian_contract(&lam);
+        let mut top = h.fixed_view_mut::<9, 9>(0, 0);
+        top -= hn;
+        for k in 0..6 {
+            let wk: Real = (0..3).map(|q| lambda[q] * w[(q, k)]).sum();
+            if wk == 0.0 {
+                continue;
+            }
+            for av in 0..3 {
+                let blk: Mat3 = -nf.dn[av] * wk; // ∂²/∂x_k ∂x_a
+                let mut dst = h.fixed_view_mut::<3, 3>(3 * k, 3 * av);
+                dst += blk;
+                let mut dst_t = h.fixed_view_mut::<3, 3>(3 * av, 3 * k);
+                dst_t += blk.transpose();
             }
         }
     }
-    if let Some(gout) = grad {
-        *gout = g;
-    }
-    e
 }
 
 /// The patch of one face: its 3 extra nodes, barycentric weights, and the fit's condition number.

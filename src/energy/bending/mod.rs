@@ -1,0 +1,75 @@
+//! Bending models: discrete second fundamental forms `b(x)` of one face, one file each.
+//!
+//! A model gives `b` (barycentric, `[b11, b12, b22]`, m) over an `N`-DOF face stencil whose first
+//! 9 DOFs are the face's own vertices, its Jacobian `G = ∂b/∂x` (column `q` is `∇b_q`, N×3) and
+//! the contraction `Σ_q λ_q ∇²b_q`. The one chain rule that composes it with any membrane
+//! material is [`crate::energy::shell::shell_element`].
+//!
+//! * [`average`]: seed 000's mid-edge average normals (18 DOFs).
+//! * [`patch`]: MorphoShell's quadratic patch fit (seed 001 §2, 18 DOFs).
+//! * [`midedge_angle`]: mid-edge normals with one rotation DOF per edge (21 DOFs).
+//! * [`none`]: no bending at all, a pure membrane (9 DOFs).
+//!
+//! Stencil slots (all models): `[v0, v1, v2, p0, p1, p2, e0, e1, e2]` truncated to the model's
+//! size, `p_i` the model's extra vertex for edge `i` (the neighbour's far vertex, or patch node
+//! `i`), `e_i` the edge opposite `v_i`.
+
+pub mod average;
+pub mod midedge_angle;
+pub mod none;
+pub mod patch;
+
+use crate::math::{Real, SMat, Sym2, Vec3};
+use crate::scene::Scene;
+
+/// `b` of one face with its Jacobian and what its Hessian contraction needs.
+pub struct BendingEval<const N: usize, C> {
+    /// The second fundamental form (m).
+    pub b: Sym2,
+    /// `G = ∂b/∂x` (column q is `∇b_q`), filled when a gradient was asked for.
+    pub jac: SMat<N, 3>,
+    /// Scratch kept for [`BendingModel::add_hessian`].
+    pub cache: C,
+}
+
+/// A discrete second fundamental form over `N` local DOFs.
+pub trait BendingModel<const N: usize>: Send + Sync {
+    /// Per-face input (boundary flags, weights, edge DOFs and signs).
+    type Face;
+    /// Scratch between [`BendingModel::eval`] and [`BendingModel::add_hessian`].
+    type Cache;
+    /// Stencil slots (3, 6 or 9).
+    const SLOTS: usize;
+    /// The bending model's name (settings value).
+    const NAME: &'static str;
+
+    /// The per-face input of face `f` with stencil `nodes` and global edge DOFs `phi`.
+    fn face(&self, scene: &Scene, f: usize, nodes: &[usize], phi: &[Real]) -> Self::Face;
+
+    /// `b` at stencil positions `x` (slots 0..6; unused slots hold the face's first vertex);
+    /// `G` when `grad`, the Hessian scratch when `hess`.
+    fn eval(
+        &self,
+        face: &Self::Face,
+        x: &[Vec3; 6],
+        grad: bool,
+        hess: bool,
+    ) -> BendingEval<N, Self::Cache>;
+
+    /// Adds `Σ_q λ_q ∇²b_q` to `h`.
+    fn add_hessian(
+        &self,
+        face: &Self::Face,
+        x: &[Vec3; 6],
+        ev: &BendingEval<N, Self::Cache>,
+        lambda: &Sym2,
+        h: &mut SMat<N, N>,
+    );
+}
+
+/// Whether stencil slots 3..6 (the extra vertices) are present.
+#[inline]
+pub fn has_extra(nodes: &[usize]) -> [bool; 3] {
+    use crate::mesh::topology::NONE;
+    [nodes[3] != NONE, nodes[4] != NONE, nodes[5] != NONE]
+}

@@ -1,0 +1,131 @@
+//! Membrane materials: the stretching energy of a face as a function of its first fundamental
+//! form `a` (barycentric, m²), one file each. Every material composes with every bending model
+//! through [`crate::energy::shell`]; the bending energy is always the Koiter plate term
+//! `h³/12 ‖ā⁻¹(b − b̄)‖²_SV √det ā / 2` with the plane-stress Lamé parameters of the face's E, ν,
+//! and the Kelvin–Voigt damping of seed 000 §3 keeps its Koiter form for every material.
+//!
+//! * [`koiter`]: St Venant–Kirchhoff / Koiter (seed 000), the default;
+//! * [`neo_hookean`]: incompressible neo-Hookean rubber;
+//! * [`mooney_rivlin`]: incompressible Mooney–Rivlin rubber;
+//! * [`baraff_witkin`]: seed 003's strain-limiting Baraff–Witkin cloth.
+
+pub mod baraff_witkin;
+pub mod koiter;
+pub mod mooney_rivlin;
+pub mod neo_hookean;
+
+use crate::energy::material::{DensityDerivs, FaceDensity, KoiterDensity};
+use crate::math::{Mat3, Real, Sym2};
+use crate::solve::Potential;
+
+/// A membrane material: gives each face's energy density at a potential's rest state.
+pub trait Membrane: Send + Sync + 'static {
+    /// The per-face density (membrane + Koiter bending + damping).
+    type Density: FaceDensity;
+    /// The density of face `f`.
+    fn density(&self, pot: &Potential, f: usize) -> Self::Density;
+}
+
+/// A hyperelastic membrane law of one face, `W(a)` (J), with its derivatives in `a`.
+pub trait MembraneLaw: Copy {
+    /// `W(a)`; sets `ga = ∂W/∂a` and `haa = ∂²W/∂a²` when `derivs`.
+    fn eval(&self, a: &Sym2, derivs: Option<(&mut Sym2, &mut Mat3)>) -> Real;
+    /// Positive semi-definite Hessian data at `a`: `haa⁺` (3×3) and `ga⁺`, the coefficient of
+    /// `Σ_k ∇²a_k` kept (its 2×2 form `[[2g0, g1], [g1, 2g2]]` positive semi-definite).
+    fn psd(&self, a: &Sym2, ga: &mut Sym2, haa: &mut Mat3);
+}
+
+/// A membrane law plus the Koiter bending and damping wells (whose stretching well 0 has weight
+/// 0: the law replaces it).
+#[derive(Clone, Copy, Debug)]
+pub struct WithKoiterBending<L> {
+    /// The membrane law.
+    pub law: L,
+    /// Bending (and damping) wells.
+    pub koiter: KoiterDensity,
+}
+
+impl<L: MembraneLaw> FaceDensity for WithKoiterBending<L> {
+    #[inline]
+    fn uses_b(&self) -> bool {
+        self.koiter.uses_b()
+    }
+
+    #[inline]
+    fn eval(&self, a: &Sym2, b: &Sym2, d: &mut DensityDerivs) -> Real {
+        let e = self.koiter.eval(a, b, d);
+        let (mut ga, mut haa) = (Sym2::zeros(), Mat3::zeros());
+        let w = self.law.eval(a, Some((&mut ga, &mut haa)));
+        d.ga += ga;
+        d.haa += haa;
+        e + w
+    }
+
+    fn gauss_newton(&self, a: &Sym2, b: &Sym2, d: &mut DensityDerivs) {
+        let mut dk = DensityDerivs::default();
+        self.koiter.eval(a, b, &mut dk);
+        let (mut ga, mut haa) = (Sym2::zeros(), Mat3::zeros());
+        self.law.psd(a, &mut ga, &mut haa);
+        d.haa = dk.haa + haa;
+        d.ga_psd = ga;
+    }
+
+    fn elastic_parts(&self, a: &Sym2, b: &Sym2) -> (Real, Real) {
+        (self.law.eval(a, None), self.koiter.elastic_parts(a, b).1)
+    }
+}
+
+/// The Koiter density of face `f` with its elastic stretching well switched off (the bending
+/// and damping wells of every non-Koiter material).
+#[inline]
+pub fn bending_wells(pot: &Potential, f: usize) -> KoiterDensity {
+    let mut d = pot.density(f);
+    d.stretch[0].0 = 0.0;
+    d
+}
+
+/// The positive semi-definite part of a `ga` coefficient: its 2×2 form
+/// `M = [[2g0, g1], [g1, 2g2]]` (the Hessian of `Σ_k g_k a_k` in the edge vectors, ⊗ I₃) with
+/// negative eigenvalues clamped to 0, in closed form.
+pub fn psd_ga(g: &Sym2) -> Sym2 {
+    let (m00, m01, m11) = (2.0 * g[0], g[1], 2.0 * g[2]);
+    let tr = m00 + m11;
+    let det = m00 * m11 - m01 * m01;
+    if m00 >= 0.0 && m11 >= 0.0 && det >= 0.0 {
+        return *g;
+    }
+    let disc = (0.25 * (m00 - m11) * (m00 - m11) + m01 * m01).sqrt();
+    let l1 = 0.5 * tr + disc; // the larger eigenvalue
+    if l1 <= 0.0 {
+        return Sym2::zeros();
+    }
+    // Eigenvector of l1: (m01, l1 − m00) or (l1 − m11, m01).
+    let (vx, vy) = if (l1 - m00).abs() + m01.abs() > (l1 - m11).abs() + m01.abs() {
+        (m01, l1 - m00)
+    } else {
+        (l1 - m11, m01)
+    };
+    let n2 = vx * vx + vy * vy;
+    if n2 == 0.0 {
+        return Sym2::new(0.5 * m00.max(0.0), 0.0, 0.5 * m11.max(0.0));
+    }
+    let s = l1 / n2;
+    Sym2::new(0.5 * s * vx * vx, s * vx * vy, 0.5 * s * vy * vy)
+}
+
+/// Clamps the negative eigenvalues of a symmetric 3×3 matrix to 0 (cyclic Jacobi, no
+/// allocation).
+pub fn psd3(m: &Mat3) -> Mat3 {
+    let (vals, vecs) = crate::energy::projection::jacobi_eigen(m);
+    if vals.iter().all(|&l| l >= 0.0) {
+        return *m;
+    }
+    let mut out = Mat3::zeros();
+    for k in 0..3 {
+        if vals[k] > 0.0 {
+            let v = vecs.column(k);
+            out += v * v.transpose() * vals[k];
+        }
+    }
+    out
+}

@@ -1,0 +1,312 @@
+//! The contracts every energy term keeps.
+//!
+//! A scene's potential Φ is a list of [`Term`]s built once by [`super::registry`] from the
+//! validated settings, holding only what the scene enables. Assembly accumulates every term into
+//! one gradient and one sparse Hessian; the Hessian's pattern is the union of the terms' stencils.
+//!
+//! Three kinds of term share the one trait:
+//! * an **element term** ([`ElementKernel`] wrapped in [`ElementTerm`]): a pure per-element kernel
+//!   over a fixed stencil of DOF nodes, `N` local DOFs, returning the energy and optionally the
+//!   gradient (+∂E/∂x, minus the force) and the Hessian; the shell faces, pressure, loads on faces;
+//! * a **vertex term** ([`VertexKernel`] wrapped in [`VertexTerm`]): one vertex, 3 DOFs; gravity,
+//!   inertia, the ground, point loads;
+//! * a **global term**: any term may add a dense low-rank part `Σ_k c_k u_k u_kᵀ` to its Hessian
+//!   ([`Term::low_rank`]) that is never densified: Newton solves with the sparse factor plus the
+//!   Woodbury identity ([`crate::solve::low_rank`]).
+//!
+//! Dispatch is once per term: a term's element loop is monomorphic.
+
+use crate::assembly::{assemble_elements, ElementMap, Want};
+use crate::energy::HessianProjection;
+use crate::math::{Mat3, Real, SMat, SVec, Vec3};
+use crate::scene::Scene;
+use crate::solve::Potential;
+
+/// The stencil of an element term: every element's DOF nodes in slot order (`NONE` where a slot
+/// is absent), the number of DOFs of each slot, and one point per element that orders elements
+/// into spatially coherent blocks.
+#[derive(Clone, Debug)]
+pub struct Stencil {
+    /// DOFs per slot (3 for a vertex node, 1 for an edge node).
+    pub slot_dofs: Vec<usize>,
+    /// Node ids, `elements × slots`.
+    pub nodes: Vec<usize>,
+    /// One point per element (its centroid) for the Morton ordering.
+    pub anchors: Vec<Vec3>,
+}
+
+impl Stencil {
+    /// Number of slots per element.
+    pub fn slots(&self) -> usize {
+        self.slot_dofs.len()
+    }
+    /// Number of elements.
+    pub fn len(&self) -> usize {
+        self.anchors.len()
+    }
+    /// Whether there are no elements.
+    pub fn is_empty(&self) -> bool {
+        self.anchors.is_empty()
+    }
+    /// The one-slot stencil of every vertex (vertex terms).
+    pub fn vertices(x: &[Vec3]) -> Stencil {
+        Stencil {
+            slot_dofs: vec![3],
+            nodes: (0..x.len()).collect(),
+            anchors: x.to_vec(),
+        }
+    }
+}
+
+/// A dense low-rank Hessian part `c u uᵀ` over all DOFs.
+#[derive(Clone, Debug)]
+pub struct LowRank {
+    /// The coefficient `c` (any sign).
+    pub c: Real,
+    /// The vector `u` (length = number of DOFs).
+    pub u: Vec<Real>,
+}
+
+/// One energy term of the potential.
+pub trait Term: Send + Sync {
+    /// The name under which its energy is reported (`log.csv`, `summary.json`).
+    fn name(&self) -> &'static str;
+
+    /// The elements and their DOF nodes.
+    fn stencil(&self, scene: &Scene) -> Stencil;
+
+    /// Adds the term's energy (returned), gradient and Hessian (lower triangle, pattern order)
+    /// at positions `x` and edge DOFs `phi` into `grad`/`values` as `want` says, skipping fixed
+    /// nodes.
+    #[allow(clippy::too_many_arguments)]
+    fn eval(
+        &self,
+        pot: &Potential,
+        map: &ElementMap,
+        x: &[Vec3],
+        phi: &[Real],
+        want: Want,
+        projection: HessianProjection,
+        grad: &mut [Real],
+        values: &mut [Real],
+    ) -> Real;
+
+    /// Energies to report, by name (default: the whole term under [`Term::name`]).
+    fn energies(
+        &self,
+        pot: &Potential,
+        map: &ElementMap,
+        x: &[Vec3],
+        phi: &[Real],
+    ) -> Vec<(&'static str, Real)> {
+        let e = self.eval(
+            pot,
+            map,
+            x,
+            phi,
+            Want::Energy,
+            HessianProjection::None,
+            &mut [],
+            &mut [],
+        );
+        vec![(self.name(), e)]
+    }
+
+    /// Per-face fields this term contributes to the frames (default: none).
+    fn face_fields(
+        &self,
+        _pot: &Potential,
+        _x: &[Vec3],
+        _phi: &[Real],
+    ) -> Vec<(String, Vec<Real>)> {
+        Vec::new()
+    }
+
+    /// The dense low-rank part of the Hessian at `x` (default: none). Entries on fixed or
+    /// pinned DOFs must be zero.
+    fn low_rank(&self, _pot: &Potential, _x: &[Vec3], _phi: &[Real], _out: &mut Vec<LowRank>) {}
+}
+
+/// A pure per-element kernel with `N` local DOFs.
+pub trait ElementKernel<const N: usize>: Send + Sync {
+    /// Slots per element (a compile-time constant for the assembly loops).
+    const SLOTS: usize;
+    /// Energy of element `e` with stencil `nodes`, optional gradient and Hessian in the local
+    /// DOF order of the stencil's slots. `gauss_newton` asks for a positive semi-definite
+    /// Hessian where the kernel has one.
+    #[allow(clippy::too_many_arguments)]
+    fn eval(
+        &self,
+        pot: &Potential,
+        e: usize,
+        nodes: &[usize],
+        x: &[Vec3],
+        phi: &[Real],
+        gauss_newton: bool,
+        grad: Option<&mut SVec<N>>,
+        hess: Option<&mut SMat<N, N>>,
+    ) -> Real;
+}
+
+/// An [`ElementKernel`] as a [`Term`]: stencil from a function, the coloured assembly loop.
+pub struct ElementTerm<K, const N: usize> {
+    /// Reported name.
+    pub name: &'static str,
+    /// The kernel.
+    pub kernel: K,
+    /// The stencil builder.
+    pub stencil: fn(&Scene, &K) -> Stencil,
+}
+
+impl<K: ElementKernel<N>, const N: usize> Term for ElementTerm<K, N> {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+    fn stencil(&self, scene: &Scene) -> Stencil {
+        (self.stencil)(scene, &self.kernel)
+    }
+    fn eval(
+        &self,
+        pot: &Potential,
+        map: &ElementMap,
+        x: &[Vec3],
+        phi: &[Real],
+        want: Want,
+        projection: HessianProjection,
+        grad: &mut [Real],
+        values: &mut [Real],
+    ) -> Real {
+        let gn = projection == HessianProjection::GaussNewton;
+        assemble_elements::<N, _>(
+            map,
+            |e, nodes, g, h| self.kernel.eval(pot, e, nodes, x, phi, gn, g, h),
+            &pot.scene.node_fixed,
+            projection,
+            want,
+            grad,
+            values,
+            &pot.pattern.col_ptr,
+        )
+    }
+}
+
+/// A per-vertex kernel: energy, gradient (N) and Hessian (N/m) of one vertex at `x`.
+pub trait VertexKernel: Send + Sync {
+    /// `None` when the vertex does not contribute.
+    fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)>;
+}
+
+/// A [`VertexKernel`] as a [`Term`]. Fixed vertices contribute nothing to Φ (a constant);
+/// the reported energy includes them.
+pub struct VertexTerm<K> {
+    /// Reported name.
+    pub name: &'static str,
+    /// The kernel.
+    pub kernel: K,
+    /// Whether its energy is reported (inertia and friction are parts of one step's
+    /// incremental potential, not stored energies: the kinetic energy is reported instead).
+    pub report: bool,
+}
+
+impl<K: VertexKernel> Term for VertexTerm<K> {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+    fn energies(
+        &self,
+        pot: &Potential,
+        _: &ElementMap,
+        x: &[Vec3],
+        _: &[Real],
+    ) -> Vec<(&'static str, Real)> {
+        if !self.report {
+            return Vec::new();
+        }
+        let e = x
+            .iter()
+            .enumerate()
+            .filter_map(|(v, xv)| self.kernel.eval(pot, v, xv).map(|r| r.0))
+            .sum();
+        vec![(self.name, e)]
+    }
+    fn stencil(&self, scene: &Scene) -> Stencil {
+        Stencil::vertices(&scene.mesh.positions)
+    }
+    fn eval(
+        &self,
+        pot: &Potential,
+        map: &ElementMap,
+        x: &[Vec3],
+        _phi: &[Real],
+        want: Want,
+        projection: HessianProjection,
+        grad: &mut [Real],
+        values: &mut [Real],
+    ) -> Real {
+        let fixed = &pot.scene.fixed;
+        assemble_elements::<3, _>(
+            map,
+            |v, _, g, h| {
+                if fixed[v] {
+                    if let Some(g) = g {
+                        g.fill(0.0);
+                    }
+                    if let Some(h) = h {
+                        h.fill(0.0);
+                    }
+                    return 0.0;
+                }
+                let (e, gv, hv) =
+                    self.kernel
+                        .eval(pot, v, &x[v])
+                        .unwrap_or((0.0, Vec3::zeros(), Mat3::zeros()));
+                if let Some(g) = g {
+                    g.copy_from(&gv);
+                }
+                if let Some(h) = h {
+                    h.copy_from(&hv);
+                }
+                e
+            },
+            &pot.scene.node_fixed,
+            projection,
+            want,
+            grad,
+            values,
+            &pot.pattern.col_ptr,
+        )
+    }
+}
+
+/// A scene's terms, shared (cheap to clone with the scene).
+#[derive(Clone, Default)]
+pub struct Terms(pub std::sync::Arc<Vec<Box<dyn Term>>>);
+
+impl std::ops::Deref for Terms {
+    type Target = [Box<dyn Term>];
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
+}
+
+impl std::fmt::Debug for Terms {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list()
+            .entries(self.0.iter().map(|t| t.name()))
+            .finish()
+    }
+}
+
+impl Terms {
+    /// Adds a term after the registry's (for library users' own terms; build the pattern
+    /// after this). Returns the term back if the list is shared with another scene.
+    pub fn push(&mut self, t: Box<dyn Term>) -> Result<(), Box<dyn Term>> {
+        match std::sync::Arc::get_mut(&mut self.0) {
+            Some(list) => {
+                list.push(t);
+                Ok(())
+            }
+            None => Err(t),
+        }
+    }
+}
