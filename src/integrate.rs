@@ -466,7 +466,14 @@ impl<'a> Solver<'a> {
         pot.eval(x, phi, Want::Hessian, &mut g, &mut values);
         // One factorisation of H + 1e-9·mean|diag|·I (τ may not grow beyond 1e-9).
         let mut shifted = vec![0.0; values.len()];
-        factor_with_shift_upto(&mut self.lin, &pot, &values, &mut shifted, 1e-9, 1e-9).is_some()
+        if factor_with_shift_upto(&mut self.lin, &pot, &values, &mut shifted, 1e-9, 1e-9).is_none()
+        {
+            return false;
+        }
+        // A dense low-rank part keeps the whole positive definite or not (inertia test).
+        let lr = pot.low_rank(x, phi);
+        lr.is_empty()
+            || crate::solve::low_rank::Woodbury::new(&mut self.lin, &lr).keeps_positive_definite()
     }
 }
 

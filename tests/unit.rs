@@ -12,3 +12,5 @@ mod geometry;
 mod io;
 #[path = "unit/settings.rs"]
 mod settings;
+#[path = "unit/terms.rs"]
+mod terms;

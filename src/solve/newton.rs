@@ -230,7 +230,16 @@ pub fn newton(
         for (s, g) in ws.step.iter_mut().zip(&ws.grad) {
             *s = -g;
         }
-        lin.solve_in_place(&mut ws.step);
+        let lr = pot.low_rank(x, phi);
+        if lr.is_empty() {
+            lin.solve_in_place(&mut ws.step);
+        } else {
+            let wb = super::low_rank::Woodbury::new(lin, &lr);
+            if !wb.solve_in_place(lin, &mut ws.step) {
+                rep.reason = "the Hessian with its low-rank part is singular".into();
+                return rep;
+            }
+        }
         rep.iterations += 1;
         let slope: Real = ws.step.iter().zip(&ws.grad).map(|(d, g)| d * g).sum();
         if slope.is_nan() || slope >= 0.0 {

@@ -1,0 +1,102 @@
+//! Solving with a sparse factor plus a dense low-rank update, never densified.
+//!
+//! With the sparse part `A = LLᵀ` factorised and the update `U C Uᵀ` (`C = diag(c_k)`, the
+//! terms' [`LowRank`] parts), the Woodbury identity gives
+//!
+//! `(A + U C Uᵀ)⁻¹ r = A⁻¹r − A⁻¹U S⁻¹ Uᵀ A⁻¹ r`, `S = C⁻¹ + Uᵀ A⁻¹ U` (k×k),
+//!
+//! one extra solve per update vector (Sherman–Morrison for k = 1). Positive definiteness of the
+//! whole matrix follows from the inertia (Haynsworth): with `A ≻ 0`, `A + UCUᵀ ≻ 0` exactly when
+//! `S` has as many positive eigenvalues as `C`.
+
+use super::linear::LinearSolver;
+use crate::energy::term::LowRank;
+use crate::math::Real;
+
+/// The update vectors solved against the factor, and the capacitance matrix `S`.
+pub struct Woodbury {
+    /// `A⁻¹ u_k`.
+    ainv_u: Vec<Vec<Real>>,
+    /// `S = C⁻¹ + Uᵀ A⁻¹ U`, `k×k` row-major.
+    s: Vec<Real>,
+    /// The coefficients kept (non-zero `c_k`).
+    c: Vec<Real>,
+    /// The vectors kept.
+    u: Vec<Vec<Real>>,
+}
+
+impl Woodbury {
+    /// Prepares the update on a factorised `lin` (k extra solves).
+    pub fn new(lin: &mut LinearSolver, parts: &[LowRank]) -> Self {
+        let kept: Vec<&LowRank> = parts.iter().filter(|p| p.c != 0.0).collect();
+        let k = kept.len();
+        let ainv_u: Vec<Vec<Real>> = kept
+            .iter()
+            .map(|p| {
+                let mut v = p.u.clone();
+                lin.solve_in_place(&mut v);
+                v
+            })
+            .collect();
+        let mut s = vec![0.0; k * k];
+        for i in 0..k {
+            for j in 0..k {
+                s[i * k + j] = dot(&kept[i].u, &ainv_u[j]);
+            }
+            s[i * k + i] += 1.0 / kept[i].c;
+        }
+        Woodbury {
+            ainv_u,
+            s,
+            c: kept.iter().map(|p| p.c).collect(),
+            u: kept.iter().map(|p| p.u.clone()).collect(),
+        }
+    }
+
+    /// Whether there is no update.
+    pub fn is_empty(&self) -> bool {
+        self.c.is_empty()
+    }
+
+    /// Solves `(A + UCUᵀ) y = r` in place, given `A⁻¹` through `lin`. Returns false if `S` is
+    /// singular (the whole matrix is).
+    pub fn solve_in_place(&self, lin: &mut LinearSolver, r: &mut [Real]) -> bool {
+        lin.solve_in_place(r);
+        let k = self.c.len();
+        if k == 0 {
+            return true;
+        }
+        let rhs = nalgebra::DVector::from_iterator(k, self.u.iter().map(|u| dot(u, r)));
+        let s = nalgebra::DMatrix::from_row_slice(k, k, &self.s);
+        let Some(z) = s.lu().solve(&rhs) else {
+            return false;
+        };
+        if !z.iter().all(|v| v.is_finite()) {
+            return false;
+        }
+        for (j, au) in self.ainv_u.iter().enumerate() {
+            for (ri, ai) in r.iter_mut().zip(au) {
+                *ri -= ai * z[j];
+            }
+        }
+        true
+    }
+
+    /// With `A ≻ 0` factorised: whether `A + UCUᵀ ≻ 0` (module doc).
+    pub fn keeps_positive_definite(&self) -> bool {
+        let k = self.c.len();
+        if k == 0 {
+            return true;
+        }
+        let s = nalgebra::DMatrix::from_row_slice(k, k, &self.s);
+        let sym = (&s + s.transpose()) * 0.5;
+        let eig = nalgebra::SymmetricEigen::new(sym);
+        let pos_s = eig.eigenvalues.iter().filter(|&&l| l > 0.0).count();
+        let pos_c = self.c.iter().filter(|&&c| c > 0.0).count();
+        pos_s == pos_c && eig.eigenvalues.iter().all(|&l| l != 0.0)
+    }
+}
+
+fn dot(a: &[Real], b: &[Real]) -> Real {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
