@@ -561,9 +561,13 @@ fn run_static(
         .iter()
         .copied()
         .fold(Real::INFINITY, Real::min);
-    let softening = st
-        .membrane_continuation
-        .factor(s.scene.mesh.bbox_diagonal(), h_min);
+    // A softened membrane under external loads or prescribed displacements would follow a
+    // different (much softer) path: "auto" keeps the continuation for rest-form programming only.
+    let loaded = s.scene.settings.loads.any_external() || !s.scene.prescribed.is_empty();
+    let softening = match st.membrane_continuation {
+        crate::settings::Softening::Auto(_) if loaded => 1.0,
+        m => m.factor(s.scene.mesh.bbox_diagonal(), h_min),
+    };
     let mut scale = 1.0 / softening.max(1.0);
     let mut ratio: Real = 10.0;
     let mut trial = x.clone();
@@ -583,6 +587,7 @@ fn run_static(
         };
         trial.copy_from_slice(&x);
         trial_phi.copy_from_slice(&phi);
+        s.scene.prescribe(&mut trial, target);
         let pot = s.potential_scaled(target, target_scale);
         let rep = newton(
             &pot,
@@ -747,6 +752,9 @@ fn run_dynamic(
         for i in 0..n {
             xhat[i] = x[i] + v[i] * h;
         }
+        // Vertices on prescribed paths are fixed: their inertia is not assembled, so the
+        // prediction can carry their prescribed position into every trial.
+        sc.prescribe(&mut xhat, dial);
         trial.copy_from_slice(&xhat);
         trial_phi.copy_from_slice(&phi);
         let moisture_clock = Instant::now();

@@ -54,6 +54,8 @@ pub struct Scene {
     pub ground: Option<crate::solve::contact::Ground>,
     /// The energy terms the settings enable, in assembly order ([`crate::energy::registry`]).
     pub terms: crate::energy::term::Terms,
+    /// Vertices on prescribed paths and their displacement at dial 1 (m); they are fixed.
+    pub prescribed: Vec<(usize, Vec3)>,
 }
 
 fn positive_face_field(mesh: &Mesh, name: &str) -> Result<Option<Vec<Real>>, MeshError> {
@@ -203,6 +205,46 @@ impl Scene {
                 fixed[v] |= (0..3).all(|k| p[k] >= b.min[k] && p[k] <= b.max[k]);
             }
         }
+        let mut clamped_edges = Vec::new();
+        for (i, sel) in c.clamp.iter().enumerate() {
+            let what = format!("constraints.clamp[{i}]");
+            let mut on = vec![false; nv];
+            for v in crate::energy::loads::select_vertices(&mesh, sel, &what)? {
+                on[v] = true;
+            }
+            let before = clamped_edges.len();
+            for (e, ends) in topo.edges.iter().enumerate() {
+                let ef = topo.edge_faces[e];
+                if ef[1] == crate::mesh::topology::NONE && on[ends[0]] && on[ends[1]] {
+                    for &v in &mesh.faces[ef[0]] {
+                        fixed[v] = true;
+                    }
+                    clamped_edges.push(e);
+                }
+            }
+            if clamped_edges.len() == before {
+                return Err(mesh.invalid(format!(
+                    "{what} selects no boundary edge: a clamp acts on a boundary, and both ends of \
+                     a boundary edge must be selected"
+                )));
+            }
+        }
+        let mut prescribed = Vec::new();
+        for (i, pd) in c.displacement.iter().enumerate() {
+            let what = format!("constraints.displacement[{i}]");
+            for v in crate::energy::loads::select_vertices(&mesh, &pd.on, &what)? {
+                if fixed[v] || prescribed.iter().any(|&(u, _)| u == v) {
+                    return Err(mesh.invalid(format!(
+                        "{what}: vertex {v} is already fixed or given another prescribed path; a \
+                         vertex is either held, or moved along one path"
+                    )));
+                }
+                prescribed.push((v, Vec3::from(pd.displacement)));
+            }
+        }
+        for &(v, _) in &prescribed {
+            fixed[v] = true;
+        }
 
         let free = unused.len() < nv && fixed.iter().all(|&f| !f);
         let gravity = settings.loads.gravity.iter().any(|&g| g != 0.0);
@@ -247,11 +289,21 @@ impl Scene {
         };
         let mut node_fixed = fixed.clone();
         if !edge_sign.is_empty() {
-            // Edge DOFs are free (see the field's doc).
+            // Edge DOFs are free (see the field's doc), except on clamped boundaries.
             node_fixed.resize(nv + topo.edges.len(), false);
+            for &e in &clamped_edges {
+                node_fixed[nv + e] = true;
+            }
         }
         let pinned_dofs = if free && settings.solver.mode == crate::settings::Mode::Static {
-            rigid_pins(&mesh, &fixed)
+            let mut pins = rigid_pins(&mesh, &fixed);
+            // Dead loads are not invariant under rotations: pinning rotational DOFs would make
+            // the pins carry a reaction. Only the translation is pinned then (balanced loads are
+            // invariant under it); rotations the loads leave free get the solver's tiny shift.
+            if settings.loads.any_external() {
+                pins.truncate(3);
+            }
+            pins
         } else {
             Vec::new()
         };
@@ -282,6 +334,7 @@ impl Scene {
             growth,
             ground,
             terms: Default::default(),
+            prescribed,
         };
         scene.terms = crate::energy::term::Terms(std::sync::Arc::new(
             crate::energy::registry::terms(&scene)?,
@@ -356,6 +409,13 @@ impl Scene {
             })
             .collect();
         (a, b)
+    }
+
+    /// Moves the vertices on prescribed paths to `reference + dial × displacement`.
+    pub fn prescribe(&self, x: &mut [Vec3], dial: Real) {
+        for &(v, u) in &self.prescribed {
+            x[v] = self.mesh.positions[v] + u * dial;
+        }
     }
 
     /// Reference (input) positions.

@@ -587,6 +587,66 @@ impl Default for Time {
 pub struct Loads {
     /// Gravitational acceleration (m/s², default: `[0, 0, 0]`; Earth: `[0, 0, -9.81]`).
     pub gravity: [Real; 3],
+    /// Point forces (`[[loads.point]]`, default: none).
+    pub point: Vec<PointLoad>,
+    /// Tractions per unit length on boundary edges (`[[loads.traction]]`, default: none).
+    pub traction: Vec<TractionLoad>,
+    /// Follower pressures on faces (`[[loads.pressure]]`, default: none).
+    pub pressure: Vec<PressureLoad>,
+}
+
+impl Loads {
+    /// Whether any point, traction or pressure load is given (gravity aside).
+    pub fn any_external(&self) -> bool {
+        !(self.point.is_empty() && self.traction.is_empty() && self.pressure.is_empty())
+    }
+}
+
+/// Which vertices (by `node_tags`) or faces (by `tri_tags`) a load or constraint acts on: those
+/// whose tag is in `tags` (any, when empty) and, when `inside` is given, whose reference position
+/// (a face: its centroid) lies in that box. At least one of the two must be given.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct Selection {
+    /// Tags (default: `[]`).
+    pub tags: Vec<i64>,
+    /// Box (m, default: none).
+    pub inside: Option<FixBox>,
+}
+
+/// A dead point force, scaled by the dial (the load factor).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLoad {
+    /// Total force on the selected vertices, shared equally among them (N).
+    pub force: [Real; 3],
+    /// The vertices.
+    #[serde(flatten)]
+    pub on: Selection,
+}
+
+/// A dead traction per unit reference length on the boundary edges whose two vertices are
+/// selected, scaled by the dial; each edge gives half of `traction × length` to each end.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TractionLoad {
+    /// Force per unit length (N/m).
+    pub traction: [Real; 3],
+    /// The boundary vertices.
+    #[serde(flatten)]
+    pub on: Selection,
+}
+
+/// A follower pressure on the selected faces (all faces when neither tags nor a box is given),
+/// pushing along each face's normal, scaled by the dial.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PressureLoad {
+    /// Pressure (Pa); positive pushes toward the side the face normals point to.
+    pub pressure: Real,
+    /// The faces (by `tri_tags` or centroid box).
+    #[serde(flatten, default)]
+    pub on: Selection,
 }
 
 /// A number, or an expression of the reference coordinates x, y (m) as a string (see
@@ -683,7 +743,7 @@ impl Default for Contact {
 }
 
 /// An axis-aligned box of vertices to hold fixed.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct FixBox {
     /// Lower corner (m).
@@ -702,6 +762,24 @@ pub struct Constraints {
     pub fix_tags: Vec<i64>,
     /// Fix vertices inside any of these boxes (default: none).
     pub fix_boxes: Vec<FixBox>,
+    /// Clamped boundaries (`[[constraints.clamp]]`): the selected boundary vertices, and every
+    /// vertex and edge DOF of the faces that have a selected boundary edge, are held (positions
+    /// and rotation) (default: none).
+    pub clamp: Vec<Selection>,
+    /// Prescribed displacements (`[[constraints.displacement]]`): selected vertices move to
+    /// `reference + dial × displacement` (default: none).
+    pub displacement: Vec<Prescribed>,
+}
+
+/// A prescribed displacement path.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Prescribed {
+    /// Displacement at dial 1 (m).
+    pub displacement: [Real; 3],
+    /// The vertices.
+    #[serde(flatten)]
+    pub on: Selection,
 }
 
 impl Default for Constraints {
@@ -710,6 +788,8 @@ impl Default for Constraints {
             use_constraint_indicators: true,
             fix_tags: Vec::new(),
             fix_boxes: Vec::new(),
+            clamp: Vec::new(),
+            displacement: Vec::new(),
         }
     }
 }

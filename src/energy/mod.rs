@@ -11,12 +11,14 @@
 //! * [`material`]: plane-stress Lamé parameters and the Koiter density (stretching, bending and
 //!   Kelvin–Voigt damping wells).
 //! * [`gravity`], [`inertia`], [`ground`]: vertex terms.
+//! * [`loads`]: point forces, tractions and pressure, scaled by the dial (the load factor).
 //! * [`projection`]: optional per-element projection of a Hessian to positive semi-definite.
 
 pub mod bending;
 pub mod gravity;
 pub mod ground;
 pub mod inertia;
+pub mod loads;
 pub mod material;
 pub mod membrane;
 pub mod projection;

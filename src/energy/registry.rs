@@ -118,5 +118,12 @@ pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
             kernel: super::gravity::Gravity,
         }));
     }
+    for load in [
+        super::loads::point::term,
+        super::loads::traction::term,
+        super::loads::pressure::term,
+    ] {
+        t.extend(load(scene)?);
+    }
     Ok(t)
 }

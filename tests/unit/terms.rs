@@ -180,7 +180,38 @@ fn every_registered_term_matches_finite_differences() {
             }
         }
     }
-    for name in ["shell", "contact", "friction", "inertia", "gravity"] {
+    // The loads, on a sheet whose boundary is held (as the pressure needs), with edge DOFs.
+    let sc = strip_scene(
+        "[material]\nthickness = 0.05\n[constraints]\nfix_boxes = [\
+         { min = [-1, -1, -1], max = [0.01, 2, 1] }, { min = [0.99, -1, -1], max = [2, 2, 1] },\
+         { min = [-1, -1, -1], max = [2, 0.01, 1] }, { min = [-1, 0.49, -1], max = [2, 2, 1] }]\n\
+         [[loads.point]]\nforce = [1, 2, 3]\ninside = { min = [0.4, 0.2, -1], max = [0.6, 0.3, 1] }\n\
+         [[loads.traction]]\ntraction = [0, 1, -2]\ninside = { min = [0.9, -1, -1], max = [2, 2, 1] }\n\
+         [[loads.pressure]]\npressure = 1e3\n",
+    );
+    let p = Pattern::for_scene(&sc);
+    let x = deformed(&sc);
+    let phi = vec![0.01; sc.num_edge_dofs()];
+    let pot = Potential {
+        dial: 0.6,
+        ..Potential::new(&sc, &p)
+    };
+    for i in 0..sc.terms.len() {
+        if sc.terms[i].name() != "traction" {
+            check_term(&sc, &p, &pot, &x, &phi, i);
+        }
+        checked.insert(sc.terms[i].name());
+    }
+    for name in [
+        "shell",
+        "contact",
+        "friction",
+        "inertia",
+        "gravity",
+        "point_load",
+        "traction",
+        "pressure",
+    ] {
         assert!(checked.contains(name), "{name} was not checked");
     }
 }

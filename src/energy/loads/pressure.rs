@@ -1,0 +1,126 @@
+//! Follower pressure on faces (`[[loads.pressure]]`), as the conservative potential of the
+//! volume it sweeps:
+//!
+//! `E = −s p V(x)`, `V = Σ_f (1/6) x₀·(x₁ × x₂)` over the loaded faces (signed volume of the
+//! cones to the origin), `s` the dial.
+//!
+//! `∂V/∂x₀ = (x₁ × x₂)/6` (cyclically), i.e. the vertex force `s p (x₁ × x₂)/6`; summed over the
+//! faces around an interior vertex this is exactly `s p Σ A_f n_f / 3`, the follower load along
+//! the normals. `∇²V` has zero diagonal blocks and `∂²V/∂x₀∂x₁ = −[x₂]×/6` (cyclically), so the
+//! Hessian is exact and symmetric. On a closed surface V is the enclosed volume; on an open one
+//! the origin enters only through the boundary vertices, which must therefore be held (fixed or
+//! clamped), and the registry refuses an open loaded region with a free boundary vertex. The
+//! per-face Hessian depends on the origin, so it is never projected face by face.
+//!
+//! Units: p in Pa, E in J, gradient N, Hessian N/m. DOF order (9): `x[v0], x[v1], x[v2]`.
+
+use super::select_faces;
+use crate::energy::term::{ElementKernel, ElementTerm, Stencil, Term};
+use crate::math::{skew, Real, SMat, SVec, Vec3};
+use crate::mesh::MeshError;
+use crate::scene::Scene;
+use crate::solve::Potential;
+
+/// The pressure kernel: pressure per face (Pa, 0 where unloaded).
+pub struct Pressure {
+    /// The loaded faces and their pressures.
+    pub faces: Vec<(usize, Real)>,
+}
+
+impl ElementKernel<9> for Pressure {
+    const SLOTS: usize = 3;
+
+    #[inline]
+    fn eval(
+        &self,
+        pot: &Potential,
+        e: usize,
+        nodes: &[usize],
+        x: &[Vec3],
+        _: &[Real],
+        _: bool,
+        grad: Option<&mut SVec<9>>,
+        hess: Option<&mut SMat<9, 9>>,
+    ) -> Real {
+        let w = -pot.dial * self.faces[e].1 / 6.0;
+        let [x0, x1, x2] = [x[nodes[0]], x[nodes[1]], x[nodes[2]]];
+        if let Some(g) = grad {
+            let gs = [x1.cross(&x2), x2.cross(&x0), x0.cross(&x1)];
+            for (i, gi) in gs.iter().enumerate() {
+                g.fixed_rows_mut::<3>(3 * i).copy_from(&(gi * w));
+            }
+        }
+        if let Some(h) = hess {
+            h.fill(0.0);
+            let xs = [x0, x1, x2];
+            for i in 0..3 {
+                let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+                // ∂²V/∂x_i∂x_j = −[x_k]×/6, and its transpose in (j, i).
+                let b = -skew(&xs[k]) * w;
+                h.fixed_view_mut::<3, 3>(3 * i, 3 * j).copy_from(&b);
+                h.fixed_view_mut::<3, 3>(3 * j, 3 * i)
+                    .copy_from(&b.transpose());
+            }
+        }
+        w * x0.dot(&x1.cross(&x2))
+    }
+}
+
+fn stencil(scene: &Scene, k: &Pressure) -> Stencil {
+    let p = &scene.mesh.positions;
+    let mut nodes = Vec::with_capacity(3 * k.faces.len());
+    let mut anchors = Vec::with_capacity(k.faces.len());
+    for &(f, _) in &k.faces {
+        let t = scene.mesh.faces[f];
+        nodes.extend_from_slice(&t);
+        anchors.push((p[t[0]] + p[t[1]] + p[t[2]]) / 3.0);
+    }
+    Stencil {
+        slot_dofs: vec![3; 3],
+        nodes,
+        anchors,
+    }
+}
+
+/// The pressure term of a scene (`None` without pressure loads). A loaded region whose
+/// boundary has a free vertex is refused (module doc); the mesh's orientation is consistent by
+/// the time a scene exists ([`crate::mesh::Topology::build`] refuses an inconsistent one).
+pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
+    let loads = &scene.settings.loads.pressure;
+    if loads.is_empty() {
+        return Ok(None);
+    }
+    let mesh = &scene.mesh;
+    let mut p = vec![0.0; scene.num_faces()];
+    for (i, l) in loads.iter().enumerate() {
+        for f in select_faces(mesh, &l.on, &format!("loads.pressure[{i}]"))? {
+            p[f] += l.pressure;
+        }
+    }
+    // Boundary of the loaded region: edges with exactly one loaded face.
+    let loaded = |f: usize| f != crate::mesh::topology::NONE && p[f] != 0.0;
+    for (e, ef) in scene.topo.edge_faces.iter().enumerate() {
+        if loaded(ef[0]) != loaded(ef[1]) {
+            for &v in &scene.topo.edges[e] {
+                if !scene.fixed[v] {
+                    return Err(mesh.invalid(format!(
+                        "loads.pressure: vertex {v} on the boundary of the loaded faces is free; a \
+                         pressure on an open surface needs its boundary held (fix or clamp it), or \
+                         load a closed surface"
+                    )));
+                }
+            }
+        }
+    }
+    let faces = p
+        .iter()
+        .enumerate()
+        .filter(|(_, &v)| v != 0.0)
+        .map(|(f, &v)| (f, v))
+        .collect();
+    Ok(Some(Box::new(ElementTerm {
+        name: "pressure",
+        kernel: Pressure { faces },
+        stencil,
+    })))
+}
