@@ -445,6 +445,7 @@ impl<'a> Solver<'a> {
             time,
             dial: pot.dial,
             energy: Default::default(),
+            observables: Vec::new(),
             residual: self.summary.residual,
             newton_iterations: now.newton - last.newton,
             steps: now.steps - last.steps,
@@ -598,9 +599,24 @@ fn run_static(
             NewtonOptions { tol: t, max_iter },
         );
         s.record(&rep);
+        // A term tracking a state across steps (a moment's angle) may refuse a step too large
+        // for it; the step is then cut like a failed solve.
+        let admissible = rep.converged && s.scene.admissible(&trial, &trial_phi);
+        let rep = if rep.converged && !admissible {
+            NewtonReport {
+                converged: false,
+                reason: "a boundary turned by more than π/2 in one step (a moment load tracks \
+                         its angle step by step)"
+                    .into(),
+                ..rep
+            }
+        } else {
+            rep
+        };
         if rep.converged {
             x.copy_from_slice(&trial);
             phi.copy_from_slice(&trial_phi);
+            s.scene.accept(&x, &phi);
             let grow = rep.iterations <= 5;
             if dial < 1.0 {
                 dial = target;
@@ -860,6 +876,7 @@ fn run_dynamic(
             v[i] = (trial[i] - x[i]) / h;
         }
         x.copy_from_slice(&trial);
+        sc.accept(&trial, &trial_phi);
         phi.copy_from_slice(&trial_phi);
         if let Some(m) = &mut moisture {
             m.u.copy_from_slice(&m.trial);

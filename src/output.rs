@@ -102,6 +102,9 @@ pub struct LogRow {
     /// Energies.
     #[serde(flatten)]
     pub energy: Energies,
+    /// Quantities the terms log (load–displacement measures), by column name.
+    #[serde(skip)]
+    pub observables: Vec<(String, Real)>,
     /// Relative residual ‖∇Φ‖∞/F of the last solve.
     pub residual: Real,
     /// Newton iterations since the previous frame.
@@ -291,6 +294,11 @@ impl Writer {
         let nf = sc.num_faces();
         let (a, b) = sc.forms(x, phi);
         row.energy = Self::energies(pot, x, phi, v);
+        row.observables = sc
+            .terms
+            .iter()
+            .flat_map(|t| t.observables(pot, x, phi))
+            .collect();
         let mut fa = Vec::with_capacity(3 * nf);
         let mut fb = Vec::with_capacity(3 * nf);
         let mut fab = Vec::with_capacity(3 * nf);
@@ -422,6 +430,9 @@ impl Writer {
             for (name, _) in r.energy.columns() {
                 s.push_str(&format!("energy_{name},"));
             }
+            for (name, _) in &r.observables {
+                s.push_str(&format!("{name},"));
+            }
         }
         s.push_str(
             "residual,newton_iterations,steps,shifted_iterations,gauss_newton_iterations,\
@@ -431,6 +442,9 @@ impl Writer {
             s.push_str(&format!("{},{:.12e},{:.6},", r.frame, r.time, r.dial));
             for (_, e) in r.energy.columns() {
                 s.push_str(&format!("{e:.12e},"));
+            }
+            for (_, o) in &r.observables {
+                s.push_str(&format!("{o:.12e},"));
             }
             s.push_str(&format!(
                 "{:.6e},{},{},{},{},{},{:.6}\n",

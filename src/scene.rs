@@ -216,10 +216,21 @@ impl Scene {
             for (e, ends) in topo.edges.iter().enumerate() {
                 let ef = topo.edge_faces[e];
                 if ef[1] == crate::mesh::topology::NONE && on[ends[0]] && on[ends[1]] {
-                    for &v in &mesh.faces[ef[0]] {
-                        fixed[v] = true;
-                    }
                     clamped_edges.push(e);
+                }
+            }
+            // The clamped boundary vertices and their edge neighbours (one ring) are held: the
+            // first row of faces stays rigid, which fixes the boundary's rotation.
+            let mut ring = vec![false; nv];
+            for &e in &clamped_edges[before..] {
+                for v in topo.edges[e] {
+                    ring[v] = true;
+                }
+            }
+            for ends in &topo.edges {
+                if ring[ends[0]] || ring[ends[1]] {
+                    fixed[ends[0]] = true;
+                    fixed[ends[1]] = true;
                 }
             }
             if clamped_edges.len() == before {
@@ -409,6 +420,20 @@ impl Scene {
             })
             .collect();
         (a, b)
+    }
+
+    /// Tells every term that `(x, phi)` is an accepted state (see
+    /// [`crate::energy::term::Term::accept`]).
+    pub fn accept(&self, x: &[Vec3], phi: &[Real]) {
+        for t in self.terms.iter() {
+            t.accept(x, phi);
+        }
+    }
+
+    /// Whether every term admits `(x, phi)` as the next accepted state (see
+    /// [`crate::energy::term::Term::admissible`]).
+    pub fn admissible(&self, x: &[Vec3], phi: &[Real]) -> bool {
+        self.terms.iter().all(|t| t.admissible(x, phi))
     }
 
     /// Moves the vertices on prescribed paths to `reference + dial × displacement`.

@@ -593,12 +593,30 @@ pub struct Loads {
     pub traction: Vec<TractionLoad>,
     /// Follower pressures on faces (`[[loads.pressure]]`, default: none).
     pub pressure: Vec<PressureLoad>,
+    /// Distributed moments along boundaries (`[[loads.moment]]`, default: none).
+    pub moment: Vec<MomentLoad>,
+}
+
+/// A distributed moment per unit length along the boundary edges whose two vertices are
+/// selected, scaled by the dial; see [`crate::energy::loads::moment`].
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MomentLoad {
+    /// Moment per unit length (N·m/m); positive turns the boundary's outward direction toward
+    /// the side the face normals point to.
+    pub moment: Real,
+    /// The boundary vertices.
+    #[serde(flatten)]
+    pub on: Selection,
 }
 
 impl Loads {
     /// Whether any point, traction or pressure load is given (gravity aside).
     pub fn any_external(&self) -> bool {
-        !(self.point.is_empty() && self.traction.is_empty() && self.pressure.is_empty())
+        !(self.point.is_empty()
+            && self.traction.is_empty()
+            && self.pressure.is_empty()
+            && self.moment.is_empty())
     }
 }
 
@@ -762,9 +780,9 @@ pub struct Constraints {
     pub fix_tags: Vec<i64>,
     /// Fix vertices inside any of these boxes (default: none).
     pub fix_boxes: Vec<FixBox>,
-    /// Clamped boundaries (`[[constraints.clamp]]`): the selected boundary vertices, and every
-    /// vertex and edge DOF of the faces that have a selected boundary edge, are held (positions
-    /// and rotation) (default: none).
+    /// Clamped boundaries (`[[constraints.clamp]]`): on the boundary edges whose two vertices
+    /// are selected, those vertices and their edge neighbours (one ring) are held, and with
+    /// edge DOFs the boundary edges' rotations too: positions and rotation (default: none).
     pub clamp: Vec<Selection>,
     /// Prescribed displacements (`[[constraints.displacement]]`): selected vertices move to
     /// `reference + dial × displacement` (default: none).

@@ -122,6 +122,7 @@ pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
         super::loads::point::term,
         super::loads::traction::term,
         super::loads::pressure::term,
+        super::loads::moment::term,
     ] {
         t.extend(load(scene)?);
     }

@@ -122,6 +122,22 @@ pub trait Term: Send + Sync {
         Vec::new()
     }
 
+    /// Called by the drivers after every accepted step (static continuation step or time
+    /// step) at the accepted state, for terms that track it (default: nothing).
+    fn accept(&self, _x: &[Vec3], _phi: &[Real]) {}
+
+    /// Whether `(x, phi)` may become the next accepted state (default: yes); a term that tracks
+    /// a state across steps refuses a step too large for it, and the driver cuts the step.
+    fn admissible(&self, _x: &[Vec3], _phi: &[Real]) -> bool {
+        true
+    }
+
+    /// Quantities to log per frame, by column name (default: none), e.g. a load's conjugate
+    /// displacement for load–displacement curves.
+    fn observables(&self, _pot: &Potential, _x: &[Vec3], _phi: &[Real]) -> Vec<(String, Real)> {
+        Vec::new()
+    }
+
     /// The dense low-rank part of the Hessian at `x` (default: none). Entries on fixed or
     /// pinned DOFs must be zero.
     fn low_rank(&self, _pot: &Potential, _x: &[Vec3], _phi: &[Real], _out: &mut Vec<LowRank>) {}
@@ -194,6 +210,10 @@ impl<K: ElementKernel<N>, const N: usize> Term for ElementTerm<K, N> {
 pub trait VertexKernel: Send + Sync {
     /// `None` when the vertex does not contribute.
     fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)>;
+    /// Quantities to log (see [`Term::observables`]; default: none).
+    fn observables(&self, _pot: &Potential, _x: &[Vec3]) -> Vec<(String, Real)> {
+        Vec::new()
+    }
 }
 
 /// A [`VertexKernel`] as a [`Term`]. Fixed vertices contribute nothing to Φ (a constant);
@@ -211,6 +231,9 @@ pub struct VertexTerm<K> {
 impl<K: VertexKernel> Term for VertexTerm<K> {
     fn name(&self) -> &'static str {
         self.name
+    }
+    fn observables(&self, pot: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
+        self.kernel.observables(pot, x)
     }
     fn energies(
         &self,

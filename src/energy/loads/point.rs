@@ -21,5 +21,9 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
             force[v] += f;
         }
     }
-    Ok(Some(nodal_term("point_load", force)))
+    Ok(Some(nodal_term(
+        "point_load",
+        "point_load_displacement",
+        force,
+    )))
 }

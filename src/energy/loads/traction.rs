@@ -40,5 +40,5 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
             )));
         }
     }
-    Ok(Some(nodal_term("traction", force)))
+    Ok(Some(nodal_term("traction", "traction_displacement", force)))
 }
