@@ -117,9 +117,9 @@ impl ElementKernel<10> for Moment {
         // ∂A/∂x_a = [x_{a+2} − x_{a+1}]×.
         let da: [Mat3; 3] = std::array::from_fn(|v| skew(&(xs[(v + 2) % 3] - xs[(v + 1) % 3])));
         if let Some(g) = grad {
-            for v in 0..3 {
+            for (v, d) in da.iter().enumerate() {
                 g.fixed_rows_mut::<3>(3 * v)
-                    .copy_from(&(da[v].transpose() * ga * w));
+                    .copy_from(&(d.transpose() * ga * w));
             }
             g[9] = if nodes[3] != NONE {
                 -w * edge.sigma
