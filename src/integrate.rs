@@ -605,9 +605,10 @@ fn run_static(
         let rep = if rep.converged && !admissible {
             NewtonReport {
                 converged: false,
-                reason: "a boundary turned by more than π/2 in one step (a moment load tracks \
-                         its angle step by step)"
-                    .into(),
+                failure: Some(crate::solve::SolveError::Refused(
+                    "a boundary turned by more than π/2 in one step (a moment load tracks its \
+                     angle step by step)",
+                )),
                 ..rep
             }
         } else {
@@ -645,7 +646,7 @@ fn run_static(
             if step < min_step {
                 failure = Some(format!(
                     "continuation step fell below {min_step} at dial {dial:.6}: {}",
-                    rep.reason
+                    rep.failure_text()
                 ));
                 break;
             }
@@ -655,7 +656,7 @@ fn run_static(
             if ratio < 1.01 {
                 failure = Some(format!(
                     "membrane continuation stalled at stretching weight {scale:.3e}: {}",
-                    rep.reason
+                    rep.failure_text()
                 ));
                 break;
             }
@@ -687,7 +688,7 @@ fn run_static(
             );
             s.record(&rep);
             if !rep.converged {
-                failure = Some(format!("after escaping a saddle: {}", rep.reason));
+                failure = Some(format!("after escaping a saddle: {}", rep.failure_text()));
                 break;
             }
         }
@@ -866,7 +867,8 @@ fn run_dynamic(
             if dt < tm.dt_min {
                 failure = Some(format!(
                     "time step fell below dt_min = {} at t = {t:.6e}: {}",
-                    tm.dt_min, rep.reason
+                    tm.dt_min,
+                    rep.failure_text()
                 ));
                 break;
             }

@@ -11,5 +11,5 @@ pub mod newton;
 pub mod potential;
 
 pub use linear::{LinearError, LinearSolver};
-pub use newton::{newton, NewtonOptions, NewtonReport};
+pub use newton::{newton, NewtonOptions, NewtonReport, SolveError};
 pub use potential::Potential;

@@ -46,7 +46,58 @@ pub struct NewtonReport {
     /// Total step halvings in line searches.
     pub line_search_cuts: usize,
     /// Why it stopped, when it did not converge.
-    pub reason: String,
+    pub failure: Option<SolveError>,
+}
+
+/// Why a Newton solve stopped without converging.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SolveError {
+    /// Φ or its gradient is NaN or infinite at the current iterate.
+    #[error("non-finite energy or gradient")]
+    NonFinite,
+    /// The Hessian has NaN or infinite entries.
+    #[error("non-finite Hessian")]
+    NonFiniteHessian,
+    /// The iteration limit was reached.
+    #[error("no convergence in {iterations} Newton iterations (residual {residual:.3e})")]
+    NotConverged {
+        /// Iterations done.
+        iterations: usize,
+        /// ‖∇Φ‖∞/F at the last iterate.
+        residual: Real,
+    },
+    /// Even the largest diagonal shift left a non-positive pivot.
+    #[error("Hessian could not be factorised even with a large shift")]
+    Factor,
+    /// The capacitance matrix of a low-rank Hessian part is singular.
+    #[error("the Hessian with its low-rank part is singular")]
+    LowRankSingular,
+    /// The step is not a descent direction (NaN or non-negative slope).
+    #[error("Newton step is not a descent direction")]
+    NotDescent,
+    /// No step length in 40 halvings decreased Φ enough.
+    #[error("line search stalled (residual {residual:.3e}, directional derivative {slope:.3e})")]
+    LineSearchStalled {
+        /// ‖∇Φ‖∞/F.
+        residual: Real,
+        /// ∇Φ·d.
+        slope: Real,
+    },
+    /// A term refused the converged state as the next accepted one (see
+    /// [`crate::energy::term::Term::admissible`]).
+    #[error("a term refused the step: {0}")]
+    Refused(&'static str),
+}
+
+impl NewtonReport {
+    /// The failure as text (empty when it converged).
+    pub fn failure_text(&self) -> String {
+        self.failure
+            .as_ref()
+            .map(|f| f.to_string())
+            .unwrap_or_default()
+    }
 }
 
 /// Reusable buffers of a Newton solve.
@@ -155,7 +206,7 @@ pub fn newton(
         rep.energy = e;
         rep.residual = pot.residual(&ws.grad);
         if !e.is_finite() || !rep.residual.is_finite() {
-            rep.reason = "non-finite energy or gradient".into();
+            rep.failure = Some(SolveError::NonFinite);
             return rep;
         }
         if rep.residual <= opts.tol {
@@ -163,14 +214,14 @@ pub fn newton(
             return rep;
         }
         if rep.iterations >= opts.max_iter {
-            rep.reason = format!(
-                "no convergence in {} Newton iterations (residual {:.3e})",
-                opts.max_iter, rep.residual
-            );
+            rep.failure = Some(SolveError::NotConverged {
+                iterations: opts.max_iter,
+                residual: rep.residual,
+            });
             return rep;
         }
         if ws.values.iter().any(|v| !v.is_finite()) {
-            rep.reason = "non-finite Hessian".into();
+            rep.failure = Some(SolveError::NonFiniteHessian);
             return rep;
         }
         let mut tau0 = if tau_prev > 1e-8 {
@@ -217,7 +268,7 @@ pub fn newton(
             match factor_with_shift(lin, pot, &ws.values, &mut ws.shifted, tau0) {
                 Some(t) => t,
                 None => {
-                    rep.reason = "Hessian could not be factorised even with a large shift".into();
+                    rep.failure = Some(SolveError::Factor);
                     return rep;
                 }
             }
@@ -236,14 +287,14 @@ pub fn newton(
         } else {
             let wb = super::low_rank::Woodbury::new(lin, &lr);
             if !wb.solve_in_place(lin, &mut ws.step) {
-                rep.reason = "the Hessian with its low-rank part is singular".into();
+                rep.failure = Some(SolveError::LowRankSingular);
                 return rep;
             }
         }
         rep.iterations += 1;
         let slope: Real = ws.step.iter().zip(&ws.grad).map(|(d, g)| d * g).sum();
         if slope.is_nan() || slope >= 0.0 {
-            rep.reason = "Newton step is not a descent direction".into();
+            rep.failure = Some(SolveError::NotDescent);
             return rep;
         }
         // Backtracking line search. Near convergence Φ changes at round-off level; allow a
@@ -269,10 +320,10 @@ pub fn newton(
             rep.line_search_cuts += 1;
         }
         if !accepted {
-            rep.reason = format!(
-                "line search stalled (residual {:.3e}, directional derivative {:.3e})",
-                rep.residual, slope
-            );
+            rep.failure = Some(SolveError::LineSearchStalled {
+                residual: rep.residual,
+                slope,
+            });
             return rep;
         }
         x.copy_from_slice(&ws.trial);
