@@ -920,7 +920,7 @@ impl Settings {
 
     /// Checks ranges and consistency.
     /// Validates `[material]`'s membrane model and its constants.
-    pub fn validate_material(&self, name: &str) -> Result<(), SettingsError> {
+    fn validate_material_model(&self, name: &str) -> Result<(), SettingsError> {
         let inv = |key: &str, reason: String| {
             Err(SettingsError::Invalid {
                 path: name.to_string(),
@@ -970,49 +970,52 @@ impl Settings {
         Ok(())
     }
 
-    /// Validates every section (see the per-section validators).
+    /// Validates every section, each by its own function (errors name the file and key).
     pub fn validate(&self, name: &str) -> Result<(), SettingsError> {
-        let inv = |key: &str, reason: String| {
-            Err(SettingsError::Invalid {
-                path: name.to_string(),
-                key: key.into(),
-                reason,
-            })
-        };
-        let pos = |key: &str, v: Real| -> Result<(), SettingsError> {
-            if !(v.is_finite() && v > 0.0) {
-                return inv(key, format!("must be a positive number, got {v}"));
-            }
-            Ok(())
-        };
-        let nonneg = |key: &str, v: Real| -> Result<(), SettingsError> {
-            if !(v.is_finite() && v >= 0.0) {
-                return inv(key, format!("must be a non-negative number, got {v}"));
-            }
-            Ok(())
-        };
+        self.validate_material(name)?;
+        self.validate_rest(name)?;
+        self.validate_solver(name)?;
+        self.validate_growth(name)?;
+        self.validate_moisture(name)?;
+        self.validate_time(name)?;
+        self.validate_loads(name)?;
+        self.validate_contact(name)?;
+        self.validate_constraints(name)?;
+        self.validate_output(name)?;
+        Ok(())
+    }
+
+    /// Validates `[material]`: moduli, density, thickness, Poisson's ratio, the membrane model and its constants.
+    pub fn validate_material(&self, name: &str) -> Result<(), SettingsError> {
+        let ck = Check(name);
         let m = &self.material;
-        pos("material.young", m.young)?;
-        pos("material.density", m.density)?;
-        pos("material.thickness", m.thickness)?;
+        ck.pos("material.young", m.young)?;
+        ck.pos("material.density", m.density)?;
+        ck.pos("material.thickness", m.thickness)?;
         if !(m.poisson > -1.0 && m.poisson <= 0.5) {
-            return inv(
+            return ck.inv(
                 "material.poisson",
                 format!("must lie in (-1, 0.5], got {}", m.poisson),
             );
         }
-        self.validate_material(name)?;
+        self.validate_material_model(name)?;
+        Ok(())
+    }
+
+    /// Validates `[rest]`: finite (or parseable) target forms, a positive definite uniform ā, the dial time.
+    pub fn validate_rest(&self, name: &str) -> Result<(), SettingsError> {
+        let ck = Check(name);
         let r = &self.rest;
         for (name, form) in [("abar", &r.abar), ("bbar", &r.bbar)] {
             for (i, v) in form.iter().enumerate() {
                 let key = format!("rest.{name}[{i}]");
                 match v {
                     Field::Value(v) if !v.is_finite() => {
-                        return inv(&key, format!("must be finite, got {v}"))
+                        return ck.inv(&key, format!("must be finite, got {v}"))
                     }
                     Field::Expr(_) => {
                         if let Err(e) = v.compile() {
-                            return inv(&key, e);
+                            return ck.inv(&key, e);
                         }
                     }
                     _ => {}
@@ -1021,34 +1024,46 @@ impl Settings {
         }
         if let [Some(a0), Some(a1), Some(a2)] = r.abar.clone().map(|f| f.constant()) {
             if r.target == TargetForms::Uniform && !(a0 > 0.0 && a0 * a2 - a1 * a1 > 0.0) {
-                return inv(
+                return ck.inv(
                     "rest.abar",
                     format!("must be positive definite, got [{a0}, {a1}, {a2}]"),
                 );
             }
         }
-        nonneg("rest.dial_time", r.dial_time)?;
+        ck.nonneg("rest.dial_time", r.dial_time)?;
+        Ok(())
+    }
+
+    /// Validates `[solver]`: tolerance, iteration and continuation controls.
+    pub fn validate_solver(&self, name: &str) -> Result<(), SettingsError> {
+        let ck = Check(name);
         let s = &self.solver;
-        pos("solver.tolerance", s.tolerance)?;
+        ck.pos("solver.tolerance", s.tolerance)?;
         if s.max_newton_iterations == 0 {
-            return inv("solver.max_newton_iterations", "must be at least 1".into());
+            return ck.inv("solver.max_newton_iterations", "must be at least 1".into());
         }
         if !(s.continuation_step > 0.0 && s.continuation_step <= 1.0) {
-            return inv(
+            return ck.inv(
                 "solver.continuation_step",
                 format!("must lie in (0, 1], got {}", s.continuation_step),
             );
         }
-        pos("solver.min_continuation_step", s.min_continuation_step)?;
+        ck.pos("solver.min_continuation_step", s.min_continuation_step)?;
         if let Softening::Factor(c) = s.membrane_continuation {
             if !(c >= 1.0 && c.is_finite()) {
-                return inv(
+                return ck.inv(
                     "solver.membrane_continuation",
                     format!("must be \"auto\" or a finite number ≥ 1, got {c}"),
                 );
             }
         }
-        nonneg("solver.symmetry_breaking", s.symmetry_breaking)?;
+        ck.nonneg("solver.symmetry_breaking", s.symmetry_breaking)?;
+        Ok(())
+    }
+
+    /// Validates `[growth]`: finite coefficients, a valid `s`, and no growth law together with `rest.target`.
+    pub fn validate_growth(&self, name: &str) -> Result<(), SettingsError> {
+        let ck = Check(name);
         let g = &self.growth;
         for (k, v) in [
             ("growth.mu", g.mu),
@@ -1059,22 +1074,22 @@ impl Settings {
             ("growth.moisture_bottom", g.moisture_bottom),
         ] {
             if !v.is_finite() {
-                return inv(k, format!("must be a finite number, got {v}"));
+                return ck.inv(k, format!("must be a finite number, got {v}"));
             }
         }
         match &g.s {
             Field::Value(v) if !v.is_finite() => {
-                return inv("growth.s", format!("must be finite, got {v}"))
+                return ck.inv("growth.s", format!("must be finite, got {v}"))
             }
             Field::Expr(_) => {
                 if let Err(e) = g.s.compile() {
-                    return inv("growth.s", e);
+                    return ck.inv("growth.s", e);
                 }
             }
             _ => {}
         }
         if g.law != GrowthLaw::None && self.rest.target != TargetForms::None {
-            return inv(
+            return ck.inv(
                 "growth.law",
                 format!(
                     "a growth law computes the target forms, so rest.target must be \"none\" \
@@ -1083,6 +1098,13 @@ impl Settings {
                 ),
             );
         }
+        Ok(())
+    }
+
+    /// Validates `[moisture]` (when enabled): diffusivities, layers, the surfaces, the ground exchange, and the dynamic mode and swelling law it needs.
+    pub fn validate_moisture(&self, name: &str) -> Result<(), SettingsError> {
+        let ck = Check(name);
+        let g = &self.growth;
         let mo = &self.moisture;
         if mo.enabled {
             for (k, v) in [
@@ -1090,39 +1112,39 @@ impl Settings {
                 ("moisture.diffusivity_across", mo.diffusivity_across),
                 ("moisture.diffusivity_through", mo.diffusivity_through),
             ] {
-                pos(k, v)?;
+                ck.pos(k, v)?;
             }
-            pos("moisture.max_change", mo.max_change)?;
-            nonneg("moisture.water_density", mo.water_density)?;
+            ck.pos("moisture.max_change", mo.max_change)?;
+            ck.nonneg("moisture.water_density", mo.water_density)?;
             if let Some(g) = &mo.ground {
-                nonneg("moisture.ground.k", g.k)?;
+                ck.nonneg("moisture.ground.k", g.k)?;
                 if !g.value.is_finite() {
-                    return inv(
+                    return ck.inv(
                         "moisture.ground.value",
                         format!("must be finite, got {}", g.value),
                     );
                 }
                 if let AutoOr::Value(d) = g.distance {
-                    nonneg("moisture.ground.distance", d)?;
+                    ck.nonneg("moisture.ground.distance", d)?;
                 }
                 if !self.contact.enabled {
-                    return inv(
+                    return ck.inv(
                         "moisture.ground",
                         "needs a ground: set contact.enabled = true".into(),
                     );
                 }
             }
             if mo.layers == 0 {
-                return inv("moisture.layers", "must be at least 1".into());
+                return ck.inv("moisture.layers", "must be at least 1".into());
             }
             if !mo.initial.is_finite() {
-                return inv(
+                return ck.inv(
                     "moisture.initial",
                     format!("must be finite, got {}", mo.initial),
                 );
             }
             if self.solver.mode != Mode::Dynamic {
-                return inv(
+                return ck.inv(
                     "moisture.enabled",
                     "moisture diffusion runs in time: set solver.mode = \"dynamic\"".into(),
                 );
@@ -1131,7 +1153,7 @@ impl Settings {
                 g.law,
                 GrowthLaw::LinearSwelling | GrowthLaw::Bilayer | GrowthLaw::MachineDirection
             ) {
-                return inv(
+                return ck.inv(
                     "moisture.enabled",
                     format!(
                         "moisture drives the rest forms through a swelling law; growth.law is \
@@ -1143,36 +1165,42 @@ impl Settings {
             for (i, b) in mo.boundary.iter().enumerate() {
                 for v in [b.value, b.k, b.ambient] {
                     if !v.is_finite() {
-                        return inv(
+                        return ck.inv(
                             &format!("moisture.boundary[{i}]"),
                             format!("non-finite value {v}"),
                         );
                     }
                 }
                 if b.tape && b.kind != SurfaceKind::Sealed {
-                    return inv(
+                    return ck.inv(
                         &format!("moisture.boundary[{i}].tape"),
                         "tape is a sealed surface: needs kind = \"sealed\"".into(),
                     );
                 }
                 if b.kind == SurfaceKind::Robin && b.k < 0.0 {
-                    return inv(
+                    return ck.inv(
                         &format!("moisture.boundary[{i}].k"),
                         format!("must be ≥ 0, got {}", b.k),
                     );
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Validates `[time]`: positive times, `dt_min ≤ dt ≤ dt_max`.
+    pub fn validate_time(&self, name: &str) -> Result<(), SettingsError> {
+        let ck = Check(name);
         let t = &self.time;
-        pos("time.end", t.end)?;
-        pos("time.dt", t.dt)?;
-        pos("time.dt_min", t.dt_min)?;
-        pos("time.dt_max", t.dt_max)?;
-        pos("time.output_interval", t.output_interval)?;
-        nonneg("time.damping", t.damping)?;
-        pos("time.equilibrium_kinetic", t.equilibrium_kinetic)?;
+        ck.pos("time.end", t.end)?;
+        ck.pos("time.dt", t.dt)?;
+        ck.pos("time.dt_min", t.dt_min)?;
+        ck.pos("time.dt_max", t.dt_max)?;
+        ck.pos("time.output_interval", t.output_interval)?;
+        ck.nonneg("time.damping", t.damping)?;
+        ck.pos("time.equilibrium_kinetic", t.equilibrium_kinetic)?;
         if t.dt_min > t.dt || t.dt > t.dt_max {
-            return inv(
+            return ck.inv(
                 "time.dt",
                 format!(
                     "need dt_min ≤ dt ≤ dt_max, got {} ≤ {} ≤ {}",
@@ -1180,45 +1208,153 @@ impl Settings {
                 ),
             );
         }
+        Ok(())
+    }
+
+    /// Validates `[loads]`: finite gravity and finite load values with well-formed selections.
+    pub fn validate_loads(&self, name: &str) -> Result<(), SettingsError> {
+        let ck = Check(name);
         if self.loads.gravity.iter().any(|g| !g.is_finite()) {
-            return inv("loads.gravity", "must be finite".into());
+            return ck.inv("loads.gravity", "must be finite".into());
         }
+        let l = &self.loads;
+        let finite3 = |key: String, v: &[Real; 3]| -> Result<(), SettingsError> {
+            if v.iter().all(|c| c.is_finite()) {
+                Ok(())
+            } else {
+                ck.inv(&key, format!("must be finite, got {v:?}"))
+            }
+        };
+        for (i, p) in l.point.iter().enumerate() {
+            finite3(format!("loads.point[{i}].force"), &p.force)?;
+            ck.selection(&format!("loads.point[{i}]"), &p.on)?;
+        }
+        for (i, t) in l.traction.iter().enumerate() {
+            finite3(format!("loads.traction[{i}].traction"), &t.traction)?;
+            ck.selection(&format!("loads.traction[{i}]"), &t.on)?;
+        }
+        for (i, p) in l.pressure.iter().enumerate() {
+            if !p.pressure.is_finite() {
+                return ck.inv(
+                    &format!("loads.pressure[{i}].pressure"),
+                    format!("must be finite, got {}", p.pressure),
+                );
+            }
+            ck.selection(&format!("loads.pressure[{i}]"), &p.on)?;
+        }
+        for (i, m) in l.moment.iter().enumerate() {
+            if !m.moment.is_finite() {
+                return ck.inv(
+                    &format!("loads.moment[{i}].moment"),
+                    format!("must be finite, got {}", m.moment),
+                );
+            }
+            ck.selection(&format!("loads.moment[{i}]"), &m.on)?;
+        }
+        Ok(())
+    }
+
+    /// Validates `[contact]` (when enabled): the plane, stiffness, smoothing, friction.
+    pub fn validate_contact(&self, name: &str) -> Result<(), SettingsError> {
+        let ck = Check(name);
         let c = &self.contact;
         if c.enabled {
             if c.point.iter().any(|v| !v.is_finite()) {
-                return inv("contact.point", "must be finite".into());
+                return ck.inv("contact.point", "must be finite".into());
             }
             let n2: Real = c.normal.iter().map(|v| v * v).sum();
             if !(n2.is_finite() && n2 > 0.0) {
-                return inv(
+                return ck.inv(
                     "contact.normal",
                     format!("must be a finite non-zero vector, got {:?}", c.normal),
                 );
             }
             if let AutoOr::Value(k) = c.stiffness {
-                pos("contact.stiffness", k)?;
+                ck.pos("contact.stiffness", k)?;
             }
             if let AutoOr::Value(d) = c.smoothing {
-                pos("contact.smoothing", d)?;
+                ck.pos("contact.smoothing", d)?;
             }
-            nonneg("contact.friction", c.friction)?;
-            pos("contact.slip_speed", c.slip_speed)?;
+            ck.nonneg("contact.friction", c.friction)?;
+            ck.pos("contact.slip_speed", c.slip_speed)?;
         }
+        Ok(())
+    }
+
+    /// Validates `[constraints]`: well-formed boxes and selections, finite displacements.
+    pub fn validate_constraints(&self, name: &str) -> Result<(), SettingsError> {
+        let ck = Check(name);
         for (i, b) in self.constraints.fix_boxes.iter().enumerate() {
             if b.min.iter().chain(b.max.iter()).any(|v| !v.is_finite())
                 || (0..3).any(|k| b.min[k] > b.max[k])
             {
-                return inv(
+                return ck.inv(
                     &format!("constraints.fix_boxes[{i}]"),
                     "needs finite min ≤ max".into(),
                 );
             }
         }
+        let cs = &self.constraints;
+        for (i, sel) in cs.clamp.iter().enumerate() {
+            ck.selection(&format!("constraints.clamp[{i}]"), sel)?;
+        }
+        for (i, d) in cs.displacement.iter().enumerate() {
+            if !d.displacement.iter().all(|c| c.is_finite()) {
+                return ck.inv(
+                    &format!("constraints.displacement[{i}].displacement"),
+                    format!("must be finite, got {:?}", d.displacement),
+                );
+            }
+            ck.selection(&format!("constraints.displacement[{i}]"), &d.on)?;
+        }
+        Ok(())
+    }
+
+    /// Validates `[output]`: a plain file-name prefix.
+    pub fn validate_output(&self, name: &str) -> Result<(), SettingsError> {
+        let ck = Check(name);
         if self.output.prefix.is_empty() || self.output.prefix.contains(['/', '\\']) {
-            return inv(
+            return ck.inv(
                 "output.prefix",
                 "must be a plain, non-empty file name".into(),
             );
+        }
+        Ok(())
+    }
+}
+
+/// The error helpers of the section validators for one settings file.
+#[derive(Clone, Copy)]
+struct Check<'a>(&'a str);
+
+impl Check<'_> {
+    fn inv(&self, key: &str, reason: String) -> Result<(), SettingsError> {
+        Err(SettingsError::Invalid {
+            path: self.0.to_string(),
+            key: key.into(),
+            reason,
+        })
+    }
+    fn pos(&self, key: &str, v: Real) -> Result<(), SettingsError> {
+        if !(v.is_finite() && v > 0.0) {
+            return self.inv(key, format!("must be a positive number, got {v}"));
+        }
+        Ok(())
+    }
+    fn nonneg(&self, key: &str, v: Real) -> Result<(), SettingsError> {
+        if !(v.is_finite() && v >= 0.0) {
+            return self.inv(key, format!("must be a non-negative number, got {v}"));
+        }
+        Ok(())
+    }
+    /// A selection's box must be finite with min ≤ max.
+    fn selection(&self, key: &str, sel: &Selection) -> Result<(), SettingsError> {
+        if let Some(b) = &sel.inside {
+            if b.min.iter().chain(b.max.iter()).any(|v| !v.is_finite())
+                || (0..3).any(|k| b.min[k] > b.max[k])
+            {
+                return self.inv(&format!("{key}.inside"), "needs finite min ≤ max".into());
+            }
         }
         Ok(())
     }

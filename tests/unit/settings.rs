@@ -109,3 +109,73 @@ fn expressions_of_x_y_give_the_per_face_forms() {
         assert!(format!("{e:#}").contains(needle), "{e:#}");
     }
 }
+
+/// Each section's validator accepts the defaults and refuses a bad value in its own section,
+/// naming the key; the other sections' validators do not see it.
+#[test]
+fn each_section_validates_itself() {
+    type V = fn(&Settings, &str) -> Result<(), shellsim::settings::SettingsError>;
+    let cases: [(&str, V, &str); 10] = [
+        ("material.young", Settings::validate_material, "young = -1"),
+        ("rest.dial_time", Settings::validate_rest, "dial_time = -1"),
+        (
+            "solver.tolerance",
+            Settings::validate_solver,
+            "tolerance = 0",
+        ),
+        ("growth.mu", Settings::validate_growth, "mu = nan"),
+        (
+            "moisture.layers",
+            Settings::validate_moisture,
+            "enabled = true\nlayers = 0",
+        ),
+        ("time.dt", Settings::validate_time, "dt = 10"),
+        (
+            "loads.point[0].force",
+            Settings::validate_loads,
+            "point = [{ force = [nan, 0, 0], tags = [1] }]",
+        ),
+        (
+            "contact.normal",
+            Settings::validate_contact,
+            "enabled = true\nnormal = [0, 0, 0]",
+        ),
+        (
+            "constraints.clamp[0].inside",
+            Settings::validate_constraints,
+            "clamp = [{ inside = { min = [1, 0, 0], max = [0, 1, 1] } }]",
+        ),
+        (
+            "output.prefix",
+            Settings::validate_output,
+            "prefix = \"a/b\"",
+        ),
+    ];
+    let defaults = Settings::default();
+    for (key, validate, line) in cases {
+        assert!(
+            validate(&defaults, "d.toml").is_ok(),
+            "{key}: defaults refused"
+        );
+        let section = key.split('.').next().unwrap();
+        let text = format!("[{section}]\n{line}\n");
+        let s: Settings = toml::from_str(&text).unwrap_or_else(|e| panic!("{text}: {e}"));
+        let err = validate(&s, "bad.toml").expect_err(key).to_string();
+        assert!(
+            err.contains(key) && err.contains("bad.toml"),
+            "{key}: {err}"
+        );
+        // The whole file is refused through the same validator.
+        assert!(s.validate("bad.toml").is_err(), "{key}");
+        // Another section's validator does not look at it.
+        let other = if section == "output" {
+            Settings::validate_material
+        } else {
+            Settings::validate_output
+        };
+        assert!(
+            other(&s, "bad.toml").is_ok(),
+            "{key}: another validator refused it"
+        );
+    }
+}
