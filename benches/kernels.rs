@@ -86,6 +86,60 @@ fn kernel(c: &mut Criterion) {
             })
         });
     }
+    {
+        // Seed 003's Baraff–Witkin membrane with no bending (9 DOFs), stretched past s = 1.
+        use shellsim::energy::bending::none::NoBending;
+        use shellsim::energy::membrane::baraff_witkin::BaraffWitkinFace;
+        use shellsim::energy::membrane::WithKoiterBending;
+        use shellsim::energy::shell::shell_element;
+        let law = BaraffWitkinFace::new(
+            &Sym2::new(1.1, 0.05, 0.9),
+            &shellsim::math::Vec2::new(1.0, 0.2),
+            0.01,
+            5e5,
+            2e5,
+            100.0,
+        );
+        let dens = WithKoiterBending {
+            law,
+            koiter: KoiterDensity {
+                stretch: [(0.0, Sym2::zeros()); 2],
+                bend: [(0.0, Sym2::zeros()); 2],
+                ..d
+            },
+        };
+        let xs = [x[0] * 1.05, x[1] * 1.05, x[2], x[0], x[0], x[0]];
+        for (name, gn) in [
+            ("baraff_witkin/energy+gradient+hessian", false),
+            ("baraff_witkin/psd", true),
+        ] {
+            g.bench_function(name, |b| {
+                let mut gr = SVec::<9>::zeros();
+                let mut h = SMat::<9, 9>::zeros();
+                b.iter(|| {
+                    if gn {
+                        shell_element::<_, NoBending, 9, 3, true>(
+                            &NoBending,
+                            &(),
+                            black_box(&xs),
+                            &dens,
+                            Some(&mut gr),
+                            Some(&mut h),
+                        )
+                    } else {
+                        shell_element::<_, NoBending, 9, 3, false>(
+                            &NoBending,
+                            &(),
+                            black_box(&xs),
+                            &dens,
+                            Some(&mut gr),
+                            Some(&mut h),
+                        )
+                    }
+                })
+            });
+        }
+    }
     g.finish();
 }
 
@@ -94,6 +148,10 @@ fn scene(edge: f64) -> Scene {
 }
 
 fn scene_with(edge: f64, model: &str) -> Scene {
+    scene_with_material(edge, model, "koiter")
+}
+
+fn scene_with_material(edge: f64, model: &str, material: &str) -> Scene {
     let mut m = rectangle(
         -0.5,
         -0.5,
@@ -109,7 +167,8 @@ fn scene_with(edge: f64, model: &str) -> Scene {
     Case::SphericalCap.program(&mut m);
     let s = Settings::from_str_with(
         &format!(
-            "[material]\nthickness = 0.05\nbending = \"{model}\"\n[rest]\ntarget = \"mesh\"\n"
+            "[material]\nthickness = 0.05\nbending = \"{model}\"\nmodel = \"{material}\"\n\
+             [rest]\ntarget = \"mesh\"\n"
         ),
         "bench",
         &[],
@@ -212,6 +271,25 @@ fn assembly(c: &mut Criterion) {
                 let mut gr = vec![0.0; p.n];
                 let mut h = vec![0.0; p.nnz()];
                 b.iter(|| pool.install(|| pot.eval(&x, &phi, Want::Hessian, &mut gr, &mut h)))
+            },
+        );
+    }
+    // A membrane-only (no bending) Baraff–Witkin sheet of the same size.
+    let sc = scene_with_material(1.0 / 224.0, "none", "baraff_witkin");
+    let p = Pattern::for_scene(&sc);
+    for threads in [1usize, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        g.bench_with_input(
+            BenchmarkId::new("baraff_witkin_membrane_hessian", threads),
+            &threads,
+            |b, _| {
+                let pot = potential(&sc, &p);
+                let mut gr = vec![0.0; p.n];
+                let mut h = vec![0.0; p.nnz()];
+                b.iter(|| pool.install(|| pot.eval(&x, &[], Want::Hessian, &mut gr, &mut h)))
             },
         );
     }

@@ -249,24 +249,26 @@ impl ElementMap {
         self.colours.len()
     }
 
-    /// Adds an element gradient into `grad`, skipping fixed nodes.
+    /// Adds an element gradient into `grad`, skipping fixed nodes; `S` slots (= `self.slots`).
     ///
     /// # Safety
     /// No other thread writes the gradient entries of element `e`'s nodes concurrently.
-    #[inline]
-    unsafe fn scatter_gradient<const N: usize>(
+    #[inline(always)]
+    unsafe fn scatter_gradient<const N: usize, const S: usize>(
         &self,
-        e: usize,
+        st: &[usize; S],
+        local: &[usize; S],
         g: &SVec<N>,
         fixed: &[bool],
         grad: Shared,
     ) {
-        for (s, &u) in self.element(e).iter().enumerate() {
+        for s in 0..S {
+            let u = st[s];
             if u == NONE || fixed[u] {
                 continue;
             }
             let (d0, k) = node_dofs(self.num_vertices, u);
-            let l = self.local[s];
+            let l = local[s];
             for c in 0..k {
                 unsafe { grad.add(d0 + c, g[l + c]) };
             }
@@ -277,31 +279,32 @@ impl ElementMap {
     ///
     /// # Safety
     /// No other thread writes the Hessian columns of element `e`'s nodes concurrently.
-    #[inline]
-    unsafe fn scatter_hessian<const N: usize>(
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    unsafe fn scatter_hessian<const N: usize, const S: usize>(
         &self,
         pattern_col_ptr: &[usize],
         e: usize,
+        st: &[usize; S],
+        local: &[usize; S],
         h: &SMat<N, N>,
         fixed: &[bool],
         values: Shared,
     ) {
-        let sl = self.slots;
-        let st = self.element(e);
-        let off = &self.offsets[e * sl * sl..(e + 1) * sl * sl];
-        for t in 0..sl {
+        let off = &self.offsets[e * S * S..(e + 1) * S * S];
+        for t in 0..S {
             let v = st[t];
             if v == NONE || fixed[v] {
                 continue;
             }
             let (dv, kv) = node_dofs(self.num_vertices, v);
-            let lt = self.local[t];
-            for s in 0..sl {
+            let lt = local[t];
+            for s in 0..S {
                 let u = st[s];
                 if u == NONE || fixed[u] || u < v {
                     continue;
                 }
-                let ls = self.local[s];
+                let ls = local[s];
                 let ku = node_dofs(self.num_vertices, u).1;
                 for d in 0..kv {
                     let base = pattern_col_ptr[dv + d];
@@ -312,7 +315,7 @@ impl ElementMap {
                             unsafe { values.add(base + c - d, h[(ls + c, lt + d)]) };
                         }
                     } else {
-                        let o = base + (kv - d) + off[sl * s + t] as usize;
+                        let o = base + (kv - d) + off[S * s + t] as usize;
                         for c in 0..ku {
                             unsafe { values.add(o + c, h[(ls + c, lt + d)]) };
                         }
@@ -442,9 +445,10 @@ impl Shared {
 
 /// Accumulates one element term into `grad` (len n) and `values` (len nnz) as `want` says and
 /// returns its energy, summed in element order. `kernel(e, nodes, grad, hess)` evaluates
-/// element `e` with `N` local DOFs (slot `s` at `map.local[s]`); `fixed` is per node.
+/// element `e` with `N` local DOFs and `S` slots (slot `s` at `map.local[s]`); `fixed` is per
+/// node. `S` must equal `map.slots`.
 #[allow(clippy::too_many_arguments)]
-pub fn assemble_elements<const N: usize, K>(
+pub fn assemble_elements<const N: usize, const S: usize, K>(
     map: &ElementMap,
     kernel: K,
     fixed: &[bool],
@@ -457,6 +461,7 @@ pub fn assemble_elements<const N: usize, K>(
 where
     K: Fn(usize, &[usize], Option<&mut SVec<N>>, Option<&mut SMat<N, N>>) -> Real + Sync,
 {
+    assert_eq!(map.slots, S, "element map and kernel disagree on the slots");
     let ne = map.len();
     if want == Want::Energy {
         let es: Vec<Real> = (0..ne)
@@ -465,6 +470,8 @@ where
             .collect();
         return es.iter().sum();
     }
+    let mut local = [0usize; S];
+    local.copy_from_slice(&map.local);
     let mut energies = vec![0.0; ne];
     let (ep, gp) = (Shared::new(&mut energies), Shared::new(grad));
     let vp = Shared::new(values);
@@ -473,15 +480,17 @@ where
             let mut g = SVec::<N>::zeros();
             let mut h = SMat::<N, N>::zeros();
             for &e in block {
+                let mut st = [NONE; S];
+                st.copy_from_slice(map.element(e));
                 let hout = (want == Want::Hessian).then_some(&mut h);
-                let en = kernel(e, map.element(e), Some(&mut g), hout);
+                let en = kernel(e, &st, Some(&mut g), hout);
                 // SAFETY: see `Shared`: blocks of one colour touch disjoint entries.
                 unsafe {
                     ep.add(e, en);
-                    map.scatter_gradient(e, &g, fixed, gp);
+                    map.scatter_gradient(&st, &local, &g, fixed, gp);
                     if want == Want::Hessian {
                         project(&mut h, projection);
-                        map.scatter_hessian(col_ptr, e, &h, fixed, vp);
+                        map.scatter_hessian(col_ptr, e, &st, &local, &h, fixed, vp);
                     }
                 }
             }

@@ -42,7 +42,13 @@ pub fn face_forms(x: &[Vec3; 6], has: [bool; 3]) -> (Sym2, Sym2) {
 /// bending model `model` (per-face input `face`), stencil positions `x`, optional gradient and
 /// Hessian over the model's `N` DOFs. `GN` selects the Gauss–Newton Hessian.
 #[inline(always)]
-pub fn shell_element<D: FaceDensity, B: BendingModel<N>, const N: usize, const GN: bool>(
+pub fn shell_element<
+    D: FaceDensity,
+    B: BendingModel<N, S>,
+    const N: usize,
+    const S: usize,
+    const GN: bool,
+>(
     model: &B,
     face: &B::Face,
     x: &[Vec3; 6],
@@ -87,10 +93,7 @@ pub fn shell_element<D: FaceDensity, B: BendingModel<N>, const N: usize, const G
             }
         }
         if let Some(ev) = &ev {
-            *h += ev.jac * d.hbb * ev.jac.transpose();
-            if !GN {
-                model.add_hessian(face, x, ev, &d.gb, h);
-            }
+            model.add_bending_hessian(face, x, ev, &d.hbb, (!GN).then_some(&d.gb), h);
         }
     }
     if let Some(gout) = grad {
@@ -109,7 +112,7 @@ pub fn shell_face<D: FaceDensity>(
     grad: Option<&mut SVec<18>>,
     hess: Option<&mut SMat<18, 18>>,
 ) -> Real {
-    shell_element::<D, MidedgeAverage, 18, false>(&MidedgeAverage, &has, x, dens, grad, hess)
+    shell_element::<D, MidedgeAverage, 18, 6, false>(&MidedgeAverage, &has, x, dens, grad, hess)
 }
 
 /// As [`shell_face`], but the Hessian is the Gauss–Newton part only,
@@ -123,11 +126,11 @@ pub fn shell_face_gauss_newton<D: FaceDensity>(
     grad: Option<&mut SVec<18>>,
     hess: Option<&mut SMat<18, 18>>,
 ) -> Real {
-    shell_element::<D, MidedgeAverage, 18, true>(&MidedgeAverage, &has, x, dens, grad, hess)
+    shell_element::<D, MidedgeAverage, 18, 6, true>(&MidedgeAverage, &has, x, dens, grad, hess)
 }
 
 /// The shell face term of a membrane material `M` and a bending model `B` with `N` local DOFs.
-pub struct Shell<M, B, const N: usize> {
+pub struct Shell<M, B, const N: usize, const S: usize> {
     /// The membrane material.
     pub membrane: M,
     /// The bending model.
@@ -143,10 +146,10 @@ pub fn gather(nodes: &[usize], x: &[Vec3]) -> [Vec3; 6] {
     })
 }
 
-impl<M: Membrane, B: BendingModel<N>, const N: usize> ElementKernel<N> for Shell<M, B, N> {
-    const SLOTS: usize = B::SLOTS;
-
-    #[inline]
+impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> ElementKernel<N, S>
+    for Shell<M, B, N, S>
+{
+    #[inline(always)]
     fn eval(
         &self,
         pot: &Potential,
@@ -162,17 +165,17 @@ impl<M: Membrane, B: BendingModel<N>, const N: usize> ElementKernel<N> for Shell
         let face = self.bending.face(pot.scene, f, nodes, phi);
         let dens = self.membrane.density(pot, f);
         if gauss_newton {
-            shell_element::<_, B, N, true>(&self.bending, &face, &xs, &dens, grad, hess)
+            shell_element::<_, B, N, S, true>(&self.bending, &face, &xs, &dens, grad, hess)
         } else {
-            shell_element::<_, B, N, false>(&self.bending, &face, &xs, &dens, grad, hess)
+            shell_element::<_, B, N, S, false>(&self.bending, &face, &xs, &dens, grad, hess)
         }
     }
 }
 
-impl<M: Membrane, B: BendingModel<N>, const N: usize> Shell<M, B, N> {
+impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Shell<M, B, N, S> {
     /// The stencil `[v0, v1, v2, p0, p1, p2, e0, e1, e2]` truncated to the model's slots.
     pub fn stencil(scene: &Scene, _: &Self) -> Stencil {
-        let slots = B::SLOTS;
+        let slots = S;
         let extra = scene.stencil_extra();
         let nv = scene.num_vertices();
         let mut nodes = Vec::with_capacity(slots * scene.num_faces());
@@ -222,7 +225,9 @@ impl<M: Membrane, B: BendingModel<N>, const N: usize> Shell<M, B, N> {
     }
 }
 
-impl<M: Membrane, B: BendingModel<N>, const N: usize> super::term::Term for Shell<M, B, N> {
+impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::term::Term
+    for Shell<M, B, N, S>
+{
     fn name(&self) -> &'static str {
         "shell"
     }
@@ -243,9 +248,9 @@ impl<M: Membrane, B: BendingModel<N>, const N: usize> super::term::Term for Shel
         values: &mut [Real],
     ) -> Real {
         let gn = projection == super::HessianProjection::GaussNewton;
-        crate::assembly::assemble_elements::<N, _>(
+        crate::assembly::assemble_elements::<N, S, _>(
             map,
-            |e, nodes, g, h| ElementKernel::<N>::eval(self, pot, e, nodes, x, phi, gn, g, h),
+            |e, nodes, g, h| ElementKernel::<N, S>::eval(self, pot, e, nodes, x, phi, gn, g, h),
             &pot.scene.node_fixed,
             projection,
             want,

@@ -143,10 +143,9 @@ pub trait Term: Send + Sync {
     fn low_rank(&self, _pot: &Potential, _x: &[Vec3], _phi: &[Real], _out: &mut Vec<LowRank>) {}
 }
 
-/// A pure per-element kernel with `N` local DOFs.
-pub trait ElementKernel<const N: usize>: Send + Sync {
-    /// Slots per element (a compile-time constant for the assembly loops).
-    const SLOTS: usize;
+/// A pure per-element kernel with `N` local DOFs over `S` stencil slots (compile-time sizes for
+/// the assembly loops).
+pub trait ElementKernel<const N: usize, const S: usize>: Send + Sync {
     /// Energy of element `e` with stencil `nodes`, optional gradient and Hessian in the local
     /// DOF order of the stencil's slots. `gauss_newton` asks for a positive semi-definite
     /// Hessian where the kernel has one.
@@ -165,7 +164,7 @@ pub trait ElementKernel<const N: usize>: Send + Sync {
 }
 
 /// An [`ElementKernel`] as a [`Term`]: stencil from a function, the coloured assembly loop.
-pub struct ElementTerm<K, const N: usize> {
+pub struct ElementTerm<K, const N: usize, const S: usize> {
     /// Reported name.
     pub name: &'static str,
     /// The kernel.
@@ -174,7 +173,7 @@ pub struct ElementTerm<K, const N: usize> {
     pub stencil: fn(&Scene, &K) -> Stencil,
 }
 
-impl<K: ElementKernel<N>, const N: usize> Term for ElementTerm<K, N> {
+impl<K: ElementKernel<N, S>, const N: usize, const S: usize> Term for ElementTerm<K, N, S> {
     fn name(&self) -> &'static str {
         self.name
     }
@@ -193,7 +192,7 @@ impl<K: ElementKernel<N>, const N: usize> Term for ElementTerm<K, N> {
         values: &mut [Real],
     ) -> Real {
         let gn = projection == HessianProjection::GaussNewton;
-        assemble_elements::<N, _>(
+        assemble_elements::<N, S, _>(
             map,
             |e, nodes, g, h| self.kernel.eval(pot, e, nodes, x, phi, gn, g, h),
             &pot.scene.node_fixed,
@@ -267,7 +266,7 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
         values: &mut [Real],
     ) -> Real {
         let fixed = &pot.scene.fixed;
-        assemble_elements::<3, _>(
+        assemble_elements::<3, 1, _>(
             map,
             |v, _, g, h| {
                 if fixed[v] {

@@ -248,7 +248,7 @@ fn baraff_witkin_closed_form_energies() {
         .map(fm);
         let xs = [x[0], x[1], x[2], x[0], x[0], x[0]];
         let mut g = SVec::<9>::zeros();
-        let e = shell_element::<_, NoBending, 9, false>(
+        let e = shell_element::<_, NoBending, 9, 3, false>(
             &NoBending,
             &(),
             &xs,
@@ -328,7 +328,7 @@ fn baraff_witkin_psd_option_is_psd() {
             koiter: no_bending_wells(),
         };
         let mut h = SMat::<9, 9>::zeros();
-        shell_element::<_, NoBending, 9, true>(&NoBending, &(), &xs, &dens, None, Some(&mut h));
+        shell_element::<_, NoBending, 9, 3, true>(&NoBending, &(), &xs, &dens, None, Some(&mut h));
         let (vals, _) = jacobi_eigen(&h);
         let scale = vals.amax().max(1e-300);
         assert!(
@@ -336,7 +336,7 @@ fn baraff_witkin_psd_option_is_psd() {
             "negative eigenvalue {} (scale {scale})",
             vals.min()
         );
-        shell_element::<_, NoBending, 9, false>(&NoBending, &(), &xs, &dens, None, Some(&mut h));
+        shell_element::<_, NoBending, 9, 3, false>(&NoBending, &(), &xs, &dens, None, Some(&mut h));
         if jacobi_eigen(&h).0.min() < -1e-8 * scale {
             exact_negative += 1;
         }
@@ -364,7 +364,7 @@ fn baraff_witkin_is_rotation_invariant() {
         );
         let xr = xs.map(|p| r * p + Vec3::new(0.3, -2.0, 1.0));
         let (mut g, mut gr) = (SVec::<9>::zeros(), SVec::<9>::zeros());
-        let e = shell_element::<_, NoBending, 9, false>(
+        let e = shell_element::<_, NoBending, 9, 3, false>(
             &NoBending,
             &(),
             &xs,
@@ -372,7 +372,7 @@ fn baraff_witkin_is_rotation_invariant() {
             Some(&mut g),
             None,
         );
-        let er = shell_element::<_, NoBending, 9, false>(
+        let er = shell_element::<_, NoBending, 9, 3, false>(
             &NoBending,
             &(),
             &xr,

@@ -20,19 +20,18 @@ pub struct AverageCache {
     qs: AverageQs,
 }
 
-impl BendingModel<18> for MidedgeAverage {
+impl BendingModel<18, 6> for MidedgeAverage {
     type Face = [bool; 3];
     type Cache = AverageCache;
-    const SLOTS: usize = 6;
     const NAME: &'static str = "midedge_average";
 
-    #[inline]
+    #[inline(always)]
     fn face(&self, _: &Scene, _: usize, nodes: &[usize], _: &[Real]) -> [bool; 3] {
         has_extra(nodes)
     }
 
     /// `∇b = [∇q_0 ∇q_1 ∇q_2] Bᵀ` with `B = ∂b/∂q`.
-    #[inline]
+    #[inline(always)]
     fn eval(
         &self,
         has: &[bool; 3],
@@ -63,7 +62,7 @@ impl BendingModel<18> for MidedgeAverage {
     }
 
     /// `Σ_q λ_q ∇²b_q = Σ_i (Bᵀλ)_i ∇²q_i`.
-    #[inline]
+    #[inline(always)]
     fn add_hessian(
         &self,
         has: &[bool; 3],

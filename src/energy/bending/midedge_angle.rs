@@ -57,7 +57,7 @@ pub enum AngleVariant {
 
 impl AngleVariant {
     /// `(g, g', g'')` at `t`.
-    #[inline]
+    #[inline(always)]
     fn eval(self, t: Real) -> (Real, Real, Real) {
         match self {
             AngleVariant::Sin => {
@@ -169,7 +169,7 @@ pub fn midedge_angle_face<D: FaceDensity, const GN: bool>(
         phi: *phi,
         sigma,
     };
-    crate::energy::shell::shell_element::<D, MidedgeAngle, 21, GN>(
+    crate::energy::shell::shell_element::<D, MidedgeAngle, 21, 9, GN>(
         &MidedgeAngle(variant),
         &face,
         x,
@@ -208,13 +208,12 @@ pub struct AngleCache {
     df: [(SVec<3>, Mat3); 3],
 }
 
-impl BendingModel<21> for MidedgeAngle {
+impl BendingModel<21, 9> for MidedgeAngle {
     type Face = AngleFace;
     type Cache = AngleCache;
-    const SLOTS: usize = 9;
     const NAME: &'static str = "midedge_angle";
 
-    #[inline]
+    #[inline(always)]
     fn face(&self, scene: &Scene, f: usize, nodes: &[usize], phi: &[Real]) -> AngleFace {
         let nv = scene.num_vertices();
         AngleFace {
@@ -225,7 +224,7 @@ impl BendingModel<21> for MidedgeAngle {
     }
 
     /// `G = Jyᵀ Jqᵀ Bᵀ` through the 9 intermediate variables of the module doc.
-    #[inline]
+    #[inline(always)]
     fn eval(
         &self,
         face: &AngleFace,
@@ -291,43 +290,81 @@ impl BendingModel<21> for MidedgeAngle {
 
     /// With `μ = Bᵀλ`: `Σ_i μ_i ∇²q_i = Jyᵀ [Σ_i μ_i (Kᵢᵀ F_i'' Kᵢ + F_i,h ∇²_a h_i)] Jy`
     /// `+ Σ_k (Jqᵀμ)_{a_k} ∇²a_k + Σ_i (Jqᵀμ)_{q̃_i} ∇²q̃_i`.
-    #[inline]
+    #[inline(always)]
     fn add_hessian(
         &self,
         face: &AngleFace,
-        _: &[Vec3; 6],
+        x: &[Vec3; 6],
         ev: &BendingEval<21, AngleCache>,
         lambda: &Sym2,
         h: &mut SMat<21, 21>,
     ) {
+        self.add_y_hessian(face, x, ev, SMat::<9, 9>::zeros(), Some(lambda), h);
+    }
+
+    /// Both bending parts in the intermediate variables `y`, then one product `Jyᵀ H_y Jy`:
+    /// `G W_bb Gᵀ = Jyᵀ (Jqᵀ Bᵀ W_bb B Jq) Jy`.
+    #[inline(always)]
+    fn add_bending_hessian(
+        &self,
+        face: &AngleFace,
+        x: &[Vec3; 6],
+        ev: &BendingEval<21, AngleCache>,
+        hbb: &Mat3,
+        lambda: Option<&Sym2>,
+        h: &mut SMat<21, 21>,
+    ) {
+        let bq = b_from_q_matrix();
+        let jq = &ev.cache.jq;
+        let hy = jq.transpose() * (bq.transpose() * hbb * bq) * jq;
+        self.add_y_hessian(face, x, ev, hy, lambda, h);
+    }
+}
+
+impl MidedgeAngle {
+    /// Adds `Jyᵀ (hy + Σ_i μ_i (Kᵢᵀ F_i'' Kᵢ + F_i,h ∇²_a h_i)) Jy` and, with `lambda`, the
+    /// second-derivative terms of `a` and `q̃` contracted with `Jqᵀμ` (`μ = Bᵀλ`).
+    #[inline(always)]
+    fn add_y_hessian(
+        &self,
+        face: &AngleFace,
+        _: &[Vec3; 6],
+        ev: &BendingEval<21, AngleCache>,
+        mut hy: SMat<9, 9>,
+        lambda: Option<&Sym2>,
+        h: &mut SMat<21, 21>,
+    ) {
         let AngleFace { has, sigma, .. } = *face;
         let c = &ev.cache;
-        let mu = b_from_q_matrix().transpose() * lambda;
-        let mut hy = SMat::<9, 9>::zeros();
-        for i in 0..3 {
-            let (gf, hf) = c.df[i];
-            let mut kmat = SMat::<3, 9>::zeros();
-            if has[i] {
-                kmat[(0, 3 + i)] = 1.0;
+        let mu = lambda.map(|l| b_from_q_matrix().transpose() * l);
+        if let Some(mu) = &mu {
+            for i in 0..3 {
+                let (gf, hf) = c.df[i];
+                let mut kmat = SMat::<3, 9>::zeros();
+                if has[i] {
+                    kmat[(0, 3 + i)] = 1.0;
+                }
+                for k in 0..3 {
+                    kmat[(1, k)] = c.dh[i].0[k];
+                }
+                kmat[(2, 6 + i)] = sigma[i];
+                hy += kmat.transpose() * hf * kmat * mu[i];
+                let mut aa = hy.fixed_view_mut::<3, 3>(0, 0);
+                aa += c.dh[i].1 * (mu[i] * gf[1]);
             }
-            for k in 0..3 {
-                kmat[(1, k)] = c.dh[i].0[k];
-            }
-            kmat[(2, 6 + i)] = sigma[i];
-            hy += kmat.transpose() * hf * kmat * mu[i];
-            let mut aa = hy.fixed_view_mut::<3, 3>(0, 0);
-            aa += c.dh[i].1 * (mu[i] * gf[1]);
         }
         *h += c.jy.transpose() * hy * c.jy;
-        let gy = c.jq.transpose() * mu;
-        let pat = first_fundamental_form_hessian_pattern(&Sym2::new(gy[0], gy[1], gy[2]));
-        for r in 0..3 {
-            for s in 0..3 {
-                for k in 0..3 {
-                    h[(3 * r + k, 3 * s + k)] += pat[(r, s)];
+        if let Some(mu) = &mu {
+            let gy = c.jq.transpose() * mu;
+            let pat = first_fundamental_form_hessian_pattern(&Sym2::new(gy[0], gy[1], gy[2]));
+            for r in 0..3 {
+                for s in 0..3 {
+                    for k in 0..3 {
+                        h[(3 * r + k, 3 * s + k)] += pat[(r, s)];
+                    }
                 }
             }
+            c.qs.add_hessians(&c.nf, has, [gy[3], gy[4], gy[5]], h);
         }
-        c.qs.add_hessians(&c.nf, has, [gy[3], gy[4], gy[5]], h);
     }
 }

@@ -32,14 +32,12 @@ pub struct BendingEval<const N: usize, C> {
     pub cache: C,
 }
 
-/// A discrete second fundamental form over `N` local DOFs.
-pub trait BendingModel<const N: usize>: Send + Sync {
+/// A discrete second fundamental form over `N` local DOFs in `S` stencil slots (3, 6 or 9).
+pub trait BendingModel<const N: usize, const S: usize>: Send + Sync {
     /// Per-face input (boundary flags, weights, edge DOFs and signs).
     type Face;
     /// Scratch between [`BendingModel::eval`] and [`BendingModel::add_hessian`].
     type Cache;
-    /// Stencil slots (3, 6 or 9).
-    const SLOTS: usize;
     /// The bending model's name (settings value).
     const NAME: &'static str;
 
@@ -65,6 +63,25 @@ pub trait BendingModel<const N: usize>: Send + Sync {
         lambda: &Sym2,
         h: &mut SMat<N, N>,
     );
+
+    /// Adds the bending part of the chain rule, `G W_bb Gᵀ` and, with `lambda = Some(W_b)`,
+    /// `Σ_q λ_q ∇²b_q`. A model may override it to form both in its own intermediate variables
+    /// with one product (the default forms them apart).
+    #[inline(always)]
+    fn add_bending_hessian(
+        &self,
+        face: &Self::Face,
+        x: &[Vec3; 6],
+        ev: &BendingEval<N, Self::Cache>,
+        hbb: &crate::math::Mat3,
+        lambda: Option<&Sym2>,
+        h: &mut SMat<N, N>,
+    ) {
+        *h += ev.jac * hbb * ev.jac.transpose();
+        if let Some(l) = lambda {
+            self.add_hessian(face, x, ev, l, h);
+        }
+    }
 }
 
 /// Whether stencil slots 3..6 (the extra vertices) are present.

@@ -10,15 +10,14 @@ use crate::scene::Scene;
 #[derive(Clone, Copy, Debug, Default)]
 pub struct NoBending;
 
-impl BendingModel<9> for NoBending {
+impl BendingModel<9, 3> for NoBending {
     type Face = ();
     type Cache = ();
-    const SLOTS: usize = 3;
     const NAME: &'static str = "none";
 
     fn face(&self, _: &Scene, _: usize, _: &[usize], _: &[Real]) {}
 
-    #[inline]
+    #[inline(always)]
     fn eval(&self, _: &(), _: &[Vec3; 6], _: bool, _: bool) -> BendingEval<9, ()> {
         BendingEval {
             b: Sym2::zeros(),
@@ -27,7 +26,7 @@ impl BendingModel<9> for NoBending {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn add_hessian(
         &self,
         _: &(),

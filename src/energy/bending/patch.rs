@@ -34,7 +34,7 @@ pub fn patch_face<D: FaceDensity, const GN: bool>(
     grad: Option<&mut SVec<18>>,
     hess: Option<&mut SMat<18, 18>>,
 ) -> Real {
-    crate::energy::shell::shell_element::<D, PatchFit, 18, GN>(&PatchFit, w, x, dens, grad, hess)
+    crate::energy::shell::shell_element::<D, PatchFit, 18, 6, GN>(&PatchFit, w, x, dens, grad, hess)
 }
 
 /// MorphoShell's patch-fit model; the per-face input is the face's weights `Ŵ`.
@@ -47,19 +47,18 @@ pub struct PatchCache {
     s: [Vec3; 3],
 }
 
-impl BendingModel<18> for PatchFit {
+impl BendingModel<18, 6> for PatchFit {
     type Face = PatchWeights;
     type Cache = PatchCache;
-    const SLOTS: usize = 6;
     const NAME: &'static str = "patch_fit";
 
-    #[inline]
+    #[inline(always)]
     fn face(&self, scene: &Scene, f: usize, _: &[usize], _: &[Real]) -> PatchWeights {
         scene.patches[f].weights
     }
 
     /// `∇b_q`: node k gets `−Ŵ_qk N`; face vertex a also gets `−(∂N/∂x_a)ᵀ s_q`.
-    #[inline]
+    #[inline(always)]
     fn eval(
         &self,
         w: &PatchWeights,
@@ -95,7 +94,7 @@ impl BendingModel<18> for PatchFit {
 
     /// `∇²b_q`: the cross blocks `−Ŵ_qk ∂N/∂x_a` (node k, face vertex a) and their transposes,
     /// and `−∇²(s_q·N)` with `s_q` fixed on the face vertices.
-    #[inline]
+    #[inline(always)]
     fn add_hessian(
         &self,
         w: &PatchWeights,

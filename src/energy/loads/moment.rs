@@ -81,9 +81,7 @@ impl Moment {
     }
 }
 
-impl ElementKernel<10> for Moment {
-    const SLOTS: usize = 4;
-
+impl ElementKernel<10, 4> for Moment {
     fn eval(
         &self,
         pot: &Potential,
@@ -199,7 +197,7 @@ impl Term for MomentTerm {
         grad: &mut [Real],
         values: &mut [Real],
     ) -> Real {
-        crate::assembly::assemble_elements::<10, _>(
+        crate::assembly::assemble_elements::<10, 4, _>(
             map,
             |e, nodes, g, h| {
                 let gn = projection == crate::energy::HessianProjection::GaussNewton;

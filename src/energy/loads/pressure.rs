@@ -27,9 +27,7 @@ pub struct Pressure {
     pub faces: Vec<(usize, Real)>,
 }
 
-impl ElementKernel<9> for Pressure {
-    const SLOTS: usize = 3;
-
+impl ElementKernel<9, 3> for Pressure {
     #[inline]
     fn eval(
         &self,
