@@ -6,7 +6,8 @@
 //! Frame fields (per face, tensors as `[xx, xy, yy]` in reference Cartesian coordinates: the
 //! (x, y) frame of a flat reference mesh, otherwise each reference face's own orthonormal frame
 //! `t1 = e1/|e1|`, `t2 = N × t1`): `a`, `b`, `abar`, `bbar`, `mean_curvature`,
-//! `gauss_curvature`, `k1`, `k2` (principal curvatures, ascending), `stretching_energy_density`,
+//! `gauss_curvature`, `k1`, `k2` (principal curvatures, ascending), `max_stretch` (the larger
+//! principal stretch `√λ_max(ā⁻¹a)`), `stretching_energy_density`,
 //! `bending_energy_density` (J/m² of rest area), `thickness`, and `tri_tags` when the input has
 //! it; with patch-fit bending, `patch_condition` (the condition number of each face's fit); with
 //! edge DOFs, `edge_angles` (rad, 3 components: the DOF `φ` of the edges opposite `v0, v1, v2`;
@@ -303,7 +304,8 @@ impl Writer {
         let mut fb = Vec::with_capacity(3 * nf);
         let mut fab = Vec::with_capacity(3 * nf);
         let mut fbb = Vec::with_capacity(3 * nf);
-        let (mut hh, mut kk, mut k1s, mut k2s) = (
+        let (mut hh, mut kk, mut k1s, mut k2s, mut stretch) = (
+            Vec::with_capacity(nf),
             Vec::with_capacity(nf),
             Vec::with_capacity(nf),
             Vec::with_capacity(nf),
@@ -324,6 +326,12 @@ impl Writer {
             kk.push(k);
             k1s.push(k1);
             k2s.push(k2);
+            // Principal stretches: √eigenvalues of ā⁻¹a.
+            let c = crate::math::sym_to_mat(&abar)
+                .try_inverse()
+                .unwrap_or_else(Mat2::identity)
+                * crate::math::sym_to_mat(&a[f]);
+            stretch.push(crate::math::eig2(&c).1.max(0.0).sqrt());
         }
         let m = &mut self.frame_mesh;
         m.positions.copy_from_slice(x);
@@ -340,6 +348,7 @@ impl Writer {
         ff.insert("gauss_curvature".into(), Field::scalar(kk));
         ff.insert("k1".into(), Field::scalar(k1s));
         ff.insert("k2".into(), Field::scalar(k2s));
+        ff.insert("max_stretch".into(), Field::scalar(stretch));
         for t in sc.terms.iter() {
             for (name, data) in t.face_fields(pot, x, phi) {
                 ff.insert(name, Field::scalar(data));
