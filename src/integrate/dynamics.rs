@@ -1,0 +1,266 @@
+//! The dynamic driver: implicit Euler (seed 000 §3) with adaptive time steps, output timing,
+//! the moisture sub-step, the friction lag and the equilibrium stop.
+
+use super::moisture::{accepted, Moisture};
+use super::{Progress, RunError, Solver};
+use crate::assembly::Want;
+use crate::math::{Real, Sym2, Vec3};
+use crate::output::Writer;
+use crate::solve::potential::{Damping, Friction, Inertia};
+use crate::solve::{newton, NewtonOptions, Potential};
+use std::time::Instant;
+
+/// Friction lag: a step is re-solved with the updated normal forces until they change by at
+/// most this fraction of the largest one ...
+const FRICTION_LAG_TOL: Real = 1e-3;
+/// ... or this many solves were made (the last one is accepted).
+const FRICTION_LAG_MAX: usize = 6;
+
+pub(super) fn run_dynamic(
+    s: &mut Solver,
+    writer: &mut Writer,
+    progress: &mut dyn Progress,
+    mut x: Vec<Vec3>,
+    mut phi: Vec<Real>,
+    v0: Option<Vec<Vec3>>,
+    t0: Real,
+) -> Result<(), RunError> {
+    let sc = s.scene;
+    let tm = sc.settings.time.clone();
+    let (tol, max_iter) = (
+        sc.settings.solver.tolerance,
+        sc.settings.solver.max_newton_iterations,
+    );
+    let dial_time = sc.settings.rest.dial_time;
+    let dial_at = |t: Real| {
+        if dial_time > 0.0 {
+            (t / dial_time).min(1.0)
+        } else {
+            1.0
+        }
+    };
+    let n = x.len();
+    let mut v = v0.unwrap_or_else(|| vec![Vec3::zeros(); n]);
+    let mut xhat = x.clone();
+    let mut trial = x.clone();
+    let mut trial_phi = phi.clone();
+    let damping = tm.damping > 0.0;
+    let (mut a_prev, mut b_prev) = if damping {
+        sc.forms(&x, &phi)
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    // Moisture: the diffusion state and the rest forms it sets (None without diffusion).
+    let mut moisture = Moisture::new(sc)?;
+    let mut targets: Vec<(Sym2, Sym2)> = Vec::new();
+    let mut trial_targets: Vec<(Sym2, Sym2)> = Vec::new();
+    if let Some(m) = &moisture {
+        targets = m.targets_of(sc, &m.u).map_err(RunError::Moisture)?;
+        m.publish(writer);
+    }
+    {
+        let pot = accepted(s.potential(dial_at(t0)), moisture.as_ref(), &targets);
+        s.frame(writer, &pot, &x, &phi, &v, t0)?;
+    }
+    // Friction: the lagged normal forces, carried from step to step.
+    let friction = sc.ground.as_ref().is_some_and(|g| g.friction > 0.0);
+    let mut lambda = match &sc.ground {
+        Some(g) if friction => g.normal_forces(&x),
+        _ => Vec::new(),
+    };
+    let mut t = t0;
+    let mut dt = tm.dt;
+    // The next output time after the start (a restart resumes the output grid).
+    let mut next_out = (((t0 / tm.output_interval) + 1e-9).floor() + 1.0) * tm.output_interval;
+    next_out = next_out.min(tm.end);
+    let mut easy = 0;
+    let mut failure: Option<String> = None;
+    let eps_t = 1e-12 * tm.end;
+    while t < tm.end - eps_t {
+        let h = dt.min(next_out - t).min(tm.end - t);
+        let dial = dial_at(t + h);
+        for i in 0..n {
+            xhat[i] = x[i] + v[i] * h;
+        }
+        // Vertices on prescribed paths are fixed: their inertia is not assembled, so the
+        // prediction can carry their prescribed position into every trial.
+        sc.prescribe(&mut xhat, dial);
+        trial.copy_from_slice(&xhat);
+        trial_phi.copy_from_slice(&phi);
+        let moisture_clock = Instant::now();
+        if let Some(m) = &mut moisture {
+            // Diffuse over the step, then set the rest forms from the new surface moisture.
+            if let Err(e) = m.update_ground(sc, &x) {
+                failure = Some(format!("moisture at t = {t:.6e}: {e}"));
+                break;
+            }
+            m.trial.copy_from_slice(&m.u);
+            if let Err(e) = m.diffusion.step(&mut m.trial, h) {
+                failure = Some(format!("moisture diffusion at t = {t:.6e}: {e}"));
+                break;
+            }
+            // The step control sees the diffusion too: a step that changes the computed moisture
+            // (prescribed nodes excluded: their jump is imposed) by more than
+            // moisture.max_change anywhere is cut before the mechanical solve.
+            m.change = (0..m.u.len())
+                .filter(|&i| !m.diffusion.is_prescribed(i))
+                .fold(0.0, |c: Real, i| c.max((m.trial[i] - m.u[i]).abs()));
+            if m.change > sc.settings.moisture.max_change && h > tm.dt_min {
+                s.summary.moisture_seconds += moisture_clock.elapsed().as_secs_f64();
+                s.summary.rejected_steps += 1;
+                dt = (h * 0.5).max(tm.dt_min);
+                easy = 0;
+                continue;
+            }
+            match m.targets_of(sc, &m.trial) {
+                Ok(tt) => trial_targets = tt,
+                Err(e) => {
+                    failure = Some(format!("at t = {t:.6e}: {e}"));
+                    break;
+                }
+            }
+            m.trial_mass = m.masses_of(sc, &m.trial);
+            s.summary.moisture_seconds += moisture_clock.elapsed().as_secs_f64();
+        }
+        let trial_mass = moisture.as_ref().map_or(&sc.mass[..], |m| m.mass(sc, true));
+        // Friction lags the normal force: solve with λ, update λ from the solution, and re-solve
+        // until it agrees (see solve::contact).
+        let mut rep;
+        let mut lag = 0;
+        loop {
+            let pot = Potential {
+                dial,
+                inertia: Some(Inertia {
+                    inv_dt2: 1.0 / (h * h),
+                    xhat: &xhat,
+                }),
+                damping: damping.then_some(Damping {
+                    eta_over_dt: tm.damping / h,
+                    a_prev: &a_prev,
+                    b_prev: &b_prev,
+                }),
+                gravity: s.gravity,
+                rest_override: moisture.as_ref().map(|_| &trial_targets[..]),
+                mass: trial_mass,
+                friction: friction.then_some(Friction {
+                    x_prev: &x,
+                    normal_force: &lambda,
+                    eps: sc.settings.contact.slip_speed * h,
+                }),
+                ..Potential::new(sc, s.pattern)
+            };
+            rep = newton(
+                &pot,
+                &mut s.lin,
+                &mut s.ws,
+                &mut trial,
+                &mut trial_phi,
+                NewtonOptions { tol, max_iter },
+            );
+            s.record(&rep);
+            let Some(ground) = sc.ground.as_ref().filter(|_| friction && rep.converged) else {
+                break;
+            };
+            let new = ground.normal_forces(&trial);
+            let scale = new.iter().fold(0.0, |m: Real, v| m.max(*v));
+            let diff = new
+                .iter()
+                .zip(&lambda)
+                .fold(0.0, |m: Real, (a, b)| m.max((a - b).abs()));
+            lambda.copy_from_slice(&new);
+            lag += 1;
+            if diff <= FRICTION_LAG_TOL * scale || lag >= FRICTION_LAG_MAX {
+                break;
+            }
+        }
+        if !rep.converged {
+            s.summary.rejected_steps += 1;
+            dt = h * 0.5;
+            easy = 0;
+            if dt < tm.dt_min {
+                failure = Some(format!(
+                    "time step fell below dt_min = {} at t = {t:.6e}: {}",
+                    tm.dt_min,
+                    rep.failure_text()
+                ));
+                break;
+            }
+            continue;
+        }
+        for i in 0..n {
+            v[i] = (trial[i] - x[i]) / h;
+        }
+        x.copy_from_slice(&trial);
+        sc.accept(&trial, &trial_phi);
+        phi.copy_from_slice(&trial_phi);
+        if let Some(m) = &mut moisture {
+            m.u.copy_from_slice(&m.trial);
+            std::mem::swap(&mut targets, &mut trial_targets);
+            std::mem::swap(&mut m.mass, &mut m.trial_mass);
+        }
+        t += h;
+        s.summary.steps += 1;
+        if damping {
+            let (a, b) = sc.forms(&x, &phi);
+            a_prev = a;
+            b_prev = b;
+        }
+        let calm = moisture
+            .as_ref()
+            .is_none_or(|m| m.change <= 0.5 * sc.settings.moisture.max_change);
+        if rep.iterations <= 3 && calm {
+            easy += 1;
+            if easy >= 3 {
+                dt = (dt * 1.5).min(tm.dt_max);
+                easy = 0;
+            }
+        } else {
+            easy = 0;
+        }
+        progress.update(
+            t / tm.end,
+            &format!("t {t:.4e} s  E {:.4e}  r {:.1e}", rep.energy, rep.residual),
+        );
+        let at_output = t >= next_out - 1e-9 * h.max(eps_t);
+        let mut stop = false;
+        if tm.stop_at_equilibrium {
+            let pot = accepted(s.potential(dial), moisture.as_ref(), &targets);
+            let mut g = vec![0.0; s.pattern.n];
+            pot.eval(&x, &phi, Want::Gradient, &mut g, &mut []);
+            let r = pot.residual(&g);
+            let en = Writer::energies(&pot, &x, &phi, &v);
+            stop = dial >= 1.0
+                && r <= tol
+                && en.kinetic
+                    <= tm.equilibrium_kinetic
+                        * (en.get("stretching").unwrap_or(0.0) + en.get("bending").unwrap_or(0.0))
+                            .max(Real::MIN_POSITIVE);
+        }
+        if at_output || stop || t >= tm.end - eps_t {
+            if let Some(m) = &moisture {
+                m.publish(writer);
+            }
+            let pot = accepted(s.potential(dial), moisture.as_ref(), &targets);
+            s.frame(writer, &pot, &x, &phi, &v, t)?;
+            while next_out <= t + eps_t {
+                next_out += tm.output_interval;
+            }
+            next_out = next_out.min(tm.end);
+        }
+        if stop {
+            break;
+        }
+    }
+    s.summary.time = t;
+    s.summary.dial = dial_at(t);
+    s.summary.converged = failure.is_none();
+    s.summary.reason = failure.unwrap_or_default();
+    let pot = accepted(s.potential(dial_at(t)), moisture.as_ref(), &targets);
+    s.summary.energy = Writer::energies(&pot, &x, &phi, &v);
+    if s.summary.reason.is_empty() {
+        return Ok(());
+    }
+    // Record the state reached when the run stopped early.
+    s.frame(writer, &pot, &x, &phi, &v, t)?;
+    Ok(())
+}

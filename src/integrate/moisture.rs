@@ -1,0 +1,244 @@
+//! The moisture coupling of a dynamic run: the prism-FEM diffusion, the rest forms and wet
+//! masses it sets each step, and the ground exchange switched by contact.
+
+use super::RunError;
+use crate::math::{Real, Sym2, Vec3};
+use crate::output::Writer;
+use crate::scene::Scene;
+use crate::solve::Potential;
+
+/// The moisture diffusion of a dynamic run and the rest forms it drives.
+pub(super) struct Moisture {
+    pub(super) diffusion: crate::diffusion::Diffusion,
+    /// Nodal moisture at the last accepted step, and the trial of the current one.
+    pub(super) u: Vec<Real>,
+    pub(super) trial: Vec<Real>,
+    /// Largest nodal change of the last trial step.
+    pub(super) change: Real,
+    /// Lumped vertex masses with the absorbed water, at `u` and at `trial` (empty when
+    /// `moisture.water_density = 0`).
+    pub(super) mass: Vec<Real>,
+    pub(super) trial_mass: Vec<Real>,
+    /// `[moisture.ground]`: each face's own conditions (top, bottom), the ground's
+    /// `(k, value, distance)`, and which sides currently touch it.
+    pub(super) base: Vec<[crate::diffusion::SurfaceBc; 2]>,
+    pub(super) taped: Vec<[bool; 2]>,
+    /// Sides covered by tape (top, bottom): the growth law sees moisture 0 there.
+    pub(super) tape: Vec<[bool; 2]>,
+    pub(super) ground: Option<(Real, Real, Real)>,
+    pub(super) touching: Vec<[bool; 2]>,
+}
+
+impl Moisture {
+    /// Builds the diffusion system of a scene with `moisture.enabled` (None otherwise).
+    pub(super) fn new(sc: &Scene) -> Result<Option<Self>, RunError> {
+        use crate::diffusion::{Diffusion, Diffusivity, Side, SurfaceBc};
+        use crate::settings::{SurfaceKind, SurfaceSide};
+        let mo = &sc.settings.moisture;
+        if !mo.enabled {
+            return Ok(None);
+        }
+        let dirs: Vec<Vec3> = sc.growth.direction.iter().map(|d| d.1).collect();
+        let mut diffusion = Diffusion::new(
+            &sc.mesh.positions,
+            &sc.mesh.faces,
+            &sc.thickness,
+            &dirs,
+            Diffusivity {
+                along: mo.diffusivity_along,
+                across: mo.diffusivity_across,
+                through: mo.diffusivity_through,
+            },
+            mo.layers,
+        )?;
+        // Sides sealed on purpose (tape): the ground exchange leaves them sealed.
+        let mut taped = vec![[false; 2]; sc.num_faces()];
+        // Sides covered by tape (`tape = true`): a non-swelling layer for the growth law.
+        let mut tape = vec![[false; 2]; sc.num_faces()];
+        for b in &mo.boundary {
+            let side = match b.side {
+                SurfaceSide::Top => Side::Top,
+                SurfaceSide::Bottom => Side::Bottom,
+            };
+            let bc = match b.kind {
+                SurfaceKind::Sealed => SurfaceBc::Sealed,
+                SurfaceKind::Value => SurfaceBc::Value(b.value),
+                SurfaceKind::Flux => SurfaceBc::Flux(b.value),
+                SurfaceKind::Robin => SurfaceBc::Robin {
+                    k: b.k,
+                    ambient: b.ambient,
+                },
+            };
+            let faces = crate::scene::region_faces(&sc.mesh, b)
+                .map_err(|e| RunError::Moisture(e.to_string()))?;
+            for f in faces {
+                diffusion
+                    .set_surface(f, side, bc)
+                    .map_err(RunError::Moisture)?;
+                if bc == SurfaceBc::Sealed {
+                    taped[f][side as usize] = true;
+                }
+                if b.tape {
+                    tape[f][side as usize] = true;
+                }
+            }
+        }
+        let u = vec![mo.initial; diffusion.num_nodes()];
+        let nf = sc.num_faces();
+        let base = (0..nf)
+            .map(|f| {
+                [
+                    diffusion.surface(f, Side::Top),
+                    diffusion.surface(f, Side::Bottom),
+                ]
+            })
+            .collect();
+        let h_mean = sc.thickness.iter().sum::<Real>() / nf.max(1) as Real;
+        let ground = mo
+            .ground
+            .as_ref()
+            .map(|g| (g.k, g.value, g.distance.or(h_mean)));
+        let mut m = Moisture {
+            trial: u.clone(),
+            u,
+            diffusion,
+            change: 0.0,
+            mass: Vec::new(),
+            trial_mass: Vec::new(),
+            base,
+            taped,
+            tape,
+            ground,
+            touching: vec![[false; 2]; nf],
+        };
+        m.mass = m.masses_of(sc, &m.u);
+        m.trial_mass = m.mass.clone();
+        Ok(Some(m))
+    }
+
+    /// Switches the ground exchange of every face side on or off from the positions `x`: a side
+    /// touches when it faces the ground (its outward normal within 60° of the ground's inward
+    /// one) and the face's centroid is within `distance` of the ground, thickness included.
+    pub(super) fn update_ground(&mut self, sc: &Scene, x: &[Vec3]) -> Result<(), String> {
+        use crate::diffusion::{Side, SurfaceBc};
+        let (Some((k, value, distance)), Some(g)) = (self.ground, &sc.ground) else {
+            return Ok(());
+        };
+        for (f, face) in sc.mesh.faces.iter().enumerate() {
+            let [p0, p1, p2] = face.map(|v| x[v]);
+            let n = (p1 - p0).cross(&(p2 - p0)).normalize();
+            let c = (p0 + p1 + p2) / 3.0;
+            let facing = n.dot(&g.normal);
+            let gap = g.normal.dot(&(c - g.point)) - 0.5 * sc.thickness[f] * facing.abs();
+            let near = gap <= distance && facing.abs() >= 0.5;
+            // The top (+n) faces the ground when n points into it.
+            let touch = [near && facing < 0.0, near && facing > 0.0];
+            for (s, side) in [Side::Top, Side::Bottom].into_iter().enumerate() {
+                if touch[s] == self.touching[f][s] {
+                    continue;
+                }
+                let base = self.base[f][s];
+                if self.taped[f][s] || matches!(base, SurfaceBc::Value(_)) {
+                    continue;
+                }
+                let bc = if touch[s] {
+                    SurfaceBc::Robin { k, ambient: value }
+                } else {
+                    base
+                };
+                self.diffusion.replace_surface(f, side, bc)?;
+                self.touching[f][s] = touch[s];
+            }
+        }
+        Ok(())
+    }
+
+    /// Lumped vertex masses with face densities ρ_shell + (m⁺ + m⁻)/2 · ρ_water (seed 000 §3,
+    /// "Mass Matrix"); empty when the water density is 0 (the scene's masses apply).
+    pub(super) fn masses_of(&self, sc: &Scene, u: &[Real]) -> Vec<Real> {
+        let rho_w = sc.settings.moisture.water_density;
+        if rho_w == 0.0 {
+            return Vec::new();
+        }
+        let mut mass = sc.mass.clone();
+        for (f, face) in sc.mesh.faces.iter().enumerate() {
+            let (top, bottom) = self.diffusion.surface_moisture(u, f);
+            let area = sc.mesh.face_area(f);
+            let dm = 0.5 * (top + bottom) * rho_w * sc.thickness[f] * area / 3.0;
+            for &v in face {
+                mass[v] += dm;
+            }
+        }
+        mass
+    }
+
+    /// The masses at the accepted state (`trial = false`) or the trial one (the scene's without
+    /// water density).
+    pub(super) fn mass<'s>(&'s self, sc: &'s Scene, trial: bool) -> &'s [Real] {
+        let m = if trial { &self.trial_mass } else { &self.mass };
+        if m.is_empty() {
+            &sc.mass
+        } else {
+            m
+        }
+    }
+
+    /// Rest forms of every face from the moisture `u`.
+    ///
+    /// A taped side (`moisture.boundary.tape`) is a layer that does not swell: the law sees
+    /// moisture 0 there, so wet paper under tape curls away from it as a bilayer does.
+    pub(super) fn targets_of(&self, sc: &Scene, u: &[Real]) -> Result<Vec<(Sym2, Sym2)>, String> {
+        (0..sc.num_faces())
+            .map(|f| {
+                let (mut top, mut bottom) = self.diffusion.surface_moisture(u, f);
+                if self.tape[f][0] {
+                    top = 0.0;
+                }
+                if self.tape[f][1] {
+                    bottom = 0.0;
+                }
+                let m = (top, bottom);
+                let reference = (sc.rest.abar0[f], sc.rest.bbar0[f]);
+                crate::scene::growth_face(
+                    &sc.settings,
+                    &sc.growth,
+                    f,
+                    reference,
+                    sc.thickness[f],
+                    m,
+                )
+                .map_err(|e| format!("growth at face {f}: {e}"))
+            })
+            .collect()
+    }
+
+    /// Hands the surface moisture of the accepted state to the writer for the next frame.
+    pub(super) fn publish(&self, writer: &mut Writer) {
+        let nf = writer.num_faces();
+        let (mut top, mut bottom) = (Vec::with_capacity(nf), Vec::with_capacity(nf));
+        for f in 0..nf {
+            let (a, b) = self.diffusion.surface_moisture(&self.u, f);
+            top.push(a);
+            bottom.push(b);
+        }
+        writer.set_face_field("moisture_top", top);
+        writer.set_face_field("moisture_bottom", bottom);
+    }
+}
+
+/// The potential of the accepted state of a dynamic run: with moisture, its rest forms
+/// `targets` and its wet masses.
+pub(super) fn accepted<'a>(
+    base: Potential<'a>,
+    moisture: Option<&'a Moisture>,
+    targets: &'a [(Sym2, Sym2)],
+) -> Potential<'a> {
+    match moisture {
+        Some(m) => Potential {
+            rest_override: Some(targets),
+            mass: m.mass(base.scene, false),
+            ..base
+        },
+        None => base,
+    }
+}

@@ -1,0 +1,179 @@
+//! The static driver: adaptive continuation of the dial (rest forms and loads), then of the
+//! stretching weight (membrane continuation), with the stability check and saddle escapes.
+
+use super::{perturb, Progress, RunError, Solver};
+use crate::math::{Real, Vec3};
+use crate::output::Writer;
+use crate::solve::{newton, NewtonOptions, NewtonReport};
+
+pub(super) fn run_static(
+    s: &mut Solver,
+    writer: &mut Writer,
+    progress: &mut dyn Progress,
+    mut x: Vec<Vec3>,
+    mut phi: Vec<Real>,
+    restart: Option<Real>,
+) -> Result<(), RunError> {
+    let st = &s.scene.settings.solver;
+    let (tol, max_iter) = (st.tolerance, st.max_newton_iterations);
+    let (min_step, sb, seed) = (st.min_continuation_step, st.symmetry_breaking, st.seed);
+    let (check, max_escapes) = (st.check_stability, st.max_saddle_escapes);
+    let cont_frames = s.scene.settings.output.continuation_frames;
+    let zeros = vec![Vec3::zeros(); x.len()];
+    let dial_start = restart.unwrap_or(0.0).clamp(0.0, 1.0);
+    {
+        let pot = s.potential(dial_start);
+        s.frame(writer, &pot, &x, &phi, &zeros, dial_start)?;
+    }
+    let mut dial = dial_start;
+    // A restart solves at least once, even from a frame at dial 1 (the settings may differ).
+    let mut need_solve = restart.is_some();
+    let mut step = st.continuation_step;
+    // Membrane continuation: the stretching weight starts at 1/softening and grows ×ratio per
+    // solve once the dial is at 1 (see the module doc).
+    let h_min = s
+        .scene
+        .thickness
+        .iter()
+        .copied()
+        .fold(Real::INFINITY, Real::min);
+    // A softened membrane under external loads or prescribed displacements would follow a
+    // different (much softer) path: "auto" keeps the continuation for rest-form programming only.
+    let loaded = s.scene.settings.loads.any_external() || !s.scene.prescribed.is_empty();
+    let softening = match st.membrane_continuation {
+        crate::settings::Softening::Auto(_) if loaded => 1.0,
+        m => m.factor(s.scene.mesh.bbox_diagonal(), h_min),
+    };
+    let mut scale = 1.0 / softening.max(1.0);
+    let mut ratio: Real = 10.0;
+    let mut trial = x.clone();
+    let mut trial_phi = phi.clone();
+    let mut failure: Option<String> = None;
+    while dial < 1.0 || scale < 1.0 || need_solve {
+        let (target, target_scale) = if dial < 1.0 {
+            ((dial + step).min(1.0), scale)
+        } else {
+            (1.0, (scale * ratio).min(1.0))
+        };
+        // Intermediate continuation steps need not be solved to full accuracy.
+        let t = if target < 1.0 || target_scale < 1.0 {
+            (tol * 1e3).min(1e-5).max(tol)
+        } else {
+            tol
+        };
+        trial.copy_from_slice(&x);
+        trial_phi.copy_from_slice(&phi);
+        s.scene.prescribe(&mut trial, target);
+        let pot = s.potential_scaled(target, target_scale);
+        let rep = newton(
+            &pot,
+            &mut s.lin,
+            &mut s.ws,
+            &mut trial,
+            &mut trial_phi,
+            NewtonOptions { tol: t, max_iter },
+        );
+        s.record(&rep);
+        // A term tracking a state across steps (a moment's angle) may refuse a step too large
+        // for it; the step is then cut like a failed solve.
+        let admissible = rep.converged && s.scene.admissible(&trial, &trial_phi);
+        let rep = if rep.converged && !admissible {
+            NewtonReport {
+                converged: false,
+                failure: Some(crate::solve::SolveError::Refused(
+                    "a boundary turned by more than π/2 in one step (a moment load tracks its \
+                     angle step by step)",
+                )),
+                ..rep
+            }
+        } else {
+            rep
+        };
+        if rep.converged {
+            x.copy_from_slice(&trial);
+            phi.copy_from_slice(&trial_phi);
+            s.scene.accept(&x, &phi);
+            let grow = rep.iterations <= 5;
+            if dial < 1.0 {
+                dial = target;
+                if grow {
+                    step = (step * 2.0).min(1.0);
+                }
+            } else {
+                scale = target_scale;
+                if grow {
+                    ratio = (ratio * ratio).min(1e3);
+                }
+            }
+            need_solve = false;
+            s.summary.steps += 1;
+            progress.update(
+                dial,
+                &format!("dial {dial:.4} E {:.4e} r {:.1e}", rep.energy, rep.residual),
+            );
+            if cont_frames && dial < 1.0 {
+                let pot = s.potential(dial);
+                s.frame(writer, &pot, &x, &phi, &zeros, dial)?;
+            }
+        } else if dial < 1.0 {
+            s.summary.rejected_steps += 1;
+            step *= 0.5;
+            if step < min_step {
+                failure = Some(format!(
+                    "continuation step fell below {min_step} at dial {dial:.6}: {}",
+                    rep.failure_text()
+                ));
+                break;
+            }
+        } else {
+            s.summary.rejected_steps += 1;
+            ratio = ratio.sqrt();
+            if ratio < 1.01 {
+                failure = Some(format!(
+                    "membrane continuation stalled at stretching weight {scale:.3e}: {}",
+                    rep.failure_text()
+                ));
+                break;
+            }
+        }
+    }
+    if failure.is_none() && check {
+        let mut escapes = 0;
+        while !s.is_stable(1.0, &x, &phi) {
+            if escapes >= max_escapes {
+                failure = Some(format!(
+                    "equilibrium is a saddle (Hessian indefinite) after {escapes} perturbations"
+                ));
+                break;
+            }
+            escapes += 1;
+            let amp = sb.max(1e-3) * s.scene.mean_edge * 10f64.powi(escapes as i32);
+            perturb(s.scene, &mut x, amp, seed.wrapping_add(escapes as u64));
+            let pot = s.potential(1.0);
+            let rep = newton(
+                &pot,
+                &mut s.lin,
+                &mut s.ws,
+                &mut x,
+                &mut phi,
+                NewtonOptions {
+                    tol,
+                    max_iter: max_iter * 5,
+                },
+            );
+            s.record(&rep);
+            if !rep.converged {
+                failure = Some(format!("after escaping a saddle: {}", rep.failure_text()));
+                break;
+            }
+        }
+        s.summary.saddle_escapes = escapes;
+    }
+    s.summary.dial = dial;
+    s.summary.converged = failure.is_none();
+    s.summary.reason = failure.unwrap_or_default();
+    let pot = s.potential(dial);
+    s.summary.energy = Writer::energies(&pot, &x, &phi, &zeros);
+    s.frame(writer, &pot, &x, &phi, &zeros, 1.0_f64.max(dial))?;
+    Ok(())
+}
