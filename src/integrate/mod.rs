@@ -20,9 +20,9 @@
 //! (amplitude ×10 each time) and re-solved. A saddle is never reported as an equilibrium.
 
 //!
-//! One driver per file: [`statics`] (continuation of the dial, membrane continuation, saddle
-//! check) and [`dynamics`] (implicit Euler with adaptive steps, the friction lag), over the
-//! shared solver state, frame output and counters here; [`moisture`] couples the moisture
+//! One driver per file: `statics.rs` (continuation of the dial, membrane continuation, saddle
+//! check) and `dynamics.rs` (implicit Euler with adaptive steps, the friction lag), over the
+//! shared solver state, frame output and counters here; `moisture.rs` couples the moisture
 //! diffusion to the rest forms of a dynamic run.
 
 mod dynamics;

@@ -33,7 +33,7 @@
 //! boundary condition. (The mid-edge average instead pins `q = 0`, a spurious clamp that is the
 //! source of its corner error on curved shapes.)
 //!
-//! DOF order (21): `x[v0], x[v1], x[v2], x[p0], x[p1], x[p2]` (18, as [`super::shell`]), then
+//! DOF order (21): `x[v0], x[v1], x[v2], x[p0], x[p1], x[p2]` (18, as [`crate::energy::shell`]), then
 //! `φ_{e0}, φ_{e1}, φ_{e2}` (rad), the DOFs of the edges opposite `v0, v1, v2`. Units: energy J,
 //! gradient N (positions) and N·m (angles).
 
