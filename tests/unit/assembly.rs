@@ -152,7 +152,7 @@ fn assembled_derivatives(model: &str) {
 }
 
 /// The assembled gradient and Hessian of `pot` at `(x, phi)` against central differences of
-/// the assembled energy and gradient (every `stride`-th DOF).
+/// the assembled energy and gradient (every `stride`-th DOF), through the one checker.
 fn check_fd(
     sc: &Scene,
     p: &Pattern,
@@ -162,56 +162,16 @@ fn check_fd(
     label: &str,
     stride: usize,
 ) {
-    let nx = 3 * sc.num_vertices();
-    let node_of = |k: usize| {
-        if k < nx {
-            k / 3
-        } else {
-            sc.num_vertices() + (k - nx)
-        }
-    };
-    let mut g = vec![0.0; p.n];
-    let mut h = vec![0.0; p.nnz()];
-    pot.eval(x, phi, Want::Hessian, &mut g, &mut h);
-    let eps = 1e-6;
-    let gmax = g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let hmax = h.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    for k in (0..p.n).step_by(stride) {
-        if sc.node_fixed[node_of(k)] {
-            continue;
-        }
-        let (mut xp, mut xm) = (x.to_vec(), x.to_vec());
-        let (mut pp, mut pm) = (phi.to_vec(), phi.to_vec());
-        if k < nx {
-            xp[k / 3][k % 3] += eps;
-            xm[k / 3][k % 3] -= eps;
-        } else {
-            pp[k - nx] += eps;
-            pm[k - nx] -= eps;
-        }
-        let mut gp = vec![0.0; p.n];
-        let mut gm = vec![0.0; p.n];
-        let ep = pot.eval(&xp, &pp, Want::Gradient, &mut gp, &mut []);
-        let em = pot.eval(&xm, &pm, Want::Gradient, &mut gm, &mut []);
-        let fd = (ep - em) / (2.0 * eps);
-        assert!(
-            (fd - g[k]).abs() < 1e-6 * gmax,
-            "{label}: grad {k}: {} vs {fd}",
-            g[k]
-        );
-        // Column k of the Hessian (lower part stored in column k, upper part in rows).
-        for (pos, &row) in p.row_idx[p.col_ptr[k]..p.col_ptr[k + 1]].iter().enumerate() {
-            let fd = (gp[row] - gm[row]) / (2.0 * eps);
-            let val = h[p.col_ptr[k] + pos];
-            if sc.node_fixed[node_of(row)] {
-                continue;
-            }
-            assert!(
-                (fd - val).abs() < 1e-6 * hmax,
-                "{label}: H({row},{k}): {val} vs {fd}"
-            );
-        }
-    }
+    super::terms::fd_check(
+        sc,
+        p,
+        x,
+        phi,
+        label,
+        stride,
+        |_, h| h,
+        |x, phi, want, g, h| pot.eval(x, phi, want, g, h),
+    );
 }
 
 #[test]
