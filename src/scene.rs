@@ -504,25 +504,7 @@ pub fn region_faces(
     mesh: &Mesh,
     b: &crate::settings::MoistureBoundary,
 ) -> Result<Vec<usize>, MeshError> {
-    let tags = if b.tags.is_empty() {
-        None
-    } else {
-        Some(mesh.face_field("tri_tags", 1)?.ok_or_else(|| {
-            mesh.invalid(
-                "moisture.boundary selects faces by tags, which needs the face field 'tri_tags'",
-            )
-        })?)
-    };
-    Ok((0..mesh.faces.len())
-        .filter(|&f| tags.is_none_or(|t| b.tags.contains(&(t.data[f].round() as i64))))
-        .filter(|&f| {
-            b.inside.as_ref().is_none_or(|bx| {
-                let [p0, p1, p2] = mesh.face_positions(f);
-                let c = (p0 + p1 + p2) / 3.0;
-                (0..3).all(|k| c[k] >= bx.min[k] && c[k] <= bx.max[k])
-            })
-        })
-        .collect())
+    crate::energy::loads::faces_matching(mesh, &b.tags, b.inside.as_ref(), "moisture.boundary")
 }
 
 /// Rejects moisture boundary regions that give one face side two different conditions.
