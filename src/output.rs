@@ -266,7 +266,11 @@ impl Writer {
 
     /// Energies of a state by term.
     pub fn energies(pot: &Potential, x: &[Vec3], phi: &[Real], v: &[Vec3]) -> Energies {
-        let terms = pot.energies(x, phi);
+        Self::energies_of(pot, pot.energies(x, phi), v)
+    }
+
+    /// The energies record of the terms' energies and the kinetic energy at velocities `v`.
+    fn energies_of(pot: &Potential, terms: Vec<(&'static str, Real)>, v: &[Vec3]) -> Energies {
         let kinetic: Real = v
             .iter()
             .zip(pot.mass)
@@ -294,7 +298,14 @@ impl Writer {
         row.frame = index;
         let nf = sc.num_faces();
         let (a, b) = sc.forms(x, phi);
-        row.energy = Self::energies(pot, x, phi, v);
+        let mut term_energies = Vec::new();
+        let mut term_fields = Vec::new();
+        for (t, map) in sc.terms.iter().zip(&pot.pattern.maps) {
+            let (e, f) = t.report(pot, map, x, phi);
+            term_energies.extend(e);
+            term_fields.extend(f);
+        }
+        row.energy = Self::energies_of(pot, term_energies, v);
         row.observables = sc
             .terms
             .iter()
@@ -349,10 +360,8 @@ impl Writer {
         ff.insert("k1".into(), Field::scalar(k1s));
         ff.insert("k2".into(), Field::scalar(k2s));
         ff.insert("max_stretch".into(), Field::scalar(stretch));
-        for t in sc.terms.iter() {
-            for (name, data) in t.face_fields(pot, x, phi) {
-                ff.insert(name, Field::scalar(data));
-            }
+        for (name, data) in term_fields {
+            ff.insert(name, Field::scalar(data));
         }
         ff.insert("thickness".into(), Field::scalar(sc.thickness.clone()));
         for (name, data) in &self.extra {

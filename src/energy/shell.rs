@@ -269,28 +269,48 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
         x: &[Vec3],
         phi: &[Real],
     ) -> Vec<(&'static str, Real)> {
-        let fe = self.face_energies(pot, x, phi);
-        let (s, b) = fe
-            .iter()
-            .fold((0.0, 0.0), |(s, b), (fs, fb)| (s + fs, b + fb));
-        vec![("stretching", s), ("bending", b)]
+        totals(&self.face_energies(pot, x, phi))
     }
 
     /// `stretching_energy_density` and `bending_energy_density` (J/m² of rest area).
     fn face_fields(&self, pot: &Potential, x: &[Vec3], phi: &[Real]) -> Vec<(String, Vec<Real>)> {
-        let fe = self.face_energies(pot, x, phi);
-        let area: Vec<Real> = (0..fe.len())
-            .map(|f| 0.5 * crate::math::sym_det(&pot.rest_forms(f).0).max(0.0).sqrt())
-            .collect();
-        vec![
-            (
-                "stretching_energy_density".into(),
-                fe.iter().zip(&area).map(|(e, a)| e.0 / a).collect(),
-            ),
-            (
-                "bending_energy_density".into(),
-                fe.iter().zip(&area).map(|(e, a)| e.1 / a).collect(),
-            ),
-        ]
+        densities(pot, &self.face_energies(pot, x, phi))
     }
+
+    /// The face energies once for both the totals and the densities.
+    fn report(
+        &self,
+        pot: &Potential,
+        _: &crate::assembly::ElementMap,
+        x: &[Vec3],
+        phi: &[Real],
+    ) -> (Vec<(&'static str, Real)>, Vec<(String, Vec<Real>)>) {
+        let fe = self.face_energies(pot, x, phi);
+        (totals(&fe), densities(pot, &fe))
+    }
+}
+
+/// Total stretching and bending energies (J) of per-face `(stretching, bending)`.
+fn totals(fe: &[(Real, Real)]) -> Vec<(&'static str, Real)> {
+    let (s, b) = fe
+        .iter()
+        .fold((0.0, 0.0), |(s, b), (fs, fb)| (s + fs, b + fb));
+    vec![("stretching", s), ("bending", b)]
+}
+
+/// Per-face energy densities (J/m² of rest area) of per-face `(stretching, bending)`.
+fn densities(pot: &Potential, fe: &[(Real, Real)]) -> Vec<(String, Vec<Real>)> {
+    let area: Vec<Real> = (0..fe.len())
+        .map(|f| 0.5 * crate::math::sym_det(&pot.rest_forms(f).0).max(0.0).sqrt())
+        .collect();
+    vec![
+        (
+            "stretching_energy_density".into(),
+            fe.iter().zip(&area).map(|(e, a)| e.0 / a).collect(),
+        ),
+        (
+            "bending_energy_density".into(),
+            fe.iter().zip(&area).map(|(e, a)| e.1 / a).collect(),
+        ),
+    ]
 }

@@ -112,6 +112,22 @@ pub trait Term: Send + Sync {
         vec![(self.name(), e)]
     }
 
+    /// Everything a frame reports at once: [`Term::energies`] and [`Term::face_fields`]. A term
+    /// whose two share a computation overrides it to do that computation once.
+    #[allow(clippy::type_complexity)]
+    fn report(
+        &self,
+        pot: &Potential,
+        map: &ElementMap,
+        x: &[Vec3],
+        phi: &[Real],
+    ) -> (Vec<(&'static str, Real)>, Vec<(String, Vec<Real>)>) {
+        (
+            self.energies(pot, map, x, phi),
+            self.face_fields(pot, x, phi),
+        )
+    }
+
     /// Per-face fields this term contributes to the frames (default: none).
     fn face_fields(
         &self,
