@@ -818,7 +818,8 @@ impl Default for Constraints {
 pub struct Output {
     /// Frame format: `"vtu"` (XML), `"vtk"` (legacy binary) or `"vtk_ascii"` (default: `"vtu"`).
     pub format: Format,
-    /// Static mode: also write a frame after every accepted continuation step (default: `false`).
+    /// Static mode: also write a frame after every accepted continuation step, each solved to the
+    /// full tolerance (default: `false`).
     pub continuation_frames: bool,
     /// Basename of frame files, `{prefix}_{index:05}.{ext}` (default: `"frame"`).
     pub prefix: String,

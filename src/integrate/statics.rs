@@ -55,8 +55,10 @@ pub(super) fn run_static(
         } else {
             (1.0, (scale * ratio).min(1.0))
         };
-        // Intermediate continuation steps need not be solved to full accuracy.
-        let t = if target < 1.0 || target_scale < 1.0 {
+        // Intermediate continuation steps need not be solved to full accuracy, unless they are
+        // written: every frame (and its row of the load–displacement curve) is converged to
+        // the tolerance.
+        let t = if (target < 1.0 || target_scale < 1.0) && !cont_frames {
             (tol * 1e3).min(1e-5).max(tol)
         } else {
             tol

@@ -256,6 +256,67 @@ fn every_registered_term_matches_finite_differences() {
     }
 }
 
+/// The strip rolled about the y axis into an arc of total angle `turn` (clamped end at x = 0,
+/// along the arc of radius 1/κ), with a small random offset.
+fn rolled(sc: &Scene, turn: Real, noise: Real) -> Vec<Vec3> {
+    let kappa = turn / 1.0;
+    let mut rng = Rng::new(9);
+    sc.mesh
+        .positions
+        .iter()
+        .map(|p| {
+            let a = kappa * p.x;
+            Vec3::new(a.sin() / kappa, p.y, (1.0 - a.cos()) / kappa)
+                + Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * noise
+        })
+        .collect()
+}
+
+/// The end moment against finite differences, with and without edge DOFs, after its tracked
+/// angles were accepted past π (the strip rolled to 1.1π, then evaluated near 1.3π), and its
+/// turn counted through full turns.
+#[test]
+fn end_moment_matches_finite_differences_past_a_half_turn() {
+    for bend in ["midedge_sin", "midedge_average"] {
+        let sc = strip_scene(&format!(
+            "[material]\nthickness = 0.05\nbending = \"{bend}\"\n\
+             [[constraints.clamp]]\ninside = {{ min = [-1, -1, -1], max = [0.01, 2, 1] }}\n\
+             [[loads.moment]]\nmoment = 2.0\ninside = {{ min = [0.99, -1, -1], max = [2, 2, 1] }}\n"
+        ));
+        let p = Pattern::for_scene(&sc);
+        let i = (0..sc.terms.len())
+            .find(|&i| sc.terms[i].name() == "moment")
+            .expect("a moment term");
+        let phi = vec![0.02; sc.num_edge_dofs()];
+        // Accept in steps below π/2, as the solver would.
+        for k in 1..=11 {
+            sc.terms[i].accept(
+                &rolled(&sc, 0.1 * k as Real * std::f64::consts::PI, 0.0),
+                &phi,
+            );
+        }
+        let x = rolled(&sc, 1.3 * std::f64::consts::PI, 0.01);
+        let pot = Potential {
+            dial: 0.8,
+            ..Potential::new(&sc, &p)
+        };
+        check_term(&sc, &p, &pot, &x, &phi, i);
+        // The turn counts through the half turn: each tip face is flat with its boundary edge
+        // along y, so its normal's angle is κ(1 + x_k)/2 (x_k its third vertex), linear in κ.
+        let turn = |t: Real| {
+            let x = rolled(&sc, t * std::f64::consts::PI, 0.0);
+            let obs = sc.terms[i].observables(&pot, &x, &phi);
+            obs.iter().find(|(n, _)| n == "moment_rotation").unwrap().1
+        };
+        let (t11, t13) = (turn(1.1), turn(1.3));
+        assert!(t11 > std::f64::consts::PI, "{bend}: turn {t11}");
+        assert!(
+            (t13 / t11 - 13.0 / 11.0).abs() < 1e-12,
+            "{bend}: turns {t11}, {t13}"
+        );
+    }
+}
+
 /// Per unit element weight (V = h A₀ = 1: ā = I on the unit right triangle, h = 2), λ = 1,
 /// μ = 0.7, r = 100, the values of REFERENCES.md from positions through the shell kernel.
 #[test]

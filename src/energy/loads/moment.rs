@@ -2,18 +2,30 @@
 //!
 //! The moment `m` (N·m per unit length) acts on the boundary edges whose two vertices are
 //! selected, about each edge's *reference* direction `t⁰` (a fixed axis, so the moment is
-//! conservative). The boundary face `f` of edge `e` turns about `t⁰` by
+//! conservative). The turn of the edge's boundary face about `t⁰` is measured through two
+//! vectors of the face that are normal to `t⁰` in the reference state: its area normal
+//! `A = (x₁ − x₀) × (x₂ − x₀)` and the in-face normal of the edge `B = A × e`,
+//! `e = x_j − x_i` the edge. Each vector's angle about `t⁰` is
 //!
-//! `θ_e = θ_e⁰ + atan2(−o⁰·A, n⁰·A)`, `A = (x₁ − x₀) × (x₂ − x₀)` (the face's area normal),
+//! `θ_V = θ_V⁰ + atan2(−o_V·V, n_V·V)`,
 //!
-//! counted positive when the face's outward direction tilts toward the side its normal points
-//! to. `n⁰` (the face normal projected normal to `t⁰`) and `o⁰ = ±t⁰ × n⁰` (outward) are taken
-//! at the last accepted state, whose accumulated angle is `θ_e⁰`
-//! ([`crate::energy::term::Term::accept`] updates them after every accepted step, and a step
-//! that turns an edge by more than π/2 is cut). So the angle is single-valued within a solve
-//! and continues through full turns across steps: a strip can be rolled into a full circle.
-//! Measuring the turn through the face normal makes it blind, to first order, to twisting about
-//! any axis normal to `t⁰` (a vector within the face would pick up twist).
+//! with `n_V` the vector's direction projected normal to `t⁰` at the last accepted state,
+//! `o_V = −k × n_V`, `k = ±t⁰` the sense in which the angle counts positive (the face's outward
+//! direction tilting toward the side its normal points to), and `θ_V⁰` the angle accumulated up
+//! to that state ([`crate::energy::term::Term::accept`] updates them after every accepted step,
+//! and a step that turns an edge by more than π/2 is cut). So each angle is single-valued within
+//! a solve and continues through full turns across steps: a strip can be rolled into a full
+//! circle. The face's turn is the mean `θ = (θ_A + θ_B)/2`.
+//!
+//! **Why two vectors.** Under a small spatial rotation `ω` of a face whose vector `w` lies
+//! normal to `t⁰`, the projected angle changes by `ω_t + ½ ω_p ω_w + O(ω³)`, where `ω_w` is the
+//! rotation about `w` and `ω_p` the one about `t⁰ × w`. For `A` the product couples twist and
+//! yaw with one sign, for `B` (normal to `A` and to the edge) with the other, and in the mean
+//! it cancels: the moment adds no load stiffness to first order. One vector alone gives a
+//! stiffness `∓ m ω_twist ω_yaw` that makes the rolled strip buckle sideways beyond three
+//! quarters of a turn (measured: the lowest eigenvalue of the Hessian turns negative at 80% of
+//! the full-circle moment, while the shell alone stays positive definite there). In plane
+//! motion `A` and `B` turn together and `θ_A = θ_B` exactly.
 //!
 //! **Energy.** Without edge DOFs the boundary's director is the face normal:
 //! `E = −s m Σ_e ℓ⁰_e θ_e` (J), `ℓ⁰` the reference edge length, `s` the dial. With edge DOFs
@@ -22,11 +34,14 @@
 //! `E = −s m Σ_e ℓ⁰_e (θ_e − σ_e φ_e)`. The boundary's natural condition is then that the
 //! bending moment equals `m`.
 //!
-//! **Derivatives.** With `p = n⁰·A`, `q = −o⁰·A`, `r² = p² + q²`:
-//! `g = ∇_A θ = (−p o⁰ − q n⁰)/r²`,
-//! `∇²_A θ = [(q² − p²)(−o⁰n⁰ᵀ − n⁰o⁰ᵀ) + 2pq(n⁰n⁰ᵀ − o⁰o⁰ᵀ)]/r⁴`;
-//! `∂A/∂x₀ = [x₂ − x₁]×` (cyclically), and `Σ_c g_c ∂²A_c/∂x_a∂x_b = −[g]×` for
-//! `(a, b) = (0, 1), (1, 2), (2, 0)` and its transpose for the reverse pairs.
+//! **Derivatives.** With `p = n_V·V`, `q = −o_V·V`, `r² = p² + q²`:
+//! `g_V = ∇_V θ_V = (−p o_V − q n_V)/r²`,
+//! `∇²_V θ_V = [(q² − p²)(−o n ᵀ − n oᵀ) + 2pq(n nᵀ − o oᵀ)]/r⁴`.
+//! `∂A/∂x_a = M_a = [x_{a+2} − x_{a+1}]×` (cyclically), and `Σ_c g_c ∂²A_c/∂x_a∂x_b = −[g]×`
+//! for `(a, b) = (0, 1), (1, 2), (2, 0)` and its transpose for the reverse pairs.
+//! `∂B/∂x_a = −[e]× M_a + c_a [A]×` with `c_j = 1`, `c_i = −1` and 0 for the third vertex;
+//! `g·B = A·(e × g)`, so `Σ_c g_c ∂²B_c` is the contraction of `A` with `e × g` plus the cross
+//! blocks `−c_b M_aᵀ[g]× + c_a [g]× M_b`.
 //!
 //! DOF order (10 local): the face's `x[v0], x[v1], x[v2]`, then the edge's DOF `φ_e` (unused
 //! without edge DOFs). Units: m in N·m/m, E in J, gradient N and N·m.
@@ -45,39 +60,76 @@ use std::sync::Mutex;
 struct Edge {
     /// Nodes: the face's vertices in face order, then the edge node.
     nodes: [usize; 4],
+    /// The edge's end vertices `(i, j)` as local slots of the face.
+    ends: [usize; 2],
     /// `m ℓ⁰` (N·m).
     weight: Real,
     /// The face's orientation sign on the edge.
     sigma: Real,
 }
 
-/// The reference frame of one edge's angle: `o`, `n` span the plane normal to the edge's
-/// reference tangent `t⁰`.
+/// The reference of one vector's angle about `t⁰`: its direction `n` projected normal to `t⁰`
+/// at the last accepted state, and the angle accumulated up to there.
 #[derive(Clone, Copy, Debug)]
 struct Frame {
-    o: Vec3,
     n: Vec3,
-    t0: Vec3,
     theta: Real,
+}
+
+/// The frames of one edge: the signed axis `k` (`θ` grows when `n` turns toward `k × n`) and
+/// one frame for `A`, one for `B`.
+#[derive(Clone, Copy, Debug)]
+struct Frames {
+    k: Vec3,
+    a: Frame,
+    b: Frame,
 }
 
 /// The moment kernel with its per-edge frames.
 pub struct Moment {
     edges: Vec<Edge>,
-    frames: Mutex<Vec<Frame>>,
+    frames: Mutex<Vec<Frames>>,
 }
 
-/// The face's area normal `A` at positions `x`.
-fn area(x: &[Vec3], e: &Edge) -> Vec3 {
-    let [a, b, c, _] = e.nodes;
-    (x[b] - x[a]).cross(&(x[c] - x[a]))
+/// The face's area normal `A` and in-face edge normal `B = A × e` at positions `x`.
+fn vectors(x: &[Vec3], e: &Edge) -> (Vec3, Vec3) {
+    let xs = [x[e.nodes[0]], x[e.nodes[1]], x[e.nodes[2]]];
+    let a = (xs[1] - xs[0]).cross(&(xs[2] - xs[0]));
+    (a, a.cross(&(xs[e.ends[1]] - xs[e.ends[0]])))
+}
+
+/// The angle of `v` about `k` in frame `f`: `(θ, g = ∇_v θ, ∇²_v θ)`.
+fn angle(k: &Vec3, f: &Frame, v: &Vec3, want_hess: bool) -> (Real, Vec3, Mat3) {
+    let o = -k.cross(&f.n);
+    let (p, q) = (f.n.dot(v), -o.dot(v));
+    let r2 = p * p + q * q;
+    let g = (-o * p - f.n * q) / r2;
+    let h = if want_hess {
+        let on: Mat3 = o * f.n.transpose();
+        let nn: Mat3 = f.n * f.n.transpose();
+        let oo: Mat3 = o * o.transpose();
+        (-(on + on.transpose()) * (q * q - p * p) + (nn - oo) * (2.0 * p * q)) / (r2 * r2)
+    } else {
+        Mat3::zeros()
+    };
+    (f.theta + q.atan2(p), g, h)
+}
+
+/// The frame of `v` (projected normal to `k`) carrying angle `theta`.
+fn frame(k: &Vec3, v: &Vec3, theta: Real) -> Frame {
+    Frame {
+        n: (v - k * k.dot(v)).normalize(),
+        theta,
+    }
 }
 
 impl Moment {
-    /// `(θ, p, q)` for area normal `a`.
-    fn angle(&self, f: &Frame, a: &Vec3) -> (Real, Real, Real) {
-        let (p, q) = (f.n.dot(a), -f.o.dot(a));
-        (f.theta + q.atan2(p), p, q)
+    /// The face's turn `θ = (θ_A + θ_B)/2` and the two angles.
+    fn turn(&self, f: &Frames, x: &[Vec3], e: &Edge) -> (Real, Real, Real) {
+        let (a, b) = vectors(x, e);
+        let ta = angle(&f.k, &f.a, &a, false).0;
+        let tb = angle(&f.k, &f.b, &b, false).0;
+        (0.5 * (ta + tb), ta, tb)
     }
 }
 
@@ -94,15 +146,18 @@ impl ElementKernel<10, 4> for Moment {
         hess: Option<&mut SMat<10, 10>>,
     ) -> Real {
         let edge = &self.edges[e];
-        let f = self.frames.lock().map(|fr| fr[e]).unwrap_or(Frame {
-            o: Vec3::x(),
-            n: Vec3::z(),
-            t0: Vec3::y(),
-            theta: 0.0,
-        });
+        let Some(f) = self.frames.lock().ok().map(|fr| fr[e]) else {
+            return Real::NAN;
+        };
         let xs = [x[nodes[0]], x[nodes[1]], x[nodes[2]]];
+        let ev = xs[edge.ends[1]] - xs[edge.ends[0]];
         let a = (xs[1] - xs[0]).cross(&(xs[2] - xs[0]));
-        let (theta, p, q) = self.angle(&f, &a);
+        let b = a.cross(&ev);
+        let want_h = hess.is_some() && !gauss_newton;
+        let (ta, ga, ha) = angle(&f.k, &f.a, &a, want_h);
+        let (tb, gb, hb) = angle(&f.k, &f.b, &b, want_h);
+        // Half of each angle: θ = (θ_A + θ_B)/2.
+        let (ga, gb, ha, hb) = (ga * 0.5, gb * 0.5, ha * 0.5, hb * 0.5);
         let w = -pot.dial * edge.weight;
         let nv = pot.scene.num_vertices();
         let tilt = if nodes[3] != NONE {
@@ -110,14 +165,25 @@ impl ElementKernel<10, 4> for Moment {
         } else {
             0.0
         };
-        let r2 = p * p + q * q;
-        let ga = (-f.o * p - f.n * q) / r2;
-        // ∂A/∂x_a = [x_{a+2} − x_{a+1}]×.
-        let da: [Mat3; 3] = std::array::from_fn(|v| skew(&(xs[(v + 2) % 3] - xs[(v + 1) % 3])));
+        let energy = w * (0.5 * (ta + tb) - tilt);
+        // c_a: ∂e/∂x_a = c_a I.
+        let c = |v: usize| {
+            if v == edge.ends[1] {
+                1.0
+            } else if v == edge.ends[0] {
+                -1.0
+            } else {
+                0.0
+            }
+        };
+        // ∂A/∂x_a = [x_{a+2} − x_{a+1}]×; ∂B/∂x_a = −[e]× M_a + c_a [A]×.
+        let ma: [Mat3; 3] = std::array::from_fn(|v| skew(&(xs[(v + 2) % 3] - xs[(v + 1) % 3])));
+        let (se, sa) = (skew(&ev), skew(&a));
+        let mb: [Mat3; 3] = std::array::from_fn(|v| -se * ma[v] + sa * c(v));
         if let Some(g) = grad {
-            for (v, d) in da.iter().enumerate() {
+            for v in 0..3 {
                 g.fixed_rows_mut::<3>(3 * v)
-                    .copy_from(&(d.transpose() * ga * w));
+                    .copy_from(&((ma[v].transpose() * ga + mb[v].transpose() * gb) * w));
             }
             g[9] = if nodes[3] != NONE {
                 -w * edge.sigma
@@ -130,27 +196,25 @@ impl ElementKernel<10, 4> for Moment {
             if gauss_newton {
                 // The Gauss–Newton Hessian of a rotation's work is 0 (its curvature is all
                 // second-order geometry, like the shell's dropped terms).
-                return w * (theta - tilt);
+                return energy;
             }
-            let on: Mat3 = f.o * f.n.transpose();
-            let nn: Mat3 = f.n * f.n.transpose();
-            let oo: Mat3 = f.o * f.o.transpose();
-            let haa =
-                (-(on + on.transpose()) * (q * q - p * p) + (nn - oo) * (2.0 * p * q)) / (r2 * r2);
-            let sg = skew(&ga);
-            for a in 0..3 {
-                for b in 0..3 {
-                    let mut blk = da[a].transpose() * haa * da[b];
-                    if b == (a + 1) % 3 {
-                        blk -= sg;
-                    } else if a == (b + 1) % 3 {
-                        blk += sg;
+            // Σ_c g_c ∂²A_c for the A angle's g and for B's contraction vector e × g_B.
+            let sga = skew(&(ga + ev.cross(&gb)));
+            let sgb = skew(&gb);
+            for i in 0..3 {
+                for j in 0..3 {
+                    let mut blk = ma[i].transpose() * ha * ma[j] + mb[i].transpose() * hb * mb[j];
+                    if j == (i + 1) % 3 {
+                        blk -= sga;
+                    } else if i == (j + 1) % 3 {
+                        blk += sga;
                     }
-                    h.fixed_view_mut::<3, 3>(3 * a, 3 * b).copy_from(&(blk * w));
+                    blk += ma[i].transpose() * sgb * (-c(j)) + sgb * ma[j] * c(i);
+                    h.fixed_view_mut::<3, 3>(3 * i, 3 * j).copy_from(&(blk * w));
                 }
             }
         }
-        w * (theta - tilt)
+        energy
     }
 }
 
@@ -214,27 +278,22 @@ impl Term for MomentTerm {
     fn accept(&self, x: &[Vec3], _: &[Real]) {
         if let Ok(mut frames) = self.0.frames.lock() {
             for (e, f) in self.0.edges.iter().zip(frames.iter_mut()) {
-                let a = area(x, e);
-                let (theta, _, _) = self.0.angle(f, &a);
-                let n = (a - f.t0 * f.t0.dot(&a)).normalize();
-                let o = f.t0.cross(&n);
-                let o = if o.dot(&f.o) < 0.0 { -o } else { o };
-                *f = Frame {
-                    o,
-                    n,
-                    t0: f.t0,
-                    theta,
-                };
+                let (a, b) = vectors(x, e);
+                let (_, ta, tb) = self.0.turn(f, x, e);
+                f.a = frame(&f.k, &a, ta);
+                f.b = frame(&f.k, &b, tb);
             }
         }
     }
-    /// Each edge's angle may change by at most π/2 per step, well inside the atan2 branch.
+    /// Each edge's angles may change by at most π/2 per step, well inside the atan2 branch.
     fn admissible(&self, x: &[Vec3], _: &[Real]) -> bool {
         let Ok(frames) = self.0.frames.lock() else {
             return false;
         };
         self.0.edges.iter().zip(frames.iter()).all(|(e, f)| {
-            (self.0.angle(f, &area(x, e)).0 - f.theta).abs() <= std::f64::consts::FRAC_PI_2
+            let (_, ta, tb) = self.0.turn(f, x, e);
+            let lim = std::f64::consts::FRAC_PI_2;
+            (ta - f.a.theta).abs() <= lim && (tb - f.b.theta).abs() <= lim
         })
     }
     fn observables(&self, _: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
@@ -243,7 +302,7 @@ impl Term for MomentTerm {
         };
         let mut sum = 0.0;
         for (e, f) in self.0.edges.iter().zip(frames.iter()) {
-            sum += self.0.angle(f, &area(x, e)).0;
+            sum += self.0.turn(f, x, e).0;
         }
         vec![("moment_rotation".into(), sum / self.0.edges.len() as Real)]
     }
@@ -281,22 +340,26 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
             let pos = &mesh.positions;
             let len = (pos[j] - pos[i]).norm();
             let sigma = scene.edge_sign.get(f).map_or(1.0, |s| s[slot]);
+            let local = |v: usize| (0..3).find(|&s| face[s] == v).unwrap_or(0);
             let edge = Edge {
                 nodes: [face[0], face[1], face[2], nv + e],
+                ends: [local(i), local(j)],
                 weight: l.moment * len,
                 sigma,
             };
             let t0 = (pos[j] - pos[i]).normalize();
-            let a = area(pos, &edge);
+            let (a, b) = vectors(pos, &edge);
             let n = (a - t0 * t0.dot(&a)).normalize();
+            // Outward: from the opposite vertex toward the edge, within the face.
             let u = (pos[i] + pos[j]) * 0.5 - pos[k];
             let o = t0.cross(&n);
             let o = if o.dot(&u) < 0.0 { -o } else { o };
-            frames.push(Frame {
-                o,
-                n,
-                t0,
-                theta: 0.0,
+            // θ grows as n turns toward −o: k × n = −o.
+            let axis = o.cross(&n);
+            frames.push(Frames {
+                k: axis,
+                a: frame(&axis, &a, 0.0),
+                b: frame(&axis, &b, 0.0),
             });
             edges.push(edge);
         }
