@@ -371,6 +371,11 @@ impl Writer {
             let ea = sc.topo.face_edges.iter().flat_map(|fe| fe.map(|e| phi[e]));
             ff.insert("edge_angles".into(), vec3(ea.collect()));
         }
+        for t in sc.terms.iter() {
+            if let Some(name) = t.state_field() {
+                ff.insert(name.into(), vec3(t.state(x, phi)));
+            }
+        }
         if !sc.patches.is_empty() {
             ff.insert(
                 "patch_condition".into(),

@@ -1,7 +1,8 @@
 //! Restart from a frame written by shellsim (seed 001, "restart from an earlier frame").
 //!
-//! A frame holds the deformed positions, the per-vertex `velocity` and, with an edge-DOF bending
-//! model, the per-face `edge_angles`. The reference geometry, rest forms and material come from
+//! A frame holds the deformed positions, the per-vertex `velocity`, with an edge-DOF bending
+//! model the per-face `edge_angles`, and the state of terms that track one across steps (an end
+//! moment's `moment_turn`, [`crate::energy::term::Term::state_field`]). The reference geometry, rest forms and material come from
 //! the mesh file and settings of the new run, so the frame must have the same vertices and faces
 //! as that mesh. The frame's time (dynamics) or dial (statics) is looked up in the `series.pvd`
 //! next to it; without one the run starts its clock at 0 and says so in a warning.
@@ -90,6 +91,21 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
                 "{name}: no 'edge_angles' field; the edge DOFs start at 0 (the mid-edge average \
                  normals)"
             )),
+        }
+    }
+    // Terms that track a state across steps (an end moment's turns) restart from theirs.
+    for t in scene.terms.iter() {
+        if let Some(field) = t.state_field() {
+            let data = frame.face_field(field, 3)?;
+            match t.restore(
+                &frame.positions,
+                &phi,
+                data.as_ref().map(|f| f.data.as_slice()),
+            ) {
+                Ok(Some(w)) => warnings.push(format!("{name}: {w}")),
+                Ok(None) => {}
+                Err(e) => return Err(bad(e.to_string())),
+            }
         }
     }
     let time = match series_time(path) {

@@ -430,3 +430,82 @@ fn end_moment_rolls_a_strip_along_the_elastica() {
         assert!(r < 0.001, "step {k}: Richardson tip error {r}");
     }
 }
+
+/// A moment-loaded run restarted from a frame past the half turn ends where the uninterrupted
+/// run ends, with the same logged turn and energy: the frame carries each loaded edge's turn
+/// (`moment_turn`), so the restart does not count it modulo 2π (which would shift the moment's
+/// energy by 2π m L and log the turn less a full circle).
+#[test]
+fn restart_of_a_moment_run_resumes_its_turns() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    rectangle(dir, 1.0, 0.04, 0.02, &[], "e.vtk");
+    let m = 2.0 * std::f64::consts::PI * 1e7 * 1e-6 / 12.0 / 0.98;
+    std::fs::write(
+        dir.join("e.toml"),
+        format!(
+            "[material]\nyoung = 1e7\npoisson = 0.0\nthickness = 0.01\n\
+             [solver]\nsymmetry_breaking = 0.0\ncontinuation_step = 0.1\n\
+             [output]\ncontinuation_frames = true\n\
+             [[constraints.clamp]]\ninside = {{ min = [-1, -1, -1], max = [-0.499, 1, 1] }}\n\
+             [[loads.moment]]\nmoment = {m}\ninside = {{ min = [0.499, -1, -1], max = [1, 1, 1] }}\n"
+        ),
+    )
+    .unwrap();
+    shellsim(&["e.toml", "e.vtk", "--out", "full", "-q"], dir);
+    let full = final_positions(dir, "full");
+    // Frame 7 is at dial 0.7: the tip has turned by 0.7 × 2π > π.
+    let frame = dir.join("full/frame_00007.vtu");
+    let turns = shellsim::mesh::io::read_mesh(&frame).unwrap();
+    let turn = turns.face_fields["moment_turn"]
+        .data
+        .iter()
+        .fold(0.0f64, |m, v| m.max(*v));
+    assert!(turn > 4.0, "turn in the frame {turn}");
+    shellsim(
+        &[
+            "e.toml",
+            "e.vtk",
+            "--out",
+            "again",
+            "-q",
+            "--restart",
+            frame.to_str().unwrap(),
+        ],
+        dir,
+    );
+    let again = final_positions(dir, "again");
+    let last = |out: &str| -> Vec<(String, f64)> {
+        let log = std::fs::read_to_string(dir.join(out).join("log.csv")).unwrap();
+        let header: Vec<String> = log
+            .lines()
+            .next()
+            .unwrap()
+            .split(',')
+            .map(String::from)
+            .collect();
+        let row: Vec<f64> = log
+            .lines()
+            .last()
+            .unwrap()
+            .split(',')
+            .map(|v| v.parse().unwrap_or(0.0))
+            .collect();
+        header.into_iter().zip(row).collect()
+    };
+    let (a, b) = (last("full"), last("again"));
+    for key in ["moment_rotation", "energy_moment", "energy_total"] {
+        let va = a.iter().find(|(k, _)| k == key).unwrap().1;
+        let vb = b.iter().find(|(k, _)| k == key).unwrap().1;
+        assert!((va - vb).abs() <= 1e-9 * va.abs(), "{key}: {va} vs {vb}");
+    }
+    let scale = full
+        .iter()
+        .flat_map(|p| p.iter())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    for (p, q) in full.iter().zip(&again) {
+        for k in 0..3 {
+            assert!((p[k] - q[k]).abs() <= 1e-9 * scale, "{p:?} vs {q:?}");
+        }
+    }
+}

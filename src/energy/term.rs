@@ -67,6 +67,16 @@ pub struct LowRank {
     pub u: Vec<Real>,
 }
 
+/// A tracked state in a restart frame that cannot be used.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("face {face}: {reason}")]
+pub struct StateError {
+    /// The face whose value is invalid.
+    pub face: usize,
+    /// What is wrong with it.
+    pub reason: String,
+}
+
 /// One energy term of the potential.
 pub trait Term: Send + Sync {
     /// The name under which its energy is reported (`log.csv`, `summary.json`).
@@ -136,6 +146,30 @@ pub trait Term: Send + Sync {
         _phi: &[Real],
     ) -> Vec<(String, Vec<Real>)> {
         Vec::new()
+    }
+
+    /// The name of the per-face field that carries the state this term tracks across steps
+    /// (default: none). Frames hold it as a 3-vector per face in the face's edge order (like
+    /// `edge_angles`), and a restart hands it back to [`Term::restore`].
+    fn state_field(&self) -> Option<&'static str> {
+        None
+    }
+
+    /// The tracked state at `(x, phi)` for [`Term::state_field`]: 3 values per face.
+    fn state(&self, _x: &[Vec3], _phi: &[Real]) -> Vec<Real> {
+        Vec::new()
+    }
+
+    /// Restores the tracked state at the restart state `(x, phi)` from the frame's field
+    /// (`None` when the frame has none: the term then says in the returned warning what it
+    /// assumed). An invalid field is an error naming the face.
+    fn restore(
+        &self,
+        _x: &[Vec3],
+        _phi: &[Real],
+        _field: Option<&[Real]>,
+    ) -> Result<Option<String>, StateError> {
+        Ok(None)
     }
 
     /// Called by the drivers after every accepted step (static continuation step or time

@@ -47,7 +47,7 @@
 //! without edge DOFs). Units: m in N·m/m, E in J, gradient N and N·m.
 
 use super::select_vertices;
-use crate::energy::term::{ElementKernel, Stencil, Term};
+use crate::energy::term::{ElementKernel, StateError, Stencil, Term};
 use crate::math::{skew, Mat3, Real, SMat, SVec, Vec3};
 use crate::mesh::topology::NONE;
 use crate::mesh::MeshError;
@@ -62,6 +62,9 @@ struct Edge {
     nodes: [usize; 4],
     /// The edge's end vertices `(i, j)` as local slots of the face.
     ends: [usize; 2],
+    /// The face and the edge's slot in it (the edge is opposite vertex `slot`).
+    face: usize,
+    slot: usize,
     /// `m ℓ⁰` (N·m).
     weight: Real,
     /// The face's orientation sign on the edge.
@@ -88,6 +91,7 @@ struct Frames {
 /// The moment kernel with its per-edge frames.
 pub struct Moment {
     edges: Vec<Edge>,
+    num_faces: usize,
     frames: Mutex<Vec<Frames>>,
 }
 
@@ -296,6 +300,52 @@ impl Term for MomentTerm {
             (ta - f.a.theta).abs() <= lim && (tb - f.b.theta).abs() <= lim
         })
     }
+    fn state_field(&self) -> Option<&'static str> {
+        Some("moment_turn")
+    }
+    /// Each loaded edge's turn θ (rad) at its boundary face and edge slot; 0 elsewhere.
+    fn state(&self, x: &[Vec3], _: &[Real]) -> Vec<Real> {
+        let mut out = vec![0.0; 3 * self.0.num_faces];
+        if let Ok(frames) = self.0.frames.lock() {
+            for (e, f) in self.0.edges.iter().zip(frames.iter()) {
+                out[3 * e.face + e.slot] = self.0.turn(f, x, e).0;
+            }
+        }
+        out
+    }
+    /// Both angles of each edge restart from the frame's turn, re-centred at `x`. Without the
+    /// field the turns are counted from the reference within ±π.
+    fn restore(
+        &self,
+        x: &[Vec3],
+        phi: &[Real],
+        field: Option<&[Real]>,
+    ) -> Result<Option<String>, StateError> {
+        let Some(field) = field else {
+            self.accept(x, phi);
+            return Ok(Some(
+                "no 'moment_turn' field: the end moment's turns are counted from the reference \
+                 mesh within ±π"
+                    .into(),
+            ));
+        };
+        let Ok(mut frames) = self.0.frames.lock() else {
+            return Ok(None);
+        };
+        for (e, f) in self.0.edges.iter().zip(frames.iter_mut()) {
+            let theta = field.get(3 * e.face + e.slot).copied().unwrap_or(Real::NAN);
+            if !theta.is_finite() {
+                return Err(StateError {
+                    face: e.face,
+                    reason: format!("field 'moment_turn' is not finite at edge {}", e.slot),
+                });
+            }
+            let (a, b) = vectors(x, e);
+            f.a = frame(&f.k, &a, theta);
+            f.b = frame(&f.k, &b, theta);
+        }
+        Ok(None)
+    }
     fn observables(&self, _: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
         let Ok(frames) = self.0.frames.lock() else {
             return Vec::new();
@@ -344,6 +394,8 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
             let edge = Edge {
                 nodes: [face[0], face[1], face[2], nv + e],
                 ends: [local(i), local(j)],
+                face: f,
+                slot,
                 weight: l.moment * len,
                 sigma,
             };
@@ -372,6 +424,7 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
     }
     Ok(Some(Box::new(MomentTerm(Moment {
         edges,
+        num_faces: mesh.faces.len(),
         frames: Mutex::new(frames),
     }))))
 }
