@@ -1,20 +1,16 @@
-//! The dynamic driver: implicit Euler (seed 000 §3) with adaptive time steps, output timing,
-//! the moisture sub-step, the friction lag and the equilibrium stop.
+//! The dynamic driver: implicit Euler (seed 000 §3) with adaptive time steps, output timing and
+//! the equilibrium stop; the moisture sub-step ([`super::moisture`]) and the friction lag
+//! ([`super::friction`]) are their own modules.
 
+use super::friction::FrictionLag;
 use super::moisture::{accepted, Moisture};
-use super::{Progress, RunError, Solver};
+use super::{OutputClock, Progress, RunError, Solver, StepControl};
 use crate::assembly::Want;
 use crate::math::{Real, Sym2, Vec3};
 use crate::output::Writer;
-use crate::solve::potential::{Damping, Friction, Inertia};
+use crate::solve::potential::{Damping, Inertia};
 use crate::solve::{newton, NewtonOptions, Potential};
 use std::time::Instant;
-
-/// Friction lag: a step is re-solved with the updated normal forces until they change by at
-/// most this fraction of the largest one ...
-const FRICTION_LAG_TOL: Real = 1e-3;
-/// ... or this many solves were made (the last one is accepted).
-const FRICTION_LAG_MAX: usize = 6;
 
 pub(super) fn run_dynamic(
     s: &mut Solver,
@@ -63,21 +59,16 @@ pub(super) fn run_dynamic(
         s.frame(writer, &pot, &x, &phi, &v, t0)?;
     }
     // Friction: the lagged normal forces, carried from step to step.
-    let friction = sc.ground.as_ref().is_some_and(|g| g.friction > 0.0);
-    let mut lambda = match &sc.ground {
-        Some(g) if friction => g.normal_forces(&x),
-        _ => Vec::new(),
-    };
+    let mut lag = FrictionLag::new(sc, &x);
     let mut t = t0;
-    let mut dt = tm.dt;
+    // Halved on failure, ×1.5 after 3 easy steps (≤ 3 Newton iterations).
+    let mut steps = StepControl::new(tm.dt, tm.dt_min, tm.dt_max, 1.5, 3, 3);
     // The next output time after the start (a restart resumes the output grid).
-    let mut next_out = (((t0 / tm.output_interval) + 1e-9).floor() + 1.0) * tm.output_interval;
-    next_out = next_out.min(tm.end);
-    let mut easy = 0;
+    let mut clock = OutputClock::new(t0, tm.output_interval, tm.end);
     let mut failure: Option<String> = None;
     let eps_t = 1e-12 * tm.end;
     while t < tm.end - eps_t {
-        let h = dt.min(next_out - t).min(tm.end - t);
+        let h = steps.step.min(clock.next - t).min(tm.end - t);
         let dial = dial_at(t + h);
         for i in 0..n {
             xhat[i] = x[i] + v[i] * h;
@@ -108,8 +99,8 @@ pub(super) fn run_dynamic(
             if m.change > sc.settings.moisture.max_change && h > tm.dt_min {
                 s.summary.moisture_seconds += moisture_clock.elapsed().as_secs_f64();
                 s.summary.rejected_steps += 1;
-                dt = (h * 0.5).max(tm.dt_min);
-                easy = 0;
+                steps.rejected(h);
+                steps.step = steps.step.max(tm.dt_min);
                 continue;
             }
             match m.targets_of(sc, &m.trial) {
@@ -124,10 +115,11 @@ pub(super) fn run_dynamic(
         }
         let trial_mass = moisture.as_ref().map_or(&sc.mass[..], |m| m.mass(sc, true));
         // Friction lags the normal force: solve with λ, update λ from the solution, and re-solve
-        // until it agrees (see solve::contact).
-        let mut rep;
-        let mut lag = 0;
-        loop {
+        // until it agrees.
+        if let Some(l) = &mut lag {
+            l.start_step();
+        }
+        let rep = loop {
             let pot = Potential {
                 dial,
                 inertia: Some(Inertia {
@@ -142,14 +134,10 @@ pub(super) fn run_dynamic(
                 gravity: s.gravity,
                 rest_override: moisture.as_ref().map(|_| &trial_targets[..]),
                 mass: trial_mass,
-                friction: friction.then_some(Friction {
-                    x_prev: &x,
-                    normal_force: &lambda,
-                    eps: sc.settings.contact.slip_speed * h,
-                }),
+                friction: lag.as_ref().map(|l| l.friction(&x, h)),
                 ..Potential::new(sc, s.pattern)
             };
-            rep = newton(
+            let rep = newton(
                 &pot,
                 &mut s.lin,
                 &mut s.ws,
@@ -158,26 +146,14 @@ pub(super) fn run_dynamic(
                 NewtonOptions { tol, max_iter },
             );
             s.record(&rep);
-            let Some(ground) = sc.ground.as_ref().filter(|_| friction && rep.converged) else {
-                break;
-            };
-            let new = ground.normal_forces(&trial);
-            let scale = new.iter().fold(0.0, |m: Real, v| m.max(*v));
-            let diff = new
-                .iter()
-                .zip(&lambda)
-                .fold(0.0, |m: Real, (a, b)| m.max((a - b).abs()));
-            lambda.copy_from_slice(&new);
-            lag += 1;
-            if diff <= FRICTION_LAG_TOL * scale || lag >= FRICTION_LAG_MAX {
-                break;
+            let again = rep.converged && lag.as_mut().is_some_and(|l| l.resolve(sc, &trial));
+            if !again {
+                break rep;
             }
-        }
+        };
         if !rep.converged {
             s.summary.rejected_steps += 1;
-            dt = h * 0.5;
-            easy = 0;
-            if dt < tm.dt_min {
+            if !steps.rejected(h) {
                 failure = Some(format!(
                     "time step fell below dt_min = {} at t = {t:.6e}: {}",
                     tm.dt_min,
@@ -208,20 +184,12 @@ pub(super) fn run_dynamic(
         let calm = moisture
             .as_ref()
             .is_none_or(|m| m.change <= 0.5 * sc.settings.moisture.max_change);
-        if rep.iterations <= 3 && calm {
-            easy += 1;
-            if easy >= 3 {
-                dt = (dt * 1.5).min(tm.dt_max);
-                easy = 0;
-            }
-        } else {
-            easy = 0;
-        }
+        steps.accepted(rep.iterations, calm);
         progress.update(
             t / tm.end,
             &format!("t {t:.4e} s  E {:.4e}  r {:.1e}", rep.energy, rep.residual),
         );
-        let at_output = t >= next_out - 1e-9 * h.max(eps_t);
+        let at_output = clock.due(t, h, eps_t);
         let mut stop = false;
         if tm.stop_at_equilibrium {
             let pot = accepted(s.potential(dial), moisture.as_ref(), &targets);
@@ -242,10 +210,7 @@ pub(super) fn run_dynamic(
             }
             let pot = accepted(s.potential(dial), moisture.as_ref(), &targets);
             s.frame(writer, &pot, &x, &phi, &v, t)?;
-            while next_out <= t + eps_t {
-                next_out += tm.output_interval;
-            }
-            next_out = next_out.min(tm.end);
+            clock.passed(t, eps_t);
         }
         if stop {
             break;

@@ -21,11 +21,13 @@
 
 //!
 //! One driver per file: `statics.rs` (continuation of the dial, membrane continuation, saddle
-//! check) and `dynamics.rs` (implicit Euler with adaptive steps, the friction lag), over the
-//! shared solver state, frame output and counters here; `moisture.rs` couples the moisture
-//! diffusion to the rest forms of a dynamic run.
+//! check) and `dynamics.rs` (implicit Euler with adaptive steps), over the shared solver state,
+//! step control, output timing, frame output and counters here; `moisture.rs` couples the
+//! moisture diffusion to the rest forms of a dynamic run, and `friction.rs` is the lag of the
+//! frictional normal forces.
 
 mod dynamics;
+pub mod friction;
 mod moisture;
 mod statics;
 
@@ -245,6 +247,98 @@ impl<'a> Solver<'a> {
     }
 }
 
+/// Adaptive step size, shared by the drivers (the dial increment of statics, the time step of
+/// dynamics): halved from the step taken when a solve fails, grown ×`grow` (up to `max`) after
+/// `easy_needed` consecutive easy steps (at most `easy_iterations` Newton iterations, and calm
+/// by the driver's other criteria), and given up below `min`.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct StepControl {
+    /// The next step.
+    pub step: Real,
+    min: Real,
+    max: Real,
+    grow: Real,
+    easy_iterations: usize,
+    easy_needed: usize,
+    easy: usize,
+}
+
+impl StepControl {
+    pub fn new(
+        step: Real,
+        min: Real,
+        max: Real,
+        grow: Real,
+        easy_iterations: usize,
+        easy_needed: usize,
+    ) -> Self {
+        StepControl {
+            step,
+            min,
+            max,
+            grow,
+            easy_iterations,
+            easy_needed,
+            easy: 0,
+        }
+    }
+
+    /// After an accepted step that took `iterations` Newton iterations.
+    pub fn accepted(&mut self, iterations: usize, calm: bool) {
+        if iterations <= self.easy_iterations && calm {
+            self.easy += 1;
+            if self.easy >= self.easy_needed {
+                self.step = (self.step * self.grow).min(self.max);
+                self.easy = 0;
+            }
+        } else {
+            self.easy = 0;
+        }
+    }
+
+    /// After a failed step of length `taken`: the next one is half of it. Returns `false` when
+    /// that falls below the minimum (the run stops).
+    pub fn rejected(&mut self, taken: Real) -> bool {
+        self.step = taken * 0.5;
+        self.easy = 0;
+        self.step >= self.min
+    }
+}
+
+/// Output times on a fixed grid of `interval` up to `end`, resumed on the grid after a restart.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct OutputClock {
+    /// The next output time.
+    pub next: Real,
+    interval: Real,
+    end: Real,
+}
+
+impl OutputClock {
+    /// The clock of a run starting at `t0`.
+    pub fn new(t0: Real, interval: Real, end: Real) -> Self {
+        let next = (((t0 / interval) + 1e-9).floor() + 1.0) * interval;
+        OutputClock {
+            next: next.min(end),
+            interval,
+            end,
+        }
+    }
+
+    /// Whether time `t`, reached by a step `h`, is an output time (within round-off `eps`).
+    pub fn due(&self, t: Real, h: Real, eps: Real) -> bool {
+        t >= self.next - 1e-9 * h.max(eps)
+    }
+
+    /// Moves the next output time past `t`.
+    pub fn passed(&mut self, t: Real, eps: Real) {
+        while self.next <= t + eps {
+            self.next += self.interval;
+        }
+        self.next = self.next.min(self.end);
+    }
+}
+
 /// A state to start from instead of the reference mesh (a restart).
 #[derive(Clone, Debug)]
 pub struct InitialState {
@@ -298,4 +392,47 @@ pub fn run(
     s.summary.final_frame = writer.last_frame();
     writer.summary(&s.summary)?;
     Ok(s.summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{OutputClock, StepControl};
+
+    #[test]
+    fn step_control_halves_grows_and_gives_up() {
+        let mut s = StepControl::new(0.1, 0.01, 0.3, 1.5, 3, 2);
+        s.accepted(3, true);
+        assert_eq!(s.step, 0.1, "one easy step is not enough");
+        s.accepted(4, true);
+        s.accepted(3, true);
+        assert_eq!(s.step, 0.1, "a hard step resets the count");
+        s.accepted(1, false);
+        s.accepted(1, true);
+        assert_eq!(s.step, 0.1, "a step that is not calm resets the count");
+        s.accepted(1, true);
+        assert!((s.step - 0.15).abs() < 1e-15);
+        for _ in 0..10 {
+            s.accepted(1, true);
+        }
+        assert_eq!(s.step, 0.3, "capped at the maximum");
+        // Halved from the step taken (shortened to land on an output time, say).
+        assert!(s.rejected(0.04));
+        assert_eq!(s.step, 0.02);
+        assert!(!s.rejected(0.015), "0.0075 is below the minimum");
+    }
+
+    #[test]
+    fn output_clock_resumes_the_grid_and_lands_on_the_end() {
+        let mut c = OutputClock::new(0.0, 0.1, 0.25);
+        assert!((c.next - 0.1).abs() < 1e-15);
+        assert!(!c.due(0.05, 0.05, 1e-12));
+        assert!(c.due(0.1, 0.05, 1e-12));
+        c.passed(0.1, 1e-12);
+        assert!((c.next - 0.2).abs() < 1e-12);
+        c.passed(0.2, 1e-12);
+        assert_eq!(c.next, 0.25, "the last output is at the end");
+        // A restart at 0.3 of a grid of 0.1 resumes at 0.4.
+        let c = OutputClock::new(0.3, 0.1, 1.0);
+        assert!((c.next - 0.4).abs() < 1e-12);
+    }
 }

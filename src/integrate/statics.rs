@@ -1,7 +1,7 @@
 //! The static driver: adaptive continuation of the dial (rest forms and loads), then of the
 //! stretching weight (membrane continuation), with the stability check and saddle escapes.
 
-use super::{perturb, Progress, RunError, Solver};
+use super::{perturb, Progress, RunError, Solver, StepControl};
 use crate::math::{Real, Vec3};
 use crate::output::Writer;
 use crate::solve::{newton, NewtonOptions, NewtonReport};
@@ -28,7 +28,8 @@ pub(super) fn run_static(
     let mut dial = dial_start;
     // A restart solves at least once, even from a frame at dial 1 (the settings may differ).
     let mut need_solve = restart.is_some();
-    let mut step = st.continuation_step;
+    // Halved on failure, doubled after an easy solve (≤ 5 Newton iterations).
+    let mut steps = StepControl::new(st.continuation_step, min_step, 1.0, 2.0, 5, 1);
     // Membrane continuation: the stretching weight starts at 1/softening and grows ×ratio per
     // solve once the dial is at 1 (see the module doc).
     let h_min = s
@@ -51,7 +52,7 @@ pub(super) fn run_static(
     let mut failure: Option<String> = None;
     while dial < 1.0 || scale < 1.0 || need_solve {
         let (target, target_scale) = if dial < 1.0 {
-            ((dial + step).min(1.0), scale)
+            ((dial + steps.step).min(1.0), scale)
         } else {
             (1.0, (scale * ratio).min(1.0))
         };
@@ -98,9 +99,7 @@ pub(super) fn run_static(
             let grow = rep.iterations <= 5;
             if dial < 1.0 {
                 dial = target;
-                if grow {
-                    step = (step * 2.0).min(1.0);
-                }
+                steps.accepted(rep.iterations, true);
             } else {
                 scale = target_scale;
                 if grow {
@@ -119,8 +118,7 @@ pub(super) fn run_static(
             }
         } else if dial < 1.0 {
             s.summary.rejected_steps += 1;
-            step *= 0.5;
-            if step < min_step {
+            if !steps.rejected(steps.step) {
                 failure = Some(format!(
                     "continuation step fell below {min_step} at dial {dial:.6}: {}",
                     rep.failure_text()
