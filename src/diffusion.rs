@@ -113,6 +113,32 @@ const TRI3: [(Real, Real, Real); 3] = [
     (1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0),
 ];
 
+/// A surface condition that cannot be set.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SurfaceError {
+    /// Two regions give one face side different conditions.
+    #[error("face {face} {side:?}: conditions {old:?} and {new:?} contradict each other")]
+    Contradict {
+        /// The face.
+        face: usize,
+        /// Its side.
+        side: Side,
+        /// The condition already set.
+        old: SurfaceBc,
+        /// The one asked for.
+        new: SurfaceBc,
+    },
+    /// A prescribed moisture cannot be switched to or from another condition.
+    #[error("face {face} {side:?}: a prescribed moisture cannot be switched")]
+    Prescribed {
+        /// The face.
+        face: usize,
+        /// Its side.
+        side: Side,
+    },
+}
+
 impl Diffusion {
     /// Builds M and K on the reference mesh. `thickness` and `directions` (unit machine
     /// directions, any vector in or near the face plane; projected) are per face.
@@ -261,15 +287,18 @@ impl Diffusion {
         self.col_ptr[j] + c.binary_search(&i).unwrap_or(0)
     }
 
-    /// Sets the condition on face `f`'s `side`. Returns an error message if that surface already
-    /// has a different non-sealed condition (contradictory regions).
-    pub fn set_surface(&mut self, f: usize, side: Side, bc: SurfaceBc) -> Result<(), String> {
+    /// Sets the condition on face `f`'s `side`. An error if that surface already has a
+    /// different non-sealed condition (contradictory regions).
+    pub fn set_surface(&mut self, f: usize, side: Side, bc: SurfaceBc) -> Result<(), SurfaceError> {
         let s = side as usize;
         let old = self.bcs[f][s];
         if old != SurfaceBc::Sealed && old != bc {
-            return Err(format!(
-                "face {f} {side:?}: conditions {old:?} and {bc:?} contradict each other"
-            ));
+            return Err(SurfaceError::Contradict {
+                face: f,
+                side,
+                old,
+                new: bc,
+            });
         }
         if old != bc {
             self.bcs[f][s] = bc;
@@ -285,13 +314,16 @@ impl Diffusion {
 
     /// Replaces the flux or Robin condition of one face side by another (or by sealed), e.g. a
     /// surface that touches or leaves a moist ground. Prescribed values cannot be replaced.
-    pub fn replace_surface(&mut self, f: usize, side: Side, bc: SurfaceBc) -> Result<(), String> {
+    pub fn replace_surface(
+        &mut self,
+        f: usize,
+        side: Side,
+        bc: SurfaceBc,
+    ) -> Result<(), SurfaceError> {
         let s = side as usize;
         let old = self.bcs[f][s];
         if matches!(old, SurfaceBc::Value(_)) || matches!(bc, SurfaceBc::Value(_)) {
-            return Err(format!(
-                "face {f} {side:?}: a prescribed moisture cannot be switched"
-            ));
+            return Err(SurfaceError::Prescribed { face: f, side });
         }
         if old != bc {
             self.apply(f, side, old, -1.0);

@@ -100,9 +100,53 @@ impl Func {
     }
 }
 
+/// Why an expression does not parse. Positions are 1-based characters.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ExprError {
+    /// Something else than what the grammar allows at a position (`found: None` at the end).
+    #[error("expected {expected} {}", match found { Some(c) => format!("at character {at}, found '{c}'"), None => "at the end".into() })]
+    Expected {
+        /// What was expected.
+        expected: String,
+        /// The character found there.
+        found: Option<char>,
+        /// Where.
+        at: usize,
+    },
+    /// A malformed number.
+    #[error("bad number '{text}' at character {at}")]
+    BadNumber {
+        /// The number's text.
+        text: String,
+        /// Where it starts.
+        at: usize,
+    },
+    /// A name that is not a variable, constant or function.
+    #[error("unknown name '{name}' at character {at} (variables: x, y; constants: pi, e)")]
+    UnknownName {
+        /// The name.
+        name: String,
+        /// Where it starts.
+        at: usize,
+    },
+    /// A function called with the wrong number of arguments.
+    #[error("{name} takes {arity} argument(s), got {got} (at character {at})")]
+    Arity {
+        /// The function.
+        name: String,
+        /// Arguments it takes.
+        arity: usize,
+        /// Arguments given.
+        got: usize,
+        /// Where the call starts.
+        at: usize,
+    },
+}
+
 impl Expr {
     /// Parses `text`; the error names the character position (1-based) and what was expected.
-    pub fn parse(text: &str) -> Result<Expr, String> {
+    pub fn parse(text: &str) -> Result<Expr, ExprError> {
         let mut p = Parser {
             s: text.as_bytes(),
             i: 0,
@@ -177,18 +221,15 @@ impl Parser<'_> {
         self.s.get(self.i).copied()
     }
 
-    fn error(&self, expected: &str) -> String {
-        match self.s.get(self.i) {
-            Some(&c) => format!(
-                "expected {expected} at character {}, found '{}'",
-                self.i + 1,
-                c as char
-            ),
-            None => format!("expected {expected} at the end"),
+    fn error(&self, expected: &str) -> ExprError {
+        ExprError::Expected {
+            expected: expected.into(),
+            found: self.s.get(self.i).map(|&c| c as char),
+            at: self.i + 1,
         }
     }
 
-    fn expr(&mut self) -> Result<Expr, String> {
+    fn expr(&mut self) -> Result<Expr, ExprError> {
         let mut e = self.term()?;
         while let Some(c @ (b'+' | b'-')) = self.peek() {
             self.i += 1;
@@ -199,7 +240,7 @@ impl Parser<'_> {
         Ok(e)
     }
 
-    fn term(&mut self) -> Result<Expr, String> {
+    fn term(&mut self) -> Result<Expr, ExprError> {
         let mut e = self.unary()?;
         while let Some(c @ (b'*' | b'/')) = self.peek() {
             self.i += 1;
@@ -210,7 +251,7 @@ impl Parser<'_> {
         Ok(e)
     }
 
-    fn unary(&mut self) -> Result<Expr, String> {
+    fn unary(&mut self) -> Result<Expr, ExprError> {
         match self.peek() {
             Some(b'-') => {
                 self.i += 1;
@@ -224,7 +265,7 @@ impl Parser<'_> {
         }
     }
 
-    fn power(&mut self) -> Result<Expr, String> {
+    fn power(&mut self) -> Result<Expr, ExprError> {
         let base = self.atom()?;
         if self.peek() == Some(b'^') {
             self.i += 1;
@@ -234,7 +275,7 @@ impl Parser<'_> {
         Ok(base)
     }
 
-    fn atom(&mut self) -> Result<Expr, String> {
+    fn atom(&mut self) -> Result<Expr, ExprError> {
         match self.peek() {
             Some(b'(') => {
                 self.i += 1;
@@ -270,7 +311,10 @@ impl Parser<'_> {
                 let text = std::str::from_utf8(&self.s[start..self.i]).unwrap_or("");
                 text.parse::<Real>()
                     .map(Expr::Num)
-                    .map_err(|_| format!("bad number '{text}' at character {}", start + 1))
+                    .map_err(|_| ExprError::BadNumber {
+                        text: text.into(),
+                        at: start + 1,
+                    })
             }
             Some(c) if c.is_ascii_alphabetic() => {
                 let start = self.i;
@@ -288,10 +332,10 @@ impl Parser<'_> {
                     _ => {}
                 }
                 let Some((f, arity)) = Func::parse(name) else {
-                    return Err(format!(
-                        "unknown name '{name}' at character {} (variables: x, y; constants: pi, e)",
-                        start + 1
-                    ));
+                    return Err(ExprError::UnknownName {
+                        name: name.into(),
+                        at: start + 1,
+                    });
                 };
                 if self.peek() != Some(b'(') {
                     return Err(self.error(&format!("'(' after {name}")));
@@ -307,11 +351,12 @@ impl Parser<'_> {
                 }
                 self.i += 1;
                 if args.len() != arity {
-                    return Err(format!(
-                        "{name} takes {arity} argument(s), got {} (at character {})",
-                        args.len(),
-                        start + 1
-                    ));
+                    return Err(ExprError::Arity {
+                        name: name.into(),
+                        arity,
+                        got: args.len(),
+                        at: start + 1,
+                    });
                 }
                 Ok(Expr::Call(f, args))
             }
@@ -353,7 +398,7 @@ mod tests {
             ("x y", "character 3"),
             ("z", "unknown name 'z'"),
         ] {
-            let e = Expr::parse(s).unwrap_err();
+            let e = Expr::parse(s).unwrap_err().to_string();
             assert!(e.contains(needle), "{s}: {e}");
         }
     }

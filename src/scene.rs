@@ -165,7 +165,7 @@ impl Scene {
                 };
                 let reference = (rest.abar0[f], rest.bbar0[f]);
                 let (a, b) = growth_face(&settings, &growth, f, reference, h, m)
-                    .map_err(|e| mesh.invalid(format!("growth at face {f}: {e}")))?;
+                    .map_err(|e| mesh.invalid(e.to_string()))?;
                 rest.abar1[f] = a;
                 rest.bbar1[f] = b;
             }
@@ -655,6 +655,44 @@ impl GrowthInputs {
     }
 }
 
+/// A rest form that a growth law cannot produce.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum GrowthError {
+    /// A swelling stretch `1 + μ m` that is not positive.
+    #[error(
+        "growth at face {face}: the stretch 1 + mu m = 1 + {worst} is not positive (mu {mu}, \
+         moisture top {top}, bottom {bottom}): a length cannot become ≤ 0"
+    )]
+    Stretch {
+        /// The face.
+        face: usize,
+        /// The most negative `μ m`.
+        worst: Real,
+        /// The coefficient.
+        mu: Real,
+        /// Moisture on the top side.
+        top: Real,
+        /// Moisture on the bottom side.
+        bottom: Real,
+    },
+    /// The law's `ā` is not positive definite (or `b̄` is not finite).
+    #[error(
+        "growth at face {face}: growth.law {law:?} makes abar non-positive-definite (moisture \
+         top {top}, bottom {bottom})"
+    )]
+    NotPositiveDefinite {
+        /// The face.
+        face: usize,
+        /// The law.
+        law: crate::settings::GrowthLaw,
+        /// Moisture on the top side.
+        top: Real,
+        /// Moisture on the bottom side.
+        bottom: Real,
+    },
+}
+
 /// The rest forms of face `f` under `settings.growth.law`, from its reference forms, thickness
 /// and surface moisture `(m_top, m_bottom)`. Errors (without the face, which the caller names):
 /// a stretch `1 + μ m ≤ 0`, or an ā that is not positive definite.
@@ -665,7 +703,7 @@ pub fn growth_face(
     reference: (Sym2, Sym2),
     h: Real,
     moisture: (Real, Real),
-) -> Result<(Sym2, Sym2), String> {
+) -> Result<(Sym2, Sym2), GrowthError> {
     use crate::settings::GrowthLaw;
     let g = &settings.growth;
     let (a0, b0) = reference;
@@ -684,10 +722,13 @@ pub fn growth_face(
             _ => mu * mb,
         };
         if 1.0 + worst <= 0.0 || worst.is_nan() {
-            return Err(format!(
-                "the stretch 1 + mu m = 1 + {worst} is not positive (mu {mu}, moisture top \
-                 {mt}, bottom {mb}): a length cannot become ≤ 0"
-            ));
+            return Err(GrowthError::Stretch {
+                face: f,
+                worst,
+                mu,
+                top: mt,
+                bottom: mb,
+            });
         }
     }
     let (a, b) = match g.law {
@@ -707,10 +748,12 @@ pub fn growth_face(
         ),
     };
     if !(a[0] > 0.0 && crate::math::sym_det(&a) > 0.0 && b.iter().all(|v| v.is_finite())) {
-        return Err(format!(
-            "growth.law {:?} makes abar non-positive-definite (moisture top {mt}, bottom {mb})",
-            g.law
-        ));
+        return Err(GrowthError::NotPositiveDefinite {
+            face: f,
+            law: g.law,
+            top: mt,
+            bottom: mb,
+        });
     }
     Ok((a, b))
 }

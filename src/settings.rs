@@ -680,7 +680,7 @@ pub enum Field {
 
 impl Field {
     /// The parsed expression (a constant for a number).
-    pub fn compile(&self) -> Result<crate::expr::Expr, String> {
+    pub fn compile(&self) -> Result<crate::expr::Expr, crate::expr::ExprError> {
         match self {
             Field::Value(v) => Ok(crate::expr::Expr::Num(*v)),
             Field::Expr(s) => crate::expr::Expr::parse(s),
@@ -1016,7 +1016,7 @@ impl Settings {
                     }
                     Field::Expr(_) => {
                         if let Err(e) = v.compile() {
-                            return ck.inv(&key, e);
+                            return ck.inv(&key, e.to_string());
                         }
                     }
                     _ => {}
@@ -1084,7 +1084,7 @@ impl Settings {
             }
             Field::Expr(_) => {
                 if let Err(e) = g.s.compile() {
-                    return ck.inv("growth.s", e);
+                    return ck.inv("growth.s", e.to_string());
                 }
             }
             _ => {}

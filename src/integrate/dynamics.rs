@@ -4,7 +4,7 @@
 
 use super::friction::FrictionLag;
 use super::moisture::{accepted, Moisture};
-use super::{OutputClock, Progress, RunError, Solver, StepControl};
+use super::{OutputClock, Progress, RunError, RunFailure, Solver, StepControl};
 use crate::assembly::Want;
 use crate::math::{Real, Sym2, Vec3};
 use crate::output::Writer;
@@ -51,7 +51,7 @@ pub(super) fn run_dynamic(
     let mut targets: Vec<(Sym2, Sym2)> = Vec::new();
     let mut trial_targets: Vec<(Sym2, Sym2)> = Vec::new();
     if let Some(m) = &moisture {
-        targets = m.targets_of(sc, &m.u).map_err(RunError::Moisture)?;
+        targets = m.targets_of(sc, &m.u)?;
         m.publish(writer);
     }
     {
@@ -65,7 +65,7 @@ pub(super) fn run_dynamic(
     let mut steps = StepControl::new(tm.dt, tm.dt_min, tm.dt_max, 1.5, 3, 3);
     // The next output time after the start (a restart resumes the output grid).
     let mut clock = OutputClock::new(t0, tm.output_interval, tm.end);
-    let mut failure: Option<String> = None;
+    let mut failure: Option<RunFailure> = None;
     let eps_t = 1e-12 * tm.end;
     while t < tm.end - eps_t {
         let h = steps.step.min(clock.next - t).min(tm.end - t);
@@ -82,12 +82,12 @@ pub(super) fn run_dynamic(
         if let Some(m) = &mut moisture {
             // Diffuse over the step, then set the rest forms from the new surface moisture.
             if let Err(e) = m.update_ground(sc, &x) {
-                failure = Some(format!("moisture at t = {t:.6e}: {e}"));
+                failure = Some(RunFailure::MoistureSurface { t, source: e });
                 break;
             }
             m.trial.copy_from_slice(&m.u);
             if let Err(e) = m.diffusion.step(&mut m.trial, h) {
-                failure = Some(format!("moisture diffusion at t = {t:.6e}: {e}"));
+                failure = Some(RunFailure::Diffusion { t, source: e });
                 break;
             }
             // The step control sees the diffusion too: a step that changes the computed moisture
@@ -106,7 +106,7 @@ pub(super) fn run_dynamic(
             match m.targets_of(sc, &m.trial) {
                 Ok(tt) => trial_targets = tt,
                 Err(e) => {
-                    failure = Some(format!("at t = {t:.6e}: {e}"));
+                    failure = Some(RunFailure::Growth { t, source: e });
                     break;
                 }
             }
@@ -154,11 +154,11 @@ pub(super) fn run_dynamic(
         if !rep.converged {
             s.summary.rejected_steps += 1;
             if !steps.rejected(h) {
-                failure = Some(format!(
-                    "time step fell below dt_min = {} at t = {t:.6e}: {}",
-                    tm.dt_min,
-                    rep.failure_text()
-                ));
+                failure = Some(RunFailure::TimeStep {
+                    dt_min: tm.dt_min,
+                    t,
+                    cause: rep.failure_or_unknown(),
+                });
                 break;
             }
             continue;
@@ -219,7 +219,7 @@ pub(super) fn run_dynamic(
     s.summary.time = t;
     s.summary.dial = dial_at(t);
     s.summary.converged = failure.is_none();
-    s.summary.reason = failure.unwrap_or_default();
+    s.summary.reason = failure.map(|f| f.to_string()).unwrap_or_default();
     let pot = accepted(s.potential(dial_at(t)), moisture.as_ref(), &targets);
     s.summary.energy = Writer::energies(&pot, &x, &phi, &v);
     if s.summary.reason.is_empty() {

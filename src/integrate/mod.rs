@@ -39,7 +39,7 @@ use crate::scene::Scene;
 use crate::settings::Mode;
 use crate::solve::linear::LinearError;
 use crate::solve::newton::{factor_with_shift_upto, Workspace};
-use crate::solve::{LinearSolver, NewtonReport, Potential};
+use crate::solve::{LinearSolver, NewtonReport, Potential, SolveError};
 use std::time::Instant;
 
 /// Errors that stop a run (as opposed to non-convergence, which is reported in the summary).
@@ -54,7 +54,80 @@ pub enum RunError {
     Linear(#[from] LinearError),
     /// The moisture state made the rest forms invalid.
     #[error("moisture: {0}")]
-    Moisture(String),
+    Growth(#[from] crate::scene::GrowthError),
+    /// The moisture boundary conditions contradict each other.
+    #[error("moisture: {0}")]
+    Surface(#[from] crate::diffusion::SurfaceError),
+    /// The moisture regions or fields are invalid.
+    #[error("moisture: {0}")]
+    Regions(#[from] crate::mesh::MeshError),
+}
+
+/// Why a run stopped before converging (exit 1); its text is `summary.json`'s `reason`.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RunFailure {
+    /// Statics: the dial increment was halved below `solver.min_continuation_step`.
+    #[error("continuation step fell below {min} at dial {dial:.6}: {cause}")]
+    ContinuationStep {
+        /// The minimum increment.
+        min: Real,
+        /// The dial reached.
+        dial: Real,
+        /// The last solve's failure.
+        cause: SolveError,
+    },
+    /// Statics: raising the stretching weight back to 1 failed.
+    #[error("membrane continuation stalled at stretching weight {scale:.3e}: {cause}")]
+    MembraneContinuation {
+        /// The stretching weight reached.
+        scale: Real,
+        /// The last solve's failure.
+        cause: SolveError,
+    },
+    /// Statics: the equilibrium stayed a saddle after every perturbation.
+    #[error("equilibrium is a saddle (Hessian indefinite) after {escapes} perturbations")]
+    Saddle {
+        /// Perturb-and-resolve attempts made.
+        escapes: usize,
+    },
+    /// Statics: a solve after a saddle perturbation failed.
+    #[error("after escaping a saddle: {0}")]
+    AfterSaddle(SolveError),
+    /// Dynamics: the time step was halved below `time.dt_min`.
+    #[error("time step fell below dt_min = {dt_min} at t = {t:.6e}: {cause}")]
+    TimeStep {
+        /// The minimum time step (s).
+        dt_min: Real,
+        /// The time reached (s).
+        t: Real,
+        /// The last solve's failure.
+        cause: SolveError,
+    },
+    /// Dynamics: the moisture boundary conditions could not be switched.
+    #[error("moisture at t = {t:.6e}: {source}")]
+    MoistureSurface {
+        /// The time reached (s).
+        t: Real,
+        /// What went wrong.
+        source: crate::diffusion::SurfaceError,
+    },
+    /// Dynamics: the moisture diffusion solve failed.
+    #[error("moisture diffusion at t = {t:.6e}: {source}")]
+    Diffusion {
+        /// The time reached (s).
+        t: Real,
+        /// What went wrong.
+        source: LinearError,
+    },
+    /// Dynamics: the moisture made a rest form invalid.
+    #[error("at t = {t:.6e}: {source}")]
+    Growth {
+        /// The time reached (s).
+        t: Real,
+        /// What went wrong.
+        source: crate::scene::GrowthError,
+    },
 }
 
 /// Receives progress updates (a terminal progress bar, or nothing).

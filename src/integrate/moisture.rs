@@ -69,12 +69,9 @@ impl Moisture {
                     ambient: b.ambient,
                 },
             };
-            let faces = crate::scene::region_faces(&sc.mesh, b)
-                .map_err(|e| RunError::Moisture(e.to_string()))?;
+            let faces = crate::scene::region_faces(&sc.mesh, b)?;
             for f in faces {
-                diffusion
-                    .set_surface(f, side, bc)
-                    .map_err(RunError::Moisture)?;
+                diffusion.set_surface(f, side, bc)?;
                 if bc == SurfaceBc::Sealed {
                     taped[f][side as usize] = true;
                 }
@@ -119,7 +116,11 @@ impl Moisture {
     /// Switches the ground exchange of every face side on or off from the positions `x`: a side
     /// touches when it faces the ground (its outward normal within 60° of the ground's inward
     /// one) and the face's centroid is within `distance` of the ground, thickness included.
-    pub(super) fn update_ground(&mut self, sc: &Scene, x: &[Vec3]) -> Result<(), String> {
+    pub(super) fn update_ground(
+        &mut self,
+        sc: &Scene,
+        x: &[Vec3],
+    ) -> Result<(), crate::diffusion::SurfaceError> {
         use crate::diffusion::{Side, SurfaceBc};
         let (Some((k, value, distance)), Some(g)) = (self.ground, &sc.ground) else {
             return Ok(());
@@ -187,7 +188,11 @@ impl Moisture {
     ///
     /// A taped side (`moisture.boundary.tape`) is a layer that does not swell: the law sees
     /// moisture 0 there, so wet paper under tape curls away from it as a bilayer does.
-    pub(super) fn targets_of(&self, sc: &Scene, u: &[Real]) -> Result<Vec<(Sym2, Sym2)>, String> {
+    pub(super) fn targets_of(
+        &self,
+        sc: &Scene,
+        u: &[Real],
+    ) -> Result<Vec<(Sym2, Sym2)>, crate::scene::GrowthError> {
         (0..sc.num_faces())
             .map(|f| {
                 let (mut top, mut bottom) = self.diffusion.surface_moisture(u, f);
@@ -207,7 +212,6 @@ impl Moisture {
                     sc.thickness[f],
                     m,
                 )
-                .map_err(|e| format!("growth at face {f}: {e}"))
             })
             .collect()
     }

@@ -1,7 +1,7 @@
 //! The static driver: adaptive continuation of the dial (rest forms and loads), then of the
 //! stretching weight (membrane continuation), with the stability check and saddle escapes.
 
-use super::{perturb, Progress, RunError, Solver, StepControl};
+use super::{perturb, Progress, RunError, RunFailure, Solver, StepControl};
 use crate::math::{Real, Vec3};
 use crate::output::Writer;
 use crate::solve::{newton, NewtonOptions, NewtonReport};
@@ -49,7 +49,7 @@ pub(super) fn run_static(
     let mut ratio: Real = 10.0;
     let mut trial = x.clone();
     let mut trial_phi = phi.clone();
-    let mut failure: Option<String> = None;
+    let mut failure: Option<RunFailure> = None;
     while dial < 1.0 || scale < 1.0 || need_solve {
         let (target, target_scale) = if dial < 1.0 {
             ((dial + steps.step).min(1.0), scale)
@@ -119,20 +119,21 @@ pub(super) fn run_static(
         } else if dial < 1.0 {
             s.summary.rejected_steps += 1;
             if !steps.rejected(steps.step) {
-                failure = Some(format!(
-                    "continuation step fell below {min_step} at dial {dial:.6}: {}",
-                    rep.failure_text()
-                ));
+                failure = Some(RunFailure::ContinuationStep {
+                    min: min_step,
+                    dial,
+                    cause: rep.failure_or_unknown(),
+                });
                 break;
             }
         } else {
             s.summary.rejected_steps += 1;
             ratio = ratio.sqrt();
             if ratio < 1.01 {
-                failure = Some(format!(
-                    "membrane continuation stalled at stretching weight {scale:.3e}: {}",
-                    rep.failure_text()
-                ));
+                failure = Some(RunFailure::MembraneContinuation {
+                    scale,
+                    cause: rep.failure_or_unknown(),
+                });
                 break;
             }
         }
@@ -141,9 +142,7 @@ pub(super) fn run_static(
         let mut escapes = 0;
         while !s.is_stable(1.0, &x, &phi) {
             if escapes >= max_escapes {
-                failure = Some(format!(
-                    "equilibrium is a saddle (Hessian indefinite) after {escapes} perturbations"
-                ));
+                failure = Some(RunFailure::Saddle { escapes });
                 break;
             }
             escapes += 1;
@@ -163,7 +162,7 @@ pub(super) fn run_static(
             );
             s.record(&rep);
             if !rep.converged {
-                failure = Some(format!("after escaping a saddle: {}", rep.failure_text()));
+                failure = Some(RunFailure::AfterSaddle(rep.failure_or_unknown()));
                 break;
             }
         }
@@ -171,7 +170,7 @@ pub(super) fn run_static(
     }
     s.summary.dial = dial;
     s.summary.converged = failure.is_none();
-    s.summary.reason = failure.unwrap_or_default();
+    s.summary.reason = failure.map(|f| f.to_string()).unwrap_or_default();
     let pot = s.potential(dial);
     s.summary.energy = Writer::energies(&pot, &x, &phi, &zeros);
     s.frame(writer, &pot, &x, &phi, &zeros, 1.0_f64.max(dial))?;

@@ -346,7 +346,7 @@ fn fields_to_attributes(fields: &BTreeMap<String, Field>, legacy: bool) -> Vec<A
 }
 
 /// Serialises a mesh with fields to bytes in the given format.
-pub fn mesh_to_bytes(mesh: &Mesh, format: Format, title: &str) -> Result<Vec<u8>, String> {
+pub fn mesh_to_bytes(mesh: &Mesh, format: Format, title: &str) -> Result<Vec<u8>, vtkio::Error> {
     let legacy = format != Format::Vtu;
     let points: Vec<f64> = mesh
         .positions
@@ -396,11 +396,11 @@ pub fn mesh_to_bytes(mesh: &Mesh, format: Format, title: &str) -> Result<Vec<u8>
     };
     let mut out = Vec::new();
     match format {
-        Format::Vtu => vtk.write_xml(&mut out).map_err(|e| e.to_string())?,
-        Format::Vtk => vtk.write_legacy(&mut out).map_err(|e| e.to_string())?,
+        Format::Vtu => vtk.write_xml(&mut out)?,
+        Format::Vtk => vtk.write_legacy(&mut out)?,
         Format::VtkAscii => {
             let mut s = String::new();
-            vtk.write_legacy_ascii(&mut s).map_err(|e| e.to_string())?;
+            vtk.write_legacy_ascii(&mut s)?;
             out = s.into_bytes();
         }
     }
@@ -430,6 +430,6 @@ pub fn write_mesh(path: &Path, mesh: &Mesh, format: Format, title: &str) -> Resu
         path: path.display().to_string(),
         reason,
     };
-    let bytes = mesh_to_bytes(mesh, format, title).map_err(werr)?;
+    let bytes = mesh_to_bytes(mesh, format, title).map_err(|e| werr(e.to_string()))?;
     write_atomic(path, &bytes).map_err(|e| werr(e.to_string()))
 }

@@ -88,9 +88,17 @@ pub enum SolveError {
     /// [`crate::energy::term::Term::admissible`]).
     #[error("a term refused the step: {0}")]
     Refused(&'static str),
+    /// No reason was recorded (a converged solve asked for one).
+    #[error("no failure recorded")]
+    Unknown,
 }
 
 impl NewtonReport {
+    /// Why it stopped, for a solve that did not converge ([`SolveError::Unknown`] if it did).
+    pub fn failure_or_unknown(&self) -> SolveError {
+        self.failure.clone().unwrap_or(SolveError::Unknown)
+    }
+
     /// The failure as text (empty when it converged).
     pub fn failure_text(&self) -> String {
         self.failure

@@ -184,7 +184,14 @@ fn contradictory_surface_conditions_are_rejected() {
     let e = diff
         .set_surface(0, Side::Top, SurfaceBc::Flux(1.0))
         .unwrap_err();
-    assert!(e.contains("face 0"), "{e}");
+    assert!(
+        matches!(
+            e,
+            shellsim::diffusion::SurfaceError::Contradict { face: 0, .. }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("face 0"), "{e}");
     diff.set_surface(
         0,
         Side::Bottom,
