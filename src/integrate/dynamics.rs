@@ -9,7 +9,7 @@ use crate::assembly::Want;
 use crate::math::{Real, Sym2, Vec3};
 use crate::output::Writer;
 use crate::solve::potential::{Damping, Inertia};
-use crate::solve::{newton, NewtonOptions, Potential};
+use crate::solve::{newton, Potential};
 use std::time::Instant;
 
 pub(super) fn run_dynamic(
@@ -22,12 +22,11 @@ pub(super) fn run_dynamic(
     t0: Real,
 ) -> Result<(), RunError> {
     let sc = s.scene;
-    let tm = sc.settings.time.clone();
-    let (tol, max_iter) = (
-        sc.settings.solver.tolerance,
-        sc.settings.solver.max_newton_iterations,
-    );
-    let dial_time = sc.settings.rest.dial_time;
+    let cf = s.config.dynamics.clone();
+    let tm = cf.time.clone();
+    let opts = s.config.newton;
+    let tol = opts.tol;
+    let dial_time = cf.dial_time;
     let dial_at = |t: Real| {
         if dial_time > 0.0 {
             (t / dial_time).min(1.0)
@@ -59,7 +58,7 @@ pub(super) fn run_dynamic(
         s.frame(writer, &pot, &x, &phi, &v, t0)?;
     }
     // Friction: the lagged normal forces, carried from step to step.
-    let mut lag = FrictionLag::new(sc, &x);
+    let mut lag = FrictionLag::new(sc, &x, cf.slip_speed);
     let mut t = t0;
     // Halved on failure, ×1.5 after 3 easy steps (≤ 3 Newton iterations).
     let mut steps = StepControl::new(tm.dt, tm.dt_min, tm.dt_max, 1.5, 3, 3);
@@ -96,7 +95,7 @@ pub(super) fn run_dynamic(
             m.change = (0..m.u.len())
                 .filter(|&i| !m.diffusion.is_prescribed(i))
                 .fold(0.0, |c: Real, i| c.max((m.trial[i] - m.u[i]).abs()));
-            if m.change > sc.settings.moisture.max_change && h > tm.dt_min {
+            if m.change > cf.moisture_max_change && h > tm.dt_min {
                 s.summary.moisture_seconds += moisture_clock.elapsed().as_secs_f64();
                 s.summary.rejected_steps += 1;
                 steps.rejected(h);
@@ -131,7 +130,7 @@ pub(super) fn run_dynamic(
                     a_prev: &a_prev,
                     b_prev: &b_prev,
                 }),
-                gravity: s.gravity,
+                gravity: s.config.gravity,
                 rest_override: moisture.as_ref().map(|_| &trial_targets[..]),
                 mass: trial_mass,
                 friction: lag.as_ref().map(|l| l.friction(&x, h)),
@@ -143,7 +142,7 @@ pub(super) fn run_dynamic(
                 &mut s.ws,
                 &mut trial,
                 &mut trial_phi,
-                NewtonOptions { tol, max_iter },
+                opts,
             );
             s.record(&rep);
             let again = rep.converged && lag.as_mut().is_some_and(|l| l.resolve(sc, &trial));
@@ -183,7 +182,7 @@ pub(super) fn run_dynamic(
         }
         let calm = moisture
             .as_ref()
-            .is_none_or(|m| m.change <= 0.5 * sc.settings.moisture.max_change);
+            .is_none_or(|m| m.change <= 0.5 * cf.moisture_max_change);
         steps.accepted(rep.iterations, calm);
         progress.update(
             t / tm.end,

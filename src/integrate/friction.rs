@@ -25,12 +25,13 @@ pub struct FrictionLag {
 }
 
 impl FrictionLag {
-    /// The lag of `scene` started at positions `x`, or `None` without a frictional ground.
-    pub fn new(scene: &Scene, x: &[Vec3]) -> Option<FrictionLag> {
+    /// The lag of `scene` started at positions `x`, with the smoothed friction's slip speed
+    /// (`contact.slip_speed`, m/s), or `None` without a frictional ground.
+    pub fn new(scene: &Scene, x: &[Vec3], slip_speed: Real) -> Option<FrictionLag> {
         let g = scene.ground.as_ref().filter(|g| g.friction > 0.0)?;
         Some(FrictionLag {
             lambda: g.normal_forces(x),
-            slip_speed: scene.settings.contact.slip_speed,
+            slip_speed,
             solves: 0,
         })
     }

@@ -26,6 +26,7 @@
 //! moisture diffusion to the rest forms of a dynamic run, and `friction.rs` is the lag of the
 //! frictional normal forces.
 
+pub mod config;
 mod dynamics;
 pub mod friction;
 mod moisture;
@@ -192,9 +193,10 @@ pub fn perturb(scene: &Scene, x: &mut [Vec3], amp: Real, seed: u64) {
 struct Solver<'a> {
     scene: &'a Scene,
     pattern: &'a Pattern,
+    /// The run's controls, from the validated settings.
+    config: config::RunConfig,
     lin: LinearSolver,
     ws: Workspace,
-    gravity: Vec3,
     summary: Summary,
     start: Instant,
     /// The summary's counters when the previous frame was written; log rows report the
@@ -228,8 +230,9 @@ impl<'a> Solver<'a> {
     fn new(scene: &'a Scene, pattern: &'a Pattern, threads: usize) -> Result<Self, RunError> {
         let lin = LinearSolver::new(pattern)?;
         let ws = Workspace::new(pattern);
+        let config = config::RunConfig::new(scene);
         let summary = Summary {
-            mode: match scene.settings.solver.mode {
+            mode: match config.mode {
                 Mode::Static => "static",
                 Mode::Dynamic => "dynamic",
             }
@@ -243,9 +246,9 @@ impl<'a> Solver<'a> {
         Ok(Solver {
             scene,
             pattern,
+            config,
             lin,
             ws,
-            gravity: Vec3::from(scene.settings.loads.gravity),
             summary,
             start: Instant::now(),
             at_last_frame: Counters::default(),
@@ -259,7 +262,7 @@ impl<'a> Solver<'a> {
     fn potential_scaled(&self, dial: Real, stretch_scale: Real) -> Potential<'a> {
         Potential {
             dial,
-            gravity: self.gravity,
+            gravity: self.config.gravity,
             stretch_scale,
             ..Potential::new(self.scene, self.pattern)
         }
@@ -445,16 +448,11 @@ pub fn run(
             None,
         ),
     };
-    let sb = scene.settings.solver.symmetry_breaking;
+    let sb = s.config.symmetry_breaking;
     if sb > 0.0 && is_planar(scene, &x) {
-        perturb(
-            scene,
-            &mut x,
-            sb * scene.mean_edge,
-            scene.settings.solver.seed,
-        );
+        perturb(scene, &mut x, sb * scene.mean_edge, s.config.seed);
     }
-    match scene.settings.solver.mode {
+    match s.config.mode {
         Mode::Static => statics::run_static(&mut s, writer, progress, x, phi, start)?,
         Mode::Dynamic => {
             dynamics::run_dynamic(&mut s, writer, progress, x, phi, v, start.unwrap_or(0.0))?

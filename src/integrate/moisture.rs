@@ -26,6 +26,8 @@ pub(super) struct Moisture {
     /// Sides covered by tape (top, bottom): the growth law sees moisture 0 there.
     pub(super) tape: Vec<[bool; 2]>,
     pub(super) ground: Option<(Real, Real, Real)>,
+    /// Density of the absorbed water (kg/m³; 0 = masses stay dry).
+    water_density: Real,
     pub(super) touching: Vec<[bool; 2]>,
 }
 
@@ -106,6 +108,7 @@ impl Moisture {
             taped,
             tape,
             ground,
+            water_density: mo.water_density,
             touching: vec![[false; 2]; nf],
         };
         m.mass = m.masses_of(sc, &m.u);
@@ -157,7 +160,7 @@ impl Moisture {
     /// Lumped vertex masses with face densities ρ_shell + (m⁺ + m⁻)/2 · ρ_water (seed 000 §3,
     /// "Mass Matrix"); empty when the water density is 0 (the scene's masses apply).
     pub(super) fn masses_of(&self, sc: &Scene, u: &[Real]) -> Vec<Real> {
-        let rho_w = sc.settings.moisture.water_density;
+        let rho_w = self.water_density;
         if rho_w == 0.0 {
             return Vec::new();
         }

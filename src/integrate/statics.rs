@@ -14,11 +14,12 @@ pub(super) fn run_static(
     mut phi: Vec<Real>,
     restart: Option<Real>,
 ) -> Result<(), RunError> {
-    let st = &s.scene.settings.solver;
-    let (tol, max_iter) = (st.tolerance, st.max_newton_iterations);
-    let (min_step, sb, seed) = (st.min_continuation_step, st.symmetry_breaking, st.seed);
-    let (check, max_escapes) = (st.check_stability, st.max_saddle_escapes);
-    let cont_frames = s.scene.settings.output.continuation_frames;
+    let cf = s.config.statics.clone();
+    let opts = s.config.newton;
+    let tol = opts.tol;
+    let (min_step, sb, seed) = (cf.min_step, s.config.symmetry_breaking, s.config.seed);
+    let (check, max_escapes) = (cf.check_stability, cf.max_saddle_escapes);
+    let cont_frames = cf.continuation_frames;
     let zeros = vec![Vec3::zeros(); x.len()];
     let dial_start = restart.unwrap_or(0.0).clamp(0.0, 1.0);
     {
@@ -29,23 +30,10 @@ pub(super) fn run_static(
     // A restart solves at least once, even from a frame at dial 1 (the settings may differ).
     let mut need_solve = restart.is_some();
     // Halved on failure, doubled after an easy solve (≤ 5 Newton iterations).
-    let mut steps = StepControl::new(st.continuation_step, min_step, 1.0, 2.0, 5, 1);
+    let mut steps = StepControl::new(cf.first_step, min_step, 1.0, 2.0, 5, 1);
     // Membrane continuation: the stretching weight starts at 1/softening and grows ×ratio per
     // solve once the dial is at 1 (see the module doc).
-    let h_min = s
-        .scene
-        .thickness
-        .iter()
-        .copied()
-        .fold(Real::INFINITY, Real::min);
-    // A softened membrane under external loads or prescribed displacements would follow a
-    // different (much softer) path: "auto" keeps the continuation for rest-form programming only.
-    let loaded = s.scene.settings.loads.any_external() || !s.scene.prescribed.is_empty();
-    let softening = match st.membrane_continuation {
-        crate::settings::Softening::Auto(_) if loaded => 1.0,
-        m => m.factor(s.scene.mesh.bbox_diagonal(), h_min),
-    };
-    let mut scale = 1.0 / softening.max(1.0);
+    let mut scale = 1.0 / cf.softening;
     let mut ratio: Real = 10.0;
     let mut trial = x.clone();
     let mut trial_phi = phi.clone();
@@ -74,7 +62,7 @@ pub(super) fn run_static(
             &mut s.ws,
             &mut trial,
             &mut trial_phi,
-            NewtonOptions { tol: t, max_iter },
+            NewtonOptions { tol: t, ..opts },
         );
         s.record(&rep);
         // A term tracking a state across steps (a moment's angle) may refuse a step too large
@@ -156,8 +144,8 @@ pub(super) fn run_static(
                 &mut x,
                 &mut phi,
                 NewtonOptions {
-                    tol,
-                    max_iter: max_iter * 5,
+                    max_iter: opts.max_iter * 5,
+                    ..opts
                 },
             );
             s.record(&rep);

@@ -24,6 +24,8 @@ pub struct NewtonOptions {
     pub tol: Real,
     /// Iteration limit.
     pub max_iter: usize,
+    /// Which Hessian each iteration factorises (`solver.hessian_projection`).
+    pub projection: HessianProjection,
 }
 
 /// What happened in one Newton solve.
@@ -200,7 +202,7 @@ pub fn newton(
 ) -> NewtonReport {
     let mut rep = NewtonReport::default();
     let mut tau_prev: Real = 0.0;
-    let mode = pot.scene.settings.solver.hessian_projection;
+    let mode = opts.projection;
     // Adaptive mode: whether this iteration tries the exact Hessian first.
     let mut try_exact = true;
     loop {

@@ -684,6 +684,7 @@ fn low_rank_term_solves_like_the_dense_matrix() {
         shellsim::solve::NewtonOptions {
             tol: 1e-9,
             max_iter: 100,
+            ..Default::default()
         },
     );
     assert!(rep.converged, "{rep:?}");

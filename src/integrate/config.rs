@@ -1,0 +1,112 @@
+//! The controls of a run, taken once from the validated settings when the run starts: the
+//! drivers, Newton and the friction lag read these values, never the settings.
+
+use crate::energy::HessianProjection;
+use crate::math::{Real, Vec3};
+use crate::scene::Scene;
+use crate::settings::{Mode, Softening, Time};
+use crate::solve::NewtonOptions;
+
+/// Everything the drivers need to know about a run besides its scene and terms.
+#[derive(Clone, Debug)]
+pub struct RunConfig {
+    /// Static continuation or implicit-Euler dynamics.
+    pub mode: Mode,
+    /// Newton's tolerance (‖∇Φ‖∞/F), iteration limit and Hessian projection.
+    pub newton: NewtonOptions,
+    /// Amplitude of the symmetry-breaking perturbation of a planar start (× mean edge).
+    pub symmetry_breaking: Real,
+    /// Seed of that perturbation.
+    pub seed: u64,
+    /// Gravity (m/s²).
+    pub gravity: Vec3,
+    /// Static continuation.
+    pub statics: StaticConfig,
+    /// Dynamics.
+    pub dynamics: DynamicConfig,
+}
+
+/// Controls of the static driver.
+#[derive(Clone, Debug)]
+pub struct StaticConfig {
+    /// First dial increment.
+    pub first_step: Real,
+    /// The run stops below this increment.
+    pub min_step: Real,
+    /// Test the final equilibrium for a minimum.
+    pub check_stability: bool,
+    /// Perturb-and-resolve attempts at a saddle.
+    pub max_saddle_escapes: usize,
+    /// Write a frame after every accepted continuation step (each solved to full tolerance).
+    pub continuation_frames: bool,
+    /// Membrane continuation: the stretching weight starts at 1/softening (1 = off). Off when
+    /// loads or prescribed paths are given: a softened membrane would follow another path.
+    pub softening: Real,
+}
+
+/// Controls of the dynamic driver.
+#[derive(Clone, Debug)]
+pub struct DynamicConfig {
+    /// End, time steps, output interval, damping and the equilibrium stop.
+    pub time: Time,
+    /// The dial reaches 1 at this time (s; 0 = at once).
+    pub dial_time: Real,
+    /// A step that changes the moisture by more than this anywhere is cut.
+    pub moisture_max_change: Real,
+    /// Slip speed of the smoothed Coulomb friction (m/s).
+    pub slip_speed: Real,
+}
+
+impl RunConfig {
+    /// The controls of a run of `scene` (whose settings are validated).
+    pub fn new(scene: &Scene) -> RunConfig {
+        let s = &scene.settings;
+        let st = &s.solver;
+        let h_min = scene
+            .thickness
+            .iter()
+            .copied()
+            .fold(Real::INFINITY, Real::min);
+        let loaded = s.loads.any_external() || !scene.prescribed.is_empty();
+        let softening = match st.membrane_continuation {
+            Softening::Auto(_) if loaded => 1.0,
+            m => m.factor(scene.mesh.bbox_diagonal(), h_min),
+        };
+        RunConfig {
+            mode: st.mode,
+            newton: NewtonOptions {
+                tol: st.tolerance,
+                max_iter: st.max_newton_iterations,
+                projection: st.hessian_projection,
+            },
+            symmetry_breaking: st.symmetry_breaking,
+            seed: st.seed,
+            gravity: Vec3::from(s.loads.gravity),
+            statics: StaticConfig {
+                first_step: st.continuation_step,
+                min_step: st.min_continuation_step,
+                check_stability: st.check_stability,
+                max_saddle_escapes: st.max_saddle_escapes,
+                continuation_frames: s.output.continuation_frames,
+                softening: softening.max(1.0),
+            },
+            dynamics: DynamicConfig {
+                time: s.time.clone(),
+                dial_time: s.rest.dial_time,
+                moisture_max_change: s.moisture.max_change,
+                slip_speed: s.contact.slip_speed,
+            },
+        }
+    }
+}
+
+impl Default for NewtonOptions {
+    /// The settings' defaults: tolerance 1e-9, 40 iterations, adaptive projection.
+    fn default() -> Self {
+        NewtonOptions {
+            tol: 1e-9,
+            max_iter: 40,
+            projection: HessianProjection::Adaptive,
+        }
+    }
+}
