@@ -20,7 +20,7 @@ use crate::mesh::io::{mesh_to_bytes, write_atomic, Format};
 use crate::mesh::{Field, Mesh};
 use crate::rest::{push_forward, reference_frame};
 use crate::scene::Scene;
-use crate::solve::Potential;
+use crate::solve::{Potential, State};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -265,8 +265,8 @@ impl Writer {
     }
 
     /// Energies of a state by term.
-    pub fn energies(pot: &Potential, x: &[Vec3], phi: &[Real], v: &[Vec3]) -> Energies {
-        Self::energies_of(pot, pot.energies(x, phi), v)
+    pub fn energies(pot: &Potential, state: &State, v: &[Vec3]) -> Energies {
+        Self::energies_of(pot, pot.energies(&state.x, &state.dofs), v)
     }
 
     /// The energies record of the terms' energies and the kinetic energy at velocities `v`.
@@ -288,11 +288,11 @@ impl Writer {
     pub fn frame(
         &mut self,
         pot: &Potential,
-        x: &[Vec3],
-        phi: &[Real],
+        state: &State,
         v: &[Vec3],
         mut row: LogRow,
     ) -> Result<(), OutputError> {
+        let (x, phi) = (&state.x[..], &state.dofs[..]);
         let sc = pot.scene;
         let index = self.frames.len();
         row.frame = index;

@@ -12,6 +12,7 @@ use crate::math::{Real, Vec3};
 use crate::mesh::io::read_mesh;
 use crate::mesh::MeshError;
 use crate::scene::Scene;
+use crate::solve::State;
 use std::path::Path;
 
 /// Largest disagreement tolerated between the two faces' copies of an edge angle (rad). Frames
@@ -119,8 +120,10 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
     };
     Ok((
         InitialState {
-            x: frame.positions,
-            phi,
+            state: State {
+                x: frame.positions,
+                dofs: phi,
+            },
             v,
             time,
         },

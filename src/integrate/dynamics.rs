@@ -9,15 +9,14 @@ use crate::assembly::Want;
 use crate::math::{Real, Sym2, Vec3};
 use crate::output::Writer;
 use crate::solve::potential::{Damping, Inertia};
-use crate::solve::{newton, Potential};
+use crate::solve::{newton, Potential, State};
 use std::time::Instant;
 
 pub(super) fn run_dynamic(
     s: &mut Solver,
     writer: &mut Writer,
     progress: &mut dyn Progress,
-    mut x: Vec<Vec3>,
-    mut phi: Vec<Real>,
+    mut state: State,
     v0: Option<Vec<Vec3>>,
     t0: Real,
 ) -> Result<(), RunError> {
@@ -34,14 +33,13 @@ pub(super) fn run_dynamic(
             1.0
         }
     };
-    let n = x.len();
+    let n = state.x.len();
     let mut v = v0.unwrap_or_else(|| vec![Vec3::zeros(); n]);
-    let mut xhat = x.clone();
-    let mut trial = x.clone();
-    let mut trial_phi = phi.clone();
+    let mut xhat = state.x.clone();
+    let mut trial = state.clone();
     let damping = tm.damping > 0.0;
     let (mut a_prev, mut b_prev) = if damping {
-        sc.forms(&x, &phi)
+        sc.forms(&state.x, &state.dofs)
     } else {
         (Vec::new(), Vec::new())
     };
@@ -55,10 +53,10 @@ pub(super) fn run_dynamic(
     }
     {
         let pot = accepted(s.potential(dial_at(t0)), moisture.as_ref(), &targets);
-        s.frame(writer, &pot, &x, &phi, &v, t0)?;
+        s.frame(writer, &pot, &state, &v, t0)?;
     }
     // Friction: the lagged normal forces, carried from step to step.
-    let mut lag = FrictionLag::new(sc, &x, cf.slip_speed);
+    let mut lag = FrictionLag::new(sc, &state.x, cf.slip_speed);
     let mut t = t0;
     // Halved on failure, ×1.5 after 3 easy steps (≤ 3 Newton iterations).
     let mut steps = StepControl::new(tm.dt, tm.dt_min, tm.dt_max, 1.5, 3, 3);
@@ -70,17 +68,17 @@ pub(super) fn run_dynamic(
         let h = steps.step.min(clock.next - t).min(tm.end - t);
         let dial = dial_at(t + h);
         for i in 0..n {
-            xhat[i] = x[i] + v[i] * h;
+            xhat[i] = state.x[i] + v[i] * h;
         }
         // Vertices on prescribed paths are fixed: their inertia is not assembled, so the
         // prediction can carry their prescribed position into every trial.
         sc.prescribe(&mut xhat, dial);
-        trial.copy_from_slice(&xhat);
-        trial_phi.copy_from_slice(&phi);
+        trial.x.copy_from_slice(&xhat);
+        trial.dofs.copy_from_slice(&state.dofs);
         let moisture_clock = Instant::now();
         if let Some(m) = &mut moisture {
             // Diffuse over the step, then set the rest forms from the new surface moisture.
-            if let Err(e) = m.update_ground(sc, &x) {
+            if let Err(e) = m.update_ground(sc, &state.x) {
                 failure = Some(RunFailure::MoistureSurface { t, source: e });
                 break;
             }
@@ -133,19 +131,12 @@ pub(super) fn run_dynamic(
                 gravity: s.config.gravity,
                 rest_override: moisture.as_ref().map(|_| &trial_targets[..]),
                 mass: trial_mass,
-                friction: lag.as_ref().map(|l| l.friction(&x, h)),
+                friction: lag.as_ref().map(|l| l.friction(&state.x, h)),
                 ..Potential::new(sc, s.pattern)
             };
-            let rep = newton(
-                &pot,
-                &mut s.lin,
-                &mut s.ws,
-                &mut trial,
-                &mut trial_phi,
-                opts,
-            );
+            let rep = newton(&pot, &mut s.lin, &mut s.ws, &mut trial, opts);
             s.record(&rep);
-            let again = rep.converged && lag.as_mut().is_some_and(|l| l.resolve(sc, &trial));
+            let again = rep.converged && lag.as_mut().is_some_and(|l| l.resolve(sc, &trial.x));
             if !again {
                 break rep;
             }
@@ -162,12 +153,11 @@ pub(super) fn run_dynamic(
             }
             continue;
         }
-        for i in 0..n {
-            v[i] = (trial[i] - x[i]) / h;
+        for ((vi, t), x) in v.iter_mut().zip(&trial.x).zip(&state.x) {
+            *vi = (t - x) / h;
         }
-        x.copy_from_slice(&trial);
-        sc.accept(&trial, &trial_phi);
-        phi.copy_from_slice(&trial_phi);
+        state.copy_from(&trial);
+        sc.accept(&state.x, &state.dofs);
         if let Some(m) = &mut moisture {
             m.u.copy_from_slice(&m.trial);
             std::mem::swap(&mut targets, &mut trial_targets);
@@ -176,7 +166,7 @@ pub(super) fn run_dynamic(
         t += h;
         s.summary.steps += 1;
         if damping {
-            let (a, b) = sc.forms(&x, &phi);
+            let (a, b) = sc.forms(&state.x, &state.dofs);
             a_prev = a;
             b_prev = b;
         }
@@ -193,9 +183,9 @@ pub(super) fn run_dynamic(
         if tm.stop_at_equilibrium {
             let pot = accepted(s.potential(dial), moisture.as_ref(), &targets);
             let mut g = vec![0.0; s.pattern.n];
-            pot.eval(&x, &phi, Want::Gradient, &mut g, &mut []);
+            pot.eval(&state.x, &state.dofs, Want::Gradient, &mut g, &mut []);
             let r = pot.residual(&g);
-            let en = Writer::energies(&pot, &x, &phi, &v);
+            let en = Writer::energies(&pot, &state, &v);
             stop = dial >= 1.0
                 && r <= tol
                 && en.kinetic
@@ -208,7 +198,7 @@ pub(super) fn run_dynamic(
                 m.publish(writer);
             }
             let pot = accepted(s.potential(dial), moisture.as_ref(), &targets);
-            s.frame(writer, &pot, &x, &phi, &v, t)?;
+            s.frame(writer, &pot, &state, &v, t)?;
             clock.passed(t, eps_t);
         }
         if stop {
@@ -220,11 +210,11 @@ pub(super) fn run_dynamic(
     s.summary.converged = failure.is_none();
     s.summary.reason = failure.map(|f| f.to_string()).unwrap_or_default();
     let pot = accepted(s.potential(dial_at(t)), moisture.as_ref(), &targets);
-    s.summary.energy = Writer::energies(&pot, &x, &phi, &v);
+    s.summary.energy = Writer::energies(&pot, &state, &v);
     if s.summary.reason.is_empty() {
         return Ok(());
     }
     // Record the state reached when the run stopped early.
-    s.frame(writer, &pot, &x, &phi, &v, t)?;
+    s.frame(writer, &pot, &state, &v, t)?;
     Ok(())
 }

@@ -40,7 +40,7 @@ use crate::scene::Scene;
 use crate::settings::Mode;
 use crate::solve::linear::LinearError;
 use crate::solve::newton::{factor_with_shift_upto, Workspace};
-use crate::solve::{LinearSolver, NewtonReport, Potential, SolveError};
+use crate::solve::{LinearSolver, NewtonReport, Potential, SolveError, State};
 use std::time::Instant;
 
 /// Errors that stop a run (as opposed to non-convergence, which is reported in the summary).
@@ -279,8 +279,7 @@ impl<'a> Solver<'a> {
         &mut self,
         writer: &mut Writer,
         pot: &Potential,
-        x: &[Vec3],
-        phi: &[Real],
+        state: &State,
         v: &[Vec3],
         time: Real,
     ) -> Result<(), RunError> {
@@ -300,12 +299,13 @@ impl<'a> Solver<'a> {
             wall_seconds: self.start.elapsed().as_secs_f64(),
         };
         self.at_last_frame = now;
-        writer.frame(pot, x, phi, v, row)?;
+        writer.frame(pot, state, v, row)?;
         Ok(())
     }
 
-    /// Tests `H + δI ≻ 0` at `x` (see module doc).
-    fn is_stable(&mut self, dial: Real, x: &[Vec3], phi: &[Real]) -> bool {
+    /// Tests `H + δI ≻ 0` at `state` (see module doc).
+    fn is_stable(&mut self, dial: Real, state: &State) -> bool {
+        let (x, phi) = (&state.x, &state.dofs);
         let pot = self.potential(dial);
         let mut values = vec![0.0; self.pattern.nnz()];
         let mut g = vec![0.0; self.pattern.n];
@@ -418,10 +418,8 @@ impl OutputClock {
 /// A state to start from instead of the reference mesh (a restart).
 #[derive(Clone, Debug)]
 pub struct InitialState {
-    /// Positions (m).
-    pub x: Vec<Vec3>,
-    /// Edge DOFs (rad), empty without them.
-    pub phi: Vec<Real>,
+    /// Positions and edge DOFs.
+    pub state: State,
     /// Velocities (m/s), for dynamics; `None` starts at rest.
     pub v: Option<Vec<Vec3>>,
     /// Time (dynamics, s) or dial factor (statics) to resume from.
@@ -439,23 +437,18 @@ pub fn run(
 ) -> Result<Summary, RunError> {
     let pattern = Pattern::for_scene(scene);
     let mut s = Solver::new(scene, &pattern, threads)?;
-    let (mut x, phi, v, start) = match initial {
-        Some(st) => (st.x, st.phi, st.v, Some(st.time)),
-        None => (
-            scene.mesh.positions.clone(),
-            vec![0.0; scene.num_edge_dofs()],
-            None,
-            None,
-        ),
+    let (mut state, v, start) = match initial {
+        Some(st) => (st.state, st.v, Some(st.time)),
+        None => (State::reference(scene), None, None),
     };
     let sb = s.config.symmetry_breaking;
-    if sb > 0.0 && is_planar(scene, &x) {
-        perturb(scene, &mut x, sb * scene.mean_edge, s.config.seed);
+    if sb > 0.0 && is_planar(scene, &state.x) {
+        perturb(scene, &mut state.x, sb * scene.mean_edge, s.config.seed);
     }
     match s.config.mode {
-        Mode::Static => statics::run_static(&mut s, writer, progress, x, phi, start)?,
+        Mode::Static => statics::run_static(&mut s, writer, progress, state, start)?,
         Mode::Dynamic => {
-            dynamics::run_dynamic(&mut s, writer, progress, x, phi, v, start.unwrap_or(0.0))?
+            dynamics::run_dynamic(&mut s, writer, progress, state, v, start.unwrap_or(0.0))?
         }
     }
     s.summary.wall_seconds = s.start.elapsed().as_secs_f64();

@@ -4,14 +4,13 @@
 use super::{perturb, Progress, RunError, RunFailure, Solver, StepControl};
 use crate::math::{Real, Vec3};
 use crate::output::Writer;
-use crate::solve::{newton, NewtonOptions, NewtonReport};
+use crate::solve::{newton, NewtonOptions, NewtonReport, State};
 
 pub(super) fn run_static(
     s: &mut Solver,
     writer: &mut Writer,
     progress: &mut dyn Progress,
-    mut x: Vec<Vec3>,
-    mut phi: Vec<Real>,
+    mut state: State,
     restart: Option<Real>,
 ) -> Result<(), RunError> {
     let cf = s.config.statics.clone();
@@ -20,11 +19,11 @@ pub(super) fn run_static(
     let (min_step, sb, seed) = (cf.min_step, s.config.symmetry_breaking, s.config.seed);
     let (check, max_escapes) = (cf.check_stability, cf.max_saddle_escapes);
     let cont_frames = cf.continuation_frames;
-    let zeros = vec![Vec3::zeros(); x.len()];
+    let zeros = vec![Vec3::zeros(); state.x.len()];
     let dial_start = restart.unwrap_or(0.0).clamp(0.0, 1.0);
     {
         let pot = s.potential(dial_start);
-        s.frame(writer, &pot, &x, &phi, &zeros, dial_start)?;
+        s.frame(writer, &pot, &state, &zeros, dial_start)?;
     }
     let mut dial = dial_start;
     // A restart solves at least once, even from a frame at dial 1 (the settings may differ).
@@ -35,8 +34,7 @@ pub(super) fn run_static(
     // solve once the dial is at 1 (see the module doc).
     let mut scale = 1.0 / cf.softening;
     let mut ratio: Real = 10.0;
-    let mut trial = x.clone();
-    let mut trial_phi = phi.clone();
+    let mut trial = state.clone();
     let mut failure: Option<RunFailure> = None;
     while dial < 1.0 || scale < 1.0 || need_solve {
         let (target, target_scale) = if dial < 1.0 {
@@ -52,22 +50,20 @@ pub(super) fn run_static(
         } else {
             tol
         };
-        trial.copy_from_slice(&x);
-        trial_phi.copy_from_slice(&phi);
-        s.scene.prescribe(&mut trial, target);
+        trial.copy_from(&state);
+        s.scene.prescribe(&mut trial.x, target);
         let pot = s.potential_scaled(target, target_scale);
         let rep = newton(
             &pot,
             &mut s.lin,
             &mut s.ws,
             &mut trial,
-            &mut trial_phi,
             NewtonOptions { tol: t, ..opts },
         );
         s.record(&rep);
         // A term tracking a state across steps (a moment's angle) may refuse a step too large
         // for it; the step is then cut like a failed solve.
-        let admissible = rep.converged && s.scene.admissible(&trial, &trial_phi);
+        let admissible = rep.converged && s.scene.admissible(&trial.x, &trial.dofs);
         let rep = if rep.converged && !admissible {
             NewtonReport {
                 converged: false,
@@ -81,9 +77,8 @@ pub(super) fn run_static(
             rep
         };
         if rep.converged {
-            x.copy_from_slice(&trial);
-            phi.copy_from_slice(&trial_phi);
-            s.scene.accept(&x, &phi);
+            state.copy_from(&trial);
+            s.scene.accept(&state.x, &state.dofs);
             let grow = rep.iterations <= 5;
             if dial < 1.0 {
                 dial = target;
@@ -102,7 +97,7 @@ pub(super) fn run_static(
             );
             if cont_frames && dial < 1.0 {
                 let pot = s.potential(dial);
-                s.frame(writer, &pot, &x, &phi, &zeros, dial)?;
+                s.frame(writer, &pot, &state, &zeros, dial)?;
             }
         } else if dial < 1.0 {
             s.summary.rejected_steps += 1;
@@ -128,21 +123,25 @@ pub(super) fn run_static(
     }
     if failure.is_none() && check {
         let mut escapes = 0;
-        while !s.is_stable(1.0, &x, &phi) {
+        while !s.is_stable(1.0, &state) {
             if escapes >= max_escapes {
                 failure = Some(RunFailure::Saddle { escapes });
                 break;
             }
             escapes += 1;
             let amp = sb.max(1e-3) * s.scene.mean_edge * 10f64.powi(escapes as i32);
-            perturb(s.scene, &mut x, amp, seed.wrapping_add(escapes as u64));
+            perturb(
+                s.scene,
+                &mut state.x,
+                amp,
+                seed.wrapping_add(escapes as u64),
+            );
             let pot = s.potential(1.0);
             let rep = newton(
                 &pot,
                 &mut s.lin,
                 &mut s.ws,
-                &mut x,
-                &mut phi,
+                &mut state,
                 NewtonOptions {
                     max_iter: opts.max_iter * 5,
                     ..opts
@@ -160,7 +159,7 @@ pub(super) fn run_static(
     s.summary.converged = failure.is_none();
     s.summary.reason = failure.map(|f| f.to_string()).unwrap_or_default();
     let pot = s.potential(dial);
-    s.summary.energy = Writer::energies(&pot, &x, &phi, &zeros);
-    s.frame(writer, &pot, &x, &phi, &zeros, 1.0_f64.max(dial))?;
+    s.summary.energy = Writer::energies(&pot, &state, &zeros);
+    s.frame(writer, &pot, &state, &zeros, 1.0_f64.max(dial))?;
     Ok(())
 }

@@ -9,7 +9,9 @@ pub mod linear;
 pub mod low_rank;
 pub mod newton;
 pub mod potential;
+pub mod state;
 
 pub use linear::{LinearError, LinearSolver};
 pub use newton::{newton, NewtonOptions, NewtonReport, SolveError};
 pub use potential::Potential;
+pub use state::State;

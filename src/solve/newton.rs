@@ -13,6 +13,7 @@
 
 use super::linear::LinearSolver;
 use super::potential::Potential;
+use super::state::State;
 use crate::assembly::Want;
 use crate::energy::HessianProjection;
 use crate::math::{Real, Vec3};
@@ -116,8 +117,7 @@ pub struct Workspace {
     values: Vec<Real>,
     shifted: Vec<Real>,
     step: Vec<Real>,
-    trial: Vec<Vec3>,
-    trial_phi: Vec<Real>,
+    trial: State,
 }
 
 impl Workspace {
@@ -130,8 +130,10 @@ impl Workspace {
             values: vec![0.0; nnz],
             shifted: vec![0.0; nnz],
             step: vec![0.0; n],
-            trial: vec![Vec3::zeros(); pattern.num_vertices],
-            trial_phi: vec![0.0; pattern.num_edge_dofs],
+            trial: State {
+                x: vec![Vec3::zeros(); pattern.num_vertices],
+                dofs: vec![0.0; pattern.num_edge_dofs],
+            },
         }
     }
 
@@ -191,13 +193,12 @@ pub fn factor_with_shift_upto(
     }
 }
 
-/// Minimises `pot` from positions `x` and edge DOFs `phi` (both updated in place).
+/// Minimises `pot` from `state` (updated in place).
 pub fn newton(
     pot: &Potential,
     lin: &mut LinearSolver,
     ws: &mut Workspace,
-    x: &mut [Vec3],
-    phi: &mut [Real],
+    state: &mut State,
     opts: NewtonOptions,
 ) -> NewtonReport {
     let mut rep = NewtonReport::default();
@@ -212,7 +213,14 @@ pub fn newton(
             HessianProjection::Adaptive => HessianProjection::None,
             m => m,
         };
-        let e = pot.eval_projected(x, phi, Want::Hessian, first, &mut ws.grad, &mut ws.values);
+        let e = pot.eval_projected(
+            &state.x,
+            &state.dofs,
+            Want::Hessian,
+            first,
+            &mut ws.grad,
+            &mut ws.values,
+        );
         rep.energy = e;
         rep.residual = pot.residual(&ws.grad);
         if !e.is_finite() || !rep.residual.is_finite() {
@@ -258,8 +266,8 @@ pub fn newton(
                         // The assembled exact Hessian is indefinite; `first` was already
                         // Gauss–Newton otherwise.
                         pot.eval_projected(
-                            x,
-                            phi,
+                            &state.x,
+                            &state.dofs,
                             Want::Hessian,
                             HessianProjection::GaussNewton,
                             &mut ws.grad,
@@ -291,7 +299,7 @@ pub fn newton(
         for (s, g) in ws.step.iter_mut().zip(&ws.grad) {
             *s = -g;
         }
-        let lr = pot.low_rank(x, phi);
+        let lr = pot.low_rank(&state.x, &state.dofs);
         if lr.is_empty() {
             lin.solve_in_place(&mut ws.step);
         } else {
@@ -313,15 +321,8 @@ pub fn newton(
         let mut alpha = 1.0;
         let mut accepted = false;
         for _ in 0..40 {
-            for (v, t) in ws.trial.iter_mut().enumerate() {
-                *t = x[v]
-                    + Vec3::new(ws.step[3 * v], ws.step[3 * v + 1], ws.step[3 * v + 2]) * alpha;
-            }
-            let off = 3 * x.len();
-            for (k, t) in ws.trial_phi.iter_mut().enumerate() {
-                *t = phi[k] + ws.step[off + k] * alpha;
-            }
-            let et = pot.eval(&ws.trial, &ws.trial_phi, Want::Energy, &mut [], &mut []);
+            ws.trial.set_step(state, &ws.step, alpha);
+            let et = pot.eval(&ws.trial.x, &ws.trial.dofs, Want::Energy, &mut [], &mut []);
             if et.is_finite() && et <= e + 1e-4 * alpha * slope + slack {
                 accepted = true;
                 break;
@@ -336,8 +337,7 @@ pub fn newton(
             });
             return rep;
         }
-        x.copy_from_slice(&ws.trial);
-        phi.copy_from_slice(&ws.trial_phi);
+        state.copy_from(&ws.trial);
         if mode == HessianProjection::Adaptive {
             try_exact = !projected || alpha == 1.0;
         }

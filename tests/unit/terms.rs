@@ -673,14 +673,16 @@ fn low_rank_term_solves_like_the_dense_matrix() {
         .fold(0.0, Real::max);
     assert!(diff > 1e-3 * want.amax());
     // Newton converges with the tether satisfied.
-    let mut xs = x.clone();
+    let mut state = shellsim::solve::State {
+        x: x.clone(),
+        dofs: Vec::new(),
+    };
     let mut ws = shellsim::solve::newton::Workspace::new(&p);
     let rep = shellsim::solve::newton(
         &pot,
         &mut lin,
         &mut ws,
-        &mut xs,
-        &mut [],
+        &mut state,
         shellsim::solve::NewtonOptions {
             tol: 1e-9,
             max_iter: 100,
@@ -688,7 +690,8 @@ fn low_rank_term_solves_like_the_dense_matrix() {
         },
     );
     assert!(rep.converged, "{rep:?}");
-    let s: Real = xs
+    let s: Real = state
+        .x
         .iter()
         .flat_map(|p| p.iter().copied())
         .zip(&w)

@@ -1,0 +1,53 @@
+//! The state the solver updates: vertex positions, plus the scalar DOFs of every other node
+//! kind the terms declared, in node order after the vertices (today the edge DOFs of the
+//! angle-based bending models, [`crate::energy::midedge_angle`]). Newton, the drivers, restarts
+//! and frames carry one `State`; kernels see it as the two views `x` and `dofs`.
+
+use crate::math::{Real, Vec3};
+use crate::scene::Scene;
+
+/// Positions and scalar node DOFs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct State {
+    /// Vertex positions (m).
+    pub x: Vec<Vec3>,
+    /// Scalar DOFs of the non-vertex nodes (edge DOFs in rad), node `nv + k` at index `k`.
+    pub dofs: Vec<Real>,
+}
+
+impl State {
+    /// The reference state of `scene`: its mesh positions, every scalar DOF 0.
+    pub fn reference(scene: &Scene) -> State {
+        State {
+            x: scene.mesh.positions.clone(),
+            dofs: vec![0.0; scene.num_edge_dofs()],
+        }
+    }
+
+    /// Number of DOFs (3 per vertex plus the scalar DOFs): the pattern's `n`.
+    pub fn len(&self) -> usize {
+        3 * self.x.len() + self.dofs.len()
+    }
+
+    /// Whether there are no DOFs.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Copies `other` (same sizes) into `self`.
+    pub fn copy_from(&mut self, other: &State) {
+        self.x.copy_from_slice(&other.x);
+        self.dofs.copy_from_slice(&other.dofs);
+    }
+
+    /// `self = base + alpha · step`, `step` in DOF order (vertex xyz, then the scalar DOFs).
+    pub fn set_step(&mut self, base: &State, step: &[Real], alpha: Real) {
+        for (v, t) in self.x.iter_mut().enumerate() {
+            *t = base.x[v] + Vec3::new(step[3 * v], step[3 * v + 1], step[3 * v + 2]) * alpha;
+        }
+        let off = 3 * base.x.len();
+        for (k, t) in self.dofs.iter_mut().enumerate() {
+            *t = base.dofs[k] + step[off + k] * alpha;
+        }
+    }
+}
