@@ -9,27 +9,13 @@ use super::bending::{
     average::MidedgeAverage, midedge_angle::MidedgeAngle, none::NoBending, patch::PatchFit,
 };
 use super::membrane::{
-    baraff_witkin::BaraffWitkin, koiter::Koiter, mooney_rivlin::MooneyRivlin,
-    neo_hookean::NeoHookean, Membrane,
+    baraff_witkin, koiter::Koiter, mooney_rivlin::MooneyRivlin, neo_hookean::NeoHookean, Membrane,
 };
 use super::shell::Shell;
 use super::term::{Term, VertexTerm};
 use crate::mesh::MeshError;
 use crate::scene::Scene;
 use crate::settings::{BendingModel, MaterialModel, Mode};
-
-/// The membrane materials, by settings value.
-#[derive(Clone, Debug)]
-pub enum AnyMembrane {
-    /// `"koiter"`.
-    Koiter(Koiter),
-    /// `"neo_hookean"`.
-    NeoHookean(NeoHookean),
-    /// `"mooney_rivlin"`.
-    MooneyRivlin(MooneyRivlin),
-    /// `"baraff_witkin"`.
-    BaraffWitkin(BaraffWitkin),
-}
 
 /// The shell term of membrane `m` with the scene's bending model.
 fn with_bending<M: Membrane>(scene: &Scene, m: M) -> Box<dyn Term> {
@@ -60,28 +46,14 @@ fn with_bending<M: Membrane>(scene: &Scene, m: M) -> Box<dyn Term> {
     }
 }
 
-/// The shell face term: the membrane material × the bending model.
+/// The shell face term: the membrane material × the bending model. One line per material.
 pub fn shell_term(scene: &Scene) -> Result<Box<dyn Term>, MeshError> {
-    Ok(match membrane(scene)? {
-        AnyMembrane::Koiter(m) => with_bending(scene, m),
-        AnyMembrane::NeoHookean(m) => with_bending(scene, m),
-        AnyMembrane::MooneyRivlin(m) => with_bending(scene, m),
-        AnyMembrane::BaraffWitkin(m) => with_bending(scene, m),
-    })
-}
-
-/// The scene's membrane material with its per-face data.
-pub fn membrane(scene: &Scene) -> Result<AnyMembrane, MeshError> {
     let m = &scene.settings.material;
     Ok(match m.model {
-        MaterialModel::Koiter => AnyMembrane::Koiter(Koiter),
-        MaterialModel::NeoHookean => AnyMembrane::NeoHookean(NeoHookean),
-        MaterialModel::MooneyRivlin => {
-            AnyMembrane::MooneyRivlin(MooneyRivlin { c1: m.c1, c2: m.c2 })
-        }
-        MaterialModel::BaraffWitkin => {
-            AnyMembrane::BaraffWitkin(super::membrane::baraff_witkin::from_scene(scene)?)
-        }
+        MaterialModel::Koiter => with_bending(scene, Koiter),
+        MaterialModel::NeoHookean => with_bending(scene, NeoHookean),
+        MaterialModel::MooneyRivlin => with_bending(scene, MooneyRivlin { c1: m.c1, c2: m.c2 }),
+        MaterialModel::BaraffWitkin => with_bending(scene, baraff_witkin::from_scene(scene)?),
     })
 }
 
