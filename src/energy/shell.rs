@@ -56,13 +56,40 @@ pub fn shell_element<
     grad: Option<&mut SVec<N>>,
     hess: Option<&mut SMat<N, N>>,
 ) -> Real {
+    let want_h = hess.is_some();
+    let want_g = grad.is_some() || want_h;
+    // The bending evaluation (with its cache) stays in this frame: passed by reference, never
+    // moved into an `Option`.
+    if N > 9 && dens.uses_b() {
+        let ev = model.eval(face, x, want_g, want_h && !GN);
+        shell_element_with::<D, B, N, S, GN>(model, face, x, dens, Some(&ev), grad, hess)
+    } else {
+        shell_element_with::<D, B, N, S, GN>(model, face, x, dens, None, grad, hess)
+    }
+}
+
+/// [`shell_element`] after the bending model's evaluation `ev` (`None` without bending).
+#[inline(always)]
+fn shell_element_with<
+    D: FaceDensity,
+    B: BendingModel<N, S>,
+    const N: usize,
+    const S: usize,
+    const GN: bool,
+>(
+    model: &B,
+    face: &B::Face,
+    x: &[Vec3; 6],
+    dens: &D,
+    ev: Option<&super::bending::BendingEval<N, B::Cache>>,
+    grad: Option<&mut SVec<N>>,
+    hess: Option<&mut SMat<N, N>>,
+) -> Real {
     let xf = [x[0], x[1], x[2]];
     let a = first_fundamental_form(&xf);
     let want_h = hess.is_some();
     let want_g = grad.is_some() || want_h;
-    let bending = N > 9 && dens.uses_b();
-    let ev = bending.then(|| model.eval(face, x, want_g, want_h && !GN));
-    let b = ev.as_ref().map_or(Sym2::zeros(), |ev| ev.b);
+    let b = ev.map_or(Sym2::zeros(), |ev| ev.b);
     let mut d = DensityDerivs::default();
     let e = dens.eval(&a, &b, &mut d);
     if !want_g {
@@ -74,13 +101,22 @@ pub fn shell_element<
     let ja = first_fundamental_form_jacobian(&xf);
     let mut g = SVec::<N>::zeros();
     g.fixed_rows_mut::<9>(0).copy_from(&(ja.transpose() * d.ga));
-    if let Some(ev) = &ev {
+    if let Some(ev) = ev {
         g += ev.jac * d.gb;
     }
     if let Some(h) = hess {
-        h.fill(0.0);
-        h.fixed_view_mut::<9, 9>(0, 0)
-            .copy_from(&(ja.transpose() * d.haa * ja));
+        let lambda = (!GN).then_some(&d.gb);
+        // A model that forms membrane and bending in one product sets `h`; else both apart.
+        let set =
+            ev.is_some_and(|ev| model.set_shell_hessian(face, x, ev, &d.haa, &d.hbb, lambda, h));
+        if !set {
+            *h = SMat::zeros();
+            h.fixed_view_mut::<9, 9>(0, 0)
+                .copy_from(&(ja.transpose() * d.haa * ja));
+            if let Some(ev) = ev {
+                model.add_bending_hessian(face, x, ev, &d.hbb, lambda, h);
+            }
+        }
         let coef = if GN { d.ga_psd } else { d.ga };
         if coef != Sym2::zeros() {
             let pat = first_fundamental_form_hessian_pattern(&coef);
@@ -91,9 +127,6 @@ pub fn shell_element<
                     }
                 }
             }
-        }
-        if let Some(ev) = &ev {
-            model.add_bending_hessian(face, x, ev, &d.hbb, (!GN).then_some(&d.gb), h);
         }
     }
     if let Some(gout) = grad {

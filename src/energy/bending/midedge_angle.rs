@@ -299,7 +299,7 @@ impl BendingModel<21, 9> for MidedgeAngle {
         lambda: &Sym2,
         h: &mut SMat<21, 21>,
     ) {
-        self.add_y_hessian(face, x, ev, SMat::<9, 9>::zeros(), Some(lambda), h);
+        self.add_y_hessian(face, x, ev, SMat::<9, 9>::zeros(), Some(lambda), false, h);
     }
 
     /// Both bending parts in the intermediate variables `y`, then one product `Jyᵀ H_y Jy`:
@@ -317,14 +317,40 @@ impl BendingModel<21, 9> for MidedgeAngle {
         let bq = b_from_q_matrix();
         let jq = &ev.cache.jq;
         let hy = jq.transpose() * (bq.transpose() * hbb * bq) * jq;
-        self.add_y_hessian(face, x, ev, hy, lambda, h);
+        self.add_y_hessian(face, x, ev, hy, lambda, false, h);
+    }
+
+    /// The membrane's `W_aa` joins the y-space Hessian (`a` is the first block of `y`), so
+    /// one product `Jyᵀ hy Jy` sets the whole Hessian.
+    #[inline(always)]
+    fn set_shell_hessian(
+        &self,
+        face: &AngleFace,
+        x: &[Vec3; 6],
+        ev: &BendingEval<21, AngleCache>,
+        haa: &Mat3,
+        hbb: &Mat3,
+        lambda: Option<&Sym2>,
+        h: &mut SMat<21, 21>,
+    ) -> bool {
+        let bq = b_from_q_matrix();
+        let jq = &ev.cache.jq;
+        let mut hy = jq.transpose() * (bq.transpose() * hbb * bq) * jq;
+        {
+            let mut aa = hy.fixed_view_mut::<3, 3>(0, 0);
+            aa += haa;
+        }
+        self.add_y_hessian(face, x, ev, hy, lambda, true, h);
+        true
     }
 }
 
 impl MidedgeAngle {
-    /// Adds `Jyᵀ (hy + Σ_i μ_i (Kᵢᵀ F_i'' Kᵢ + F_i,h ∇²_a h_i)) Jy` and, with `lambda`, the
-    /// second-derivative terms of `a` and `q̃` contracted with `Jqᵀμ` (`μ = Bᵀλ`).
+    /// Adds (or, with `set`, assigns) `Jyᵀ (hy + Σ_i μ_i (Kᵢᵀ F_i'' Kᵢ + F_i,h ∇²_a h_i)) Jy`
+    /// and, with `lambda`, adds the second-derivative terms of `a` and `q̃` contracted with
+    /// `Jqᵀμ` (`μ = Bᵀλ`).
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn add_y_hessian(
         &self,
         face: &AngleFace,
@@ -332,6 +358,7 @@ impl MidedgeAngle {
         ev: &BendingEval<21, AngleCache>,
         mut hy: SMat<9, 9>,
         lambda: Option<&Sym2>,
+        set: bool,
         h: &mut SMat<21, 21>,
     ) {
         let AngleFace { has, sigma, .. } = *face;
@@ -353,7 +380,11 @@ impl MidedgeAngle {
                 aa += c.dh[i].1 * (mu[i] * gf[1]);
             }
         }
-        *h += c.jy.transpose() * hy * c.jy;
+        if set {
+            *h = c.jy.transpose() * hy * c.jy;
+        } else {
+            *h += c.jy.transpose() * hy * c.jy;
+        }
         if let Some(mu) = &mu {
             let gy = c.jq.transpose() * mu;
             let pat = first_fundamental_form_hessian_pattern(&Sym2::new(gy[0], gy[1], gy[2]));

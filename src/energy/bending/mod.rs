@@ -82,6 +82,26 @@ pub trait BendingModel<const N: usize, const S: usize>: Send + Sync {
             self.add_hessian(face, x, ev, l, h);
         }
     }
+
+    /// Sets `h` to the membrane and bending parts of the chain rule at once,
+    /// `Jaᵀ W_aa Ja + G W_bb Gᵀ` and, with `lambda = Some(W_b)`, `Σ_q λ_q ∇²b_q`, when the model
+    /// can form them in its own intermediate variables with one product; returns `false` (and
+    /// leaves `h` alone) when it cannot, and the caller forms them apart. `Ja` is the Jacobian of
+    /// `a` on the first 9 DOFs.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn set_shell_hessian(
+        &self,
+        _face: &Self::Face,
+        _x: &[Vec3; 6],
+        _ev: &BendingEval<N, Self::Cache>,
+        _haa: &crate::math::Mat3,
+        _hbb: &crate::math::Mat3,
+        _lambda: Option<&Sym2>,
+        _h: &mut SMat<N, N>,
+    ) -> bool {
+        false
+    }
 }
 
 /// Whether stencil slots 3..6 (the extra vertices) are present.
