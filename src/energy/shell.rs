@@ -102,7 +102,7 @@ fn shell_element_with<
     let mut g = SVec::<N>::zeros();
     g.fixed_rows_mut::<9>(0).copy_from(&(ja.transpose() * d.ga));
     if let Some(ev) = ev {
-        g += ev.jac * d.gb;
+        model.add_gradient(ev, &d.gb, &mut g);
     }
     if let Some(h) = hess {
         let lambda = (!GN).then_some(&d.gb);

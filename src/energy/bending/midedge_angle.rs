@@ -250,7 +250,6 @@ impl BendingModel<21, 9> for MidedgeAngle {
         let b = b_from_q(&q);
         let mut jq = SMat::<3, 9>::zeros();
         let mut jy = SMat::<9, 21>::zeros();
-        let mut jac = SMat::<21, 3>::zeros();
         if grad {
             for i in 0..3 {
                 let (gf, _) = df[i];
@@ -272,11 +271,11 @@ impl BendingModel<21, 9> for MidedgeAngle {
                 }
                 jy[(6 + i, 18 + i)] = 1.0;
             }
-            jac = jy.transpose() * (jq.transpose() * b_from_q_matrix().transpose());
         }
         BendingEval {
             b,
-            jac,
+            // G is never formed: the gradient and Hessian go through the y variables.
+            jac: SMat::<21, 3>::zeros(),
             cache: AngleCache {
                 nf,
                 qs,
@@ -318,6 +317,13 @@ impl BendingModel<21, 9> for MidedgeAngle {
         let jq = &ev.cache.jq;
         let hy = jq.transpose() * (bq.transpose() * hbb * bq) * jq;
         self.add_y_hessian(face, x, ev, hy, lambda, false, h);
+    }
+
+    /// `G W_b = Jyᵀ (Jqᵀ (Bᵀ W_b))`: three products of a vector, never the 21×3 `G`.
+    #[inline(always)]
+    fn add_gradient(&self, ev: &BendingEval<21, AngleCache>, wb: &Sym2, g: &mut SVec<21>) {
+        let c = &ev.cache;
+        *g += c.jy.transpose() * (c.jq.transpose() * (b_from_q_matrix().transpose() * wb));
     }
 
     /// The membrane's `W_aa` joins the y-space Hessian (`a` is the first block of `y`), so

@@ -19,14 +19,15 @@ pub mod midedge_angle;
 pub mod none;
 pub mod patch;
 
-use crate::math::{Real, SMat, Sym2, Vec3};
+use crate::math::{Real, SMat, SVec, Sym2, Vec3};
 use crate::scene::Scene;
 
 /// `b` of one face with its Jacobian and what its Hessian contraction needs.
 pub struct BendingEval<const N: usize, C> {
     /// The second fundamental form (m).
     pub b: Sym2,
-    /// `G = ∂b/∂x` (column q is `∇b_q`), filled when a gradient was asked for.
+    /// `G = ∂b/∂x` (column q is `∇b_q`), filled when a gradient was asked for, by models that
+    /// use the default [`BendingModel::add_gradient`] (a model that overrides it may leave it 0).
     pub jac: SMat<N, 3>,
     /// Scratch kept for [`BendingModel::add_hessian`].
     pub cache: C,
@@ -63,6 +64,12 @@ pub trait BendingModel<const N: usize, const S: usize>: Send + Sync {
         lambda: &Sym2,
         h: &mut SMat<N, N>,
     );
+
+    /// Adds the bending part of the gradient, `G W_b`.
+    #[inline(always)]
+    fn add_gradient(&self, ev: &BendingEval<N, Self::Cache>, wb: &Sym2, g: &mut SVec<N>) {
+        *g += ev.jac * wb;
+    }
 
     /// Adds the bending part of the chain rule, `G W_bb Gᵀ` and, with `lambda = Some(W_b)`,
     /// `Σ_q λ_q ∇²b_q`. A model may override it to form both in its own intermediate variables
