@@ -1,7 +1,6 @@
 //! The controls of a run, taken once from the validated settings when the run starts: the
 //! drivers, Newton and the friction lag read these values, never the settings.
 
-use crate::energy::HessianProjection;
 use crate::math::{Real, Vec3};
 use crate::scene::Scene;
 use crate::settings::{Mode, Softening, Time};
@@ -101,12 +100,13 @@ impl RunConfig {
 }
 
 impl Default for NewtonOptions {
-    /// The settings' defaults: tolerance 1e-9, 40 iterations, adaptive projection.
+    /// The `[solver]` settings' defaults.
     fn default() -> Self {
+        let s = crate::settings::Solver::default();
         NewtonOptions {
-            tol: 1e-9,
-            max_iter: 40,
-            projection: HessianProjection::Adaptive,
+            tol: s.tolerance,
+            max_iter: s.max_newton_iterations,
+            projection: s.hessian_projection,
         }
     }
 }

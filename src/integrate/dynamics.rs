@@ -22,7 +22,7 @@ pub(super) fn run_dynamic(
 ) -> Result<(), RunError> {
     let sc = s.scene;
     let cf = s.config.dynamics.clone();
-    let tm = cf.time.clone();
+    let tm = &cf.time;
     let opts = s.config.newton;
     let tol = opts.tol;
     let dial_time = cf.dial_time;

@@ -24,16 +24,6 @@ impl State {
         }
     }
 
-    /// Number of DOFs (3 per vertex plus the scalar DOFs): the pattern's `n`.
-    pub fn len(&self) -> usize {
-        3 * self.x.len() + self.dofs.len()
-    }
-
-    /// Whether there are no DOFs.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
     /// Copies `other` (same sizes) into `self`.
     pub fn copy_from(&mut self, other: &State) {
         self.x.copy_from_slice(&other.x);

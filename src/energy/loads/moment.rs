@@ -128,9 +128,8 @@ fn frame(k: &Vec3, v: &Vec3, theta: Real) -> Frame {
 }
 
 impl Moment {
-    /// The face's turn `θ = (θ_A + θ_B)/2` and the two angles.
-    fn turn(&self, f: &Frames, x: &[Vec3], e: &Edge) -> (Real, Real, Real) {
-        let (a, b) = vectors(x, e);
+    /// The face's turn `θ = (θ_A + θ_B)/2` and the two angles, for its vectors `(a, b)`.
+    fn turn(f: &Frames, (a, b): (Vec3, Vec3)) -> (Real, Real, Real) {
         let ta = angle(&f.k, &f.a, &a, false).0;
         let tb = angle(&f.k, &f.b, &b, false).0;
         (0.5 * (ta + tb), ta, tb)
@@ -283,7 +282,7 @@ impl Term for MomentTerm {
         if let Ok(mut frames) = self.0.frames.lock() {
             for (e, f) in self.0.edges.iter().zip(frames.iter_mut()) {
                 let (a, b) = vectors(x, e);
-                let (_, ta, tb) = self.0.turn(f, x, e);
+                let (_, ta, tb) = Moment::turn(f, (a, b));
                 f.a = frame(&f.k, &a, ta);
                 f.b = frame(&f.k, &b, tb);
             }
@@ -295,7 +294,7 @@ impl Term for MomentTerm {
             return false;
         };
         self.0.edges.iter().zip(frames.iter()).all(|(e, f)| {
-            let (_, ta, tb) = self.0.turn(f, x, e);
+            let (_, ta, tb) = Moment::turn(f, vectors(x, e));
             let lim = std::f64::consts::FRAC_PI_2;
             (ta - f.a.theta).abs() <= lim && (tb - f.b.theta).abs() <= lim
         })
@@ -308,7 +307,7 @@ impl Term for MomentTerm {
         let mut out = vec![0.0; 3 * self.0.num_faces];
         if let Ok(frames) = self.0.frames.lock() {
             for (e, f) in self.0.edges.iter().zip(frames.iter()) {
-                out[3 * e.face + e.slot] = self.0.turn(f, x, e).0;
+                out[3 * e.face + e.slot] = Moment::turn(f, vectors(x, e)).0;
             }
         }
         out
@@ -352,7 +351,7 @@ impl Term for MomentTerm {
         };
         let mut sum = 0.0;
         for (e, f) in self.0.edges.iter().zip(frames.iter()) {
-            sum += self.0.turn(f, x, e).0;
+            sum += Moment::turn(f, vectors(x, e)).0;
         }
         vec![("moment_rotation".into(), sum / self.0.edges.len() as Real)]
     }
