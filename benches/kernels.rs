@@ -5,7 +5,6 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use shellsim::assembly::{Pattern, Want};
-use shellsim::cases::Case;
 use shellsim::energy::{material::sv_matrix, shell_face, KoiterDensity, Lame2d};
 use shellsim::math::{SMat, SVec, Sym2, Vec3};
 use shellsim::mesh::generate::{rectangle, Rng, Spacing};
@@ -13,6 +12,10 @@ use shellsim::scene::Scene;
 use shellsim::settings::Settings;
 use shellsim::solve::{LinearSolver, Potential};
 use std::hint::black_box;
+
+#[path = "common/scene.rs"]
+mod scene;
+use scene::{curved, scene_with_material};
 
 fn patch() -> ([Vec3; 6], KoiterDensity) {
     let mut rng = Rng::new(3);
@@ -151,43 +154,32 @@ fn scene_with(edge: f64, model: &str) -> Scene {
     scene_with_material(edge, model, "koiter")
 }
 
-fn scene_with_material(edge: f64, model: &str, material: &str) -> Scene {
-    let mut m = rectangle(
-        -0.5,
-        -0.5,
-        1.0,
-        1.0,
-        edge,
-        Spacing {
-            jitter: 0.2,
-            seed: 1,
-            ..Default::default()
-        },
-    );
-    Case::SphericalCap.program(&mut m);
-    let s = Settings::from_str_with(
-        &format!(
-            "[material]\nthickness = 0.05\nbending = \"{model}\"\nmodel = \"{material}\"\n\
-             [rest]\ntarget = \"mesh\"\n"
-        ),
-        "bench",
-        &[],
-    )
-    .unwrap();
-    Scene::build(m, s).unwrap()
-}
-
-fn curved(sc: &Scene) -> Vec<Vec3> {
-    sc.mesh
-        .positions
-        .iter()
-        .map(|p| Vec3::new(p.x, p.y, (1.0 - p.x * p.x - p.y * p.y).sqrt()))
-        .collect()
-}
-
 fn potential<'a>(sc: &'a Scene, p: &'a Pattern) -> Potential<'a> {
     Potential {
         ..Potential::new(sc, p)
+    }
+}
+
+/// The Hessian assembly of `sc` at `(x, phi)` on 1 and 2 threads, as `name/threads`.
+fn bench_hessian(
+    g: &mut criterion::BenchmarkGroup<criterion::measurement::WallTime>,
+    name: &str,
+    sc: &Scene,
+    x: &[Vec3],
+    phi: &[f64],
+) {
+    let p = Pattern::for_scene(sc);
+    for threads in [1usize, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        g.bench_with_input(BenchmarkId::new(name, threads), &threads, |b, _| {
+            let pot = potential(sc, &p);
+            let mut gr = vec![0.0; p.n];
+            let mut h = vec![0.0; p.nnz()];
+            b.iter(|| pool.install(|| pot.eval(x, phi, Want::Hessian, &mut gr, &mut h)))
+        });
     }
 }
 
@@ -256,43 +248,11 @@ fn assembly(c: &mut Criterion) {
     }
     // The same Hessian assembly with edge DOFs (the default bending model).
     let sc = scene_with(1.0 / 224.0, "midedge_sin");
-    let p = Pattern::for_scene(&sc);
     let phi = vec![0.0; sc.num_edge_dofs()];
-    for threads in [1usize, 2] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        g.bench_with_input(
-            BenchmarkId::new("midedge_sin_hessian", threads),
-            &threads,
-            |b, _| {
-                let pot = potential(&sc, &p);
-                let mut gr = vec![0.0; p.n];
-                let mut h = vec![0.0; p.nnz()];
-                b.iter(|| pool.install(|| pot.eval(&x, &phi, Want::Hessian, &mut gr, &mut h)))
-            },
-        );
-    }
+    bench_hessian(&mut g, "midedge_sin_hessian", &sc, &x, &phi);
     // A membrane-only (no bending) Baraff–Witkin sheet of the same size.
     let sc = scene_with_material(1.0 / 224.0, "none", "baraff_witkin");
-    let p = Pattern::for_scene(&sc);
-    for threads in [1usize, 2] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        g.bench_with_input(
-            BenchmarkId::new("baraff_witkin_membrane_hessian", threads),
-            &threads,
-            |b, _| {
-                let pot = potential(&sc, &p);
-                let mut gr = vec![0.0; p.n];
-                let mut h = vec![0.0; p.nnz()];
-                b.iter(|| pool.install(|| pot.eval(&x, &[], Want::Hessian, &mut gr, &mut h)))
-            },
-        );
-    }
+    bench_hessian(&mut g, "baraff_witkin_membrane_hessian", &sc, &x, &[]);
     g.finish();
 }
 

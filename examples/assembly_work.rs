@@ -1,16 +1,15 @@
 //! A fixed amount of work for instruction counts (`perf stat -e instructions`,
 //! `valgrind --tool=callgrind`), steady on a noisy machine where wall times are not: builds a
-//! jittered, spherical-cap-programmed sheet and assembles energy, gradient and Hessian a fixed
-//! number of times on one thread.
+//! jittered, spherical-cap-programmed sheet (the benches' scene, `benches/common/scene.rs`) and
+//! assembles energy, gradient and Hessian a fixed number of times on one thread.
 //!
 //!     cargo run --release --example assembly_work -- BENDING EDGE REPEATS
 use shellsim::assembly::{Pattern, Want};
-use shellsim::cases::Case;
-use shellsim::math::Vec3;
-use shellsim::mesh::generate::{rectangle, Spacing};
-use shellsim::scene::Scene;
-use shellsim::settings::Settings;
 use shellsim::solve::Potential;
+
+#[path = "../benches/common/scene.rs"]
+mod scene;
+use scene::{curved, scene_with_material};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -20,35 +19,9 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(1.0 / 100.0);
     let repeats: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(5);
-    let mut m = rectangle(
-        -0.5,
-        -0.5,
-        1.0,
-        1.0,
-        edge,
-        Spacing {
-            jitter: 0.2,
-            seed: 1,
-            ..Default::default()
-        },
-    );
-    Case::SphericalCap.program(&mut m);
-    let s = Settings::from_str_with(
-        &format!(
-            "[material]\nthickness = 0.05\nbending = \"{model}\"\n[rest]\ntarget = \"mesh\"\n"
-        ),
-        "work",
-        &[],
-    )
-    .expect("settings");
-    let sc = Scene::build(m, s).expect("scene");
+    let sc = scene_with_material(edge, model, "koiter");
     let p = Pattern::for_scene(&sc);
-    let x: Vec<Vec3> = sc
-        .mesh
-        .positions
-        .iter()
-        .map(|q| Vec3::new(q.x, q.y, (1.0 - q.x * q.x - q.y * q.y).sqrt()))
-        .collect();
+    let x = curved(&sc);
     let phi = vec![0.01; sc.num_edge_dofs()];
     let pot = Potential::new(&sc, &p);
     let (mut g, mut h) = (vec![0.0; p.n], vec![0.0; p.nnz()]);

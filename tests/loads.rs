@@ -329,6 +329,18 @@ fn prescribed_displacement_follows_the_dial() {
     assert_eq!(*dials.last().unwrap(), 1.0);
 }
 
+/// Settings of the elastica strip (ν = 0, Young's modulus `e`, thickness `h`): clamped at
+/// x = −0.5, end moment `m` at x = 0.5, 10 load steps, a frame after each.
+fn elastica_settings(e: f64, h: f64, m: f64) -> String {
+    format!(
+        "[material]\nyoung = {e}\npoisson = 0.0\nthickness = {h}\n\
+         [solver]\nsymmetry_breaking = 0.0\ncontinuation_step = 0.1\n\
+         [output]\ncontinuation_frames = true\n\
+         [[constraints.clamp]]\ninside = {{ min = [-1, -1, -1], max = [-0.499, 1, 1] }}\n\
+         [[loads.moment]]\nmoment = {m}\ninside = {{ min = [0.499, -1, -1], max = [1, 1, 1] }}\n"
+    )
+}
+
 /// The elastica: a strip clamped at one end and rolled up by an end moment, against the exact
 /// solution at every continuation step up to the full circle (M = 2πEI/L'). The clamp holds
 /// the first row of faces (one edge dx), so the free length is L' = L − dx from the clamped line
@@ -356,17 +368,7 @@ fn end_moment_rolls_a_strip_along_the_elastica() {
         let xc = -0.5 + edge;
         let m = 2.0 * std::f64::consts::PI * dplate / lp;
         let out = format!("oe_{edge}");
-        std::fs::write(
-            dir.join("e.toml"),
-            format!(
-                "[material]\nyoung = {e}\npoisson = 0.0\nthickness = {h}\n\
-                 [solver]\nsymmetry_breaking = 0.0\ncontinuation_step = 0.1\n\
-                 [output]\ncontinuation_frames = true\n\
-                 [[constraints.clamp]]\ninside = {{ min = [-1, -1, -1], max = [-0.499, 1, 1] }}\n\
-                 [[loads.moment]]\nmoment = {m}\ninside = {{ min = [0.499, -1, -1], max = [1, 1, 1] }}\n"
-            ),
-        )
-        .unwrap();
+        std::fs::write(dir.join("e.toml"), elastica_settings(e, h, m)).unwrap();
         shellsim(&["e.toml", "e.vtk", "--out", &out, "-q"], dir);
         let s = summary(dir, &out);
         assert_eq!(s["converged"], true, "{edge}: {s}");
@@ -441,17 +443,7 @@ fn restart_of_a_moment_run_resumes_its_turns() {
     let dir = d.path();
     rectangle(dir, 1.0, 0.04, 0.02, &[], "e.vtk");
     let m = 2.0 * std::f64::consts::PI * 1e7 * 1e-6 / 12.0 / 0.98;
-    std::fs::write(
-        dir.join("e.toml"),
-        format!(
-            "[material]\nyoung = 1e7\npoisson = 0.0\nthickness = 0.01\n\
-             [solver]\nsymmetry_breaking = 0.0\ncontinuation_step = 0.1\n\
-             [output]\ncontinuation_frames = true\n\
-             [[constraints.clamp]]\ninside = {{ min = [-1, -1, -1], max = [-0.499, 1, 1] }}\n\
-             [[loads.moment]]\nmoment = {m}\ninside = {{ min = [0.499, -1, -1], max = [1, 1, 1] }}\n"
-        ),
-    )
-    .unwrap();
+    std::fs::write(dir.join("e.toml"), elastica_settings(1e7, 0.01, m)).unwrap();
     shellsim(&["e.toml", "e.vtk", "--out", "full", "-q"], dir);
     let full = final_positions(dir, "full");
     // Frame 7 is at dial 0.7: the tip has turned by 0.7 × 2π > π.
