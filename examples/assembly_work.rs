@@ -1,7 +1,8 @@
 //! A fixed amount of work for instruction counts (`perf stat -e instructions`,
 //! `valgrind --tool=callgrind`), steady on a noisy machine where wall times are not: builds a
 //! jittered, spherical-cap-programmed sheet (the benches' scene, `benches/common/scene.rs`) and
-//! assembles energy, gradient and Hessian a fixed number of times on one thread.
+//! assembles energy, gradient and Hessian a fixed number of times on one thread, printing the
+//! wall time per assembly.
 //!
 //!     cargo run --release --example assembly_work -- BENDING EDGE REPEATS
 use shellsim::assembly::{Pattern, Want};
@@ -30,14 +31,17 @@ fn main() {
         .build()
         .unwrap();
     let mut e = 0.0;
+    let start = std::time::Instant::now();
     pool.install(|| {
         for _ in 0..repeats {
             e += pot.eval(&x, &phi, Want::Hessian, &mut g, &mut h);
         }
     });
+    let per = start.elapsed().as_secs_f64() / repeats.max(1) as f64;
     println!(
-        "{} faces, {model}: energy {e:.6e}, h[0] {:.6e}",
+        "{} faces, {model}: energy {e:.6e}, h[0] {:.6e}, {:.1} ms per assembly",
         sc.num_faces(),
-        h[0]
+        h[0],
+        1e3 * per
     );
 }

@@ -387,7 +387,8 @@ impl MidedgeAngle {
             }
         }
         if set {
-            *h = c.jy.transpose() * hy * c.jy;
+            // Written straight into `h`: no 21×21 temporary to copy.
+            (c.jy.transpose() * hy).mul_to(&c.jy, h);
         } else {
             *h += c.jy.transpose() * hy * c.jy;
         }
