@@ -183,7 +183,8 @@ impl Scene {
             }
         }
 
-        let mut fixed: Vec<bool> = unused_mask(nv, &unused);
+        let is_unused = unused_mask(nv, &unused);
+        let mut fixed: Vec<bool> = is_unused.clone();
         let c = &settings.constraints;
         if c.use_constraint_indicators {
             if let Some(ci) = mesh.vertex_field("constraint_indicators", 1)? {
@@ -257,7 +258,8 @@ impl Scene {
             fixed[v] = true;
         }
 
-        let free = unused.len() < nv && fixed.iter().all(|&f| !f);
+        // Free: no vertex that carries the sheet is held (unused vertices are held, inertly).
+        let free = unused.len() < nv && (0..nv).all(|v| is_unused[v] || !fixed[v]);
         let gravity = settings.loads.gravity.iter().any(|&g| g != 0.0);
         if free && gravity && settings.solver.mode == crate::settings::Mode::Static {
             return Err(mesh.invalid(

@@ -708,3 +708,46 @@ fn friction_on_an_incline_follows_coulomb() {
         assert!((0..n).all(|i| vel.get(i)[2].abs() < 1e-3));
     }
 }
+
+/// A vertex that no face uses is held and takes no part: a free sheet with one reaches the same
+/// equilibrium as without it, in the same Newton iterations (the rigid-motion pins must still
+/// be chosen among the vertices that carry the sheet).
+#[test]
+fn an_unused_vertex_changes_nothing() {
+    use shellsim::mesh::io::{read_mesh, write_mesh, Format};
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let args = ["mesh", "square", "-o", "m.vtk", "--program", "spherical_cap"];
+    shellsim(&[&args[..], &["--edge", "0.1"]].concat(), dir);
+    let mut m = read_mesh(&dir.join("m.vtk")).unwrap();
+    let nv = m.positions.len();
+    // Far away and in the middle of the vertex list's end: it would be picked as a pin.
+    m.positions.push(shellsim::math::Vec3::new(3.0, -2.0, 1.0));
+    for f in m.vertex_fields.values_mut() {
+        f.data.extend(std::iter::repeat_n(0.0, f.components));
+    }
+    write_mesh(&dir.join("m_unused.vtk"), &m, Format::Vtk, "unused").unwrap();
+    std::fs::write(
+        dir.join("s.toml"),
+        "[material]\nthickness = 0.05\n[rest]\ntarget = \"mesh\"\n",
+    )
+    .unwrap();
+    let mut finals = Vec::new();
+    for (mesh, out) in [("m.vtk", "a"), ("m_unused.vtk", "b")] {
+        shellsim(&["s.toml", mesh, "--out", out, "-q"], dir);
+        let s = summary(dir, out);
+        assert_eq!(s["converged"], true, "{mesh}");
+        let frame = dir.join(out).join(s["final_frame"].as_str().unwrap());
+        finals.push((read_positions(&frame), s["newton_iterations"].as_u64().unwrap()));
+    }
+    let (a, na) = &finals[0];
+    let (b, nb) = &finals[1];
+    assert_eq!(b.len(), nv + 1);
+    assert_eq!(na, nb, "Newton iterations with and without the unused vertex");
+    let worst = (0..nv)
+        .flat_map(|v| (0..3).map(move |k| (a[v][k] - b[v][k]).abs()))
+        .fold(0.0, f64::max);
+    // Same pins, same equations: equal up to round-off in the solver.
+    assert!(worst < 1e-9, "positions differ by {worst:e} m");
+    assert_eq!(b[nv], [3.0, -2.0, 1.0], "the unused vertex stays where it is");
+}
