@@ -383,7 +383,7 @@ fn coupled_step(c: &mut Criterion) {
             .build()
             .unwrap();
         let once = || {
-            let mut w = shellsim::output::Writer::new(dir.path(), &sc).unwrap();
+            let mut w = shellsim::output::Writer::new(dir.path(), &sc, true).unwrap();
             shellsim::integrate::run(&sc, &mut w, &mut shellsim::integrate::Quiet, threads, None)
                 .unwrap()
         };

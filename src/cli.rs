@@ -14,7 +14,7 @@ use crate::mesh::Topology;
 use crate::output::Writer;
 use crate::scene::Scene;
 use crate::settings::Settings;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, bail, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -39,9 +39,13 @@ pub struct Cli {
     /// Triangle mesh (.vtk legacy ASCII/binary, or .vtu/.vtp XML with inline data).
     #[arg(required = true)]
     mesh: Option<PathBuf>,
-    /// Output folder (created if needed).
+    /// Output folder (created if needed). One holding an earlier run's output is refused
+    /// unless --overwrite is given.
     #[arg(long, default_value = "out")]
     out: PathBuf,
+    /// Replace an earlier run's output in --out (its frames, series, log and summary).
+    #[arg(long)]
+    overwrite: bool,
     /// Worker threads for assembly (default: all cores). Results do not depend on it.
     #[arg(long)]
     threads: Option<usize>,
@@ -198,19 +202,26 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
+    let cores = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
     let threads = match cli.threads {
         Some(0) => bail!("--threads must be at least 1"),
+        Some(n) if n > cores => {
+            // Results do not depend on the thread count, so more threads than cores only cost.
+            eprintln!("warning: --threads {n} is more than the {cores} cores here; using {cores}");
+            cores
+        }
         Some(n) => n,
-        None => std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1),
+        None => cores,
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .map_err(|e| anyhow!("cannot start {threads} threads: {e}"))?;
-    let mut writer = Writer::new(&cli.out, &scene)
-        .with_context(|| format!("output folder {}", cli.out.display()))?;
+    crate::integrate::catch_signals()
+        .map_err(|e| anyhow!("cannot install signal handlers: {e}"))?;
+    let mut writer = Writer::new(&cli.out, &scene, cli.overwrite)?;
     let summary = pool.install(|| {
         if !cli.quiet && std::io::stderr().is_terminal() {
             let pb = indicatif::ProgressBar::new(1000);
@@ -226,6 +237,15 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
             run(&scene, &mut writer, &mut Quiet, threads, initial)
         }
     })?;
+    if let Some(sig) = crate::integrate::interrupted() {
+        eprintln!(
+            "shellsim: {} (state so far in {})",
+            summary.reason,
+            cli.out.display()
+        );
+        // The shell convention: 128 + the signal (130 for SIGINT, 143 for SIGTERM).
+        return Ok((128 + sig) as u8);
+    }
     if summary.converged {
         Ok(0)
     } else {
@@ -359,6 +379,8 @@ fn error_cmd(a: ErrorArgs) -> Result<()> {
         )
     })?;
     let frame = read_mesh(&a.frame)?;
+    // A frame with a non-finite position or field has no error to measure.
+    frame.validate()?;
     let disp = frame.vertex_field("displacement", 3)?.ok_or_else(|| {
         anyhow!(
             "{}: no 'displacement' vertex field; is it a shellsim frame?",

@@ -36,8 +36,32 @@ pub enum OutputError {
         /// Why.
         reason: String,
     },
+    /// The folder holds the output of an earlier run.
+    #[error(
+        "{path} holds the output of an earlier run ({what}); pass --overwrite to replace it, or \
+         choose another --out"
+    )]
+    Used {
+        /// The folder.
+        path: String,
+        /// What is there.
+        what: String,
+    },
+    /// Another run writes into the folder.
+    #[error(
+        "{path}: another shellsim run (process {pid}) is writing into this folder; wait for it \
+         or choose another --out (remove {path}/.shellsim.lock if that process is not shellsim)"
+    )]
+    Locked {
+        /// The folder.
+        path: String,
+        /// The process holding the lock.
+        pid: u32,
+    },
     /// A frame contained NaN or infinity; it was not written.
-    #[error("frame {index} at t = {time} contains non-finite values in '{field}'; not written")]
+    #[error(
+        "frame {index} at t = {time:e} would hold a non-finite value in '{field}; not written"
+    )]
     NonFinite {
         /// Frame index.
         index: usize,
@@ -183,6 +207,84 @@ pub struct Writer {
     frames_t: Vec<Mat2>,
     /// Extra per-face fields written into every following frame (moisture).
     extra: std::collections::BTreeMap<String, Vec<Real>>,
+    /// The folder's lock, released when the writer is dropped.
+    _lock: Lock,
+}
+
+/// `.shellsim.lock` in an output folder: created exclusively, holding the process id, removed
+/// on drop. A lock whose process is gone (a killed run) is taken over.
+struct Lock(std::path::PathBuf);
+
+impl Lock {
+    fn take(dir: &Path) -> Result<Lock, OutputError> {
+        use std::io::Write;
+        let path = dir.join(".shellsim.lock");
+        for _ in 0..2 {
+            match std::fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&path)
+            {
+                Ok(mut f) => {
+                    writeln!(f, "{}", std::process::id()).map_err(|e| ioerr(&path, e))?;
+                    return Ok(Lock(path));
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    let pid = std::fs::read_to_string(&path)
+                        .ok()
+                        .and_then(|t| t.trim().parse::<u32>().ok());
+                    let alive = pid.is_some_and(|p| {
+                        p != std::process::id() && Path::new(&format!("/proc/{p}")).exists()
+                    });
+                    if alive {
+                        return Err(OutputError::Locked {
+                            path: dir.display().to_string(),
+                            pid: pid.unwrap_or(0),
+                        });
+                    }
+                    // Stale: its run ended without removing it.
+                    let _ = std::fs::remove_file(&path);
+                }
+                Err(e) => return Err(ioerr(&path, e)),
+            }
+        }
+        Err(ioerr(&path, "cannot take the lock"))
+    }
+}
+
+impl Drop for Lock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
+/// Files of an earlier run in `dir`: its summary, series and log, frames `PREFIX_NNNNN.vtu|vtk`
+/// and temporary files left by an interrupted write.
+fn previous_outputs(dir: &Path, prefix: &str) -> std::io::Result<Vec<std::path::PathBuf>> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir)? {
+        let p = e?.path();
+        let Some(name) = p.file_name().and_then(|n| n.to_str()) else {
+            continue;
+        };
+        let frame = name
+            .strip_prefix(prefix)
+            .and_then(|r| r.strip_prefix('_'))
+            .and_then(|r| r.split_once('.'))
+            .is_some_and(|(n, ext)| {
+                !n.is_empty()
+                    && n.bytes().all(|c| c.is_ascii_digit())
+                    && (ext == "vtu" || ext == "vtk")
+            });
+        let ours = matches!(name, "summary.json" | "series.pvd" | "log.csv")
+            || frame
+            || (name.starts_with('.') && name.ends_with(".tmp"));
+        if ours && p.is_file() {
+            out.push(p);
+        }
+    }
+    out.sort();
+    Ok(out)
 }
 
 fn ioerr(path: &Path, e: impl ToString) -> OutputError {
@@ -212,9 +314,38 @@ fn output_frames(mesh: &Mesh) -> Vec<Mat2> {
 }
 
 impl Writer {
-    /// Creates (or reuses) the output folder and checks it is writable, before any work.
-    pub fn new(dir: &Path, scene: &Scene) -> Result<Self, OutputError> {
+    /// Creates the output folder, takes its lock (one run per folder) and checks it is
+    /// writable, before any work. A folder holding an earlier run's output (summary, series,
+    /// log, frames) is refused unless `overwrite`, which removes those files first.
+    pub fn new(dir: &Path, scene: &Scene, overwrite: bool) -> Result<Self, OutputError> {
         std::fs::create_dir_all(dir).map_err(|e| ioerr(dir, e))?;
+        let lock = Lock::take(dir)?;
+        let prefix = &scene.settings.output.prefix;
+        let previous = previous_outputs(dir, prefix).map_err(|e| ioerr(dir, e))?;
+        if !previous.is_empty() {
+            if !overwrite {
+                let frames = previous
+                    .iter()
+                    .filter(|p| p.extension().is_some_and(|e| e == "vtu" || e == "vtk"))
+                    .count();
+                let names: Vec<String> = previous
+                    .iter()
+                    .filter_map(|p| p.file_name()?.to_str().map(String::from))
+                    .filter(|n| !n.starts_with(prefix.as_str()) && !n.ends_with(".tmp"))
+                    .collect();
+                let mut what = names.join(", ");
+                if frames > 0 {
+                    what += &format!("{}{frames} frames", if what.is_empty() { "" } else { ", " });
+                }
+                return Err(OutputError::Used {
+                    path: dir.display().to_string(),
+                    what,
+                });
+            }
+            for p in &previous {
+                std::fs::remove_file(p).map_err(|e| ioerr(p, e))?;
+            }
+        }
         let probe = dir.join(".shellsim-write-test");
         std::fs::write(&probe, b"").map_err(|e| ioerr(dir, format!("not writable: {e}")))?;
         let _ = std::fs::remove_file(&probe);
@@ -241,6 +372,7 @@ impl Writer {
             frames_t: output_frames(mesh),
             frame_mesh,
             extra: Default::default(),
+            _lock: lock,
         })
     }
 
@@ -409,14 +541,37 @@ impl Writer {
                 field: format!("positions (vertex {p})"),
             });
         }
-        for (name, fld) in m.face_fields.iter().chain(m.vertex_fields.iter()) {
-            if fld.data.iter().any(|v| !v.is_finite()) {
+        let all = m
+            .face_fields
+            .iter()
+            .map(|f| (f, "face"))
+            .chain(m.vertex_fields.iter().map(|f| (f, "vertex")));
+        for ((name, fld), what) in all {
+            if let Some(i) = fld.data.iter().position(|v| !v.is_finite()) {
                 return Err(OutputError::NonFinite {
                     index,
                     time: row.time,
-                    field: name.clone(),
+                    field: format!(
+                        "{name}' at {what} {} (value {:e})",
+                        i / fld.components.max(1),
+                        fld.data[i]
+                    ),
                 });
             }
+        }
+        let bad_row = row
+            .energy
+            .columns()
+            .into_iter()
+            .map(|(n, e)| (format!("energy_{n}"), e))
+            .chain(row.observables.iter().cloned())
+            .find(|(_, v)| !v.is_finite());
+        if let Some((name, v)) = bad_row {
+            return Err(OutputError::NonFinite {
+                index,
+                time: row.time,
+                field: format!("{name}' of the log row (value {v:e})"),
+            });
         }
         let name = format!("{}_{index:05}.{}", self.prefix, self.format.extension());
         let path = self.dir.join(&name);

@@ -113,6 +113,12 @@ pub fn sample_on_edges(mesh: &Mesh, f: usize, m: impl Fn(Real, Real) -> Sym2) ->
     Sym2::new(m11, 0.5 * (m11 + m22 - m33), m22)
 }
 
+/// Smallest eigenvalue of a target `ā` in reference coordinates (a stretch of 1e-6); the
+/// largest accepted is its inverse.
+pub const MIN_METRIC: Real = 1e-12;
+/// Largest target curvature × sheet size (a radius of 1e-9 of the sheet).
+pub const MAX_CURVATURE_TIMES_SIZE: Real = 1e9;
+
 /// Target forms given per face in reference Cartesian coordinates (e.g. the `abar_info` and
 /// `bbar_info` fields), pulled back. Requires a flat reference mesh; checks ā > 0 per face.
 pub fn pulled_back_targets(
@@ -134,8 +140,32 @@ pub fn pulled_back_targets(
         let axy = abar_xy(f);
         if !(axy[0] > 0.0 && crate::math::sym_det(&axy) > 0.0) {
             return Err(mesh.invalid(format!(
-                "{what}: abar at face {f} is not positive definite: [{}, {}, {}]",
+                "{what}: abar at face {f} is not positive definite: [{:e}, {:e}, {:e}]",
                 axy[0], axy[1], axy[2]
+            )));
+        }
+        // Stretches beyond 1e±6 are no material's, and their squares overflow in the energy.
+        let (lo, hi) = crate::math::eig2(&crate::math::sym_to_mat(&axy));
+        if lo < MIN_METRIC || hi > 1.0 / MIN_METRIC {
+            return Err(mesh.invalid(format!(
+                "{what}: abar at face {f}, [{:e}, {:e}, {:e}], asks for stretches {:e} to {:e}, \
+                 outside 1e-6..1e6",
+                axy[0],
+                axy[1],
+                axy[2],
+                lo.sqrt(),
+                hi.sqrt()
+            )));
+        }
+        let bxy = bbar_xy(f);
+        let size = mesh.bbox_diagonal();
+        if let Some(c) = [bxy[0], bxy[1], bxy[2]]
+            .into_iter()
+            .find(|c| !c.is_finite() || c.abs() * size > MAX_CURVATURE_TIMES_SIZE)
+        {
+            return Err(mesh.invalid(format!(
+                "{what}: bbar at face {f} has an entry {c:e} 1/m: a curvature radius below \
+                 1e-9 of the sheet's size ({size:e} m)"
             )));
         }
         let t = reference_frame(mesh, f);

@@ -27,6 +27,57 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
         path: name.clone(),
         reason,
     };
+    let time = match series_time(path) {
+        Some(t) => {
+            let t = t.map_err(&bad)?;
+            check_time(scene, t).map_err(bad)?;
+            Some(t)
+        }
+        None => None,
+    };
+    let (state, v, mut warnings) = restart_from_frame(frame, &name, scene)?;
+    if time.is_none() {
+        warnings.push(format!(
+            "{name}: not listed in a series.pvd next to it; the restart starts at time 0"
+        ));
+    }
+    Ok((
+        InitialState {
+            state,
+            v,
+            time: time.unwrap_or(0.0),
+        },
+        warnings,
+    ))
+}
+
+/// A restart's time must be finite and inside the run: the dial in [0, 1] in statics, the time
+/// in [0, time.end] in dynamics.
+fn check_time(scene: &Scene, t: Real) -> Result<(), String> {
+    let (what, hi) = match scene.settings.solver.mode {
+        crate::settings::Mode::Static => ("dial", 1.0),
+        crate::settings::Mode::Dynamic => ("time", scene.settings.time.end),
+    };
+    if !(t.is_finite() && (0.0..=hi).contains(&t)) {
+        return Err(format!(
+            "series.pvd gives the frame the {what} {t:e}, outside this run's [0, {hi:e}]"
+        ));
+    }
+    Ok(())
+}
+
+/// Positions, velocities (if the frame has them) and edge DOFs of a restart frame for `scene`,
+/// with warnings; `name` names the frame in messages.
+#[allow(clippy::type_complexity)]
+pub fn restart_from_frame(
+    frame: crate::mesh::Mesh,
+    name: &str,
+    scene: &Scene,
+) -> Result<(State, Option<Vec<Vec3>>, Vec<String>), MeshError> {
+    let bad = |reason: String| MeshError::Invalid {
+        path: name.to_string(),
+        reason,
+    };
     let mut warnings = Vec::new();
     if frame.positions.len() != scene.num_vertices() || frame.faces != scene.mesh.faces {
         return Err(bad(format!(
@@ -45,6 +96,17 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
         .position(|p| !p.iter().all(|c| c.is_finite()))
     {
         return Err(bad(format!("vertex {v} has a non-finite position")));
+    }
+    // A face collapsed to a line or a point has no normal and no forms to restart from.
+    for (f, face) in frame.faces.iter().enumerate() {
+        let [a, b, c] = face.map(|v| frame.positions[v]);
+        let l = (b - a).norm().max((c - a).norm()).max((c - b).norm());
+        if !(l > 0.0 && ((b - a) / l).cross(&((c - a) / l)).norm() > 1e-12) {
+            return Err(bad(format!(
+                "face {f} {face:?} is collapsed in the restart frame (zero area): no state to \
+                 restart from"
+            )));
+        }
     }
     let v = match frame.vertex_field("velocity", 3)? {
         Some(f) => {
@@ -80,8 +142,8 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
                             seen[e] = true;
                         } else if (phi[e] - val).abs() > EDGE_ANGLE_TOLERANCE {
                             return Err(bad(format!(
-                                "field 'edge_angles': the two faces of edge {:?} disagree ({} \
-                                 at face {fi} vs {})",
+                                "field 'edge_angles': the two faces of edge {:?} disagree ({:e} \
+                                 at face {fi} vs {:e})",
                                 scene.topo.edges[e], val, phi[e]
                             )));
                         }
@@ -109,30 +171,19 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
             }
         }
     }
-    let time = match series_time(path) {
-        Some(t) => t,
-        None => {
-            warnings.push(format!(
-                "{name}: not listed in a series.pvd next to it; the restart starts at time 0"
-            ));
-            0.0
-        }
-    };
     Ok((
-        InitialState {
-            state: State {
-                x: frame.positions,
-                dofs: phi,
-            },
-            v,
-            time,
+        State {
+            x: frame.positions,
+            dofs: phi,
         },
+        v,
         warnings,
     ))
 }
 
-/// The `timestep` of `path`'s entry in the `series.pvd` of its folder.
-fn series_time(path: &Path) -> Option<Real> {
+/// The `timestep` of `path`'s entry in the `series.pvd` of its folder: `None` without an entry,
+/// an error when the entry's value is not a number.
+fn series_time(path: &Path) -> Option<Result<Real, String>> {
     let dir = path.parent()?;
     let file = path.file_name()?.to_str()?;
     let text = std::fs::read_to_string(dir.join("series.pvd")).ok()?;
@@ -140,6 +191,9 @@ fn series_time(path: &Path) -> Option<Real> {
         .filter(|l| l.contains(&format!("file=\"{file}\"")))
         .find_map(|l| {
             let rest = &l[l.find("timestep=\"")? + 10..];
-            rest[..rest.find('"')?].parse().ok()
+            let v = &rest[..rest.find('"')?];
+            Some(v.parse::<Real>().map_err(|_| {
+                format!("series.pvd gives the frame the timestep '{v}', not a number")
+            }))
         })
 }

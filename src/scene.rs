@@ -58,13 +58,13 @@ pub struct Scene {
     pub prescribed: Vec<(usize, Vec3)>,
 }
 
-fn positive_face_field(mesh: &Mesh, name: &str) -> Result<Option<Vec<Real>>, MeshError> {
+fn positive_face_field(mesh: &Mesh, name: &str, max: Real) -> Result<Option<Vec<Real>>, MeshError> {
     let Some(f) = mesh.face_field(name, 1)? else {
         return Ok(None);
     };
-    if let Some(i) = f.data.iter().position(|&v| !v.is_finite() || v <= 0.0) {
+    if let Some(i) = f.data.iter().position(|&v| !(v > 0.0 && v <= max)) {
         return Err(mesh.invalid(format!(
-            "face field '{name}' must be positive, but face {i} has {}",
+            "face field '{name}' must lie in (0, {max:e}], but face {i} has {:e}",
             f.data[i]
         )));
     }
@@ -90,14 +90,14 @@ impl Scene {
         let m = &settings.material;
         let thickness = match (
             m.use_mesh_thickness,
-            positive_face_field(&mesh, "ref_thicknesses")?,
+            positive_face_field(&mesh, "ref_thicknesses", crate::mesh::MAX_COORDINATE)?,
         ) {
             (true, Some(t)) => t,
             _ => vec![m.thickness; nf],
         };
         let young = match (
             m.use_mesh_shear_modulus,
-            positive_face_field(&mesh, "ref_shear_moduli")?,
+            positive_face_field(&mesh, "ref_shear_moduli", crate::settings::MAX_MODULUS)?,
         ) {
             (true, Some(mu)) => mu.iter().map(|mu| 2.0 * mu * (1.0 + m.poisson)).collect(),
             _ => vec![m.young; nf],

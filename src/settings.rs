@@ -8,6 +8,15 @@ use crate::mesh::io::Format;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+/// Most time steps a dynamic run may need at its largest step (`time.end / time.dt_max`).
+pub const MAX_STEPS: Real = 1e9;
+/// Most frames a dynamic run may write (`time.end / time.output_interval`).
+pub const MAX_FRAMES: Real = 1e6;
+/// Largest Young's modulus accepted (Pa).
+pub const MAX_MODULUS: Real = 1e15;
+/// Most element layers through the thickness in `[moisture]`.
+pub const MAX_LAYERS: usize = 256;
+
 /// Errors in the settings file or its overrides.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -171,7 +180,7 @@ pub enum BendingModel {
 }
 
 /// The softening factor of the static solver's membrane continuation.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Softening {
     /// A factor ≥ 1 (1 disables the continuation).
@@ -669,7 +678,7 @@ pub struct PressureLoad {
 
 /// A number, or an expression of the reference coordinates x, y (m) as a string (see
 /// [`crate::expr`]), evaluated at each face's reference centroid.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Field {
     /// A constant.
@@ -703,7 +712,7 @@ impl From<Real> for Field {
 }
 
 /// A number or the word `"auto"`.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum AutoOr {
     /// A value.
@@ -835,13 +844,27 @@ impl Default for Output {
     }
 }
 
-/// Parses a `--set key=value` value as TOML (number, bool, array, quoted string), falling back
-/// to a bare string.
-fn parse_override_value(v: &str) -> toml::Value {
+/// Parses a `--set key=value` value with TOML's rules (number, bool, array, inline table,
+/// quoted string); a bare word (letters, digits, `_`, `-`, not starting with a digit or sign)
+/// is taken as a string, so `--set solver.mode=dynamic` works. Anything else that TOML rejects
+/// (an integer beyond 64 bits, say) is an error with TOML's reason.
+fn parse_override_value(v: &str) -> Result<toml::Value, String> {
     let doc = format!("v = {v}");
     match doc.parse::<toml::Table>() {
-        Ok(mut t) => t.remove("v").unwrap_or(toml::Value::String(v.into())),
-        Err(_) => toml::Value::String(v.into()),
+        Ok(mut t) => Ok(t.remove("v").unwrap_or(toml::Value::String(v.into()))),
+        Err(e) => {
+            let word = v.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+                && v.chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+            if word {
+                Ok(toml::Value::String(v.into()))
+            } else {
+                Err(format!(
+                    "'{v}' is not a TOML value: {}",
+                    e.message().trim_end()
+                ))
+            }
+        }
     }
 }
 
@@ -868,10 +891,8 @@ pub fn apply_overrides(table: &mut toml::Table, overrides: &[String]) -> Result<
                 .as_table_mut()
                 .ok_or_else(|| oerr(&format!("'{p}' is not a table")))?;
         }
-        cur.insert(
-            parts[parts.len() - 1].to_string(),
-            parse_override_value(value.trim()),
-        );
+        let value = parse_override_value(value.trim()).map_err(|e| oerr(&e))?;
+        cur.insert(parts[parts.len() - 1].to_string(), value);
     }
     Ok(())
 }
@@ -991,6 +1012,16 @@ impl Settings {
         let ck = Check(name);
         let m = &self.material;
         ck.pos("material.young", m.young)?;
+        if m.young > MAX_MODULUS {
+            return ck.inv(
+                "material.young",
+                format!(
+                    "{:e} Pa is beyond {MAX_MODULUS:e} Pa (diamond is 1.2e12): energies of such a \
+                     sheet overflow",
+                    m.young
+                ),
+            );
+        }
         ck.pos("material.density", m.density)?;
         ck.pos("material.thickness", m.thickness)?;
         if !(m.poisson > -1.0 && m.poisson <= 0.5) {
@@ -1135,8 +1166,11 @@ impl Settings {
                     );
                 }
             }
-            if mo.layers == 0 {
-                return ck.inv("moisture.layers", "must be at least 1".into());
+            if mo.layers == 0 || mo.layers > MAX_LAYERS {
+                return ck.inv(
+                    "moisture.layers",
+                    format!("must lie in 1..={MAX_LAYERS}, got {}", mo.layers),
+                );
             }
             if !mo.initial.is_finite() {
                 return ck.inv(
@@ -1204,8 +1238,41 @@ impl Settings {
             return ck.inv(
                 "time.dt",
                 format!(
-                    "need dt_min ≤ dt ≤ dt_max, got {} ≤ {} ≤ {}",
+                    "need dt_min ≤ dt ≤ dt_max, got {:e} ≤ {:e} ≤ {:e}",
                     t.dt_min, t.dt, t.dt_max
+                ),
+            );
+        }
+        // Bounds on the work a run can ask for: steps at the largest step, and frames.
+        let steps = t.end / t.dt_max;
+        if steps > MAX_STEPS {
+            return ck.inv(
+                "time.end",
+                format!(
+                    "{:e} s at steps of at most time.dt_max = {:e} s is {steps:e} steps, more \
+                     than {MAX_STEPS:e}; raise time.dt_max or lower time.end",
+                    t.end, t.dt_max
+                ),
+            );
+        }
+        let frames = t.end / t.output_interval;
+        if frames > MAX_FRAMES {
+            return ck.inv(
+                "time.output_interval",
+                format!(
+                    "{:e} s between frames over {:e} s is {frames:e} frames, more than \
+                     {MAX_FRAMES:e}",
+                    t.output_interval, t.end
+                ),
+            );
+        }
+        if t.output_interval < t.dt_min {
+            return ck.inv(
+                "time.output_interval",
+                format!(
+                    "{:e} s is below time.dt_min = {:e} s: frames cannot be closer than the \
+                     smallest step",
+                    t.output_interval, t.dt_min
                 ),
             );
         }
@@ -1358,5 +1425,73 @@ impl Check<'_> {
             }
         }
         Ok(())
+    }
+}
+
+/// A settings value that is a number or a string, for the enums that accept either; their
+/// errors say what they accept instead of serde's "untagged enum".
+enum NumOrStr {
+    Num(Real),
+    Str(String),
+}
+
+fn num_or_str<'de, D: serde::Deserializer<'de>>(
+    d: D,
+    expecting: &'static str,
+) -> Result<NumOrStr, D::Error> {
+    struct V(&'static str);
+    impl serde::de::Visitor<'_> for V {
+        type Value = NumOrStr;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str(self.0)
+        }
+        fn visit_f64<E>(self, v: f64) -> Result<NumOrStr, E> {
+            Ok(NumOrStr::Num(v))
+        }
+        fn visit_i64<E>(self, v: i64) -> Result<NumOrStr, E> {
+            Ok(NumOrStr::Num(v as Real))
+        }
+        fn visit_u64<E>(self, v: u64) -> Result<NumOrStr, E> {
+            Ok(NumOrStr::Num(v as Real))
+        }
+        fn visit_str<E>(self, v: &str) -> Result<NumOrStr, E> {
+            Ok(NumOrStr::Str(v.into()))
+        }
+    }
+    d.deserialize_any(V(expecting))
+}
+
+/// Number-or-`"auto"` settings.
+fn number_or_auto<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<Real>, D::Error> {
+    use serde::de::Error;
+    match num_or_str(d, "a number or \"auto\"")? {
+        NumOrStr::Num(v) => Ok(Some(v)),
+        NumOrStr::Str(s) if s == "auto" => Ok(None),
+        NumOrStr::Str(s) => Err(D::Error::custom(format!(
+            "expected a number or \"auto\", got \"{s}\""
+        ))),
+    }
+}
+
+impl<'de> Deserialize<'de> for AutoOr {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        Ok(number_or_auto(d)?.map_or(AutoOr::Auto(Auto::Auto), AutoOr::Value))
+    }
+}
+
+impl<'de> Deserialize<'de> for Softening {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        Ok(number_or_auto(d)?.map_or(Softening::Auto(Auto::Auto), Softening::Factor))
+    }
+}
+
+impl<'de> Deserialize<'de> for Field {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        Ok(
+            match num_or_str(d, "a number or an expression of x and y in quotes")? {
+                NumOrStr::Num(v) => Field::Value(v),
+                NumOrStr::Str(s) => Field::Expr(s),
+            },
+        )
     }
 }

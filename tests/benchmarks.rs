@@ -240,7 +240,10 @@ fn cantilever_under_gravity_matches_beam_theory() {
             ),
         )
         .unwrap();
-        shellsim(&["c.toml", "c.vtk", "--out", "oc", "-q"], dir);
+        shellsim(
+            &["c.toml", "c.vtk", "--out", "oc", "-q", "--overwrite"],
+            dir,
+        );
         let p = read_positions(&dir.join("oc/frame_00001.vtu"));
         let tip: Vec<f64> = p.iter().filter(|p| p[0] > 0.49).map(|p| p[2]).collect();
         let w = -tip.iter().sum::<f64>() / tip.len() as f64;
@@ -687,7 +690,10 @@ fn friction_on_an_incline_follows_coulomb() {
             ),
         )
         .unwrap();
-        shellsim(&["f.toml", "s.vtk", "--out", "of", "-q"], dir);
+        shellsim(
+            &["f.toml", "s.vtk", "--out", "of", "-q", "--overwrite"],
+            dir,
+        );
         let m = shellsim::mesh::io::read_mesh(&dir.join("of/frame_00001.vtu")).unwrap();
         let vel = &m.vertex_fields["velocity"];
         let disp = &m.vertex_fields["displacement"];
@@ -717,7 +723,14 @@ fn an_unused_vertex_changes_nothing() {
     use shellsim::mesh::io::{read_mesh, write_mesh, Format};
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    let args = ["mesh", "square", "-o", "m.vtk", "--program", "spherical_cap"];
+    let args = [
+        "mesh",
+        "square",
+        "-o",
+        "m.vtk",
+        "--program",
+        "spherical_cap",
+    ];
     shellsim(&[&args[..], &["--edge", "0.1"]].concat(), dir);
     let mut m = read_mesh(&dir.join("m.vtk")).unwrap();
     let nv = m.positions.len();
@@ -738,16 +751,26 @@ fn an_unused_vertex_changes_nothing() {
         let s = summary(dir, out);
         assert_eq!(s["converged"], true, "{mesh}");
         let frame = dir.join(out).join(s["final_frame"].as_str().unwrap());
-        finals.push((read_positions(&frame), s["newton_iterations"].as_u64().unwrap()));
+        finals.push((
+            read_positions(&frame),
+            s["newton_iterations"].as_u64().unwrap(),
+        ));
     }
     let (a, na) = &finals[0];
     let (b, nb) = &finals[1];
     assert_eq!(b.len(), nv + 1);
-    assert_eq!(na, nb, "Newton iterations with and without the unused vertex");
+    assert_eq!(
+        na, nb,
+        "Newton iterations with and without the unused vertex"
+    );
     let worst = (0..nv)
         .flat_map(|v| (0..3).map(move |k| (a[v][k] - b[v][k]).abs()))
         .fold(0.0, f64::max);
     // Same pins, same equations: equal up to round-off in the solver.
     assert!(worst < 1e-9, "positions differ by {worst:e} m");
-    assert_eq!(b[nv], [3.0, -2.0, 1.0], "the unused vertex stays where it is");
+    assert_eq!(
+        b[nv],
+        [3.0, -2.0, 1.0],
+        "the unused vertex stays where it is"
+    );
 }

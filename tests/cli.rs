@@ -207,7 +207,7 @@ fn bad_meshes_are_rejected_with_exit_2_and_nothing_written() {
     );
     expect_bad(&["s.toml", "trunc.vtk"], p, "trunc.vtk");
     write(p, "nan.vtk", &TWO_TRIANGLES.replace("1 1 0\n", "nan 1 0\n"));
-    expect_bad(&["s.toml", "nan.vtk"], p, "line 8");
+    expect_bad(&["s.toml", "nan.vtk"], p, "line 8, POINTS: value");
     write(
         p,
         "zero.vtk",
@@ -751,7 +751,7 @@ fn absorbed_water_adds_mass() {
              [solver]\nmode = \"dynamic\"\nsymmetry_breaking = 0.0\n[time]\nend = {t}\ndt = 0.01\ndt_max = 0.01\noutput_interval = {t}\n"
         );
         write(p, "m.toml", &scene);
-        let r = run(&["m.toml", "s.vtk", "--out", "o", "-q"], p);
+        let r = run(&["m.toml", "s.vtk", "--out", "o", "-q", "--overwrite"], p);
         assert_eq!(r.code, 0, "{}", r.stderr);
         let s = summary_of(p, "o");
         let kinetic = s["energy"]["kinetic"].as_f64().unwrap();
@@ -793,12 +793,12 @@ fn bad_growth_and_moisture_fields_are_rejected() {
         (
             "nan.vtk",
             with_fields("moisture_top 1 2 double\n0.1 nan\n"),
-            "line 19: non-finite",
+            "line 19, CELL_DATA FIELD array 'moisture_top': value 1 of 2 is non-finite",
         ),
         (
             "nan2.vtk",
             with_fields("moisture_bottom 1 2 double\ninf 0.1\n"),
-            "line 19: non-finite",
+            "line 19, CELL_DATA FIELD array 'moisture_bottom': value 0 of 2 is non-finite",
         ),
         (
             "neg.vtk",
@@ -825,7 +825,7 @@ fn bad_growth_and_moisture_fields_are_rejected() {
         (
             "mdnan.vtk",
             "machine_direction 3 2 double\n1 0 0 nan 1 0\n",
-            "line 19: non-finite",
+            "line 19, CELL_DATA FIELD array 'machine_direction': value 3 of 6 is non-finite",
         ),
     ] {
         write(p, name, &with_fields(field));
@@ -886,7 +886,7 @@ fn taped_side_does_not_swell() {
              [output]\nformat = \"vtk_ascii\"\n"
         );
         write(p, "t.toml", &scene);
-        let r = run(&["t.toml", "s.vtk", "--out", "o", "-q"], p);
+        let r = run(&["t.toml", "s.vtk", "--out", "o", "-q", "--overwrite"], p);
         assert_eq!(r.code, 0, "{}", r.stderr);
         let m = shellsim::mesh::io::read_mesh(&p.join("o/frame_00001.vtk")).unwrap();
         let top = &m.face_fields["moisture_top"].data;
@@ -906,4 +906,275 @@ fn taped_side_does_not_swell() {
          [[moisture.boundary]]\nside = \"top\"\nkind = \"robin\"\nk = 1e-6\ntape = true\n",
     );
     expect_bad(&["bad.toml", "s.vtk"], p, "moisture.boundary[0].tape");
+}
+
+/// An output folder holds one run: a rerun is refused (exit 2, the folder untouched) unless
+/// `--overwrite`, which leaves no file of the earlier run behind; a live run's lock refuses a
+/// second run, a dead one's lock is taken over.
+#[test]
+fn output_folders_hold_one_run() {
+    let d = tmp();
+    let p = d.path();
+    write(p, "m.vtk", TWO_TRIANGLES);
+    let dynamic = |frames: u32| {
+        format!(
+            "[material]\nthickness = 0.05\n[solver]\nmode = \"dynamic\"\n[time]\nend = {e}\ndt = 0.01\ndt_max = 0.01\noutput_interval = 0.01\n",
+            e = 0.01 * frames as f64
+        )
+    };
+    write(p, "five.toml", &dynamic(5));
+    write(p, "two.toml", &dynamic(2));
+    let r = run(&["five.toml", "m.vtk", "--out", "o", "-q"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_eq!(frames(&p.join("o")), 6);
+    let before = std::fs::read(p.join("o/summary.json")).unwrap();
+    let r = run(&["two.toml", "m.vtk", "--out", "o", "-q"], p);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("earlier run")
+            && r.stderr.contains("--overwrite")
+            && r.stderr.contains("6 frames"),
+        "{}",
+        r.stderr
+    );
+    assert_eq!(std::fs::read(p.join("o/summary.json")).unwrap(), before);
+    assert_eq!(frames(&p.join("o")), 6, "a refused rerun touches nothing");
+    let r = run(&["two.toml", "m.vtk", "--out", "o", "-q", "--overwrite"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_eq!(
+        frames(&p.join("o")),
+        3,
+        "no frame of the earlier run is left"
+    );
+    let series = std::fs::read_to_string(p.join("o/series.pvd")).unwrap();
+    assert_eq!(series.matches("<DataSet").count(), 3, "{series}");
+    let log = std::fs::read_to_string(p.join("o/log.csv")).unwrap();
+    assert_eq!(log.lines().count(), 4, "{log}");
+    assert!(
+        !p.join("o/.shellsim.lock").exists(),
+        "the lock goes with the run"
+    );
+    // A lock held by a live process (this test) refuses the run.
+    std::fs::write(
+        p.join("o/.shellsim.lock"),
+        format!("{}\n", std::process::id()),
+    )
+    .unwrap();
+    let r = run(&["two.toml", "m.vtk", "--out", "o", "-q", "--overwrite"], p);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(
+        r.stderr
+            .contains(&format!("process {}", std::process::id())),
+        "{}",
+        r.stderr
+    );
+    // A lock whose process is gone is stale.
+    std::fs::write(p.join("o/.shellsim.lock"), "4000000000\n").unwrap();
+    let r = run(&["two.toml", "m.vtk", "--out", "o", "-q", "--overwrite"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+}
+
+/// Restarts take their time or dial from `series.pvd`; a value that is not a number, or lies
+/// outside the run, is bad input.
+#[test]
+fn restart_time_must_lie_inside_the_run() {
+    let d = tmp();
+    let p = d.path();
+    write(p, "m.vtk", TWO_TRIANGLES);
+    write(p, "s.toml", STATIC);
+    let r = run(&["s.toml", "m.vtk", "--out", "a", "-q"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let frame = final_frame(p, "a");
+    let series = std::fs::read_to_string(p.join("a/series.pvd")).unwrap();
+    let name = frame.rsplit('/').next().unwrap().to_string();
+    for (value, needle) in [
+        ("NaN", "dial NaN"),
+        ("-5", "dial -5e0"),
+        ("1e300", "dial 1e300"),
+        ("x", "'x'"),
+    ] {
+        let mut out = String::new();
+        for l in series.lines() {
+            if l.contains(&format!("file=\"{name}\"")) {
+                let i = l.find("timestep=\"").unwrap() + 10;
+                let j = i + l[i..].find('"').unwrap();
+                out.push_str(&format!("{}{value}{}\n", &l[..i], &l[j..]));
+            } else {
+                out.push_str(l);
+                out.push('\n');
+            }
+        }
+        std::fs::write(p.join("a/series.pvd"), out).unwrap();
+        let r = run(
+            &["s.toml", "m.vtk", "--out", "b", "-q", "--restart", &frame],
+            p,
+        );
+        assert_eq!(r.code, 2, "timestep {value}: {}", r.stderr);
+        assert!(r.stderr.contains(needle), "timestep {value}: {}", r.stderr);
+        assert_eq!(frames(&p.join("b")), 0);
+    }
+}
+
+/// Sizes that would run on without limit are refused up front, naming the key; more threads
+/// than cores is a warning, and the run goes on with the cores.
+#[test]
+fn unbounded_sizes_are_refused() {
+    let d = tmp();
+    let p = d.path();
+    write(p, "m.vtk", TWO_TRIANGLES);
+    write(p, "s.toml", STATIC);
+    let dynamic = "[solver]\nmode = \"dynamic\"\n[material]\nthickness = 0.05\n";
+    write(p, "d.toml", dynamic);
+    for (set, needle) in [
+        ("time.end=1e300", "time.end"),
+        ("time.output_interval=1e-12", "time.output_interval"),
+        ("time.output_interval=1e-7", "frames"),
+    ] {
+        expect_bad(&["d.toml", "m.vtk", "-q", "--set", set], p, needle);
+    }
+    // Values whose energies overflow are refused up front, naming the key or the face.
+    expect_bad(
+        &["s.toml", "m.vtk", "-q", "--set", "material.young=1e308"],
+        p,
+        "material.young",
+    );
+    write(
+        p,
+        "big.vtk",
+        &TWO_TRIANGLES.replacen("1 0 1 1 0 1", "9.2e18 0 1 1 0 1", 1),
+    );
+    expect_bad(&["s.toml", "big.vtk", "-q"], p, "abar at face 0");
+    write(
+        p,
+        "mu.vtk",
+        &TWO_TRIANGLES.replacen("1000 1000", "1000 1e308", 1),
+    );
+    expect_bad(
+        &["s.toml", "mu.vtk", "-q"],
+        p,
+        "'ref_shear_moduli' must lie in (0, 1e15], but face 1",
+    );
+    let wet = "[growth]\nlaw = \"linear_swelling\"\nmu = 0.01\n[moisture]\nenabled = true\nlayers = 100000\n[solver]\nmode = \"dynamic\"\n";
+    write(p, "w.toml", wet);
+    expect_bad(&["w.toml", "m.vtk", "-q"], p, "moisture.layers");
+    let r = run(
+        &["s.toml", "m.vtk", "--out", "t", "-q", "--threads", "100000"],
+        p,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("warning: --threads 100000"),
+        "{}",
+        r.stderr
+    );
+}
+
+/// A restart frame whose faces have collapsed (all vertices at one point) is bad input, named
+/// by face, before anything is written.
+#[test]
+fn collapsed_restart_frames_are_bad_input() {
+    let d = tmp();
+    let p = d.path();
+    write(p, "m.vtk", TWO_TRIANGLES);
+    let text = TWO_TRIANGLES.replacen(
+        "0 0 0\n1 0 0\n1 1 0\n0 1 0\n",
+        "0.5 0.5 0\n0.5 0.5 0\n0.5 0.5 0\n0.5 0.5 0\n",
+        1,
+    );
+    assert_ne!(text, TWO_TRIANGLES);
+    write(p, "c.vtk", &text);
+    write(p, "s.toml", STATIC);
+    let r = run(
+        &["s.toml", "m.vtk", "--out", "o", "-q", "--restart", "c.vtk"],
+        p,
+    );
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("face 0") && r.stderr.contains("collapsed"),
+        "{}",
+        r.stderr
+    );
+    assert_eq!(frames(&p.join("o")), 0);
+}
+
+/// SIGINT or SIGTERM ends a run cleanly: the step under way finishes, the state reached is the
+/// last frame, the log and the series list every frame, `summary.json` says "interrupted", no
+/// temporary file or lock is left, and the exit code is 128 + the signal. A second signal
+/// exits at once.
+#[test]
+fn signals_stop_runs_cleanly() {
+    let d = tmp();
+    let p = d.path();
+    strip_mesh(p, "1", "1", "0.05", "m.vtk");
+    let long = "[material]\nthickness = 0.05\n[loads]\ngravity = [0.0, 0.0, -9.81]\n[constraints]\nfix_boxes = [{ min = [-1.0, -1.0, -1.0], max = [-0.45, 1.0, 1.0] }]\n\
+                [solver]\nmode = \"dynamic\"\n[time]\nend = 1000.0\ndt = 0.001\ndt_max = 0.001\noutput_interval = 0.01\n";
+    write(p, "long.toml", long);
+    for (sig, code, twice) in [
+        ("INT", 130, false),
+        ("TERM", 143, false),
+        ("TERM", 143, true),
+    ] {
+        let out = format!("o_{sig}_{twice}");
+        let mut child = bin()
+            .args(["long.toml", "m.vtk", "--out", &out, "-q"])
+            .current_dir(p)
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let dir = p.join(&out);
+        let t0 = std::time::Instant::now();
+        while frames(&dir) < 3 {
+            assert!(t0.elapsed().as_secs() < 60, "no frames after 60 s");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let pid = child.id().to_string();
+        let kill = |s: &str| {
+            let st = Command::new("kill")
+                .args([&format!("-{s}"), &pid])
+                .status()
+                .unwrap();
+            assert!(st.success());
+        };
+        kill(sig);
+        if twice {
+            kill(sig);
+        }
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(code), "SIG{sig} twice: {twice}");
+        assert!(
+            !dir.join(".shellsim.lock").exists() || twice,
+            "the lock is released"
+        );
+        if twice {
+            continue;
+        }
+        let s = summary_of(p, &out);
+        assert_eq!(s["converged"], false);
+        let reason = s["reason"].as_str().unwrap();
+        assert!(
+            reason.starts_with(&format!("interrupted by SIG{sig} at t ")),
+            "{reason}"
+        );
+        let n = frames(&dir);
+        let series = std::fs::read_to_string(dir.join("series.pvd")).unwrap();
+        assert_eq!(
+            series.matches("<DataSet").count(),
+            n,
+            "series and frames in step"
+        );
+        let log = std::fs::read_to_string(dir.join("log.csv")).unwrap();
+        assert_eq!(log.lines().count(), n + 1, "log and frames in step");
+        assert!(dir.join(s["final_frame"].as_str().unwrap()).exists());
+        let tmp_left = std::fs::read_dir(&dir)
+            .unwrap()
+            .filter(|e| {
+                e.as_ref()
+                    .unwrap()
+                    .file_name()
+                    .to_string_lossy()
+                    .ends_with(".tmp")
+            })
+            .count();
+        assert_eq!(tmp_left, 0);
+    }
 }

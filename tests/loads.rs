@@ -66,7 +66,10 @@ fn cantilever_end_load_matches_euler_bernoulli() {
             ),
         )
         .unwrap();
-        shellsim(&["c.toml", "c.vtk", "--out", "oc", "-q"], dir);
+        shellsim(
+            &["c.toml", "c.vtk", "--out", "oc", "-q", "--overwrite"],
+            dir,
+        );
         let x = final_positions(dir, "oc");
         let tip: Vec<f64> = x.iter().filter(|q| q[0] > 0.499).map(|q| q[2]).collect();
         ratios.push(-tip.iter().sum::<f64>() / tip.len() as f64 / theory);

@@ -24,6 +24,8 @@ fn run_scene(dir: &Path, scene: &str, mesh: &Path, sets: &[&str]) -> Vec<Mesh> {
         "--out".into(),
         out.to_str().unwrap().into(),
         "-q".into(),
+        // A scene may be run twice into its folder (two meshes).
+        "--overwrite".into(),
     ];
     for s in sets {
         args.push("--set".into());

@@ -65,6 +65,10 @@ pub(super) fn run_dynamic(
     let mut failure: Option<RunFailure> = None;
     let eps_t = 1e-12 * tm.end;
     while t < tm.end - eps_t {
+        if let Some(f) = super::interruption("t", t) {
+            failure = Some(f);
+            break;
+        }
         let h = steps.step.min(clock.next - t).min(tm.end - t);
         let dial = dial_at(t + h);
         for i in 0..n {

@@ -105,6 +105,16 @@ pub enum RunFailure {
         /// The last solve's failure.
         cause: SolveError,
     },
+    /// A signal (SIGINT, SIGTERM) asked the run to stop; the state reached is the last frame.
+    #[error("interrupted by {signal} at {what} {at:e}")]
+    Interrupted {
+        /// The signal's name.
+        signal: &'static str,
+        /// "dial" or "t".
+        what: &'static str,
+        /// The dial or time reached.
+        at: Real,
+    },
     /// Dynamics: the moisture boundary conditions could not be switched.
     #[error("moisture at t = {t:.6e}: {source}")]
     MoistureSurface {
@@ -129,6 +139,49 @@ pub enum RunFailure {
         /// What went wrong.
         source: crate::scene::GrowthError,
     },
+}
+
+/// The signal that asked the run to stop (0: none). Set by [`catch_signals`]' handler and read
+/// by the drivers between steps.
+static STOP: std::sync::atomic::AtomicI32 = std::sync::atomic::AtomicI32::new(0);
+
+/// Makes SIGINT and SIGTERM stop a run cleanly: the drivers finish the step under way, write
+/// the state reached as the last frame, the log and `summary.json` (`reason` "interrupted …")
+/// and return. A second signal exits at once with 128 + its number.
+pub fn catch_signals() -> std::io::Result<()> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    for sig in [SIGINT, SIGTERM] {
+        // SAFETY: the handler only touches an atomic and calls `_exit`, both async-signal-safe.
+        unsafe {
+            signal_hook::low_level::register(sig, move || {
+                if STOP.swap(sig, std::sync::atomic::Ordering::SeqCst) != 0 {
+                    signal_hook::low_level::exit(128 + sig);
+                }
+            })?;
+        }
+    }
+    Ok(())
+}
+
+/// The signal number that interrupted the run, if any.
+pub fn interrupted() -> Option<i32> {
+    match STOP.load(std::sync::atomic::Ordering::SeqCst) {
+        0 => None,
+        s => Some(s),
+    }
+}
+
+/// The [`RunFailure`] of an interruption, if a signal came.
+fn interruption(what: &'static str, at: Real) -> Option<RunFailure> {
+    interrupted().map(|sig| RunFailure::Interrupted {
+        signal: match sig {
+            signal_hook::consts::SIGINT => "SIGINT",
+            signal_hook::consts::SIGTERM => "SIGTERM",
+            _ => "a signal",
+        },
+        what,
+        at,
+    })
 }
 
 /// Receives progress updates (a terminal progress bar, or nothing).
@@ -445,11 +498,27 @@ pub fn run(
     if sb > 0.0 && is_planar(scene, &state.x) {
         perturb(scene, &mut state.x, sb * scene.mean_edge, s.config.seed);
     }
-    match s.config.mode {
-        Mode::Static => statics::run_static(&mut s, writer, progress, state, start)?,
+    let ran = match s.config.mode {
+        Mode::Static => statics::run_static(&mut s, writer, progress, state, start),
         Mode::Dynamic => {
-            dynamics::run_dynamic(&mut s, writer, progress, state, v, start.unwrap_or(0.0))?
+            dynamics::run_dynamic(&mut s, writer, progress, state, v, start.unwrap_or(0.0))
         }
+    };
+    match ran {
+        Ok(()) => {}
+        // A state that would put NaN or infinity into a frame ends the run (exit 1) with the
+        // last good frame and a summary saying where.
+        Err(RunError::Output(e @ OutputError::NonFinite { .. })) => {
+            s.summary.converged = false;
+            s.summary.reason = format!(
+                "{e}; the run stopped{}",
+                match writer.num_frames() {
+                    0 => String::from(" before its first frame"),
+                    _ => format!(", last good frame {}", writer.last_frame()),
+                }
+            );
+        }
+        Err(e) => return Err(e),
     }
     s.summary.wall_seconds = s.start.elapsed().as_secs_f64();
     s.summary.frames = writer.num_frames();

@@ -37,6 +37,10 @@ pub(super) fn run_static(
     let mut trial = state.clone();
     let mut failure: Option<RunFailure> = None;
     while dial < 1.0 || scale < 1.0 || need_solve {
+        if let Some(f) = super::interruption("dial", dial) {
+            failure = Some(f);
+            break;
+        }
         let (target, target_scale) = if dial < 1.0 {
             ((dial + steps.step).min(1.0), scale)
         } else {
@@ -124,6 +128,10 @@ pub(super) fn run_static(
     if failure.is_none() && check {
         let mut escapes = 0;
         while !s.is_stable(1.0, &state) {
+            if let Some(f) = super::interruption("dial", dial) {
+                failure = Some(f);
+                break;
+            }
             if escapes >= max_escapes {
                 failure = Some(RunFailure::Saddle { escapes });
                 break;

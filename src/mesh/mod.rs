@@ -7,7 +7,9 @@
 pub mod delaunay;
 pub mod generate;
 pub mod io;
+mod legacy;
 pub mod topology;
+mod xml;
 
 pub use topology::Topology;
 
@@ -46,6 +48,41 @@ impl Field {
     }
 }
 
+/// What a reader produces: flat coordinates, triangles, and `(components, values)` per array.
+struct RawMesh {
+    points: Vec<Real>,
+    faces: Vec<[usize; 3]>,
+    cell_data: BTreeMap<String, (usize, Vec<Real>)>,
+    point_data: BTreeMap<String, (usize, Vec<Real>)>,
+}
+
+impl RawMesh {
+    fn into_mesh(self) -> Result<Mesh, String> {
+        if !self.points.len().is_multiple_of(3) {
+            return Err(format!(
+                "POINTS holds {} values, not a multiple of 3",
+                self.points.len()
+            ));
+        }
+        let fields = |m: BTreeMap<String, (usize, Vec<Real>)>| {
+            m.into_iter()
+                .map(|(k, (components, data))| (k, Field { components, data }))
+                .collect()
+        };
+        Ok(Mesh {
+            positions: self
+                .points
+                .chunks_exact(3)
+                .map(|c| Vec3::new(c[0], c[1], c[2]))
+                .collect(),
+            faces: self.faces,
+            face_fields: fields(self.cell_data),
+            vertex_fields: fields(self.point_data),
+            source: None,
+        })
+    }
+}
+
 /// A triangle mesh with its fields, as read from a file.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
@@ -60,6 +97,10 @@ pub struct Mesh {
     /// Where the mesh came from (for error messages).
     pub source: Option<PathBuf>,
 }
+
+/// The largest coordinate magnitude accepted (m): far beyond any sheet, far below the range
+/// where squared lengths and energies overflow.
+pub const MAX_COORDINATE: Real = 1e30;
 
 /// Errors in reading or validating a mesh. Each names the file and the offending index.
 #[derive(Debug, thiserror::Error)]
@@ -134,39 +175,42 @@ impl Mesh {
         }
         for (i, p) in self.positions.iter().enumerate() {
             if !p.iter().all(|c| c.is_finite()) {
-                return Err(self.invalid(format!("vertex {i} has a non-finite coordinate {p:?}")));
+                return Err(self.invalid(format!(
+                    "vertex {i} has a non-finite coordinate ({:e}, {:e}, {:e})",
+                    p.x, p.y, p.z
+                )));
+            }
+        }
+        for (i, p) in self.positions.iter().enumerate() {
+            if let Some(c) = p.iter().find(|c| c.abs() > MAX_COORDINATE) {
+                return Err(self.invalid(format!(
+                    "vertex {i} has a coordinate {c:e} m, beyond ±{MAX_COORDINATE:e} m: rescale \
+                     the mesh (energies of such a sheet overflow)"
+                )));
             }
         }
         let mut used = vec![false; nv];
-        let mut lmax: Real = 0.0;
-        for f in &self.faces {
-            for &v in f {
-                if v < nv {
-                    lmax = lmax.max((self.positions[v] - self.positions[f[0]]).norm());
-                }
-            }
-        }
         for (fi, f) in self.faces.iter().enumerate() {
+            // Every index is checked before any is used.
+            if let Some(&v) = f.iter().find(|&&v| v >= nv) {
+                return Err(self.invalid(format!(
+                    "face {fi} refers to vertex {v}, but there are only {nv} vertices"
+                )));
+            }
             for &v in f {
-                if v >= nv {
-                    return Err(self.invalid(format!(
-                        "face {fi} refers to vertex {v}, but there are only {nv} vertices"
-                    )));
-                }
                 used[v] = true;
             }
             if f[0] == f[1] || f[1] == f[2] || f[0] == f[2] {
                 return Err(self.invalid(format!("face {fi} repeats a vertex: {f:?}")));
             }
             let [a, b, c] = self.face_positions(fi);
-            let cr = (b - a).cross(&(c - a)).norm();
-            let l2 = (b - a)
-                .norm_squared()
-                .max((c - a).norm_squared())
-                .max((c - b).norm_squared());
-            if cr <= 1e-12 * l2 || l2 == 0.0 {
+            // Scale-free: the edges divided by the longest one.
+            let l = (b - a).norm().max((c - a).norm()).max((c - b).norm());
+            let cr = ((b - a) / l).cross(&((c - a) / l)).norm();
+            if l == 0.0 || cr <= 1e-12 {
                 return Err(self.invalid(format!(
-                    "face {fi} {f:?} has zero area (degenerate triangle)"
+                    "face {fi} {f:?} has zero area (degenerate triangle: twice its area is \
+                     {cr:e} of its longest edge squared)"
                 )));
             }
         }

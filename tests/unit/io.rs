@@ -196,3 +196,134 @@ fn delaunay_rectangle_is_valid_delaunay_and_well_shaped() {
     assert!(min_angle > 15.0, "min angle {min_angle}");
     assert_eq!(make().faces, m.faces, "not deterministic");
 }
+
+/// Files written by VTK's own writers (VTK 9.7, `scripts/make_vtk_fixtures.py`) in every
+/// variant shellsim reads: each gives the script's mesh exactly (all arrays are Float64 or
+/// Int32, so nothing is rounded).
+#[test]
+fn files_written_by_vtk_itself_are_read_in_every_variant() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/vtk");
+    let files = [
+        "ascii.vtu",
+        "base64.vtu",
+        "zlib.vtu",
+        "zlib_uint64.vtu",
+        "base64_bigendian.vtu",
+        "zlib.vtp",
+        "ascii.vtp",
+        "ascii_51.vtk",
+        "binary_51.vtk",
+        "ascii_42.vtk",
+        "binary_42.vtk",
+        "poly_ascii_51.vtk",
+        "poly_binary_42.vtk",
+    ];
+    for name in files {
+        let m = read_mesh(&dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(m.positions.len(), 9, "{name}");
+        for (v, p) in m.positions.iter().enumerate() {
+            let (x, y) = ((v % 3) as f64 / 2.0, (v / 3) as f64 / 2.0);
+            assert_eq!([p.x, p.y, p.z], [x, y, 0.1 * x * y], "{name} vertex {v}");
+        }
+        assert_eq!(m.faces.len(), 8, "{name}");
+        assert_eq!(m.faces[0], [0, 1, 4], "{name}");
+        assert_eq!(m.faces[7], [4, 8, 7], "{name}");
+        let abar = &m.face_fields["abar_info"];
+        assert_eq!(abar.components, 3, "{name}");
+        for f in 0..8 {
+            let g = f as f64;
+            assert_eq!(
+                abar.get(f),
+                &[1.0 + g, 0.125 * g, 2.0 + g],
+                "{name} face {f}"
+            );
+        }
+        let vel = &m.vertex_fields["velocity"];
+        assert_eq!(vel.get(5), &[5.0, -5.0, 2.5], "{name}");
+        let tags = &m.vertex_fields["node_tags"];
+        assert_eq!(
+            tags.data,
+            (0..9).map(|v| (7 * v - 20) as f64).collect::<Vec<_>>(),
+            "{name}"
+        );
+        m.validate().unwrap();
+    }
+    let e = read_mesh(&dir.join("appended.vtu"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("appended") && e.contains("Ascii"), "{e}");
+}
+
+/// Bad input gets an error naming the place, never a panic: a first vertex index out of range,
+/// a header count of 2³²−1 (no allocation from it), inconsistent compression headers, arrays of
+/// the wrong length, coordinates beyond range.
+#[test]
+fn malformed_files_are_named_errors_not_panics() {
+    use shellsim::mesh::io::mesh_from_bytes;
+    let check = |bytes: &[u8], ext: &str, needles: &[&str]| {
+        let e = match mesh_from_bytes(bytes, ext) {
+            Err(e) => e,
+            Ok(m) => match m.validate() {
+                Err(e) => e.to_string(),
+                Ok(_) => panic!("accepted: {}", String::from_utf8_lossy(bytes)),
+            },
+        };
+        for n in needles {
+            assert!(e.contains(n), "'{n}' not in: {e}");
+        }
+        assert!(!e.contains("{ ") && !e.contains("please report"), "{e}");
+    };
+    let head = "# vtk DataFile Version 3.0\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 double\n0 0 0 1 0 0 0 1 0\n";
+    check(
+        format!("{head}POLYGONS 1 4\n3 7 1 2\n").as_bytes(),
+        "vtk",
+        &["face 0", "vertex 7"],
+    );
+    check(
+        format!("{head}POLYGONS 4294967295 4\n3 0 1 2\n").as_bytes(),
+        "vtk",
+        &["line 7", "POLYGONS", "4294967295"],
+    );
+    check(
+        format!("{head}POLYGONS 1 4\n3 0 1 x\n").as_bytes(),
+        "vtk",
+        &["line 8", "POLYGONS", "'x'"],
+    );
+    check(
+        format!("{head}POLYGONS 1 4\n3 0 1 2\nCELL_DATA 1\nFIELD f 1\nbbar_info 3 1 double\n1 0\n")
+            .as_bytes(),
+        "vtk",
+        &["bbar_info", "2 of 3", "truncated"],
+    );
+    check(
+        format!("{head}POLYGONS 1 4\n3 0 1 2\nCELL_DATA 2\nSCALARS t double\nLOOKUP_TABLE default\n1 2\n").as_bytes(),
+        "vtk",
+        &["CELL_DATA", "2 entries", "1 cells"],
+    );
+    check(
+        b"# vtk DataFile Version 3.0\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 double\n0 0 0 1e160 0 0 0 1 0\nPOLYGONS 1 4\n3 0 1 2\n",
+        "vtk",
+        &["vertex 1", "1e160", "rescale"],
+    );
+    // XML: a short array, and a compression header announcing more than there is.
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/vtk");
+    let ascii = std::fs::read_to_string(dir.join("ascii.vtu")).unwrap();
+    let short = ascii.replacen("1 0 2 2 0.125 3", "1 0 2 2 0.125", 1);
+    check(
+        short.as_bytes(),
+        "vtu",
+        &["CellData array 'abar_info'", "23 values, expected 24"],
+    );
+    let zlib = std::fs::read(dir.join("zlib.vtu")).unwrap();
+    // The first base64 header of the file, its block count changed from 1 to 255.
+    let text = String::from_utf8(zlib).unwrap();
+    let at = text.find("format=\"binary\"").unwrap();
+    let start = at + text[at..].find('>').unwrap() + 1;
+    let first = text[start..].trim_start();
+    let off = text.len() - first.len();
+    let mut bad = text.clone().into_bytes();
+    // "AQAAAA" encodes 01 00 00 00 00 (1 block); "/wAAAA" encodes ff 00 00 00 00.
+    assert_eq!(&text[off..off + 6], "AQAAAA", "fixture layout changed");
+    bad[off..off + 6].copy_from_slice(b"/wAAAA");
+    check(&bad, "vtu", &["byte", "255 blocks"]);
+}

@@ -179,3 +179,35 @@ fn each_section_validates_itself() {
         );
     }
 }
+
+/// Values that accept a number or a word say so, `--set` follows TOML's rules (a bare word is a
+/// string; an out-of-range integer is an error, not a string), and numbers print as `{:e}`.
+#[test]
+fn messages_name_what_is_accepted() {
+    let e = Settings::from_str_with(
+        "[solver]\nmembrane_continuation = \"sometimes\"\n",
+        "s",
+        &[],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("expected a number or \"auto\", got \"sometimes\"") && e.contains("line 2"),
+        "{e}"
+    );
+    assert!(!e.contains("untagged"), "{e}");
+    let e = Settings::from_str_with("", "s", &["solver.seed=18446744073709551615".into()])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("not a TOML value") && !e.contains("invalid type: string"),
+        "{e}"
+    );
+    let s = Settings::from_str_with("", "s", &["solver.mode=dynamic".into()]).unwrap();
+    assert_eq!(s.solver.mode, shellsim::settings::Mode::Dynamic);
+    let e = Settings::from_str_with("", "s", &["material.young=1e300".into()])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("1e300 Pa"), "{e}");
+    assert!(!e.contains("000000000000"), "{e}");
+}
