@@ -106,7 +106,13 @@ impl Energies {
 impl Serialize for Energies {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeMap;
-        let cols = self.columns();
+        // A run stopped by a non-finite state may hold non-finite energies: they are left
+        // out, never written as `null`.
+        let cols: Vec<_> = self
+            .columns()
+            .into_iter()
+            .filter(|(_, v)| v.is_finite())
+            .collect();
         let mut m = s.serialize_map(Some(cols.len()))?;
         for (k, v) in cols {
             m.serialize_entry(k, &v)?;
@@ -144,6 +150,10 @@ pub struct LogRow {
     pub rejected_steps: usize,
     /// Wall time since the start (s).
     pub wall_seconds: Real,
+}
+
+fn not_finite(v: &Real) -> bool {
+    !v.is_finite()
 }
 
 /// The run summary written to `summary.json`.
@@ -184,7 +194,8 @@ pub struct Summary {
     pub time: Real,
     /// Final dial factor.
     pub dial: Real,
-    /// Final relative residual.
+    /// Final relative residual (left out when it is not finite).
+    #[serde(skip_serializing_if = "not_finite")]
     pub residual: Real,
     /// Final energies.
     pub energy: Energies,

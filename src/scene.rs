@@ -76,6 +76,22 @@ impl Scene {
     pub fn build(mesh: Mesh, settings: Settings) -> Result<Scene, MeshError> {
         let unused = mesh.validate()?;
         let topo = Topology::build(&mesh)?;
+        // A reference mesh folded flat onto itself across an edge has no mid-edge normal there.
+        let normal = |f: usize| {
+            let [a, b, c] = mesh.face_positions(f);
+            (b - a).cross(&(c - a)).normalize()
+        };
+        for (e, ef) in topo.edge_faces.iter().enumerate() {
+            if ef[1] != crate::mesh::topology::NONE
+                && normal(ef[0]).dot(&normal(ef[1])) < -1.0 + 1e-9
+            {
+                return Err(mesh.invalid(format!(
+                    "faces {} and {} are folded onto each other across edge {:?} (their normals \
+                     are opposite): the reference surface must not fold back on itself",
+                    ef[0], ef[1], topo.edges[e]
+                )));
+            }
+        }
         let mut warnings = Vec::new();
         if !unused.is_empty() {
             warnings.push(format!(
@@ -95,6 +111,15 @@ impl Scene {
             (true, Some(t)) => t,
             _ => vec![m.thickness; nf],
         };
+        // A shell is thin: a thickness beyond 10× the sheet's size is no shell (and overflows).
+        let size = mesh.bbox_diagonal();
+        if let Some(f) = thickness.iter().position(|&h| h > 10.0 * size) {
+            return Err(mesh.invalid(format!(
+                "thickness {:e} m at face {f} is more than 10× the sheet's size ({size:e} m): \
+                 not a thin shell",
+                thickness[f]
+            )));
+        }
         let young = match (
             m.use_mesh_shear_modulus,
             positive_face_field(&mesh, "ref_shear_moduli", crate::settings::MAX_MODULUS)?,
@@ -663,8 +688,8 @@ impl GrowthInputs {
 pub enum GrowthError {
     /// A swelling stretch `1 + μ m` that is not positive.
     #[error(
-        "growth at face {face}: the stretch 1 + mu m = 1 + {worst} is not positive (mu {mu}, \
-         moisture top {top}, bottom {bottom}): a length cannot become ≤ 0"
+        "growth at face {face}: the stretch 1 + mu m = 1 + {worst:e} is not positive (mu {mu:e}, \
+         moisture top {top:e}, bottom {bottom:e}): a length cannot become ≤ 0"
     )]
     Stretch {
         /// The face.
@@ -681,7 +706,7 @@ pub enum GrowthError {
     /// The law's `ā` is not positive definite (or `b̄` is not finite).
     #[error(
         "growth at face {face}: growth.law {law:?} makes abar non-positive-definite (moisture \
-         top {top}, bottom {bottom})"
+         top {top:e}, bottom {bottom:e})"
     )]
     NotPositiveDefinite {
         /// The face.

@@ -12,6 +12,10 @@ use std::path::Path;
 pub const MAX_STEPS: Real = 1e9;
 /// Most frames a dynamic run may write (`time.end / time.output_interval`).
 pub const MAX_FRAMES: Real = 1e6;
+/// Largest moisture magnitude accepted (a mass fraction; beyond this swelling overflows).
+pub const MAX_MOISTURE: Real = 1e3;
+/// Largest density accepted (kg/m³).
+pub const MAX_DENSITY: Real = 1e30;
 /// Largest Young's modulus accepted (Pa).
 pub const MAX_MODULUS: Real = 1e15;
 /// Most element layers through the thickness in `[moisture]`.
@@ -955,11 +959,14 @@ impl Settings {
             if !(m.c1.is_finite() && m.c1 > 0.0) {
                 return inv(
                     "material.c1",
-                    format!("model = \"mooney_rivlin\" needs c1 > 0 (Pa), got {}", m.c1),
+                    format!(
+                        "model = \"mooney_rivlin\" needs c1 > 0 (Pa), got {:e}",
+                        m.c1
+                    ),
                 );
             }
             if !(m.c2.is_finite() && m.c2 >= 0.0) {
-                return inv("material.c2", format!("must be ≥ 0 (Pa), got {}", m.c2));
+                return inv("material.c2", format!("must be ≥ 0 (Pa), got {:e}", m.c2));
             }
         }
         let bw = &m.baraff_witkin;
@@ -967,7 +974,7 @@ impl Settings {
             return inv(
                 "material.baraff_witkin.r",
                 format!(
-                    "must be ≥ 0 (a negative cubic term softens the strain limit), got {}",
+                    "must be ≥ 0 (a negative cubic term softens the strain limit), got {:e}",
                     bw.r
                 ),
             );
@@ -977,7 +984,7 @@ impl Settings {
                 if !(v.is_finite() && v > 0.0) {
                     return inv(
                         &format!("material.baraff_witkin.{key}"),
-                        format!("must be a positive number (Pa), got {v}"),
+                        format!("must be a positive number (Pa), got {v:e}"),
                     );
                 }
             }
@@ -986,7 +993,7 @@ impl Settings {
         if !d.iter().all(|c| c.is_finite()) || d.iter().all(|&c| c == 0.0) {
             return inv(
                 "material.baraff_witkin.direction",
-                format!("must be a finite non-zero vector, got {d:?}"),
+                format!("must be a finite non-zero vector, got {}", vec_e(&d)),
             );
         }
         Ok(())
@@ -1024,10 +1031,28 @@ impl Settings {
         }
         ck.pos("material.density", m.density)?;
         ck.pos("material.thickness", m.thickness)?;
+        for (key, v, max, unit) in [
+            ("material.density", m.density, MAX_DENSITY, "kg/m³"),
+            (
+                "material.thickness",
+                m.thickness,
+                crate::mesh::MAX_COORDINATE,
+                "m",
+            ),
+        ] {
+            if v > max {
+                return ck.inv(
+                    key,
+                    format!(
+                        "{v:e} {unit} is beyond {max:e} {unit}: energies of such a sheet overflow"
+                    ),
+                );
+            }
+        }
         if !(m.poisson > -1.0 && m.poisson <= 0.5) {
             return ck.inv(
                 "material.poisson",
-                format!("must lie in (-1, 0.5], got {}", m.poisson),
+                format!("must lie in (-1, 0.5], got {:e}", m.poisson),
             );
         }
         self.validate_material_model(name)?;
@@ -1043,7 +1068,7 @@ impl Settings {
                 let key = format!("rest.{name}[{i}]");
                 match v {
                     Field::Value(v) if !v.is_finite() => {
-                        return ck.inv(&key, format!("must be finite, got {v}"))
+                        return ck.inv(&key, format!("must be finite, got {v:e}"))
                     }
                     Field::Expr(_) => {
                         if let Err(e) = v.compile() {
@@ -1077,7 +1102,7 @@ impl Settings {
         if !(s.continuation_step > 0.0 && s.continuation_step <= 1.0) {
             return ck.inv(
                 "solver.continuation_step",
-                format!("must lie in (0, 1], got {}", s.continuation_step),
+                format!("must lie in (0, 1], got {:e}", s.continuation_step),
             );
         }
         ck.pos("solver.min_continuation_step", s.min_continuation_step)?;
@@ -1085,7 +1110,7 @@ impl Settings {
             if !(c >= 1.0 && c.is_finite()) {
                 return ck.inv(
                     "solver.membrane_continuation",
-                    format!("must be \"auto\" or a finite number ≥ 1, got {c}"),
+                    format!("must be \"auto\" or a finite number ≥ 1, got {c:e}"),
                 );
             }
         }
@@ -1105,13 +1130,13 @@ impl Settings {
             ("growth.moisture_top", g.moisture_top),
             ("growth.moisture_bottom", g.moisture_bottom),
         ] {
-            if !v.is_finite() {
-                return ck.inv(k, format!("must be a finite number, got {v}"));
+            if !(v.abs() <= MAX_MOISTURE) {
+                return ck.inv(k, format!("must lie in ±{MAX_MOISTURE:e}, got {v:e}"));
             }
         }
         match &g.s {
             Field::Value(v) if !v.is_finite() => {
-                return ck.inv("growth.s", format!("must be finite, got {v}"))
+                return ck.inv("growth.s", format!("must be finite, got {v:e}"))
             }
             Field::Expr(_) => {
                 if let Err(e) = g.s.compile() {
@@ -1153,7 +1178,7 @@ impl Settings {
                 if !g.value.is_finite() {
                     return ck.inv(
                         "moisture.ground.value",
-                        format!("must be finite, got {}", g.value),
+                        format!("must be finite, got {:e}", g.value),
                     );
                 }
                 if let AutoOr::Value(d) = g.distance {
@@ -1172,10 +1197,10 @@ impl Settings {
                     format!("must lie in 1..={MAX_LAYERS}, got {}", mo.layers),
                 );
             }
-            if !mo.initial.is_finite() {
+            if !(mo.initial.abs() <= MAX_MOISTURE) {
                 return ck.inv(
                     "moisture.initial",
-                    format!("must be finite, got {}", mo.initial),
+                    format!("must lie in ±{MAX_MOISTURE:e}, got {:e}", mo.initial),
                 );
             }
             if self.solver.mode != Mode::Dynamic {
@@ -1202,7 +1227,15 @@ impl Settings {
                     if !v.is_finite() {
                         return ck.inv(
                             &format!("moisture.boundary[{i}]"),
-                            format!("non-finite value {v}"),
+                            format!("non-finite value {v:e}"),
+                        );
+                    }
+                }
+                for (what, v) in [("value", b.value), ("ambient", b.ambient)] {
+                    if v.abs() > MAX_MOISTURE {
+                        return ck.inv(
+                            &format!("moisture.boundary[{i}].{what}"),
+                            format!("must lie in ±{MAX_MOISTURE:e}, got {v:e}"),
                         );
                     }
                 }
@@ -1215,7 +1248,7 @@ impl Settings {
                 if b.kind == SurfaceKind::Robin && b.k < 0.0 {
                     return ck.inv(
                         &format!("moisture.boundary[{i}].k"),
-                        format!("must be ≥ 0, got {}", b.k),
+                        format!("must be ≥ 0, got {:e}", b.k),
                     );
                 }
             }
@@ -1290,7 +1323,7 @@ impl Settings {
             if v.iter().all(|c| c.is_finite()) {
                 Ok(())
             } else {
-                ck.inv(&key, format!("must be finite, got {v:?}"))
+                ck.inv(&key, format!("must be finite, got {}", vec_e(v)))
             }
         };
         for (i, p) in l.point.iter().enumerate() {
@@ -1305,7 +1338,7 @@ impl Settings {
             if !p.pressure.is_finite() {
                 return ck.inv(
                     &format!("loads.pressure[{i}].pressure"),
-                    format!("must be finite, got {}", p.pressure),
+                    format!("must be finite, got {:e}", p.pressure),
                 );
             }
             ck.selection(&format!("loads.pressure[{i}]"), &p.on)?;
@@ -1314,7 +1347,7 @@ impl Settings {
             if !m.moment.is_finite() {
                 return ck.inv(
                     &format!("loads.moment[{i}].moment"),
-                    format!("must be finite, got {}", m.moment),
+                    format!("must be finite, got {:e}", m.moment),
                 );
             }
             ck.selection(&format!("loads.moment[{i}]"), &m.on)?;
@@ -1334,7 +1367,7 @@ impl Settings {
             if !(n2.is_finite() && n2 > 0.0) {
                 return ck.inv(
                     "contact.normal",
-                    format!("must be a finite non-zero vector, got {:?}", c.normal),
+                    format!("must be a finite non-zero vector, got {}", vec_e(&c.normal)),
                 );
             }
             if let AutoOr::Value(k) = c.stiffness {
@@ -1370,7 +1403,7 @@ impl Settings {
             if !d.displacement.iter().all(|c| c.is_finite()) {
                 return ck.inv(
                     &format!("constraints.displacement[{i}].displacement"),
-                    format!("must be finite, got {:?}", d.displacement),
+                    format!("must be finite, got {}", vec_e(&d.displacement)),
                 );
             }
             ck.selection(&format!("constraints.displacement[{i}]"), &d.on)?;
@@ -1405,13 +1438,13 @@ impl Check<'_> {
     }
     fn pos(&self, key: &str, v: Real) -> Result<(), SettingsError> {
         if !(v.is_finite() && v > 0.0) {
-            return self.inv(key, format!("must be a positive number, got {v}"));
+            return self.inv(key, format!("must be a positive number, got {v:e}"));
         }
         Ok(())
     }
     fn nonneg(&self, key: &str, v: Real) -> Result<(), SettingsError> {
         if !(v.is_finite() && v >= 0.0) {
-            return self.inv(key, format!("must be a non-negative number, got {v}"));
+            return self.inv(key, format!("must be a non-negative number, got {v:e}"));
         }
         Ok(())
     }
@@ -1494,4 +1527,10 @@ impl<'de> Deserialize<'de> for Field {
             },
         )
     }
+}
+
+/// `[a, b, c]` with every number in `{:e}` form, for messages.
+fn vec_e(v: &[Real]) -> String {
+    let parts: Vec<String> = v.iter().map(|x| format!("{x:e}")).collect();
+    format!("[{}]", parts.join(", "))
 }

@@ -1178,3 +1178,57 @@ fn signals_stop_runs_cleanly() {
         assert_eq!(tmp_left, 0);
     }
 }
+
+/// `shellsim error` measures only finite frames: one with a NaN is bad input (exit 2).
+#[test]
+fn error_command_refuses_non_finite_frames() {
+    let d = tmp();
+    let p = d.path();
+    let r = run(
+        &[
+            "mesh",
+            "square",
+            "--edge",
+            "0.5",
+            "--program",
+            "cylinder",
+            "-o",
+            "m.vtk",
+        ],
+        p,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    write(
+        p,
+        "s.toml",
+        "[rest]\ntarget = \"mesh\"\n[output]\nformat = \"vtk_ascii\"\n",
+    );
+    let r = run(&["s.toml", "m.vtk", "--out", "a", "-q"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let frame = final_frame(p, "a");
+    let text = std::fs::read_to_string(p.join(&frame)).unwrap();
+    let i = text.find("displacement 3").unwrap();
+    let start = i + text[i..].find('\n').unwrap() + 1;
+    let end = start + text[start..].find(' ').unwrap();
+    let bad = format!("{}nan{}", &text[..start], &text[end..]);
+    write(p, "bad.vtk", &bad);
+    let r = run(&["error", "cylinder", "bad.vtk"], p);
+    assert_eq!(r.code, 2, "{}", r.stdout);
+    assert!(
+        r.stderr.contains("displacement") && r.stderr.contains("non-finite"),
+        "{}",
+        r.stderr
+    );
+}
+
+/// A reference mesh folded flat onto itself (two faces with opposite normals across an edge)
+/// has no mid-edge normal there: bad input naming the faces.
+#[test]
+fn folded_reference_meshes_are_bad_input() {
+    let d = tmp();
+    let p = d.path();
+    let folded = "# vtk DataFile Version 3.0\nfold\nASCII\nDATASET POLYDATA\nPOINTS 4 double\n0 0 0 1 0 0 0 1 0 0.5 0.2 0\nPOLYGONS 2 8\n3 0 1 2\n3 0 2 3\n";
+    write(p, "f.vtk", folded);
+    write(p, "s.toml", "[material]\nthickness = 0.01\n");
+    expect_bad(&["s.toml", "f.vtk", "-q"], p, "faces 0 and 1 are folded");
+}

@@ -69,7 +69,7 @@ pub enum RunError {
 #[non_exhaustive]
 pub enum RunFailure {
     /// Statics: the dial increment was halved below `solver.min_continuation_step`.
-    #[error("continuation step fell below {min} at dial {dial:.6}: {cause}")]
+    #[error("continuation step fell below {min:e} at dial {dial:.6}: {cause}")]
     ContinuationStep {
         /// The minimum increment.
         min: Real,
@@ -96,7 +96,7 @@ pub enum RunFailure {
     #[error("after escaping a saddle: {0}")]
     AfterSaddle(SolveError),
     /// Dynamics: the time step was halved below `time.dt_min`.
-    #[error("time step fell below dt_min = {dt_min} at t = {t:.6e}: {cause}")]
+    #[error("time step fell below dt_min = {dt_min:e} at t = {t:.6e}: {cause}")]
     TimeStep {
         /// The minimum time step (s).
         dt_min: Real,

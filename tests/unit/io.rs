@@ -305,6 +305,18 @@ fn malformed_files_are_named_errors_not_panics() {
         "vtk",
         &["vertex 1", "1e160", "rescale"],
     );
+    // Binary legacy: a signed index of −7 is named as −7, not as 4294967289.
+    let mut bin =
+        b"# vtk DataFile Version 3.0\nt\nBINARY\nDATASET POLYDATA\nPOINTS 3 double\n".to_vec();
+    for x in [0.0f64, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+        bin.extend_from_slice(&x.to_be_bytes());
+    }
+    bin.extend_from_slice(b"\nPOLYGONS 1 4\n");
+    for i in [3i32, -7, 1, 2] {
+        bin.extend_from_slice(&i.to_be_bytes());
+    }
+    bin.push(b'\n');
+    check(&bin, "vtk", &["POLYGONS", "-7e0", "not an index"]);
     // XML: a short array, and a compression header announcing more than there is.
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/vtk");
     let ascii = std::fs::read_to_string(dir.join("ascii.vtu")).unwrap();
