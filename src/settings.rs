@@ -1130,7 +1130,7 @@ impl Settings {
             ("growth.moisture_top", g.moisture_top),
             ("growth.moisture_bottom", g.moisture_bottom),
         ] {
-            if !(v.abs() <= MAX_MOISTURE) {
+            if !v.is_finite() || v.abs() > MAX_MOISTURE {
                 return ck.inv(k, format!("must lie in ±{MAX_MOISTURE:e}, got {v:e}"));
             }
         }
@@ -1197,7 +1197,7 @@ impl Settings {
                     format!("must lie in 1..={MAX_LAYERS}, got {}", mo.layers),
                 );
             }
-            if !(mo.initial.abs() <= MAX_MOISTURE) {
+            if !mo.initial.is_finite() || mo.initial.abs() > MAX_MOISTURE {
                 return ck.inv(
                     "moisture.initial",
                     format!("must lie in ±{MAX_MOISTURE:e}, got {:e}", mo.initial),
