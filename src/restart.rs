@@ -110,10 +110,17 @@ pub fn restart_from_frame(
     }
     let v = match frame.vertex_field("velocity", 3)? {
         Some(f) => {
-            if let Some(i) = f.data.iter().position(|c| !c.is_finite()) {
+            // Beyond 1e30 m/s the kinetic energy overflows: no state to restart from.
+            if let Some(i) = f
+                .data
+                .iter()
+                .position(|c| !c.is_finite() || c.abs() > crate::mesh::MAX_COORDINATE)
+            {
                 return Err(bad(format!(
-                    "field 'velocity' is not finite at vertex {}",
-                    i / 3
+                    "field 'velocity' at vertex {} is {:e} m/s, beyond ±{:e} m/s",
+                    i / 3,
+                    f.data[i],
+                    crate::mesh::MAX_COORDINATE
                 )));
             }
             Some(

@@ -1127,13 +1127,15 @@ fn signals_stop_runs_cleanly() {
             assert!(t0.elapsed().as_secs() < 60, "no frames after 60 s");
             std::thread::sleep(std::time::Duration::from_millis(20));
         }
-        let pid = child.id().to_string();
+        let pid = child.id() as libc::pid_t;
         let kill = |s: &str| {
-            let st = Command::new("kill")
-                .args([&format!("-{s}"), &pid])
-                .status()
-                .unwrap();
-            assert!(st.success());
+            let sig = if s == "INT" {
+                libc::SIGINT
+            } else {
+                libc::SIGTERM
+            };
+            // SAFETY: a plain kill(2) of our own child process.
+            assert_eq!(unsafe { libc::kill(pid, sig) }, 0);
         };
         kill(sig);
         if twice {
@@ -1231,4 +1233,44 @@ fn folded_reference_meshes_are_bad_input() {
     write(p, "f.vtk", folded);
     write(p, "s.toml", "[material]\nthickness = 0.01\n");
     expect_bad(&["s.toml", "f.vtk", "-q"], p, "faces 0 and 1 are folded");
+}
+
+/// Restart velocities whose kinetic energy overflows are bad input, naming the vertex.
+#[test]
+fn huge_restart_velocities_are_bad_input() {
+    let d = tmp();
+    let p = d.path();
+    write(p, "m.vtk", TWO_TRIANGLES);
+    let dynamic = "[material]\nthickness = 0.05\n[solver]\nmode = \"dynamic\"\n[time]\nend = 0.02\ndt = 0.01\noutput_interval = 0.01\n[output]\nformat = \"vtk_ascii\"\n";
+    write(p, "d.toml", dynamic);
+    let r = run(&["d.toml", "m.vtk", "--out", "a", "-q"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let text = std::fs::read_to_string(p.join("a/frame_00001.vtk")).unwrap();
+    let i = text.find("velocity 3").unwrap();
+    let start = i + text[i..].find('\n').unwrap() + 1;
+    let end = start + text[start..].find(' ').unwrap();
+    write(
+        p,
+        "a/fast.vtk",
+        &format!("{}1e300{}", &text[..start], &text[end..]),
+    );
+    let r = run(
+        &[
+            "d.toml",
+            "m.vtk",
+            "--out",
+            "b",
+            "-q",
+            "--restart",
+            "a/fast.vtk",
+        ],
+        p,
+    );
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("'velocity' at vertex 0 is 1e300"),
+        "{}",
+        r.stderr
+    );
+    assert_eq!(frames(&p.join("b")), 0);
 }
