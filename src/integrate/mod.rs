@@ -518,6 +518,17 @@ pub fn run(
                 }
             );
         }
+        // An output failure mid-run (a full disk): the frames, series and log written so far
+        // stay in step; a summary saying why is written if there is still room for it.
+        Err(RunError::Output(e @ OutputError::Io { .. })) => {
+            s.summary.converged = false;
+            s.summary.reason = format!("output failed: {e}");
+            s.summary.wall_seconds = s.start.elapsed().as_secs_f64();
+            s.summary.frames = writer.num_frames();
+            s.summary.final_frame = writer.last_frame();
+            let _ = writer.summary(&s.summary);
+            return Err(RunError::Output(e));
+        }
         Err(e) => return Err(e),
     }
     s.summary.wall_seconds = s.start.elapsed().as_secs_f64();
