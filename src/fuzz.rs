@@ -249,18 +249,7 @@ impl Harness {
                 }
             })
         };
-        quiet_panics();
-        QUIET.with(|q| q.set(true));
-        let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(run));
-        QUIET.with(|q| q.set(false));
-        match r {
-            Ok(r) => r,
-            Err(p) => Err(p
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| p.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "panic".into())),
-        }
+        crate::mesh::io::catch_quietly(run).and_then(|r| r)
     }
 
     /// `execs` mutated executions from RNG seed `seed`.
@@ -288,23 +277,6 @@ impl Harness {
         rep.seconds = start.elapsed().as_secs_f64();
         rep
     }
-}
-
-thread_local! {
-    static QUIET: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
-
-/// Installs (once) a panic hook that stays silent while a fuzz execution runs on this thread.
-fn quiet_panics() {
-    static HOOK: std::sync::Once = std::sync::Once::new();
-    HOOK.call_once(|| {
-        let previous = std::panic::take_hook();
-        std::panic::set_hook(Box::new(move |info| {
-            if !QUIET.with(|q| q.get()) {
-                previous(info);
-            }
-        }));
-    });
 }
 
 /// The harnesses of all targets, with seeds from a source tree at `root`: the VTK files under

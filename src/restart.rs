@@ -100,8 +100,7 @@ pub fn restart_from_frame(
     // A face collapsed to a line or a point has no normal and no forms to restart from.
     for (f, face) in frame.faces.iter().enumerate() {
         let [a, b, c] = face.map(|v| frame.positions[v]);
-        let l = (b - a).norm().max((c - a).norm()).max((c - b).norm());
-        if !(l > 0.0 && ((b - a) / l).cross(&((c - a) / l)).norm() > 1e-12) {
+        if crate::mesh::area_ratio(&a, &b, &c) <= 1e-12 {
             return Err(bad(format!(
                 "face {f} {face:?} is collapsed in the restart frame (zero area): no state to \
                  restart from"

@@ -54,31 +54,36 @@ pub fn mesh_from_bytes(bytes: &[u8], ext: &str) -> Result<Mesh, String> {
 }
 
 thread_local! {
-    /// Set while a reader runs under [`guard`]: its panics are reported as errors, not printed.
-    static GUARDED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Set while code runs under [`catch_quietly`]: its panics are returned, not printed.
+    static QUIET: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
-/// Runs a reader, turning a panic (a bug) into an error instead of a crash. The panic hook
-/// stays quiet for panics inside the guard and defers to the previous hook for all others.
-fn guard<T>(f: impl FnOnce() -> Result<T, String>) -> Result<T, String> {
+/// Runs `f`, returning a panic's message as `Err` instead of unwinding. The panic hook stays
+/// quiet for panics inside and defers to the previous hook for all others (installed once).
+pub(crate) fn catch_quietly<T>(f: impl FnOnce() -> T) -> Result<T, String> {
     static HOOK: std::sync::Once = std::sync::Once::new();
     HOOK.call_once(|| {
         let previous = std::panic::take_hook();
         std::panic::set_hook(Box::new(move |info| {
-            if !GUARDED.with(|g| g.get()) {
+            if !QUIET.with(|q| q.get()) {
                 previous(info);
             }
         }));
     });
-    let was = GUARDED.with(|g| g.replace(true));
+    let was = QUIET.with(|q| q.replace(true));
     let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
-    GUARDED.with(|g| g.set(was));
-    r.unwrap_or_else(|p| {
-        let what = p
-            .downcast_ref::<&str>()
+    QUIET.with(|q| q.set(was));
+    r.map_err(|p| {
+        p.downcast_ref::<&str>()
             .map(|s| s.to_string())
             .or_else(|| p.downcast_ref::<String>().cloned())
-            .unwrap_or_default();
+            .unwrap_or_else(|| "panic".into())
+    })
+}
+
+/// Runs a reader, turning a panic (a bug) into an error instead of a crash.
+fn guard<T>(f: impl FnOnce() -> Result<T, String>) -> Result<T, String> {
+    catch_quietly(f).unwrap_or_else(|what| {
         Err(format!(
             "the reader failed on this file ({what}); please report it with the file"
         ))

@@ -56,6 +56,38 @@ struct RawMesh {
     point_data: BTreeMap<String, (usize, Vec<Real>)>,
 }
 
+/// The triangles of cell vertex lists, checking each is a triangle (and of VTK cell type 5 when
+/// the file gives types).
+fn triangles(cells: &[Vec<usize>], types: Option<&[usize]>) -> Result<Vec<[usize; 3]>, String> {
+    cells
+        .iter()
+        .enumerate()
+        .map(|(c, cell)| {
+            let ty = types.map(|t| t[c]);
+            match cell[..] {
+                [a, b, d] if ty.is_none_or(|t| t == 5) => Ok([a, b, d]),
+                _ => Err(format!(
+                    "cell {c} is not a triangle ({} vertices{}); shellsim reads triangle meshes \
+                     only",
+                    cell.len(),
+                    ty.map(|t| format!(", VTK cell type {t}"))
+                        .unwrap_or_default()
+                )),
+            }
+        })
+        .collect()
+}
+
+/// Twice the area of triangle `(a, b, c)` over its longest edge squared: scale-free, 0 for a
+/// degenerate triangle (and for one whose edges overflow).
+pub fn area_ratio(a: &Vec3, b: &Vec3, c: &Vec3) -> Real {
+    let l = (b - a).norm().max((c - a).norm()).max((c - b).norm());
+    if !(l > 0.0 && l.is_finite()) {
+        return 0.0;
+    }
+    ((b - a) / l).cross(&((c - a) / l)).norm()
+}
+
 impl RawMesh {
     fn into_mesh(self) -> Result<Mesh, String> {
         if !self.points.len().is_multiple_of(3) {
@@ -204,10 +236,8 @@ impl Mesh {
                 return Err(self.invalid(format!("face {fi} repeats a vertex: {f:?}")));
             }
             let [a, b, c] = self.face_positions(fi);
-            // Scale-free: the edges divided by the longest one.
-            let l = (b - a).norm().max((c - a).norm()).max((c - b).norm());
-            let cr = ((b - a) / l).cross(&((c - a) / l)).norm();
-            if l == 0.0 || cr <= 1e-12 {
+            let cr = area_ratio(&a, &b, &c);
+            if cr <= 1e-12 {
                 return Err(self.invalid(format!(
                     "face {fi} {f:?} has zero area (degenerate triangle: twice its area is \
                      {cr:e} of its longest edge squared)"

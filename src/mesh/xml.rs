@@ -533,19 +533,7 @@ pub fn parse(bytes: &[u8]) -> Result<RawMesh, Fail> {
         let el = piece.child("Polys").ok_or_else(|| piece.at("no <Polys>"))?;
         cell_lists(el, &enc, n)?
     };
-    let mut faces = Vec::with_capacity(cells.len());
-    for (c, cell) in cells.iter().enumerate() {
-        let ty = types.as_ref().map(|t| t[c]);
-        if cell.len() != 3 || ty.is_some_and(|t| t != 5) {
-            return Err(format!(
-                "cell {c} is not a triangle ({} vertices{}); shellsim reads triangle meshes only",
-                cell.len(),
-                ty.map(|t| format!(", VTK cell type {t}"))
-                    .unwrap_or_default()
-            ));
-        }
-        faces.push([cell[0], cell[1], cell[2]]);
-    }
+    let faces = super::triangles(&cells, types.as_deref())?;
     let nf = faces.len();
     Ok(RawMesh {
         points,
