@@ -203,6 +203,18 @@ pub struct Summary {
     /// `[moisture]`): the coupled step's cost over the mechanics alone is
     /// `wall / (wall − moisture_seconds)`.
     pub moisture_seconds: Real,
+    /// Accepted and rejected error-controlled diffusion sub-steps, and the numeric
+    /// factorisations they needed (0 without `[moisture]`).
+    pub diffusion_substeps: usize,
+    /// See `diffusion_substeps`.
+    pub diffusion_rejected: usize,
+    /// See `diffusion_substeps`.
+    pub diffusion_factorisations: usize,
+    /// Conjugate-gradient iterations of the diffusion solves, and the solves done by the
+    /// sparse Cholesky instead (strong lateral coupling).
+    pub diffusion_cg_iterations: usize,
+    /// See `diffusion_cg_iterations`.
+    pub diffusion_direct_solves: usize,
     /// Warnings raised while loading.
     pub warnings: Vec<String>,
 }

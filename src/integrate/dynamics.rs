@@ -87,9 +87,19 @@ pub(super) fn run_dynamic(
                 break;
             }
             m.trial.copy_from_slice(&m.u);
-            if let Err(e) = m.diffusion.step(&mut m.trial, h) {
-                failure = Some(RunFailure::Diffusion { t, source: e });
-                break;
+            let tol = m.tolerance(sc);
+            match m.diffusion.advance(&mut m.trial, h, tol) {
+                Ok(a) => {
+                    s.summary.diffusion_substeps += a.substeps;
+                    s.summary.diffusion_rejected += a.rejected;
+                    s.summary.diffusion_factorisations += a.factorisations;
+                    s.summary.diffusion_cg_iterations += a.cg_iterations;
+                    s.summary.diffusion_direct_solves += a.direct_solves;
+                }
+                Err(e) => {
+                    failure = Some(RunFailure::Diffusion { t, source: e });
+                    break;
+                }
             }
             // The step control sees the diffusion too: a step that changes the computed moisture
             // (prescribed nodes excluded: their jump is imposed) by more than

@@ -129,7 +129,7 @@ pub enum RunFailure {
         /// The time reached (s).
         t: Real,
         /// What went wrong.
-        source: LinearError,
+        source: crate::diffusion::DiffusionError,
     },
     /// Dynamics: the moisture made a rest form invalid.
     #[error("at t = {t:.6e}: {source}")]

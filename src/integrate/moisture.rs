@@ -34,7 +34,7 @@ pub(super) struct Moisture {
 impl Moisture {
     /// Builds the diffusion system of a scene with `moisture.enabled` (None otherwise).
     pub(super) fn new(sc: &Scene) -> Result<Option<Self>, RunError> {
-        use crate::diffusion::{Diffusion, Diffusivity, Side, SurfaceBc};
+        use crate::diffusion::{Diffusion, Diffusivity, Layering, Side, SurfaceBc};
         use crate::settings::{SurfaceKind, SurfaceSide};
         let mo = &sc.settings.moisture;
         if !mo.enabled {
@@ -51,7 +51,10 @@ impl Moisture {
                 across: mo.diffusivity_across,
                 through: mo.diffusivity_through,
             },
-            mo.layers,
+            Layering {
+                count: mo.layers,
+                grading: mo.grading,
+            },
         )?;
         // Sides sealed on purpose (tape): the ground exchange leaves them sealed.
         let mut taped = vec![[false; 2]; sc.num_faces()];
@@ -114,6 +117,31 @@ impl Moisture {
         m.mass = m.masses_of(sc, &m.u);
         m.trial_mass = m.mass.clone();
         Ok(Some(m))
+    }
+
+    /// The diffusion's error tolerance: `moisture.tolerance` relative, with an absolute floor
+    /// of `10⁻³` of it times the moisture scale (the largest of the initial moisture, every
+    /// prescribed, ambient and ground moisture, and the current largest nodal value), so that
+    /// nodes the moisture has not yet reached do not hold the sub-steps down.
+    pub(super) fn tolerance(&self, sc: &Scene) -> crate::diffusion::Tolerance {
+        use crate::settings::SurfaceKind;
+        let mo = &sc.settings.moisture;
+        let mut scale = mo.initial.abs();
+        for b in &mo.boundary {
+            match b.kind {
+                SurfaceKind::Value => scale = scale.max(b.value.abs()),
+                SurfaceKind::Robin => scale = scale.max(b.ambient.abs()),
+                SurfaceKind::Flux | SurfaceKind::Sealed => {}
+            }
+        }
+        if let Some(g) = &mo.ground {
+            scale = scale.max(g.value.abs());
+        }
+        let now = self.u.iter().fold(0.0, |m: Real, u| m.max(u.abs()));
+        crate::diffusion::Tolerance {
+            rtol: mo.tolerance,
+            atol: 1e-3 * mo.tolerance * scale.max(now).max(Real::MIN_POSITIVE),
+        }
     }
 
     /// Switches the ground exchange of every face side on or off from the positions `x`: a side

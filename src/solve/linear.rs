@@ -80,11 +80,24 @@ impl LinearSolver {
     /// Numeric factorisation of the matrix with the pattern's structure and these values.
     pub fn factor(&mut self, values: &[Real]) -> Result<(), LinearError> {
         self.factored = false;
+        let mut l = std::mem::take(&mut self.l_values);
+        let r = self.factor_to(values, &mut l);
+        self.l_values = l;
+        r?;
+        self.factored = true;
+        Ok(())
+    }
+
+    /// Numeric factorisation into caller-owned storage `l` (resized to [`Self::factor_nnz`]), to
+    /// keep several factors of one pattern (e.g. one per time step size) and solve with
+    /// [`Self::solve_with`].
+    pub fn factor_to(&mut self, values: &[Real], l: &mut Vec<Real>) -> Result<(), LinearError> {
+        l.resize(self.symbolic.len_val(), 0.0);
         let a = SparseColMatRef::new(self.pattern.as_ref(), values);
         let stack = MemStack::new(&mut self.mem);
         self.symbolic
             .factorize_numeric_llt::<Real>(
-                &mut self.l_values,
+                l,
                 a,
                 Side::Lower,
                 LltRegularization::default(),
@@ -97,15 +110,13 @@ impl LinearSolver {
                     LinearError::NonPositivePivot { index }
                 }
             })?;
-        self.factored = true;
         Ok(())
     }
 
-    /// Solves `A x = rhs` in place with the last successful factorisation.
-    pub fn solve_in_place(&mut self, rhs: &mut [Real]) {
-        debug_assert!(self.factored, "solve before a successful factorisation");
+    /// Solves `A x = rhs` in place with a factor made by [`Self::factor_to`].
+    pub fn solve_with(&mut self, l: &[Real], rhs: &mut [Real]) {
         let n = rhs.len();
-        let llt = LltRef::new(&self.symbolic, &self.l_values);
+        let llt = LltRef::new(&self.symbolic, l);
         let stack = MemStack::new(&mut self.mem);
         llt.solve_in_place_with_conj(
             Conj::No,
@@ -113,5 +124,13 @@ impl LinearSolver {
             Par::Seq,
             stack,
         );
+    }
+
+    /// Solves `A x = rhs` in place with the last successful factorisation.
+    pub fn solve_in_place(&mut self, rhs: &mut [Real]) {
+        debug_assert!(self.factored, "solve before a successful factorisation");
+        let l = std::mem::take(&mut self.l_values);
+        self.solve_with(&l, rhs);
+        self.l_values = l;
     }
 }
