@@ -73,8 +73,9 @@ fn positive_face_field(mesh: &Mesh, name: &str, max: Real) -> Result<Option<Vec<
 
 impl Scene {
     /// Validates the mesh and builds the scene. Errors name the file, field and index.
-    pub fn build(mesh: Mesh, settings: Settings) -> Result<Scene, MeshError> {
+    pub fn build(mut mesh: Mesh, settings: Settings) -> Result<Scene, MeshError> {
         let unused = mesh.validate()?;
+        mesh.anchor_faces_at_wide_angles();
         let topo = Topology::build(&mesh)?;
         // A reference mesh folded flat onto itself across an edge has no mid-edge normal there.
         let normal = |f: usize| {

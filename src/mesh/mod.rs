@@ -194,6 +194,47 @@ impl Mesh {
         0.5 * (p1 - p0).cross(&(p2 - p0)).norm()
     }
 
+    /// Rotates each face's vertex list cyclically (orientation kept) so that its first vertex
+    /// sits at a wide angle: every per-face frame (the reference metric, the rest forms, the
+    /// edge slots) is built from the two edges at the first vertex, and a sliver whose first
+    /// angle is tiny makes those edges nearly parallel, so that its metric `[e1 e2]ᵀ[e1 e2]`
+    /// loses all its digits to cancellation (a needle of width 1e-8 gets a singular ā = I).
+    /// A face is rotated only when the sine of its first angle is below half the largest of
+    /// its three: regular meshes are left alone, and a second call changes nothing. A face
+    /// field `edge_angles` (3 values per face, in slot order) is rotated along. Returns the
+    /// number of faces rotated.
+    pub fn anchor_faces_at_wide_angles(&mut self) -> usize {
+        let mut rotated = 0;
+        for f in 0..self.faces.len() {
+            let [a, b, c] = self.faces[f];
+            let p = [self.positions[a], self.positions[b], self.positions[c]];
+            let sine = |k: usize| {
+                let (e1, e2) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
+                let den = e1.norm() * e2.norm();
+                if den > 0.0 {
+                    e1.cross(&e2).norm() / den
+                } else {
+                    0.0
+                }
+            };
+            let s = [sine(0), sine(1), sine(2)];
+            let best = if s[1] >= s[2] { 1 } else { 2 };
+            if s[0] < 0.5 * s[best] {
+                self.faces[f] = [0, 1, 2].map(|j| self.faces[f][(best + j) % 3]);
+                if let Some(field) = self.face_fields.get_mut("edge_angles") {
+                    if field.components == 3 && field.data.len() >= 3 * (f + 1) {
+                        let old = [0, 1, 2].map(|j| field.data[3 * f + j]);
+                        for j in 0..3 {
+                            field.data[3 * f + j] = old[(best + j) % 3];
+                        }
+                    }
+                }
+                rotated += 1;
+            }
+        }
+        rotated
+    }
+
     /// Checks coordinates, faces and fields; returns the unused vertices (a warning, not an
     /// error). Topological checks (manifoldness, orientation) live in [`Topology::build`].
     pub fn validate(&self) -> Result<Vec<usize>, MeshError> {
