@@ -9,14 +9,14 @@ what each run left behind:
 * exit 0/1 without summary.json, or NaN/inf/null in log.csv or summary.json, or
 * (with `pip install vtk`) a frame holding a non-finite value.
 
-    python3 scripts/probe.py [RUNS] [SEED]        # after cargo build --release
+    python3 scripts/probe.py [RUNS] [SEED]        # after cargo build --release (or SHELLSIM_BIN=path)
 
 Prints the counts; exits 1 if any run failed a check.
 """
 import json, math, os, random, re, subprocess, sys, tempfile, time
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
-BIN = os.path.join(ROOT, "target", "release", "shellsim")
+BIN = os.environ.get("SHELLSIM_BIN") or os.path.join(ROOT, "target", "release", "shellsim")
 EXTREMES = ["0", "-1", "-7", "4294967295", "1e308", "-1e308", "1e-320", "nan", "inf", "9.2e18", "1e160", "3"]
 NUM = re.compile(rb"(?<![A-Za-z0-9_])-?\d+(\.\d+)?([eE][-+]?\d+)?")
 try:
@@ -78,11 +78,25 @@ def main():
         p = os.path.join(work, f"{prog}.vtk")
         subprocess.run([BIN, "mesh", "square", "--edge", "0.25", "--program", prog, "-o", p], check=True, capture_output=True)
         meshes.append((p, open(p, "rb").read()))
+    # A square with a column of needles 1e-8 wide (the hard case for per-face frames).
+    xs, ys = [0, 0.25, 0.5, 0.5 + 1e-8, 0.75, 1.0], [0, 0.25, 0.5, 0.75, 1.0]
+    pts = "".join(f"{x!r} {y!r} 0\n" for y in ys for x in xs)
+    tris = []
+    for j in range(len(ys) - 1):
+        for i in range(len(xs) - 1):
+            a = j * len(xs) + i
+            tris += [(a, a + 1, a + len(xs) + 1), (a, a + len(xs) + 1, a + len(xs))]
+    sliver = (f"# vtk DataFile Version 3.0\nsliver\nASCII\nDATASET POLYDATA\nPOINTS {len(xs) * len(ys)} double\n{pts}"
+              f"POLYGONS {len(tris)} {4 * len(tris)}\n" + "".join("3 %d %d %d\n" % t for t in tris)).encode()
+    meshes.append((os.path.join(work, "sliver.vtk"), sliver))
     settings = [
         b"[material]\nthickness = 0.05\n[rest]\ntarget = \"mesh\"\n",
         b"[material]\nthickness = 0.05\nbending = \"midedge_sin\"\n[rest]\ntarget = \"mesh\"\n",
         b"[material]\nthickness = 0.05\n[rest]\ntarget = \"mesh\"\n[solver]\nmode = \"dynamic\"\n[time]\nend = 0.05\ndt = 0.01\noutput_interval = 0.01\n",
         b"[material]\nthickness = 0.01\n[growth]\nlaw = \"linear_swelling\"\nmu = 0.05\n[moisture]\nenabled = true\n[[moisture.boundary]]\nside = \"top\"\nkind = \"value\"\nvalue = 1.0\n[solver]\nmode = \"dynamic\"\n[time]\nend = 0.05\noutput_interval = 0.025\n",
+        b"[material]\nthickness = 0.01\n[growth]\nlaw = \"machine_direction\"\nmu = 0.02\nmu_perp = 0.06\n[moisture]\nenabled = true\nlayers = 5\ngrading = 1.5\ntolerance = 1e-3\ndiffusivity_through = 1e-6\n[[moisture.boundary]]\nside = \"top\"\nkind = \"robin\"\nk = 5e-5\nambient = 0.3\n[[moisture.boundary]]\nside = \"bottom\"\nkind = \"flux\"\nvalue = -1e-7\n[solver]\nmode = \"dynamic\"\n[time]\nend = 0.2\ndt = 0.01\noutput_interval = 0.1\n",
+        b"[material]\nthickness = 0.05\n[rest]\ntarget = \"uniform\"\nabar = [16.0, 0.0, 16.0]\nbbar = [0.0, 0.0, 0.0]\n",
+        b"[material]\nthickness = 0.01\n[loads]\ngravity = [0.0, 0.0, -9.81]\n[constraints]\nfix_boxes = [{ min = [-1.0, -1.0, -1.0], max = [-0.49, 1.0, 1.0] }]\n[solver]\nmode = \"dynamic\"\n[time]\nend = 1e4\ndt = 1e3\ndt_max = 1e4\noutput_interval = 5e3\n",
     ]
     counts, failures = {}, []
     for i in range(runs):

@@ -173,7 +173,11 @@ pub enum DiffusionError {
     Linear(#[from] LinearError),
     /// The error control could not meet the tolerance with sub-steps down to `2^-40` of the
     /// step: the state or the conditions are not finite or not resolvable.
-    #[error("the diffusion error control failed: sub-step {h:e} s still has error {error:e} times the tolerance")]
+    #[error(
+        "the diffusion error control failed: sub-step {h:e} s still has an error estimate of {} \
+         times the tolerance",
+        crate::math::sci(*.error)
+    )]
     StepControl {
         /// The last sub-step tried (s).
         h: Real,

@@ -51,3 +51,13 @@ pub fn eig2(m: &Mat2) -> (Real, Real) {
     let disc = (0.25 * tr * tr - det).max(0.0).sqrt();
     (0.5 * tr - disc, 0.5 * tr + disc)
 }
+
+/// A number for a message: `{:.3e}` when finite, else `"not finite"` (messages, logs and
+/// summaries never carry `NaN` or `inf`).
+pub fn sci(x: Real) -> String {
+    if x.is_finite() {
+        format!("{x:.3e}")
+    } else {
+        "not finite".into()
+    }
+}

@@ -63,7 +63,10 @@ pub enum SolveError {
     #[error("non-finite Hessian")]
     NonFiniteHessian,
     /// The iteration limit was reached.
-    #[error("no convergence in {iterations} Newton iterations (residual {residual:.3e})")]
+    #[error(
+        "no convergence in {iterations} Newton iterations (residual {})",
+        crate::math::sci(*.residual)
+    )]
     NotConverged {
         /// Iterations done.
         iterations: usize,
@@ -80,7 +83,11 @@ pub enum SolveError {
     #[error("Newton step is not a descent direction")]
     NotDescent,
     /// No step length in 40 halvings decreased Φ enough.
-    #[error("line search stalled (residual {residual:.3e}, directional derivative {slope:.3e})")]
+    #[error(
+        "line search stalled (residual {}, directional derivative {})",
+        crate::math::sci(*.residual),
+        crate::math::sci(*.slope)
+    )]
     LineSearchStalled {
         /// ‖∇Φ‖∞/F.
         residual: Real,
