@@ -429,3 +429,34 @@ fn flux_and_robin_conditions_balance() {
     }
     assert!(u.iter().all(|v| (v - 0.3).abs() < 1e-6), "{:?}", &u[..4]);
 }
+
+/// Failure messages end up in `summary.json`'s `reason`: a non-finite number in them is
+/// written as "not finite", never as `NaN` or `inf`.
+#[test]
+fn failure_messages_print_no_non_finite_numbers() {
+    use shellsim::solve::newton::SolveError;
+    let texts = [
+        SolveError::LineSearchStalled {
+            residual: Real::INFINITY,
+            slope: Real::NEG_INFINITY,
+        }
+        .to_string(),
+        SolveError::NotConverged {
+            iterations: 40,
+            residual: Real::NAN,
+        }
+        .to_string(),
+        shellsim::diffusion::DiffusionError::StepControl {
+            h: 1e-9,
+            error: Real::NAN,
+        }
+        .to_string(),
+    ];
+    for t in &texts {
+        assert!(t.contains("not finite"), "{t}");
+        assert!(
+            !t.to_lowercase().contains("nan") && !t.contains("inf"),
+            "{t}"
+        );
+    }
+}
