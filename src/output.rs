@@ -575,9 +575,9 @@ impl Writer {
                     index,
                     time: row.time,
                     field: format!(
-                        "{name}' at {what} {} (value {:e})",
+                        "{name}' at {what} {} (value {})",
                         i / fld.components.max(1),
-                        fld.data[i]
+                        crate::math::sci(fld.data[i])
                     ),
                 });
             }
@@ -593,7 +593,7 @@ impl Writer {
             return Err(OutputError::NonFinite {
                 index,
                 time: row.time,
-                field: format!("{name}' of the log row (value {v:e})"),
+                field: format!("{name}' of the log row (value {})", crate::math::sci(v)),
             });
         }
         let name = format!("{}_{index:05}.{}", self.prefix, self.format.extension());

@@ -18,6 +18,11 @@ pub const MAX_MOISTURE: Real = 1e3;
 pub const MAX_DENSITY: Real = 1e30;
 /// Largest Young's modulus accepted (Pa).
 pub const MAX_MODULUS: Real = 1e15;
+/// Largest gravitational acceleration (m/s², 10¹⁴ g): beyond it the gravity energy of a sheet
+/// with the largest accepted density and coordinates overflows.
+pub const MAX_GRAVITY: Real = 1e15;
+/// Largest load value: forces (N), tractions (N/m), pressures (Pa), moments (N·m/m).
+pub const MAX_LOAD: Real = 1e30;
 /// Most element layers through the thickness in `[moisture]`.
 pub const MAX_LAYERS: usize = 256;
 
@@ -1343,15 +1348,25 @@ impl Settings {
     /// Validates `[loads]`: finite gravity and finite load values with well-formed selections.
     pub fn validate_loads(&self, name: &str) -> Result<(), SettingsError> {
         let ck = Check(name);
-        if self.loads.gravity.iter().any(|g| !g.is_finite()) {
-            return ck.inv("loads.gravity", "must be finite".into());
+        let g = &self.loads.gravity;
+        if g.iter().any(|c| !c.is_finite() || c.abs() > MAX_GRAVITY) {
+            return ck.inv(
+                "loads.gravity",
+                format!(
+                    "must be finite with components within ±{MAX_GRAVITY:e} m/s², got {}",
+                    vec_e(g)
+                ),
+            );
         }
         let l = &self.loads;
         let finite3 = |key: String, v: &[Real; 3]| -> Result<(), SettingsError> {
-            if v.iter().all(|c| c.is_finite()) {
+            if v.iter().all(|c| c.is_finite() && c.abs() <= MAX_LOAD) {
                 Ok(())
             } else {
-                ck.inv(&key, format!("must be finite, got {}", vec_e(v)))
+                ck.inv(
+                    &key,
+                    format!("must be finite within ±{MAX_LOAD:e}, got {}", vec_e(v)),
+                )
             }
         };
         for (i, p) in l.point.iter().enumerate() {
@@ -1363,19 +1378,25 @@ impl Settings {
             ck.selection(&format!("loads.traction[{i}]"), &t.on)?;
         }
         for (i, p) in l.pressure.iter().enumerate() {
-            if !p.pressure.is_finite() {
+            if !(p.pressure.is_finite() && p.pressure.abs() <= MAX_LOAD) {
                 return ck.inv(
                     &format!("loads.pressure[{i}].pressure"),
-                    format!("must be finite, got {:e}", p.pressure),
+                    format!(
+                        "must be finite within ±{MAX_LOAD:e} Pa, got {:e}",
+                        p.pressure
+                    ),
                 );
             }
             ck.selection(&format!("loads.pressure[{i}]"), &p.on)?;
         }
         for (i, m) in l.moment.iter().enumerate() {
-            if !m.moment.is_finite() {
+            if !(m.moment.is_finite() && m.moment.abs() <= MAX_LOAD) {
                 return ck.inv(
                     &format!("loads.moment[{i}].moment"),
-                    format!("must be finite, got {:e}", m.moment),
+                    format!(
+                        "must be finite within ±{MAX_LOAD:e} N·m/m, got {:e}",
+                        m.moment
+                    ),
                 );
             }
             ck.selection(&format!("loads.moment[{i}]"), &m.on)?;

@@ -115,7 +115,7 @@ fn expressions_of_x_y_give_the_per_face_forms() {
 #[test]
 fn each_section_validates_itself() {
     type V = fn(&Settings, &str) -> Result<(), shellsim::settings::SettingsError>;
-    let cases: [(&str, V, &str); 10] = [
+    let cases: [(&str, V, &str); 13] = [
         ("material.young", Settings::validate_material, "young = -1"),
         ("rest.dial_time", Settings::validate_rest, "dial_time = -1"),
         (
@@ -134,6 +134,21 @@ fn each_section_validates_itself() {
             "loads.point[0].force",
             Settings::validate_loads,
             "point = [{ force = [nan, 0, 0], tags = [1] }]",
+        ),
+        (
+            "loads.gravity",
+            Settings::validate_loads,
+            "gravity = [-1e308, 0, -9.81]",
+        ),
+        (
+            "moisture.grading",
+            Settings::validate_moisture,
+            "enabled = true\ngrading = 0.5",
+        ),
+        (
+            "moisture.tolerance",
+            Settings::validate_moisture,
+            "enabled = true\ntolerance = 1",
         ),
         (
             "contact.normal",
