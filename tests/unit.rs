@@ -2,6 +2,8 @@
 #![allow(clippy::needless_range_loop)]
 #[path = "unit/assembly.rs"]
 mod assembly;
+#[path = "unit/closed.rs"]
+mod closed;
 #[path = "unit/diffusion.rs"]
 mod diffusion;
 #[path = "unit/fd.rs"]

@@ -248,3 +248,75 @@ fn jitter(mesh: &mut Mesh, sp: Spacing, on_boundary: impl Fn(&Vec3) -> bool) {
         p.y += sp.jitter * shortest[i] * v / s;
     }
 }
+
+/// An icosphere of `radius` centred at the origin: the icosahedron with each face split into
+/// 4 `subdivisions` times, new vertices projected onto the sphere. `10·4ⁿ + 2` vertices and
+/// `20·4ⁿ` faces, counter-clockwise seen from outside (outward normals), closed and manifold.
+pub fn icosphere(radius: Real, subdivisions: usize) -> Mesh {
+    let t = (1.0 + (5.0 as Real).sqrt()) / 2.0;
+    let mut positions: Vec<Vec3> = [
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ]
+    .iter()
+    .map(|p| Vec3::new(p[0], p[1], p[2]).normalize())
+    .collect();
+    let mut faces: Vec<[usize; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..subdivisions {
+        let mut mid = std::collections::HashMap::new();
+        let mut midpoint = |a: usize, b: usize, positions: &mut Vec<Vec3>| -> usize {
+            let key = (a.min(b), a.max(b));
+            *mid.entry(key).or_insert_with(|| {
+                positions.push(((positions[a] + positions[b]) / 2.0).normalize());
+                positions.len() - 1
+            })
+        };
+        let mut next = Vec::with_capacity(4 * faces.len());
+        for &[a, b, c] in &faces {
+            let ab = midpoint(a, b, &mut positions);
+            let bc = midpoint(b, c, &mut positions);
+            let ca = midpoint(c, a, &mut positions);
+            next.extend_from_slice(&[[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        faces = next;
+    }
+    for p in &mut positions {
+        *p *= radius;
+    }
+    Mesh {
+        positions,
+        faces,
+        ..Default::default()
+    }
+}

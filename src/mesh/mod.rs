@@ -4,6 +4,7 @@
 //! Consumes: a VTK file (or a generator's parameters). Produces: a validated [`Mesh`] and its
 //! [`Topology`]. Nothing downstream touches files.
 
+pub mod closed;
 pub mod delaunay;
 pub mod generate;
 pub mod io;
