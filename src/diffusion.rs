@@ -189,8 +189,6 @@ pub enum DiffusionError {
 /// The diffusion system of one mesh.
 pub struct Diffusion {
     layers: usize,
-    /// Heights of the column nodes (fractions of the thickness).
-    heights: Vec<Real>,
     nv: usize,
     faces: Vec<[usize; 3]>,
     areas: Vec<Real>,
@@ -201,8 +199,6 @@ pub struct Diffusion {
     /// Stiffness K in pattern order, and the Robin matrix R.
     stiffness: Vec<Real>,
     robin: Vec<Real>,
-    /// `A = K + R` in pattern order, kept up to date with the conditions.
-    operator: Vec<Real>,
     /// Whether each node is free (not prescribed).
     mask: Vec<bool>,
     /// A stored by rows, both triangles (for the matrix-vector products): row pointers,
@@ -215,7 +211,7 @@ pub struct Diffusion {
     rows_free: Vec<Real>,
     /// `A g`, g the prescribed values (0 elsewhere).
     lift: Vec<Real>,
-    /// `operator` and `mask` need refreshing.
+    /// `mask`, the row-stored values of A and `lift` need refreshing.
     stale: bool,
     /// The load f + r (flux and Robin ambient).
     rhs: Vec<Real>,
@@ -234,8 +230,8 @@ pub struct Diffusion {
     factors: Vec<(u64, Vec<Real>)>,
     /// Banded Cholesky factors of S's vertex-column blocks (the CG preconditioner), by `h`.
     bands: Vec<(u64, Vec<[Real; 3]>)>,
-    /// CG scratch: residual, preconditioned residual, direction, S × direction.
-    cg: [Vec<Real>; 4],
+    /// CG scratch: iterate, residual, preconditioned residual, direction, S × direction.
+    cg: [Vec<Real>; 5],
     /// The sub-step size the error control proposes next (s; 0 before the first step).
     h_next: Real,
     /// Scratch vectors.
@@ -408,24 +404,13 @@ impl Diffusion {
             }
             (ptr, cols, src)
         };
-        let heights = (0..=2 * layers)
-            .map(|k| {
-                if k % 2 == 0 {
-                    heights[k / 2]
-                } else {
-                    0.5 * (heights[k / 2] + heights[k / 2 + 1])
-                }
-            })
-            .collect();
         Ok(Diffusion {
             layers,
-            heights,
             nv,
             faces: faces.to_vec(),
             areas,
             mass,
             robin: vec![0.0; nnz],
-            operator: stiffness.clone(),
             stiffness,
             mask: vec![true; nn],
             stale: true,
@@ -466,11 +451,6 @@ impl Diffusion {
     /// [`Self::column`]).
     pub fn node(&self, v: usize, k: usize) -> usize {
         v * self.column() + k
-    }
-
-    /// Heights of a column's nodes as fractions of the thickness (0 bottom, 1 top).
-    pub fn heights(&self) -> &[Real] {
-        &self.heights
     }
 
     fn pos(&self, i: usize, j: usize) -> usize {
@@ -586,20 +566,14 @@ impl Diffusion {
         self.bands.clear();
     }
 
-    /// Brings `A = K + R` and the free-node mask up to date after the conditions changed.
+    /// Brings the row-stored `A = K + R`, the free-node mask and `lift` up to date after the
+    /// conditions changed.
     fn refresh(&mut self) {
         if self.stale {
-            for ((o, k), r) in self
-                .operator
-                .iter_mut()
-                .zip(&self.stiffness)
-                .zip(&self.robin)
-            {
-                *o = k + r;
-            }
             self.mask = self.fixed.iter().map(|f| f.is_none()).collect();
             for q in 0..self.rows_src.len() {
-                let a = self.operator[self.rows_src[q]];
+                let p = self.rows_src[q];
+                let a = self.stiffness[p] + self.robin[p];
                 self.rows_val[q] = a;
                 self.rows_free[q] = if self.mask[self.rows_col[q] as usize] {
                     a
@@ -626,7 +600,7 @@ impl Diffusion {
             }
         } else {
             let m = if i == j { self.mass[i] } else { 0.0 };
-            m + c * self.operator[p]
+            m + c * (self.stiffness[p] + self.robin[p])
         }
     }
 
@@ -737,12 +711,12 @@ impl Diffusion {
         let key = h.to_bits();
         if !self.direct {
             let c = TRBDF2_D * h;
-            let [mut r, mut z, mut pd, mut q] = std::mem::take(&mut self.cg);
+            let [mut xs, mut r, mut z, mut pd, mut q] = std::mem::take(&mut self.cg);
             let bi = self.bands.iter().position(|(k, _)| *k == key).unwrap_or(0);
-            let mut xs = match guess {
-                Some(x) => x.to_vec(),
-                None => vec![0.0; b.len()],
-            };
+            match guess {
+                Some(x) => xs.copy_from_slice(x),
+                None => xs.fill(0.0),
+            }
             // Prescribed rows are identities: exact from the start, and left out of the norms
             // (their scale, 1, has nothing to do with the free rows', M + c A).
             for (i, x) in xs.iter_mut().enumerate() {
@@ -794,9 +768,11 @@ impl Diffusion {
                     pd[i] = z[i] + beta * pd[i];
                 }
             }
-            self.cg = [r, z, pd, q];
             if done {
                 b.copy_from_slice(&xs);
+            }
+            self.cg = [xs, r, z, pd, q];
+            if done {
                 return Ok(());
             }
             self.direct = true;
@@ -839,9 +815,9 @@ impl Diffusion {
         self.refresh();
         let c = TRBDF2_D * h;
         let n = u.len();
-        let [mut au, mut ug, mut ag, mut lift, mut guess] = std::mem::take(&mut self.work);
-        // The prescribed values' columns, moved to the right-hand side: lift = A g.
-        lift.copy_from_slice(&self.lift);
+        let [mut au, mut ug, mut ag, mut anew, mut guess] = std::mem::take(&mut self.work);
+        // The prescribed values' columns are on the right-hand side: `self.lift` = A g.
+        let lift = &self.lift;
         self.operator_times(u, &mut au);
         for i in 0..n {
             ug[i] = match self.fixed[i] {
@@ -856,7 +832,9 @@ impl Diffusion {
         for i in 0..n {
             out[i] = match self.fixed[i] {
                 Some(gi) => gi,
-                None => self.mass[i] * (a1 * ug[i] - a0 * u[i]) + c * self.rhs[i] - c * lift[i],
+                None => {
+                    self.mass[i] * (a1 * ug[i] - a0 * u[i]) + c * self.rhs[i] - c * self.lift[i]
+                }
             };
         }
         // CG starts from the line through uⁿ and u_γ, extended to t + h.
@@ -864,18 +842,18 @@ impl Diffusion {
             guess[i] = u[i] + (ug[i] - u[i]) / (2.0 * TRBDF2_D);
         }
         self.solve(h, out, Some(&guess), report)?;
-        // Error estimate: reuse `lift` for A uⁿ⁺¹.
-        self.operator_times(out, &mut lift);
+        // Error estimate.
+        self.operator_times(out, &mut anew);
         let w = 0.25 * std::f64::consts::SQRT_2;
         let (e1, e2, e3) = ((4.0 * w - 1.0) / 3.0, -1.0 / 3.0, 2.0 * TRBDF2_D / 3.0);
         for i in 0..n {
             est[i] = match self.fixed[i] {
                 Some(_) => 0.0,
-                None => -h * (e1 * au[i] + e2 * ag[i] + e3 * lift[i]),
+                None => -h * (e1 * au[i] + e2 * ag[i] + e3 * anew[i]),
             };
         }
         self.solve(h, est, None, report)?;
-        self.work = [au, ug, ag, lift, guess];
+        self.work = [au, ug, ag, anew, guess];
         Ok(())
     }
 
