@@ -4,6 +4,8 @@
 //! and a reason in `summary.json`. Never a panic (exit 101), never a non-finite value in a frame,
 //! and never exit 0 with a wrong shape.
 
+mod common;
+
 use shellsim::mesh::io::{read_mesh, write_mesh, Format};
 use shellsim::mesh::Mesh;
 use std::path::Path;
@@ -44,36 +46,13 @@ fn run(dir: &Path, settings: &str, mesh: &str, out: &str, extra: &[&str]) -> Out
     if code == 1 {
         assert!(!reason.is_empty(), "{out}: exit 1 without a reason");
     }
-    let mut last = None;
-    for k in 0.. {
-        let path = dir.join(out).join(format!("frame_{k:05}.vtu"));
-        if !path.exists() {
-            break;
-        }
-        let m = read_mesh(&path).unwrap_or_else(|e| panic!("{out} frame {k}: {e:#}"));
-        assert!(
-            m.positions.iter().all(|p| p.iter().all(|c| c.is_finite())),
-            "{out} frame {k}: non-finite position"
-        );
-        for (name, f) in &m.face_fields {
-            assert!(
-                f.data.iter().all(|v| v.is_finite()),
-                "{out} frame {k}: non-finite {name}"
-            );
-        }
-        last = Some(m);
-    }
+    let last = common::finite_frames(&dir.join(out), "vtu", out).pop();
     println!("{out}: exit {code} {reason}");
     Outcome { code, reason, last }
 }
 
 fn square(dir: &Path, edge: &str, name: &str) {
-    let o = Command::new(env!("CARGO_BIN_EXE_shellsim"))
-        .args(["mesh", "square", "--edge", edge, "-o", name])
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    common::shellsim(&["mesh", "square", "--edge", edge, "-o", name], dir);
 }
 
 /// The largest distance between two vertices (the diagonal of a square).

@@ -5,7 +5,6 @@
 
 mod common;
 use common::shellsim;
-use shellsim::mesh::io::read_mesh;
 use shellsim::mesh::Mesh;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -33,25 +32,7 @@ fn run_scene(dir: &Path, scene: &str, mesh: &Path, sets: &[&str]) -> Vec<Mesh> {
     }
     let args: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
     shellsim(&args, dir);
-    let mut frames = Vec::new();
-    for k in 0.. {
-        let p = out.join(format!("frame_{k:05}.vtk"));
-        if !p.exists() {
-            break;
-        }
-        let m = read_mesh(&p).unwrap();
-        assert!(
-            m.positions.iter().all(|p| p.iter().all(|v| v.is_finite())),
-            "{scene}: non-finite position in frame {k}"
-        );
-        for (name, f) in &m.face_fields {
-            assert!(
-                f.data.iter().all(|v| v.is_finite()),
-                "{scene}: non-finite {name} in frame {k}"
-            );
-        }
-        frames.push(m);
-    }
+    let frames = common::finite_frames(&out, "vtk", scene);
     assert!(frames.len() >= 2, "{scene}: no frames");
     frames
 }

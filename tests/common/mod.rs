@@ -18,3 +18,31 @@ pub fn shellsim(args: &[&str], dir: &Path) -> String {
     );
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
+
+/// Reads `frame_00000.EXT`, `frame_00001.EXT`, … from the run folder `out` until one is
+/// missing, asserting that every position and face field is finite (`label` names the run in
+/// the messages).
+#[allow(dead_code)] // not every test crate reads frames
+pub fn finite_frames(out: &Path, ext: &str, label: &str) -> Vec<shellsim::mesh::Mesh> {
+    let mut frames = Vec::new();
+    for k in 0.. {
+        let p = out.join(format!("frame_{k:05}.{ext}"));
+        if !p.exists() {
+            break;
+        }
+        let m = shellsim::mesh::io::read_mesh(&p)
+            .unwrap_or_else(|e| panic!("{label}: frame {k}: {e:#}"));
+        assert!(
+            m.positions.iter().all(|p| p.iter().all(|v| v.is_finite())),
+            "{label}: non-finite position in frame {k}"
+        );
+        for (name, f) in &m.face_fields {
+            assert!(
+                f.data.iter().all(|v| v.is_finite()),
+                "{label}: non-finite {name} in frame {k}"
+            );
+        }
+        frames.push(m);
+    }
+    frames
+}

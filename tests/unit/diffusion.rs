@@ -23,6 +23,15 @@ fn plate(
     (diff, m.positions.len(), nf)
 }
 
+/// Sets `bc` on `sides` of every one of the `nf` faces.
+fn everywhere(diff: &mut Diffusion, nf: usize, sides: &[Side], bc: SurfaceBc) {
+    for f in 0..nf {
+        for &side in sides {
+            diff.set_surface(f, side, bc).unwrap();
+        }
+    }
+}
+
 /// Crank §4.3, slab −a < x < a with both faces at C_s = 1 from C₀ = 0: the mid-plane value.
 fn crank_slab_mid(dt_over_a2: Real) -> Real {
     let mut s = 0.0;
@@ -44,12 +53,12 @@ fn slab(layers: usize, dt: Real, t_end: Real) -> Real {
         through: dcoef,
     };
     let (mut diff, nv, nf) = plate(1e-3, 5e-4, 2.0 * a, iso, Layering::uniform(layers));
-    for f in 0..nf {
-        diff.set_surface(f, Side::Top, SurfaceBc::Value(1.0))
-            .unwrap();
-        diff.set_surface(f, Side::Bottom, SurfaceBc::Value(1.0))
-            .unwrap();
-    }
+    everywhere(
+        &mut diff,
+        nf,
+        &[Side::Top, Side::Bottom],
+        SurfaceBc::Value(1.0),
+    );
     // The initial data is 0 everywhere, the surface nodes included: the surface value 1 holds
     // for t > 0 (the first solve imposes it). Starting them at 1 would add the content of a
     // ramp one layer wide, an O(Δz) error.
@@ -123,13 +132,9 @@ fn default_layering_resolves_the_robin_slab_surface() {
             through: d,
         };
         let (mut diff, _, nf) = plate(1e-3, 1e-3, h, iso, layering);
-        for f in 0..nf {
-            for side in [Side::Top, Side::Bottom] {
-                let k = bi * d / l;
-                diff.set_surface(f, side, SurfaceBc::Robin { k, ambient: 1.0 })
-                    .unwrap();
-            }
-        }
+        let k = bi * d / l;
+        let robin = SurfaceBc::Robin { k, ambient: 1.0 };
+        everywhere(&mut diff, nf, &[Side::Top, Side::Bottom], robin);
         let tol = Tolerance {
             rtol: defaults.tolerance,
             atol: 1e-3 * defaults.tolerance,
@@ -171,17 +176,11 @@ fn error_estimate_and_control() {
     };
     let smooth = || {
         let (mut diff, _, nf) = plate(1e-3, 1e-3, 1e-4, iso, Layering::uniform(4));
-        for f in 0..nf {
-            diff.set_surface(
-                f,
-                Side::Top,
-                SurfaceBc::Robin {
-                    k: 1e-5,
-                    ambient: 1.0,
-                },
-            )
-            .unwrap();
-        }
+        let robin = SurfaceBc::Robin {
+            k: 1e-5,
+            ambient: 1.0,
+        };
+        everywhere(&mut diff, nf, &[Side::Top], robin);
         // A smooth start: the profile after 1 s.
         let mut u = vec![0.0; diff.num_nodes()];
         for _ in 0..100 {
@@ -399,10 +398,7 @@ fn flux_and_robin_conditions_balance() {
         through: 1e-9,
     };
     let (mut diff, _, nf) = plate(1e-2, 2.5e-3, 1e-4, d, Layering::uniform(2));
-    for f in 0..nf {
-        diff.set_surface(f, Side::Top, SurfaceBc::Flux(1e-6))
-            .unwrap();
-    }
+    everywhere(&mut diff, nf, &[Side::Top], SurfaceBc::Flux(1e-6));
     let mut u = vec![0.0; diff.num_nodes()];
     for _ in 0..50 {
         diff.step(&mut u, 2.0).unwrap();
@@ -412,17 +408,11 @@ fn flux_and_robin_conditions_balance() {
     assert!((total / added - 1.0).abs() < 1e-12, "{total} vs {added}");
 
     let (mut diff, _, nf) = plate(1e-2, 2.5e-3, 1e-4, d, Layering::uniform(2));
-    for f in 0..nf {
-        diff.set_surface(
-            f,
-            Side::Bottom,
-            SurfaceBc::Robin {
-                k: 1e-5,
-                ambient: 0.3,
-            },
-        )
-        .unwrap();
-    }
+    let robin = SurfaceBc::Robin {
+        k: 1e-5,
+        ambient: 0.3,
+    };
+    everywhere(&mut diff, nf, &[Side::Bottom], robin);
     let mut u = vec![0.0; diff.num_nodes()];
     for _ in 0..200 {
         diff.step(&mut u, 10.0).unwrap();
