@@ -387,3 +387,40 @@ pub fn curvatures(a: &Sym2, b: &Sym2) -> (Real, Real, Real, Real) {
     let (k1, k2) = crate::math::eig2(&s);
     (h, k, k1, k2)
 }
+
+/// `w` times the signed volume of the cone from the origin over triangle `x`,
+/// `w V_f = w x₀·(x₁ × x₂)/6` (m³ × w), with optional gradient and Hessian (9 DOFs:
+/// `x0, x1, x2`). Summed over a closed surface's faces, `V = Σ V_f` is the enclosed volume
+/// (exact for the polyhedron, see [`crate::mesh::closed`]).
+///
+/// `∂V_f/∂x₀ = (x₁ × x₂)/6` (cyclically): summed around a vertex, `(1/3) Σ A n̂`, the seed's
+/// Eq. 15 nodal force direction. `∇²V_f` has zero 3×3 diagonal blocks and
+/// `∂²V_f/∂x_i∂x_j = −[x_k]×/6` for `(i, j, k)` cyclic, with the transpose for `(j, i)`: the
+/// derivative of the area and normal that seed 002's Eq. 16 drops. It depends on the origin
+/// (only the sum over a closed surface does not), so it must never be projected face by face.
+pub fn cone_volume(
+    x: &[Vec3; 3],
+    w: Real,
+    grad: Option<&mut SVec<9>>,
+    hess: Option<&mut SMat<9, 9>>,
+) -> Real {
+    let w6 = w / 6.0;
+    let [x0, x1, x2] = *x;
+    if let Some(g) = grad {
+        let gs = [x1.cross(&x2), x2.cross(&x0), x0.cross(&x1)];
+        for (i, gi) in gs.iter().enumerate() {
+            g.fixed_rows_mut::<3>(3 * i).copy_from(&(gi * w6));
+        }
+    }
+    if let Some(h) = hess {
+        h.fill(0.0);
+        for i in 0..3 {
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            let b = -crate::math::skew(&x[k]) * w6;
+            h.fixed_view_mut::<3, 3>(3 * i, 3 * j).copy_from(&b);
+            h.fixed_view_mut::<3, 3>(3 * j, 3 * i)
+                .copy_from(&b.transpose());
+        }
+    }
+    w6 * x0.dot(&x1.cross(&x2))
+}

@@ -182,6 +182,9 @@ pub struct Summary {
     pub shifted_iterations: usize,
     /// Newton iterations that fell back to the Gauss–Newton Hessian.
     pub gauss_newton_iterations: usize,
+    /// Newton iterations whose sparse Hessian part was indefinite and made positive definite
+    /// by a dense low-rank part (an enclosed gas past a pressure limit point).
+    pub indefinite_iterations: usize,
     /// Saddle points detected and escaped by perturbation.
     pub saddle_escapes: usize,
     /// Vertices.
@@ -515,10 +518,11 @@ impl Writer {
         ff.insert("k1".into(), Field::scalar(k1s));
         ff.insert("k2".into(), Field::scalar(k2s));
         ff.insert("max_stretch".into(), Field::scalar(stretch));
+        // The rest thickness, unless a term gives the current one.
+        ff.insert("thickness".into(), Field::scalar(sc.thickness.clone()));
         for (name, data) in term_fields {
             ff.insert(name, Field::scalar(data));
         }
-        ff.insert("thickness".into(), Field::scalar(sc.thickness.clone()));
         for (name, data) in &self.extra {
             ff.insert(name.clone(), Field::scalar(data.clone()));
         }
@@ -528,7 +532,14 @@ impl Writer {
         }
         for t in sc.terms.iter() {
             if let Some(name) = t.state_field() {
-                ff.insert(name.into(), vec3(t.state(x, phi)));
+                let data = t.state(x, phi);
+                ff.insert(
+                    name.into(),
+                    Field {
+                        components: t.state_components(),
+                        data,
+                    },
+                );
             }
         }
         if !sc.patches.is_empty() {

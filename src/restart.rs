@@ -165,7 +165,7 @@ pub fn restart_from_frame(
     // Terms that track a state across steps (an end moment's turns) restart from theirs.
     for t in scene.terms.iter() {
         if let Some(field) = t.state_field() {
-            let data = frame.face_field(field, 3)?;
+            let data = frame.face_field(field, t.state_components())?;
             match t.restore(
                 &frame.positions,
                 &phi,

@@ -458,6 +458,30 @@ impl Scene {
         }
     }
 
+    /// Applies every term's projection after an accepted implicit step (see
+    /// [`crate::energy::term::Term::project`]).
+    pub fn project(&self, pot: &crate::solve::Potential, state: &mut crate::solve::State) {
+        for t in self.terms.iter() {
+            t.project(pot, &mut state.x, &state.dofs);
+        }
+    }
+
+    /// Lets every term update its multiplier after a converged solve; `true` when one did and
+    /// the solve must be repeated (see [`crate::energy::term::Term::update`]).
+    pub fn update(
+        &self,
+        pot: &crate::solve::Potential,
+        x: &[Vec3],
+        phi: &[Real],
+        sensitivity: &mut dyn FnMut(&[Real]) -> Option<Real>,
+    ) -> bool {
+        let mut again = false;
+        for t in self.terms.iter() {
+            again |= t.update(pot, x, phi, sensitivity);
+        }
+        again
+    }
+
     /// Whether every term admits `(x, phi)` as the next accepted state (see
     /// [`crate::energy::term::Term::admissible`]).
     pub fn admissible(&self, x: &[Vec3], phi: &[Real]) -> bool {

@@ -84,6 +84,8 @@ pub struct Settings {
     pub time: Time,
     /// External loads.
     pub loads: Loads,
+    /// An enclosed gas (closed meshes): amount, pressure or volume control.
+    pub gas: Gas,
     /// Ground contact with friction.
     pub contact: Contact,
     /// Fixed vertices.
@@ -128,6 +130,8 @@ pub struct Material {
     pub c2: Real,
     /// Baraff–Witkin constants and warp direction.
     pub baraff_witkin: BaraffWitkinSettings,
+    /// The prism element's density law and thickness mode.
+    pub prism: PrismSettings,
 }
 
 /// The membrane material.
@@ -143,6 +147,54 @@ pub enum MaterialModel {
     MooneyRivlin,
     /// Strain-limiting Baraff–Witkin (seed 003).
     BaraffWitkin,
+    /// Seed 002's three-prism element with a thickness (`[material.prism]`).
+    Prism,
+}
+
+/// The 3D strain energy of the prism element.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PrismLaw {
+    /// St Venant–Kirchhoff, `ψ = μ E:E + λ/2 tr²E` (seed 002 Eqs. 6–7).
+    #[default]
+    Stvk,
+    /// Compressible neo-Hookean, `ψ = μ/2 (I₁ − 3) − μ ln J + λ/2 ln²J`.
+    NeoHookean,
+}
+
+/// How the prism element's thickness follows the deformation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PrismThickness {
+    /// `h = h̄ Ā/A` inside the energy: exact incompressibility.
+    #[default]
+    Incompressible,
+    /// Seed 002's position-based volume preservation after each step (dynamics).
+    Pbd,
+}
+
+/// `[material.prism]`: seed 002's three-prism membrane.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PrismSettings {
+    /// `"stvk"` or `"neo_hookean"` (default: `"stvk"`, the seed's).
+    pub law: PrismLaw,
+    /// `"incompressible"` (h = h̄ Ā/A inside the energy) or `"pbd"` (the seed's position-based
+    /// volume preservation after each implicit step; dynamic mode) (default:
+    /// `"incompressible"`).
+    pub thickness: PrismThickness,
+    /// `"pbd"`: projections per step (default: `1`, the seed's Algorithm 2).
+    pub pbd_iterations: usize,
+}
+
+impl Default for PrismSettings {
+    fn default() -> Self {
+        PrismSettings {
+            law: PrismLaw::Stvk,
+            thickness: PrismThickness::Incompressible,
+            pbd_iterations: 1,
+        }
+    }
 }
 
 /// `[material.baraff_witkin]`.
@@ -243,6 +295,7 @@ impl Default for Material {
             c1: 0.0,
             c2: 0.0,
             baraff_witkin: BaraffWitkinSettings::default(),
+            prism: PrismSettings::default(),
         }
     }
 }
@@ -626,6 +679,69 @@ pub struct Loads {
     pub moment: Vec<MomentLoad>,
 }
 
+/// How the enclosed gas is controlled (see [`crate::energy::gas`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GasControl {
+    /// No gas.
+    #[default]
+    None,
+    /// A fixed amount of ideal gas (`amount`), dialled from the outside pressure's.
+    Amount,
+    /// A prescribed gauge pressure (`pressure`), dialled from 0.
+    Pressure,
+    /// A prescribed enclosed volume (`volume`), the pressure being its multiplier.
+    Volume,
+}
+
+/// The gas law of amount control.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GasProcess {
+    /// `p V = const` (seed 002 Eq. 12).
+    #[default]
+    Isothermal,
+    /// `p V^γ = const`.
+    Adiabatic,
+}
+
+/// `[gas]`: a gas enclosed by the mesh (seed 002 §5). The mesh must be a closed, consistently
+/// oriented surface with outward normals.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Gas {
+    /// `"none"`, `"amount"`, `"pressure"` or `"volume"` (default: `"none"`).
+    pub control: GasControl,
+    /// Amount control: the gas's `p V` at the reference volume when the dial reaches 1, i.e.
+    /// its `n R T` (J = Pa·m³, > 0).
+    pub amount: Real,
+    /// Pressure control: the gauge pressure at dial 1 (Pa; positive inflates).
+    pub pressure: Real,
+    /// Volume control: the enclosed volume at dial 1 (m³, > 0).
+    pub volume: Real,
+    /// Pressure outside (Pa, ≥ 0, default: `0`); amount control inflates against it.
+    pub external_pressure: Real,
+    /// Amount control: `"isothermal"` (p V = const) or `"adiabatic"` (p V^γ = const)
+    /// (default: `"isothermal"`).
+    pub process: GasProcess,
+    /// Heat capacity ratio γ of the adiabatic process (dimensionless, > 1, default: `1.4`).
+    pub gamma: Real,
+}
+
+impl Default for Gas {
+    fn default() -> Self {
+        Gas {
+            control: GasControl::None,
+            amount: 0.0,
+            pressure: 0.0,
+            volume: 0.0,
+            external_pressure: 0.0,
+            process: GasProcess::Isothermal,
+            gamma: 1.4,
+        }
+    }
+}
+
 /// A distributed moment per unit length along the boundary edges whose two vertices are
 /// selected, scaled by the dial; see [`crate::energy::loads::moment`].
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -985,6 +1101,35 @@ impl Settings {
                 return inv("material.c2", format!("must be ≥ 0 (Pa), got {:e}", m.c2));
             }
         }
+        if m.model == MaterialModel::Prism {
+            let p = &m.prism;
+            let needs_lambda = p.law == PrismLaw::Stvk || p.thickness == PrismThickness::Pbd;
+            if needs_lambda && m.poisson >= 0.5 {
+                return inv(
+                    "material.poisson",
+                    format!(
+                        "the prism element with law = {:?} and thickness = {:?} uses the 3D Lamé \
+                         λ = Eν/((1+ν)(1−2ν)), infinite at ν = 0.5: use ν < 0.5 (e.g. 0.49), or \
+                         law = \"neo_hookean\" with thickness = \"incompressible\"",
+                        p.law, p.thickness
+                    ),
+                );
+            }
+            if p.thickness == PrismThickness::Pbd && self.solver.mode != Mode::Dynamic {
+                return inv(
+                    "material.prism.thickness",
+                    "\"pbd\" is seed 002's projection after each implicit step: it needs \
+                     solver.mode = \"dynamic\" (use \"incompressible\" in static mode)"
+                        .into(),
+                );
+            }
+            if p.pbd_iterations == 0 || p.pbd_iterations > 100 {
+                return inv(
+                    "material.prism.pbd_iterations",
+                    format!("must lie in 1..=100, got {}", p.pbd_iterations),
+                );
+            }
+        }
         let bw = &m.baraff_witkin;
         if !(bw.r.is_finite() && bw.r >= 0.0) {
             return inv(
@@ -1024,6 +1169,7 @@ impl Settings {
         self.validate_moisture(name)?;
         self.validate_time(name)?;
         self.validate_loads(name)?;
+        self.validate_gas(name)?;
         self.validate_contact(name)?;
         self.validate_constraints(name)?;
         self.validate_output(name)?;
@@ -1400,6 +1546,64 @@ impl Settings {
                 );
             }
             ck.selection(&format!("loads.moment[{i}]"), &m.on)?;
+        }
+        Ok(())
+    }
+
+    /// Validates `[gas]`: the control's value (a positive amount or volume, a finite
+    /// pressure), the external pressure and γ.
+    pub fn validate_gas(&self, name: &str) -> Result<(), SettingsError> {
+        let ck = Check(name);
+        let g = &self.gas;
+        if g.control == GasControl::None {
+            return Ok(());
+        }
+        let within = |key: &str, v: Real, unit: &str| {
+            if v.is_finite() && v.abs() <= MAX_LOAD {
+                Ok(())
+            } else {
+                ck.inv(
+                    key,
+                    format!("must be finite within ±{MAX_LOAD:e} {unit}, got {v:e}"),
+                )
+            }
+        };
+        match g.control {
+            GasControl::Amount => {
+                if g.amount.is_nan() || g.amount <= 0.0 {
+                    return ck.inv(
+                        "gas.amount",
+                        format!(
+                            "amount control needs a positive amount of gas (p V at the reference \
+                             volume, J), got {:e}",
+                            g.amount
+                        ),
+                    );
+                }
+                within("gas.amount", g.amount, "J")?;
+            }
+            GasControl::Pressure => within("gas.pressure", g.pressure, "Pa")?,
+            GasControl::Volume => {
+                if g.volume.is_nan() || g.volume <= 0.0 {
+                    return ck.inv(
+                        "gas.volume",
+                        format!(
+                            "volume control needs a positive enclosed volume (m³), got {:e}",
+                            g.volume
+                        ),
+                    );
+                }
+                within("gas.volume", g.volume, "m³")?;
+            }
+            GasControl::None => {}
+        }
+        ck.nonneg("gas.external_pressure", g.external_pressure)?;
+        within("gas.external_pressure", g.external_pressure, "Pa")?;
+        if !(g.gamma > 1.0 && g.gamma <= 10.0) {
+            return ck.inv(
+                "gas.gamma",
+                format!("must lie in (1, 10] (1.4 for air), got {:e}", g.gamma),
+            );
         }
         Ok(())
     }

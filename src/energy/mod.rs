@@ -12,9 +12,11 @@
 //!   Kelvin–Voigt damping wells).
 //! * [`gravity`], [`inertia`], [`ground`]: vertex terms.
 //! * [`loads`]: point forces, tractions and pressure, scaled by the dial (the load factor).
+//! * [`gas`]: an enclosed gas (amount, pressure or volume control) with its rank-one stiffness.
 //! * [`projection`]: optional per-element projection of a Hessian to positive semi-definite.
 
 pub mod bending;
+pub mod gas;
 pub mod gravity;
 pub mod ground;
 pub mod inertia;

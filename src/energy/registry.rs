@@ -9,7 +9,8 @@ use super::bending::{
     average::MidedgeAverage, midedge_angle::MidedgeAngle, none::NoBending, patch::PatchFit,
 };
 use super::membrane::{
-    baraff_witkin, koiter::Koiter, mooney_rivlin::MooneyRivlin, neo_hookean::NeoHookean, Membrane,
+    baraff_witkin, koiter::Koiter, mooney_rivlin::MooneyRivlin, neo_hookean::NeoHookean,
+    prism::Prism, Membrane,
 };
 use super::shell::Shell;
 use super::term::{Term, VertexTerm};
@@ -54,6 +55,7 @@ pub fn shell_term(scene: &Scene) -> Result<Box<dyn Term>, MeshError> {
         MaterialModel::NeoHookean => with_bending(scene, NeoHookean),
         MaterialModel::MooneyRivlin => with_bending(scene, MooneyRivlin { c1: m.c1, c2: m.c2 }),
         MaterialModel::BaraffWitkin => with_bending(scene, baraff_witkin::from_scene(scene)?),
+        MaterialModel::Prism => with_bending(scene, Prism::new(scene)),
     })
 }
 
@@ -95,6 +97,7 @@ pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
         super::loads::traction::term,
         super::loads::pressure::term,
         super::loads::moment::term,
+        super::gas::term,
     ] {
         t.extend(load(scene)?);
     }

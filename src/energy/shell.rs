@@ -305,9 +305,41 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
         totals(&self.face_energies(pot, x, phi))
     }
 
-    /// `stretching_energy_density` and `bending_energy_density` (J/m² of rest area).
+    /// `stretching_energy_density` and `bending_energy_density` (J/m² of rest area), and the
+    /// material's own fields.
     fn face_fields(&self, pot: &Potential, x: &[Vec3], phi: &[Real]) -> Vec<(String, Vec<Real>)> {
-        densities(pot, &self.face_energies(pot, x, phi))
+        let mut f = densities(pot, &self.face_energies(pot, x, phi));
+        f.extend(self.membrane.face_fields(pot, x));
+        f
+    }
+
+    fn observables(&self, pot: &Potential, x: &[Vec3], _phi: &[Real]) -> Vec<(String, Real)> {
+        self.membrane.observables(pot, x)
+    }
+
+    fn project(&self, pot: &Potential, x: &mut [Vec3], _phi: &[Real]) -> Option<Real> {
+        self.membrane.project(pot, x)
+    }
+
+    fn state_field(&self) -> Option<&'static str> {
+        self.membrane.state_field()
+    }
+
+    fn state_components(&self) -> usize {
+        1
+    }
+
+    fn state(&self, _x: &[Vec3], _phi: &[Real]) -> Vec<Real> {
+        self.membrane.state()
+    }
+
+    fn restore(
+        &self,
+        _x: &[Vec3],
+        _phi: &[Real],
+        field: Option<&[Real]>,
+    ) -> Result<Option<String>, super::term::StateError> {
+        self.membrane.restore(field)
     }
 
     /// The face energies once for both the totals and the densities.
@@ -319,7 +351,9 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
         phi: &[Real],
     ) -> (Vec<(&'static str, Real)>, Vec<(String, Vec<Real>)>) {
         let fe = self.face_energies(pot, x, phi);
-        (totals(&fe), densities(pot, &fe))
+        let mut f = densities(pot, &fe);
+        f.extend(self.membrane.face_fields(pot, x));
+        (totals(&fe), f)
     }
 }
 

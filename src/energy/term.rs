@@ -155,7 +155,21 @@ pub trait Term: Send + Sync {
         None
     }
 
-    /// The tracked state at `(x, phi)` for [`Term::state_field`]: 3 values per face.
+    /// Values per face of [`Term::state_field`] (default: 3).
+    fn state_components(&self) -> usize {
+        3
+    }
+
+    /// A projection applied after each accepted implicit step (before the velocities are
+    /// taken from the positions), such as seed 002's position-based volume preservation; it may
+    /// move the positions and the term's own state. Returns the relative constraint error it
+    /// corrected, or `None` when the term has none (default).
+    fn project(&self, _pot: &Potential, _x: &mut [Vec3], _phi: &[Real]) -> Option<Real> {
+        None
+    }
+
+    /// The tracked state at `(x, phi)` for [`Term::state_field`]: [`Term::state_components`]
+    /// values per face.
     fn state(&self, _x: &[Vec3], _phi: &[Real]) -> Vec<Real> {
         Vec::new()
     }
@@ -188,6 +202,36 @@ pub trait Term: Send + Sync {
         Vec::new()
     }
 
+    /// After a converged solve at `(x, phi)`: updates a multiplier the term carries (a
+    /// prescribed volume's pressure) and returns `true` when the solve must be repeated with
+    /// it (default: nothing to update). `sensitivity(u)` is `uᵀ H⁻¹ u` with the solve's last
+    /// Hessian (sparse factor and low-rank parts; `None` when there is none), the derivative of
+    /// the equilibrium's `u·x` with respect to a load along `u`.
+    fn update(
+        &self,
+        _pot: &Potential,
+        _x: &[Vec3],
+        _phi: &[Real],
+        _sensitivity: &mut dyn FnMut(&[Real]) -> Option<Real>,
+    ) -> bool {
+        false
+    }
+
+    /// Static continuation, before the solve at the new dial `pot.dial` from the equilibrium
+    /// `(x, phi)` at dial `from`: a term that knows how its load moves the equilibrium may move
+    /// `x` (and its own multiplier) along the tangent of the equilibrium path (Euler's predictor),
+    /// with `solve(r)` applying the last Hessian's inverse to `r` (`false` when there is none)
+    /// (default: nothing).
+    fn predict(
+        &self,
+        _pot: &Potential,
+        _from: Real,
+        _x: &mut [Vec3],
+        _phi: &[Real],
+        _solve: &mut dyn FnMut(&mut [Real]) -> bool,
+    ) {
+    }
+
     /// The dense low-rank part of the Hessian at `x` (default: none). Entries on fixed or
     /// pinned DOFs must be zero.
     fn low_rank(&self, _pot: &Potential, _x: &[Vec3], _phi: &[Real], _out: &mut Vec<LowRank>) {}
@@ -196,6 +240,11 @@ pub trait Term: Send + Sync {
 /// A pure per-element kernel with `N` local DOFs over `S` stencil slots (compile-time sizes for
 /// the assembly loops).
 pub trait ElementKernel<const N: usize, const S: usize>: Send + Sync {
+    /// Whether the per-element projections (`"abs"`, `"clamp_zero"`) may be applied to its
+    /// element Hessians (not for a split that is not itself meaningful, such as the cones of an
+    /// enclosed volume, whose per-face Hessians depend on the origin).
+    const PROJECTABLE: bool = true;
+
     /// Energy of element `e` with stencil `nodes`, optional gradient and Hessian in the local
     /// DOF order of the stencil's slots. `gauss_newton` asks for a positive semi-definite
     /// Hessian where the kernel has one.
@@ -246,7 +295,11 @@ impl<K: ElementKernel<N, S>, const N: usize, const S: usize> Term for ElementTer
             map,
             |e, nodes, g, h| self.kernel.eval(pot, e, nodes, x, phi, gn, g, h),
             &pot.scene.node_fixed,
-            projection,
+            if K::PROJECTABLE {
+                projection
+            } else {
+                HessianProjection::None
+            },
             want,
             grad,
             values,

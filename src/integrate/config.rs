@@ -39,7 +39,8 @@ pub struct StaticConfig {
     /// Write a frame after every accepted continuation step (each solved to full tolerance).
     pub continuation_frames: bool,
     /// Membrane continuation: the stretching weight starts at 1/softening (1 = off). Off when
-    /// loads or prescribed paths are given: a softened membrane would follow another path.
+    /// loads, prescribed paths or a gas are given: a softened membrane would follow another
+    /// path (and inflate without bound).
     pub softening: Real,
 }
 
@@ -66,7 +67,9 @@ impl RunConfig {
             .iter()
             .copied()
             .fold(Real::INFINITY, Real::min);
-        let loaded = s.loads.any_external() || !scene.prescribed.is_empty();
+        let loaded = s.loads.any_external()
+            || !scene.prescribed.is_empty()
+            || s.gas.control != crate::settings::GasControl::None;
         let softening = match st.membrane_continuation {
             Softening::Auto(_) if loaded => 1.0,
             m => m.factor(scene.mesh.bbox_diagonal(), h_min),

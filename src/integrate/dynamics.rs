@@ -9,7 +9,7 @@ use crate::assembly::Want;
 use crate::math::{Real, Sym2, Vec3};
 use crate::output::Writer;
 use crate::solve::potential::{Damping, Inertia};
-use crate::solve::{newton, Potential, State};
+use crate::solve::{Potential, State};
 use std::time::Instant;
 
 pub(super) fn run_dynamic(
@@ -148,8 +148,7 @@ pub(super) fn run_dynamic(
                 friction: lag.as_ref().map(|l| l.friction(&state.x, h)),
                 ..Potential::new(sc, s.pattern)
             };
-            let rep = newton(&pot, &mut s.lin, &mut s.ws, &mut trial, opts);
-            s.record(&rep);
+            let rep = s.solve(&pot, &mut trial, opts);
             let again = rep.converged && lag.as_mut().is_some_and(|l| l.resolve(sc, &trial.x));
             if !again {
                 break rep;
@@ -166,6 +165,12 @@ pub(super) fn run_dynamic(
                 break;
             }
             continue;
+        }
+        // Projections after the implicit step (seed 002's volume preservation), before the
+        // velocities are taken from the positions (its Algorithm 1, lines 10–12).
+        {
+            let pot = accepted(s.potential(dial), moisture.as_ref(), &trial_targets);
+            sc.project(&pot, &mut trial);
         }
         for ((vi, t), x) in v.iter_mut().zip(&trial.x).zip(&state.x) {
             *vi = (t - x) / h;

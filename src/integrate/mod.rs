@@ -39,8 +39,10 @@ use crate::output::{LogRow, OutputError, Summary, Writer};
 use crate::scene::Scene;
 use crate::settings::Mode;
 use crate::solve::linear::LinearError;
-use crate::solve::newton::{factor_with_shift_upto, Workspace};
-use crate::solve::{LinearSolver, NewtonReport, Potential, SolveError, State};
+use crate::solve::newton::Workspace;
+use crate::solve::{
+    newton, LinearSolver, NewtonOptions, NewtonReport, Potential, SolveError, State,
+};
 use std::time::Instant;
 
 /// Errors that stop a run (as opposed to non-convergence, which is reported in the summary).
@@ -243,6 +245,20 @@ pub fn perturb(scene: &Scene, x: &mut [Vec3], amp: Real, seed: u64) {
     }
 }
 
+/// `r ← H⁻¹ r` with the last factorisation of `lin` and the low-rank parts of `pot` at `state`
+/// (Woodbury); `false` when there is no factor or the low-rank solve is singular.
+fn apply_inverse(lin: &mut LinearSolver, pot: &Potential, state: &State, r: &mut [Real]) -> bool {
+    if !lin.is_factored() {
+        return false;
+    }
+    let lr = pot.low_rank(&state.x, &state.dofs);
+    let wb = crate::solve::low_rank::Woodbury::new(lin, &lr);
+    wb.solve_in_place(lin, r)
+}
+
+/// Multiplier updates allowed per solve (see [`Solver::solve`]).
+const MAX_UPDATES: usize = 50;
+
 struct Solver<'a> {
     scene: &'a Scene,
     pattern: &'a Pattern,
@@ -325,7 +341,41 @@ impl<'a> Solver<'a> {
         self.summary.newton_iterations += rep.iterations;
         self.summary.shifted_iterations += rep.shifted_iterations;
         self.summary.gauss_newton_iterations += rep.gauss_newton_iterations;
+        self.summary.indefinite_iterations += rep.indefinite_iterations;
         self.summary.residual = rep.residual;
+    }
+
+    /// Newton on `pot` from `state`, then the terms' multiplier updates (a prescribed volume's
+    /// pressure, [`crate::energy::term::Term::update`]), re-solving until no term asks for
+    /// another solve. The report sums the iterations of every solve; more than
+    /// [`MAX_UPDATES`] updates is a failure.
+    fn solve(&mut self, pot: &Potential, state: &mut State, opts: NewtonOptions) -> NewtonReport {
+        let mut total = NewtonReport::default();
+        for _ in 0..MAX_UPDATES {
+            let rep = newton(pot, &mut self.lin, &mut self.ws, state, opts);
+            self.record(&rep);
+            total.absorb(&rep);
+            if !rep.converged {
+                return total;
+            }
+            let lin = &mut self.lin;
+            let mut sensitivity = |u: &[Real]| -> Option<Real> {
+                let mut y = u.to_vec();
+                apply_inverse(lin, pot, state, &mut y)
+                    .then(|| u.iter().zip(&y).map(|(a, b)| a * b).sum::<Real>())
+            };
+            if !self
+                .scene
+                .update(pot, &state.x, &state.dofs, &mut sensitivity)
+            {
+                return total;
+            }
+        }
+        total.converged = false;
+        total.failure = Some(SolveError::MultiplierNotConverged {
+            updates: MAX_UPDATES,
+        });
+        total
     }
 
     fn frame(
@@ -356,6 +406,17 @@ impl<'a> Solver<'a> {
         Ok(())
     }
 
+    /// Lets the terms predict the equilibrium at dial `pot.dial` from the one at `from`
+    /// (see [`crate::energy::term::Term::predict`]) with the last factorisation.
+    fn predict(&mut self, pot: &Potential, from: Real, state: &mut State) {
+        let lin = &mut self.lin;
+        let at = state.clone();
+        let mut solve = |r: &mut [Real]| apply_inverse(lin, pot, &at, r);
+        for t in self.scene.terms.iter() {
+            t.predict(pot, from, &mut state.x, &state.dofs, &mut solve);
+        }
+    }
+
     /// Tests `H + δI ≻ 0` at `state` (see module doc).
     fn is_stable(&mut self, dial: Real, state: &State) -> bool {
         let (x, phi) = (&state.x, &state.dofs);
@@ -363,16 +424,10 @@ impl<'a> Solver<'a> {
         let mut values = vec![0.0; self.pattern.nnz()];
         let mut g = vec![0.0; self.pattern.n];
         pot.eval(x, phi, Want::Hessian, &mut g, &mut values);
-        // One factorisation of H + 1e-9·mean|diag|·I (τ may not grow beyond 1e-9).
-        let mut shifted = vec![0.0; values.len()];
-        if factor_with_shift_upto(&mut self.lin, &pot, &values, &mut shifted, 1e-9, 1e-9).is_none()
-        {
-            return false;
-        }
-        // A dense low-rank part keeps the whole positive definite or not (inertia test).
+        // One factorisation of H + 1e-9·mean|diag|·I, with the dense low-rank part through
+        // the inertia (an indefinite sparse part is fine when the whole is positive definite).
         let lr = pot.low_rank(x, phi);
-        lr.is_empty()
-            || crate::solve::low_rank::Woodbury::new(&mut self.lin, &lr).keeps_positive_definite()
+        crate::solve::newton::is_positive_definite(&mut self.lin, &pot, &values, &lr, 1e-9)
     }
 }
 

@@ -4,7 +4,7 @@
 use super::{perturb, Progress, RunError, RunFailure, Solver, StepControl};
 use crate::math::{Real, Vec3};
 use crate::output::Writer;
-use crate::solve::{newton, NewtonOptions, NewtonReport, State};
+use crate::solve::{NewtonOptions, NewtonReport, State};
 
 pub(super) fn run_static(
     s: &mut Solver,
@@ -57,14 +57,10 @@ pub(super) fn run_static(
         trial.copy_from(&state);
         s.scene.prescribe(&mut trial.x, target);
         let pot = s.potential_scaled(target, target_scale);
-        let rep = newton(
-            &pot,
-            &mut s.lin,
-            &mut s.ws,
-            &mut trial,
-            NewtonOptions { tol: t, ..opts },
-        );
-        s.record(&rep);
+        if target != dial {
+            s.predict(&pot, dial, &mut trial);
+        }
+        let rep = s.solve(&pot, &mut trial, NewtonOptions { tol: t, ..opts });
         // A term tracking a state across steps (a moment's angle) may refuse a step too large
         // for it; the step is then cut like a failed solve.
         let admissible = rep.converged && s.scene.admissible(&trial.x, &trial.dofs);
@@ -145,17 +141,14 @@ pub(super) fn run_static(
                 seed.wrapping_add(escapes as u64),
             );
             let pot = s.potential(1.0);
-            let rep = newton(
+            let rep = s.solve(
                 &pot,
-                &mut s.lin,
-                &mut s.ws,
                 &mut state,
                 NewtonOptions {
                     max_iter: opts.max_iter * 5,
                     ..opts
                 },
             );
-            s.record(&rep);
             if !rep.converged {
                 failure = Some(RunFailure::AfterSaddle(rep.failure_or_unknown()));
                 break;

@@ -1,15 +1,25 @@
-//! Sparse symmetric positive-definite solves with faer's Cholesky (LLᵀ).
+//! Sparse symmetric solves with faer's Cholesky: LLᵀ for positive-definite matrices, and LDLᵀ
+//! (no pivoting) with its inertia for the symmetric indefinite ones that a dense low-rank term
+//! makes positive definite (an inflated balloon past its pressure limit point: the sparse part
+//! has one negative eigenvalue, the gas's rank-one stiffness removes it; see
+//! [`super::low_rank`]).
 //!
 //! The symbolic factorisation (AMD ordering, elimination tree, supernodes) is computed once per
 //! sparsity pattern; every Newton iteration only refactorises numerically. Factorisation and
 //! solves run sequentially (`Par::Seq`) so the result never depends on the thread count.
+//!
+//! The inertia of an LDLᵀ factorisation is that of `D` (Sylvester's law: `P A Pᵀ = L D Lᵀ` is a
+//! congruence), read from the diagonal of the factor's storage (the first entry of each
+//! simplicial column, the diagonal of each supernode's block).
 
 use crate::assembly::Pattern;
 use crate::math::Real;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, LltRef, SymbolicCholesky, SymmetricOrdering,
+    factorize_symbolic_cholesky, LdltRef, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
+    SymmetricOrdering,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
@@ -24,9 +34,23 @@ pub enum LinearError {
         /// Pivot index (in the permuted order).
         index: usize,
     },
+    /// An LDLᵀ factorisation met an exactly zero pivot (the matrix is singular).
+    #[error("matrix singular (zero pivot at {index})")]
+    ZeroPivot {
+        /// Pivot index (in the permuted order).
+        index: usize,
+    },
     /// faer could not build the symbolic structure (out of memory, bad pattern).
     #[error("sparse Cholesky setup failed: {0}")]
     Setup(String),
+}
+
+/// Which factorisation the solver holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    None,
+    Llt,
+    Ldlt,
 }
 
 /// A Cholesky solver bound to one sparsity pattern.
@@ -35,7 +59,7 @@ pub struct LinearSolver {
     symbolic: SymbolicCholesky<usize>,
     l_values: Vec<Real>,
     mem: MemBuffer,
-    factored: bool,
+    kind: Kind,
 }
 
 impl LinearSolver {
@@ -60,6 +84,7 @@ impl LinearSolver {
         .map_err(|e| LinearError::Setup(format!("{e:?}")))?;
         let req = StackReq::any_of(&[
             symbolic.factorize_numeric_llt_scratch::<Real>(Par::Seq, Default::default()),
+            symbolic.factorize_numeric_ldlt_scratch::<Real>(Par::Seq, Default::default()),
             symbolic.solve_in_place_scratch::<Real>(1, Par::Seq),
         ]);
         let mem = MemBuffer::try_new(req).map_err(|e| LinearError::Setup(format!("{e:?}")))?;
@@ -68,7 +93,7 @@ impl LinearSolver {
             pattern,
             symbolic,
             mem,
-            factored: false,
+            kind: Kind::None,
         })
     }
 
@@ -79,13 +104,88 @@ impl LinearSolver {
 
     /// Numeric factorisation of the matrix with the pattern's structure and these values.
     pub fn factor(&mut self, values: &[Real]) -> Result<(), LinearError> {
-        self.factored = false;
+        self.kind = Kind::None;
         let mut l = std::mem::take(&mut self.l_values);
         let r = self.factor_to(values, &mut l);
         self.l_values = l;
         r?;
-        self.factored = true;
+        self.kind = Kind::Llt;
         Ok(())
+    }
+
+    /// Numeric LDLᵀ factorisation (no pivoting) of a symmetric, possibly indefinite matrix with
+    /// the pattern's structure; returns its number of negative eigenvalues (the negative
+    /// pivots). An exactly zero pivot is an error. Without pivoting the factorisation is stable
+    /// for matrices that are positive definite up to a few directions, which is what it serves
+    /// (callers check their solves' results).
+    pub fn factor_indefinite(&mut self, values: &[Real]) -> Result<usize, LinearError> {
+        self.kind = Kind::None;
+        let mut l = std::mem::take(&mut self.l_values);
+        let a = SparseColMatRef::new(self.pattern.as_ref(), values);
+        let stack = MemStack::new(&mut self.mem);
+        let r = self
+            .symbolic
+            .factorize_numeric_ldlt::<Real>(
+                &mut l,
+                a,
+                Side::Lower,
+                LdltRegularization::default(),
+                Par::Seq,
+                stack,
+                Default::default(),
+            )
+            .map(|_| ())
+            .map_err(|e| match e {
+                faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } => {
+                    LinearError::ZeroPivot { index }
+                }
+            });
+        self.l_values = l;
+        r?;
+        let d = self.ldlt_diagonal();
+        if d.iter().any(|v| !v.is_finite()) {
+            return Err(LinearError::ZeroPivot {
+                index: d.iter().position(|v| !v.is_finite()).unwrap_or(0),
+            });
+        }
+        self.kind = Kind::Ldlt;
+        Ok(d.iter().filter(|&&v| v < 0.0).count())
+    }
+
+    /// The pivots `D` of the last LDLᵀ factorisation, in the permuted order.
+    fn ldlt_diagonal(&self) -> Vec<Real> {
+        let l = &self.l_values;
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                // Each column stores its diagonal first.
+                let cp = s.col_ptr();
+                (0..s.nrows()).map(|j| l[cp[j]]).collect()
+            }
+            SymbolicCholeskyRaw::Supernodal(s) => {
+                let mut d = Vec::with_capacity(s.nrows());
+                let begin = s.supernode_begin();
+                let end = s.supernode_end();
+                let vp = s.col_ptr_for_val();
+                for k in 0..s.n_supernodes() {
+                    let ncols = end[k] - begin[k];
+                    let nrows = ncols + s.supernode(k).pattern().len();
+                    for j in 0..ncols {
+                        d.push(l[vp[k] + j * nrows + j]);
+                    }
+                }
+                d
+            }
+        }
+    }
+
+    /// Whether a factorisation is held (the last one succeeded).
+    pub fn is_factored(&self) -> bool {
+        self.kind != Kind::None
+    }
+
+    /// Whether the last factorisation was an LDLᵀ one (of an indefinite matrix).
+    pub fn is_indefinite(&self) -> bool {
+        self.kind == Kind::Ldlt
     }
 
     /// Numeric factorisation into caller-owned storage `l` (resized to [`Self::factor_nnz`]), to
@@ -128,9 +228,24 @@ impl LinearSolver {
 
     /// Solves `A x = rhs` in place with the last successful factorisation.
     pub fn solve_in_place(&mut self, rhs: &mut [Real]) {
-        debug_assert!(self.factored, "solve before a successful factorisation");
+        debug_assert!(
+            self.kind != Kind::None,
+            "solve before a successful factorisation"
+        );
         let l = std::mem::take(&mut self.l_values);
-        self.solve_with(&l, rhs);
+        if self.kind == Kind::Ldlt {
+            let n = rhs.len();
+            let ldlt = LdltRef::new(&self.symbolic, &l);
+            let stack = MemStack::new(&mut self.mem);
+            ldlt.solve_in_place_with_conj(
+                Conj::No,
+                MatMut::from_column_major_slice_mut(rhs, n, 1),
+                Par::Seq,
+                stack,
+            );
+        } else {
+            self.solve_with(&l, rhs);
+        }
         self.l_values = l;
     }
 }

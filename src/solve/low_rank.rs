@@ -5,9 +5,17 @@
 //!
 //! `(A + U C Uᵀ)⁻¹ r = A⁻¹r − A⁻¹U S⁻¹ Uᵀ A⁻¹ r`, `S = C⁻¹ + Uᵀ A⁻¹ U` (k×k),
 //!
-//! one extra solve per update vector (Sherman–Morrison for k = 1). Positive definiteness of the
-//! whole matrix follows from the inertia (Haynsworth): with `A ≻ 0`, `A + UCUᵀ ≻ 0` exactly when
-//! `S` has as many positive eigenvalues as `C`.
+//! one extra solve per update vector (Sherman–Morrison for k = 1). `A` need not be positive
+//! definite, only invertible: an LDLᵀ factor of an indefinite sparse part serves as well.
+//!
+//! The inertia of the whole matrix follows from that of `A` and `S` (Haynsworth, applied to the
+//! bordered matrix `[[A, U], [Uᵀ, −C⁻¹]]` eliminated both ways):
+//!
+//! `n₋(A + UCUᵀ) = n₋(A) + n₊(S) − n₊(C)`, and `A + UCUᵀ` is singular exactly when `S` is.
+//!
+//! So with `A ≻ 0` the whole is positive definite when `S` has as many positive eigenvalues as
+//! `C`; an indefinite `A` with one negative eigenvalue and one positive `c` (a gas's stiffness)
+//! gives a positive definite whole when `S < 0`.
 
 use super::linear::LinearSolver;
 use crate::energy::term::LowRank;
@@ -84,16 +92,25 @@ impl Woodbury {
 
     /// With `A ≻ 0` factorised: whether `A + UCUᵀ ≻ 0` (module doc).
     pub fn keeps_positive_definite(&self) -> bool {
+        self.negative_eigenvalues(0) == Some(0)
+    }
+
+    /// The number of negative eigenvalues of `A + UCUᵀ`, given `A`'s (`negative_a`), or `None`
+    /// when the whole is singular (module doc).
+    pub fn negative_eigenvalues(&self, negative_a: usize) -> Option<usize> {
         let k = self.c.len();
         if k == 0 {
-            return true;
+            return Some(negative_a);
         }
         let s = nalgebra::DMatrix::from_row_slice(k, k, &self.s);
         let sym = (&s + s.transpose()) * 0.5;
         let eig = nalgebra::SymmetricEigen::new(sym);
+        if eig.eigenvalues.iter().any(|&l| l == 0.0 || !l.is_finite()) {
+            return None;
+        }
         let pos_s = eig.eigenvalues.iter().filter(|&&l| l > 0.0).count();
         let pos_c = self.c.iter().filter(|&&c| c > 0.0).count();
-        pos_s == pos_c && eig.eigenvalues.iter().all(|&l| l != 0.0)
+        (negative_a + pos_s).checked_sub(pos_c)
     }
 }
 

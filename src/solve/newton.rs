@@ -46,6 +46,9 @@ pub struct NewtonReport {
     pub shifted_iterations: usize,
     /// Iterations that fell back to the Gauss–Newton Hessian (adaptive mode).
     pub gauss_newton_iterations: usize,
+    /// Iterations whose exact Hessian had an indefinite sparse part made positive definite by
+    /// its low-rank part (an LDLᵀ factorisation; adaptive mode).
+    pub indefinite_iterations: usize,
     /// Total step halvings in line searches.
     pub line_search_cuts: usize,
     /// Why it stopped, when it did not converge.
@@ -98,12 +101,32 @@ pub enum SolveError {
     /// [`crate::energy::term::Term::admissible`]).
     #[error("a term refused the step: {0}")]
     Refused(&'static str),
+    /// A term's multiplier (a prescribed volume's pressure) did not settle.
+    #[error("the multiplier of a constraint did not settle in {updates} updates")]
+    MultiplierNotConverged {
+        /// Updates done.
+        updates: usize,
+    },
     /// No reason was recorded (a converged solve asked for one).
     #[error("no failure recorded")]
     Unknown,
 }
 
 impl NewtonReport {
+    /// Adds a later solve of the same step: its counts, and its outcome as the outcome.
+    pub fn absorb(&mut self, later: &NewtonReport) {
+        self.converged = later.converged;
+        self.iterations += later.iterations;
+        self.residual = later.residual;
+        self.energy = later.energy;
+        self.max_shift = self.max_shift.max(later.max_shift);
+        self.shifted_iterations += later.shifted_iterations;
+        self.gauss_newton_iterations += later.gauss_newton_iterations;
+        self.indefinite_iterations += later.indefinite_iterations;
+        self.line_search_cuts += later.line_search_cuts;
+        self.failure.clone_from(&later.failure);
+    }
+
     /// Why it stopped, for a solve that did not converge ([`SolveError::Unknown`] if it did).
     pub fn failure_or_unknown(&self) -> SolveError {
         self.failure.clone().unwrap_or(SolveError::Unknown)
@@ -200,6 +223,68 @@ pub fn factor_with_shift_upto(
     }
 }
 
+/// The exact model Hessian of the adaptive mode: the sparse part `values` factorised by
+/// Cholesky with at most the shift `tau_max` (relative, for free rigid-body modes), or, when
+/// that fails and there are low-rank parts `lr`, by LDLᵀ without a shift; accepted when the
+/// whole (sparse + low-rank) is positive definite (the inertia, [`super::low_rank`]). Returns the
+/// shift used and the prepared low-rank solve, or `None` if the exact Hessian is not positive
+/// definite.
+pub fn exact_model(
+    lin: &mut LinearSolver,
+    pot: &Potential,
+    values: &[Real],
+    shifted: &mut [Real],
+    lr: &[crate::energy::term::LowRank],
+    tau_max: Real,
+) -> Option<(Real, super::low_rank::Woodbury)> {
+    if let Some(t) = factor_with_shift_upto(lin, pot, values, shifted, tau_max, tau_max) {
+        let wb = super::low_rank::Woodbury::new(lin, lr);
+        if wb.keeps_positive_definite() {
+            return Some((t, wb));
+        }
+        return None;
+    }
+    if lr.is_empty() {
+        return None;
+    }
+    let negative = lin.factor_indefinite(values).ok()?;
+    let wb = super::low_rank::Woodbury::new(lin, lr);
+    (wb.negative_eigenvalues(negative) == Some(0)).then_some((0.0, wb))
+}
+
+/// Whether the whole Hessian (sparse `values` + low-rank `lr`) shifted by `δ·mean|diag|`
+/// is positive definite: Cholesky of the shifted sparse part, or with low-rank parts its LDLᵀ
+/// and the inertia ([`super::low_rank`]). The stability test of an equilibrium.
+pub fn is_positive_definite(
+    lin: &mut LinearSolver,
+    pot: &Potential,
+    values: &[Real],
+    lr: &[crate::energy::term::LowRank],
+    delta: Real,
+) -> bool {
+    let n = pot.pattern.n;
+    let scale = (0..n)
+        .map(|i| values[pot.pattern.diag(i)].abs())
+        .sum::<Real>()
+        / (n.max(1) as Real);
+    let mut shifted = values.to_vec();
+    for i in 0..n {
+        shifted[pot.pattern.diag(i)] += delta * scale;
+    }
+    if lin.factor(&shifted).is_ok() {
+        return super::low_rank::Woodbury::new(lin, lr).keeps_positive_definite();
+    }
+    if lr.is_empty() {
+        return false;
+    }
+    match lin.factor_indefinite(&shifted) {
+        Ok(negative) => {
+            super::low_rank::Woodbury::new(lin, lr).negative_eigenvalues(negative) == Some(0)
+        }
+        Err(_) => false,
+    }
+}
+
 /// Minimises `pot` from `state` (updated in place).
 pub fn newton(
     pot: &Potential,
@@ -254,19 +339,29 @@ pub fn newton(
         } else {
             tau_prev
         };
+        // Dense low-rank Hessian parts (an enclosed gas's stiffness): solved by the Woodbury
+        // identity on the sparse factor, never densified.
+        let lr = pot.low_rank(&state.x, &state.dofs);
+        let mut model: Option<super::low_rank::Woodbury> = None;
         let mut factored = false;
         if mode == HessianProjection::Adaptive {
-            // Exact Hessian, at most with the tiny shift that free rigid-body modes need; if it
-            // is genuinely indefinite, use the Gauss–Newton Hessian instead.
+            // Exact Hessian, at most with the tiny shift that free rigid-body modes need; with a
+            // low-rank part, an indefinite sparse part is accepted when the whole is positive
+            // definite (LDLᵀ and the inertia). If it is genuinely indefinite, use the
+            // Gauss–Newton Hessian instead.
             let exact = if try_exact {
-                factor_with_shift_upto(lin, pot, &ws.values, &mut ws.shifted, tau0.min(1e-8), 1e-8)
+                exact_model(lin, pot, &ws.values, &mut ws.shifted, &lr, tau0.min(1e-8))
             } else {
                 None
             };
             match exact {
-                Some(t) => {
+                Some((t, wb)) => {
                     factored = true;
                     tau0 = t;
+                    model = Some(wb);
+                    if lin.is_indefinite() {
+                        rep.indefinite_iterations += 1;
+                    }
                 }
                 None => {
                     if try_exact {
@@ -306,15 +401,13 @@ pub fn newton(
         for (s, g) in ws.step.iter_mut().zip(&ws.grad) {
             *s = -g;
         }
-        let lr = pot.low_rank(&state.x, &state.dofs);
-        if lr.is_empty() {
-            lin.solve_in_place(&mut ws.step);
-        } else {
-            let wb = super::low_rank::Woodbury::new(lin, &lr);
-            if !wb.solve_in_place(lin, &mut ws.step) {
-                rep.failure = Some(SolveError::LowRankSingular);
-                return rep;
-            }
+        let wb = match model {
+            Some(wb) => wb,
+            None => super::low_rank::Woodbury::new(lin, &lr),
+        };
+        if !wb.solve_in_place(lin, &mut ws.step) {
+            rep.failure = Some(SolveError::LowRankSingular);
+            return rep;
         }
         rep.iterations += 1;
         let slope: Real = ws.step.iter().zip(&ws.grad).map(|(d, g)| d * g).sum();

@@ -112,6 +112,12 @@ impl<'a> Potential<'a> {
         let (abar, bbar) = self.rest_forms(f);
         let (ws, wb) = KoiterDensity::weights(&abar, sc.thickness[f], sc.stretch_factor);
         let ws = ws * self.stretch_scale;
+        // A pure membrane has no bending energy (b ≡ 0, whatever b̄ the mesh's shape gives).
+        let wb = if sc.settings.material.bending == crate::settings::BendingModel::None {
+            0.0
+        } else {
+            wb
+        };
         let mut d = KoiterDensity {
             c: sv_matrix(&abar, sc.lame[f]),
             stretch: [(ws, abar), (0.0, Sym2::zeros())],
@@ -212,17 +218,23 @@ impl<'a> Potential<'a> {
             t.low_rank(self, x, phi, &mut out);
         }
         for lr in &mut out {
-            for (u, &fx) in self.scene.node_fixed.iter().enumerate() {
-                if fx {
-                    let (d0, k) = self.pattern.node_dofs(u);
-                    lr.u[d0..d0 + k].fill(0.0);
-                }
-            }
-            for &d in &self.scene.pinned_dofs {
-                lr.u[d] = 0.0;
-            }
+            self.mask_fixed(&mut lr.u);
         }
         out
+    }
+
+    /// Zeroes the entries of a DOF vector on fixed nodes and pinned DOFs (the DOFs the
+    /// solver does not move).
+    pub fn mask_fixed(&self, v: &mut [Real]) {
+        for (u, &fx) in self.scene.node_fixed.iter().enumerate() {
+            if fx {
+                let (d0, k) = self.pattern.node_dofs(u);
+                v[d0..d0 + k].fill(0.0);
+            }
+        }
+        for &d in &self.scene.pinned_dofs {
+            v[d] = 0.0;
+        }
     }
 
     /// Energies by term name at `(x, phi)` (each term's [`crate::energy::term::Term::energies`]).

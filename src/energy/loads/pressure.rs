@@ -16,7 +16,7 @@
 
 use super::select_faces;
 use crate::energy::term::{ElementKernel, ElementTerm, Stencil, Term};
-use crate::math::{skew, Real, SMat, SVec, Vec3};
+use crate::math::{Real, SMat, SVec, Vec3};
 use crate::mesh::MeshError;
 use crate::scene::Scene;
 use crate::solve::Potential;
@@ -28,6 +28,9 @@ pub struct Pressure {
 }
 
 impl ElementKernel<9, 3> for Pressure {
+    /// The per-face split of `∇²V` depends on the origin: never projected face by face.
+    const PROJECTABLE: bool = false;
+
     #[inline]
     fn eval(
         &self,
@@ -40,27 +43,8 @@ impl ElementKernel<9, 3> for Pressure {
         grad: Option<&mut SVec<9>>,
         hess: Option<&mut SMat<9, 9>>,
     ) -> Real {
-        let w = -pot.dial * self.faces[e].1 / 6.0;
-        let [x0, x1, x2] = [x[nodes[0]], x[nodes[1]], x[nodes[2]]];
-        if let Some(g) = grad {
-            let gs = [x1.cross(&x2), x2.cross(&x0), x0.cross(&x1)];
-            for (i, gi) in gs.iter().enumerate() {
-                g.fixed_rows_mut::<3>(3 * i).copy_from(&(gi * w));
-            }
-        }
-        if let Some(h) = hess {
-            h.fill(0.0);
-            let xs = [x0, x1, x2];
-            for i in 0..3 {
-                let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-                // ∂²V/∂x_i∂x_j = −[x_k]×/6, and its transpose in (j, i).
-                let b = -skew(&xs[k]) * w;
-                h.fixed_view_mut::<3, 3>(3 * i, 3 * j).copy_from(&b);
-                h.fixed_view_mut::<3, 3>(3 * j, 3 * i)
-                    .copy_from(&b.transpose());
-            }
-        }
-        w * x0.dot(&x1.cross(&x2))
+        let xs = [x[nodes[0]], x[nodes[1]], x[nodes[2]]];
+        crate::geometry::cone_volume(&xs, -pot.dial * self.faces[e].1, grad, hess)
     }
 }
 

@@ -7,15 +7,19 @@
 //! * [`koiter`]: St Venant–Kirchhoff / Koiter (seed 000), the default;
 //! * [`neo_hookean`]: incompressible neo-Hookean rubber;
 //! * [`mooney_rivlin`]: incompressible Mooney–Rivlin rubber;
-//! * [`baraff_witkin`]: seed 003's strain-limiting Baraff–Witkin cloth.
+//! * [`baraff_witkin`]: seed 003's strain-limiting Baraff–Witkin cloth;
+//! * [`prism`]: seed 002's three-prism element with a thickness (3D St Venant–Kirchhoff or
+//!   neo-Hookean), incompressible or with the seed's position-based volume preservation.
 
 pub mod baraff_witkin;
 pub mod koiter;
 pub mod mooney_rivlin;
 pub mod neo_hookean;
+pub mod prism;
 
 use crate::energy::material::{DensityDerivs, FaceDensity, KoiterDensity};
-use crate::math::{Mat3, Real, Sym2};
+use crate::energy::term::StateError;
+use crate::math::{Mat3, Real, Sym2, Vec3};
 use crate::solve::Potential;
 
 /// A membrane material: gives each face's energy density at a potential's rest state.
@@ -24,6 +28,37 @@ pub trait Membrane: Send + Sync + 'static {
     type Density: FaceDensity;
     /// The density of face `f`.
     fn density(&self, pot: &Potential, f: usize) -> Self::Density;
+
+    /// Per-face fields for the frames (default: none).
+    fn face_fields(&self, _pot: &Potential, _x: &[Vec3]) -> Vec<(String, Vec<Real>)> {
+        Vec::new()
+    }
+
+    /// Quantities for `log.csv` (default: none).
+    fn observables(&self, _pot: &Potential, _x: &[Vec3]) -> Vec<(String, Real)> {
+        Vec::new()
+    }
+
+    /// A projection after each accepted implicit step that moves the positions (default: none;
+    /// see [`crate::energy::term::Term::project`]).
+    fn project(&self, _pot: &Potential, _x: &mut [Vec3]) -> Option<Real> {
+        None
+    }
+
+    /// The per-face state a restart needs, one value per face (default: none).
+    fn state_field(&self) -> Option<&'static str> {
+        None
+    }
+
+    /// That state.
+    fn state(&self) -> Vec<Real> {
+        Vec::new()
+    }
+
+    /// Restores that state from a restart frame's field (`None` when absent).
+    fn restore(&self, _field: Option<&[Real]>) -> Result<Option<String>, StateError> {
+        Ok(None)
+    }
 }
 
 /// A hyperelastic membrane law of one face, `W(a)` (J), with its derivatives in `a`.
