@@ -8,6 +8,8 @@ mod closed;
 mod diffusion;
 #[path = "unit/fd.rs"]
 mod fd;
+#[path = "unit/gas.rs"]
+mod gas;
 #[path = "unit/geometry.rs"]
 mod geometry;
 #[path = "unit/io.rs"]

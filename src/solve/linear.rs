@@ -178,6 +178,12 @@ impl LinearSolver {
         }
     }
 
+    /// Whether the symbolic factorisation is supernodal (larger matrices) rather than
+    /// simplicial (the two store the LDLᵀ pivots differently).
+    pub fn is_supernodal(&self) -> bool {
+        matches!(self.symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_))
+    }
+
     /// Whether a factorisation is held (the last one succeeded).
     pub fn is_factored(&self) -> bool {
         self.kind != Kind::None

@@ -156,11 +156,14 @@ fn check_term(sc: &Scene, p: &Pattern, pot: &Potential, x: &[Vec3], phi: &[Real]
     );
 }
 
-const MATERIALS: [&str; 4] = [
+const MATERIALS: [&str; 7] = [
     "model = \"koiter\"",
     "model = \"neo_hookean\"",
     "model = \"mooney_rivlin\"\nc1 = 3e5\nc2 = 1e5",
     "model = \"baraff_witkin\"\nbaraff_witkin = { direction = [1, 1, 0] }",
+    "model = \"prism\"\npoisson = 0.45",
+    "model = \"prism\"\npoisson = 0.5\nprism = { law = \"neo_hookean\" }",
+    "model = \"prism\"\npoisson = 0.4\nprism = { law = \"neo_hookean\", thickness = \"pbd\" }",
 ];
 const BENDING: [&str; 5] = [
     "bending = \"midedge_average\"",
