@@ -35,11 +35,7 @@ fn main() {
             r.execs as f64 / r.seconds
         );
         for (i, (msg, input)) in r.crashes.iter().enumerate() {
-            let ext = match h.target {
-                shellsim::fuzz::Target::Legacy => "vtk",
-                shellsim::fuzz::Target::Settings => "toml",
-                _ => "vtu",
-            };
+            let ext = h.target.ext();
             let _ = std::fs::create_dir_all(&crash_dir);
             let p = crash_dir.join(format!("{}-{i}.{ext}", h.target.name()));
             let _ = std::fs::write(&p, input);

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The long fuzzing run: EXECS mutated inputs per input path (legacy VTK, XML VTK, settings,
-# restart frames; default 250000 each, 10⁶ in all) in-process, on stable Rust.
+# restart frames, OFF, OBJ, PLY, STL; default 250000 each, 2·10⁶ in all) in-process, on stable
+# Rust.
 #
 #     scripts/fuzz.sh [EXECS_PER_TARGET] [SEED]
 #

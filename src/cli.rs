@@ -36,7 +36,8 @@ pub struct Cli {
     /// Settings file (TOML); see docs/settings.md.
     #[arg(required = true)]
     settings: Option<PathBuf>,
-    /// Triangle mesh (.vtk legacy ASCII/binary, or .vtu/.vtp XML with inline data).
+    /// Triangle mesh: .vtk (legacy ASCII/binary), .vtu/.vtp (XML with inline data), or .off,
+    /// .obj, .ply, .stl.
     #[arg(required = true)]
     mesh: Option<PathBuf>,
     /// Output folder (created if needed). One holding an earlier run's output is refused
@@ -79,6 +80,18 @@ enum Shape {
     Disk,
     /// Annulus --inner ≤ r ≤ --radius, optionally a sector of --sweep degrees.
     Annulus,
+    /// Closed: a geodesic sphere of radius --radius.
+    Sphere,
+    /// Closed: a capsule (a tube with hemispherical ends) of radius --radius and length
+    /// 3 × radius.
+    Capsule,
+    /// Closed: two overlapping lobes (radii --radius and 0.85 × radius) joined smoothly.
+    Peanut,
+    /// Closed: a teddy-like head (radius --radius) with two ears (0.38 × radius) on a body
+    /// (1.25 × radius), joined smoothly.
+    Teddy,
+    /// Closed: a torus of major radius --radius and tube radius --tube.
+    Torus,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
@@ -113,6 +126,9 @@ struct MeshArgs {
     /// Inner radius of an annulus (m).
     #[arg(long, default_value_t = 0.5)]
     inner: Real,
+    /// Tube radius of a torus (m).
+    #[arg(long, default_value_t = 0.3)]
+    tube: Real,
     /// Angular extent of an annulus in degrees (360 = full ring).
     #[arg(long, default_value_t = 360.0)]
     sweep: Real,
@@ -285,8 +301,18 @@ fn mesh_cmd(a: MeshArgs) -> Result<()> {
     if a.delaunay && a.jitter > 0.0 {
         bail!("--jitter does not apply to --delaunay meshes (they are irregular already)");
     }
-    if a.delaunay && matches!(a.shape, Shape::Disk) {
+    let closed = matches!(
+        a.shape,
+        Shape::Sphere | Shape::Capsule | Shape::Peanut | Shape::Teddy | Shape::Torus
+    );
+    if a.delaunay && (closed || matches!(a.shape, Shape::Disk)) {
         bail!("--delaunay supports square, rectangle and annulus");
+    }
+    if closed && (a.jitter > 0.0 || a.grading != 1.0 || a.checkerboard || a.program.is_some()) {
+        bail!(
+            "--jitter, --grading, --checkerboard and --program apply to flat sheets, not to \
+             closed surfaces"
+        );
     }
     let mut mesh = match a.shape {
         Shape::Square | Shape::Rectangle => {
@@ -328,6 +354,34 @@ fn mesh_cmd(a: MeshArgs) -> Result<()> {
             } else {
                 annulus(a.inner, a.radius, sweep, a.edge, sp)
             }
+        }
+        Shape::Sphere | Shape::Capsule | Shape::Peanut | Shape::Teddy => {
+            pos("radius", a.radius)?;
+            if a.edge > a.radius {
+                bail!(
+                    "--edge ({}) must not exceed --radius ({}) for a closed surface",
+                    a.edge,
+                    a.radius
+                );
+            }
+            let name = format!("{:?}", a.shape).to_lowercase();
+            crate::mesh::surfaces::closed_shape(&name, a.radius, a.edge)
+                .map_err(|e| anyhow!("cannot mesh the {name}: {e}"))?
+        }
+        Shape::Torus => {
+            pos("radius", a.radius)?;
+            pos("tube", a.tube)?;
+            if a.tube >= a.radius {
+                bail!(
+                    "--tube ({}) must be smaller than --radius ({})",
+                    a.tube,
+                    a.radius
+                );
+            }
+            if a.edge > a.tube {
+                bail!("--edge ({}) must not exceed --tube ({})", a.edge, a.tube);
+            }
+            crate::mesh::surfaces::torus(a.radius, a.tube, a.edge)
         }
     };
     if let Some(p) = &a.program {

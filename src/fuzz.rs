@@ -1,5 +1,6 @@
 //! An in-process fuzzer on stable Rust for shellsim's input paths: legacy VTK, XML VTK, the
-//! settings (through [`Scene::build`]) and restart frames.
+//! shape-collection formats (OFF, OBJ, PLY, STL), the settings (through [`Scene::build`]) and
+//! restart frames.
 //!
 //! Each execution takes a seed input, applies one to four structured mutations (truncation,
 //! bit flips, a number replaced by an extreme one, a count edited, a span deleted, duplicated or
@@ -26,15 +27,27 @@ pub enum Target {
     Settings,
     /// `.vtu` frame bytes → restart state for a fixed scene.
     Restart,
+    /// `.off` bytes → mesh → validation → topology.
+    Off,
+    /// `.obj` bytes → mesh → validation → topology.
+    Obj,
+    /// `.ply` bytes (ASCII and binary) → mesh → validation → topology.
+    Ply,
+    /// `.stl` bytes (ASCII and binary) → mesh → validation → topology.
+    Stl,
 }
 
 impl Target {
     /// All targets, in order.
-    pub const ALL: [Target; 4] = [
+    pub const ALL: [Target; 8] = [
         Target::Legacy,
         Target::Xml,
         Target::Settings,
         Target::Restart,
+        Target::Off,
+        Target::Obj,
+        Target::Ply,
+        Target::Stl,
     ];
     /// Its name in reports and crash files.
     pub fn name(self) -> &'static str {
@@ -43,7 +56,31 @@ impl Target {
             Target::Xml => "xml",
             Target::Settings => "settings",
             Target::Restart => "restart",
+            Target::Off => "off",
+            Target::Obj => "obj",
+            Target::Ply => "ply",
+            Target::Stl => "stl",
         }
+    }
+
+    /// The file extension of its inputs.
+    pub fn ext(self) -> &'static str {
+        match self {
+            Target::Legacy => "vtk",
+            Target::Xml | Target::Restart => "vtu",
+            Target::Settings => "toml",
+            Target::Off => "off",
+            Target::Obj => "obj",
+            Target::Ply => "ply",
+            Target::Stl => "stl",
+        }
+    }
+
+    /// The target of an extension or name (`vtk` and `legacy` alike).
+    pub fn from_name(name: &str) -> Option<Target> {
+        Target::ALL
+            .into_iter()
+            .find(|t| t.name() == name || (t.ext() == name && *t != Target::Restart))
     }
 }
 
@@ -215,18 +252,16 @@ impl Harness {
     pub fn exec(&self, input: &[u8]) -> Result<bool, String> {
         let run = || -> Result<bool, String> {
             Ok(match self.target {
-                Target::Legacy | Target::Xml => {
-                    let ext = if self.target == Target::Legacy {
-                        "vtk"
-                    } else {
-                        "vtu"
-                    };
-                    match mesh_from_bytes(input, ext) {
-                        Err(e) if e.contains("please report") => return Err(e),
-                        Err(_) => false,
-                        Ok(m) => m.validate().is_ok() && Topology::build(&m).is_ok(),
-                    }
-                }
+                Target::Legacy
+                | Target::Xml
+                | Target::Off
+                | Target::Obj
+                | Target::Ply
+                | Target::Stl => match mesh_from_bytes(input, self.target.ext()) {
+                    Err(e) if e.contains("please report") => return Err(e),
+                    Err(_) => false,
+                    Ok(m) => m.validate().is_ok() && Topology::build(&m).is_ok(),
+                },
                 Target::Settings => {
                     let text = String::from_utf8_lossy(input);
                     match Settings::from_str_with(&text, "fuzz", &[]) {
@@ -280,7 +315,8 @@ impl Harness {
 }
 
 /// The harnesses of all targets, with seeds from a source tree at `root`: the VTK files under
-/// `tests/data/vtk`, the scenes under `settings/`, and files shellsim writes itself (a small
+/// `tests/data/vtk` and `tests/data/shapes`, the scenes under `settings/`, and files shellsim
+/// writes itself (a small
 /// programmed sheet in every output format, a restart frame with velocities and edge angles).
 pub fn harnesses(root: &std::path::Path) -> Result<Vec<Harness>, String> {
     use crate::mesh::io::{mesh_to_bytes, Format};
@@ -343,6 +379,14 @@ pub fn harnesses(root: &std::path::Path) -> Result<Vec<Harness>, String> {
         },
     );
     let restart = vec![own(&frame, Format::Vtu)?];
+    let shapes = |t: Target| -> Result<Harness, String> {
+        Ok(Harness {
+            target: t,
+            seeds: read_dir("tests/data/shapes", &[t.ext()])?,
+            mesh: None,
+            scene: None,
+        })
+    };
     Ok(vec![
         Harness {
             target: Target::Legacy,
@@ -368,5 +412,9 @@ pub fn harnesses(root: &std::path::Path) -> Result<Vec<Harness>, String> {
             mesh: None,
             scene: Some(scene),
         },
+        shapes(Target::Off)?,
+        shapes(Target::Obj)?,
+        shapes(Target::Ply)?,
+        shapes(Target::Stl)?,
     ])
 }

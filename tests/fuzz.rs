@@ -47,13 +47,9 @@ fn crash_inputs_found_before_are_rejected_cleanly() {
     for entry in std::fs::read_dir(&dir).unwrap() {
         let p = entry.unwrap().path();
         let name = p.file_name().unwrap().to_string_lossy().into_owned();
-        let target = match name.split('-').next().unwrap() {
-            "legacy" => Target::Legacy,
-            "xml" => Target::Xml,
-            "settings" => Target::Settings,
-            "restart" => Target::Restart,
-            other => panic!("{name}: unknown target '{other}'"),
-        };
+        let prefix = name.split('-').next().unwrap();
+        let target = Target::from_name(prefix)
+            .unwrap_or_else(|| panic!("{name}: unknown target '{prefix}'"));
         let h = hs.iter().find(|h| h.target == target).unwrap();
         let bytes = std::fs::read(&p).unwrap();
         assert_eq!(

@@ -16,5 +16,7 @@ mod geometry;
 mod io;
 #[path = "unit/settings.rs"]
 mod settings;
+#[path = "unit/shapes.rs"]
+mod shapes;
 #[path = "unit/terms.rs"]
 mod terms;

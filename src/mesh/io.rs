@@ -1,4 +1,5 @@
-//! Reading and writing triangle meshes in VTK formats.
+//! Reading and writing triangle meshes in VTK formats, and reading the formats shape
+//! collections use (OFF, OBJ, PLY, STL: [`super::shapes`]).
 //!
 //! Read: legacy `.vtk` (ASCII or big-endian binary, versions 2.0–5.1; POLYDATA or
 //! UNSTRUCTURED_GRID of triangles) and XML `.vtu`/`.vtp` with inline (base64 or ASCII) data, which
@@ -39,14 +40,20 @@ pub fn read_mesh(path: &Path) -> Result<Mesh, MeshError> {
     Ok(mesh)
 }
 
-/// Parses mesh bytes of the format named by a file extension (`vtk`, `vtu`, `vtp`).
+/// Parses mesh bytes of the format named by a file extension (`vtk`, `vtu`, `vtp`, and the
+/// shape-collection formats `off`, `obj`, `ply`, `stl`, [`super::shapes`]).
 pub fn mesh_from_bytes(bytes: &[u8], ext: &str) -> Result<Mesh, String> {
     let raw = match ext {
         "vtk" => guard(|| super::legacy::parse(bytes))?,
         "vtu" | "vtp" => guard(|| super::xml::parse(bytes))?,
+        "off" => guard(|| super::shapes::parse_off(bytes))?,
+        "obj" => guard(|| super::shapes::parse_obj(bytes))?,
+        "ply" => guard(|| super::shapes::parse_ply(bytes))?,
+        "stl" => guard(|| super::shapes::parse_stl(bytes))?,
         other => {
             return Err(format!(
-                "unknown mesh extension '.{other}' (expected .vtk, .vtu or .vtp)"
+                "unknown mesh extension '.{other}' (expected .vtk, .vtu, .vtp, .off, .obj, .ply \
+                 or .stl)"
             ))
         }
     };

@@ -1,7 +1,7 @@
 //! Triangle meshes: the reference positions, the faces, and the per-face and per-vertex fields
 //! that a mesh file carries (`abar_info`, `ref_thicknesses`, `constraint_indicators`, ...).
 //!
-//! Consumes: a VTK file (or a generator's parameters). Produces: a validated [`Mesh`] and its
+//! Consumes: a VTK, OFF, OBJ, PLY or STL file (or a generator's parameters). Produces: a validated [`Mesh`] and its
 //! [`Topology`]. Nothing downstream touches files.
 
 pub mod closed;
@@ -9,6 +9,8 @@ pub mod delaunay;
 pub mod generate;
 pub mod io;
 mod legacy;
+mod shapes;
+pub mod surfaces;
 pub mod topology;
 mod xml;
 
