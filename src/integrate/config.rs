@@ -38,6 +38,9 @@ pub struct StaticConfig {
     pub max_saddle_escapes: usize,
     /// Write a frame after every accepted continuation step (each solved to full tolerance).
     pub continuation_frames: bool,
+    /// Under a prescribed gas pressure, its value at dial 1 (Pa): a stalled continuation is
+    /// reported as the pressure's limit point.
+    pub pressure_control: Option<Real>,
     /// Membrane continuation: the stretching weight starts at 1/softening (1 = off). Off when
     /// loads, prescribed paths or a gas are given: a softened membrane would follow another
     /// path (and inflate without bound).
@@ -91,6 +94,8 @@ impl RunConfig {
                 max_saddle_escapes: st.max_saddle_escapes,
                 continuation_frames: s.output.continuation_frames,
                 softening: softening.max(1.0),
+                pressure_control: (s.gas.control == crate::settings::GasControl::Pressure)
+                    .then_some(s.gas.pressure),
             },
             dynamics: DynamicConfig {
                 time: s.time.clone(),

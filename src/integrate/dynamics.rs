@@ -69,7 +69,7 @@ pub(super) fn run_dynamic(
             failure = Some(f);
             break;
         }
-        let h = steps.step.min(clock.next - t).min(tm.end - t);
+        let h = clock.step_from(t, steps.step).min(tm.end - t);
         let dial = dial_at(t + h);
         for i in 0..n {
             xhat[i] = state.x[i] + v[i] * h;
@@ -218,7 +218,7 @@ pub(super) fn run_dynamic(
             }
             let pot = accepted(s.potential(dial), moisture.as_ref(), &targets);
             s.frame(writer, &pot, &state, &v, t)?;
-            clock.passed(t, eps_t);
+            clock.passed(t, h, eps_t);
         }
         if stop {
             break;

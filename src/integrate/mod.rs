@@ -80,6 +80,23 @@ pub enum RunFailure {
         /// The last solve's failure.
         cause: SolveError,
     },
+    /// Statics under a prescribed gas pressure: no equilibrium beyond a pressure (a limit
+    /// point of the pressure–volume curve, or a snap).
+    #[error(
+        "no equilibrium found beyond a gauge pressure of {} Pa (dial {dial:.6}, enclosed volume {} m³): the balloon's pressure has a maximum there (its limit point: a rubber sphere's pressure peaks at a stretch of 7^(1/6) = 1.38) and a higher pressure has no equilibrium nearby. Prescribe the volume (gas.control = \"volume\") or the amount of gas (\"amount\") to follow the curve through it. Last solve: {cause}",
+        crate::math::sci(*.pressure),
+        crate::math::sci(*.volume)
+    )]
+    PressureLimit {
+        /// The last gauge pressure with an equilibrium (Pa).
+        pressure: Real,
+        /// Its dial.
+        dial: Real,
+        /// The enclosed volume there (m³).
+        volume: Real,
+        /// The last solve's failure.
+        cause: SolveError,
+    },
     /// Statics: raising the stretching weight back to 1 failed.
     #[error("membrane continuation stalled at stretching weight {scale:.3e}: {cause}")]
     MembraneContinuation {
@@ -509,17 +526,32 @@ impl OutputClock {
         }
     }
 
-    /// Whether time `t`, reached by a step `h`, is an output time (within round-off `eps`).
+    /// Whether time `t`, reached by a step `h`, is an output time (within round-off: 1e-9 of
+    /// the step, at least `eps`).
     pub fn due(&self, t: Real, h: Real, eps: Real) -> bool {
         t >= self.next - 1e-9 * h.max(eps)
     }
 
-    /// Moves the next output time past `t`.
-    pub fn passed(&mut self, t: Real, eps: Real) {
-        while self.next <= t + eps {
+    /// Moves the next output time past `t`, reached by a step `h` (with [`Self::due`]'s
+    /// tolerance, so that an output time just ahead of `t` by round-off is passed too).
+    pub fn passed(&mut self, t: Real, h: Real, eps: Real) {
+        let tol = 1e-9 * h.max(eps);
+        while self.next <= t + tol {
             self.next += self.interval;
         }
         self.next = self.next.min(self.end);
+    }
+
+    /// The step to take from `t` given the step control's `step`: `step`, shortened to land on
+    /// the next output time, or stretched by up to 1% to land on it instead of leaving a sliver
+    /// (a step of round-off size, which an implicit solve cannot resolve).
+    pub fn step_from(&self, t: Real, step: Real) -> Real {
+        let left = self.next - t;
+        if left <= 1.01 * step {
+            left
+        } else {
+            step
+        }
     }
 }
 
@@ -626,10 +658,21 @@ mod tests {
         assert!((c.next - 0.1).abs() < 1e-15);
         assert!(!c.due(0.05, 0.05, 1e-12));
         assert!(c.due(0.1, 0.05, 1e-12));
-        c.passed(0.1, 1e-12);
+        c.passed(0.1, 0.05, 1e-12);
         assert!((c.next - 0.2).abs() < 1e-12);
-        c.passed(0.2, 1e-12);
+        c.passed(0.2, 0.05, 1e-12);
         assert_eq!(c.next, 0.25, "the last output is at the end");
+        // Three steps of 1/30 s reach 0.0999999999, due at 0.1 within round-off: the clock
+        // passes 0.1 too, and the next step does not shrink to the leftover 1e-10 s.
+        let mut c = OutputClock::new(0.0, 0.1, 1.0);
+        let t = 3.0 * 0.0333333333;
+        assert!(c.due(t, 0.0333333333, 1e-12));
+        c.passed(t, 0.0333333333, 1e-12);
+        assert!((c.next - 0.2).abs() < 1e-12);
+        assert_eq!(c.step_from(t, 0.0333333333), 0.0333333333);
+        // A step that would leave a sliver before the output is stretched to it.
+        let c = OutputClock::new(0.0, 0.1, 1.0);
+        assert_eq!(c.step_from(0.0667, 0.0333), c.next - 0.0667);
         // A restart at 0.3 of a grid of 0.1 resumes at 0.4.
         let c = OutputClock::new(0.3, 0.1, 1.0);
         assert!((c.next - 0.4).abs() < 1e-12);

@@ -102,10 +102,18 @@ pub(super) fn run_static(
         } else if dial < 1.0 {
             s.summary.rejected_steps += 1;
             if !steps.rejected(steps.step) {
-                failure = Some(RunFailure::ContinuationStep {
-                    min: min_step,
-                    dial,
-                    cause: rep.failure_or_unknown(),
+                failure = Some(match cf.pressure_control {
+                    Some(p) => RunFailure::PressureLimit {
+                        pressure: p * dial,
+                        dial,
+                        volume: crate::mesh::closed::enclosed_volume(&state.x, &s.scene.mesh.faces),
+                        cause: rep.failure_or_unknown(),
+                    },
+                    None => RunFailure::ContinuationStep {
+                        min: min_step,
+                        dial,
+                        cause: rep.failure_or_unknown(),
+                    },
                 });
                 break;
             }
