@@ -662,10 +662,15 @@ mod tests {
         assert!((c.next - 0.2).abs() < 1e-12);
         c.passed(0.2, 0.05, 1e-12);
         assert_eq!(c.next, 0.25, "the last output is at the end");
-        // Three steps of 1/30 s reach 0.0999999999, due at 0.1 within round-off: the clock
-        // passes 0.1 too, and the next step does not shrink to the leftover 1e-10 s.
+        // Steps of 0.0333333333 s: the third is stretched to land on 0.1 instead of leaving a
+        // 1e-10 s sliver, which an implicit solve cannot resolve.
         let mut c = OutputClock::new(0.0, 0.1, 1.0);
-        let t = 3.0 * 0.0333333333;
+        let t = 2.0 * 0.0333333333;
+        let h = c.step_from(t, 0.0333333333);
+        assert_eq!(h, c.next - t);
+        assert!(c.due(t + h, h, 1e-12));
+        // An output reached within round-off is passed (the next one is 0.2, not 0.1).
+        let t = 0.1 - 1e-11;
         assert!(c.due(t, 0.0333333333, 1e-12));
         c.passed(t, 0.0333333333, 1e-12);
         assert!((c.next - 0.2).abs() < 1e-12);
