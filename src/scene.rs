@@ -460,10 +460,15 @@ impl Scene {
 
     /// Applies every term's projection after an accepted implicit step (see
     /// [`crate::energy::term::Term::project`]).
-    pub fn project(&self, pot: &crate::solve::Potential, state: &mut crate::solve::State) {
+    pub fn project(
+        &self,
+        pot: &crate::solve::Potential,
+        state: &mut crate::solve::State,
+    ) -> Result<(), crate::energy::term::StateError> {
         for t in self.terms.iter() {
-            t.project(pot, &mut state.x, &state.dofs);
+            t.project(pot, &mut state.x, &state.dofs)?;
         }
+        Ok(())
     }
 
     /// Lets every term update its multiplier after a converged solve; `true` when one did and

@@ -317,7 +317,12 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
         self.membrane.observables(pot, x)
     }
 
-    fn project(&self, pot: &Potential, x: &mut [Vec3], _phi: &[Real]) -> Option<Real> {
+    fn project(
+        &self,
+        pot: &Potential,
+        x: &mut [Vec3],
+        _phi: &[Real],
+    ) -> Result<Option<Real>, super::term::StateError> {
         self.membrane.project(pot, x)
     }
 

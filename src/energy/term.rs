@@ -163,9 +163,15 @@ pub trait Term: Send + Sync {
     /// A projection applied after each accepted implicit step (before the velocities are
     /// taken from the positions), such as seed 002's position-based volume preservation; it may
     /// move the positions and the term's own state. Returns the relative constraint error it
-    /// corrected, or `None` when the term has none (default).
-    fn project(&self, _pot: &Potential, _x: &mut [Vec3], _phi: &[Real]) -> Option<Real> {
-        None
+    /// corrected, or `None` when the term has none (default); an error (an element turned inside
+    /// out) leaves its state as it was, and the driver cuts the step.
+    fn project(
+        &self,
+        _pot: &Potential,
+        _x: &mut [Vec3],
+        _phi: &[Real],
+    ) -> Result<Option<Real>, StateError> {
+        Ok(None)
     }
 
     /// The tracked state at `(x, phi)` for [`Term::state_field`]: [`Term::state_components`]

@@ -168,9 +168,21 @@ pub(super) fn run_dynamic(
         }
         // Projections after the implicit step (seed 002's volume preservation), before the
         // velocities are taken from the positions (its Algorithm 1, lines 10–12).
-        {
+        let projected = {
             let pot = accepted(s.potential(dial), moisture.as_ref(), &trial_targets);
-            sc.project(&pot, &mut trial);
+            sc.project(&pot, &mut trial)
+        };
+        if let Err(e) = projected {
+            s.summary.rejected_steps += 1;
+            if !steps.rejected(h) {
+                failure = Some(RunFailure::TimeStep {
+                    dt_min: tm.dt_min,
+                    t,
+                    cause: crate::solve::SolveError::Projection(e.to_string()),
+                });
+                break;
+            }
+            continue;
         }
         for ((vi, t), x) in v.iter_mut().zip(&trial.x).zip(&state.x) {
             *vi = (t - x) / h;

@@ -107,6 +107,9 @@ pub enum SolveError {
         /// Updates done.
         updates: usize,
     },
+    /// A projection after the step failed (an element turned inside out).
+    #[error("the step's projection failed: {0}")]
+    Projection(String),
     /// No reason was recorded (a converged solve asked for one).
     #[error("no failure recorded")]
     Unknown,

@@ -537,7 +537,7 @@ fn position_based_projection_restores_the_skin_volume() {
                 .1
         };
         let r0 = ratio(&x);
-        let c = shell.project(&pot, &mut x, &[]).unwrap();
+        let c = shell.project(&pot, &mut x, &[]).unwrap().unwrap();
         let r1 = ratio(&x);
         println!("{iterations} projections: ratio {r0} → {r1} (C/V₀ = {c:e})");
         assert!((c - (r0 - 1.0)).abs() < 1e-12);
@@ -551,6 +551,17 @@ fn position_based_projection_restores_the_skin_volume() {
             if sc.fixed[v] {
                 assert_eq!(x[v], before[v]);
             }
+        }
+        // A collapsed face has no normal: the projection refuses (its thickness would not be a
+        // number), naming a face, and leaves the thickness state as it was.
+        if iterations == 1 {
+            let mut y = x.clone();
+            let f0 = sc.mesh.faces[0];
+            y[f0[1]] = y[f0[0]];
+            let state = shell.state(&x, &[]);
+            let err = shell.project(&pot, &mut y, &[]).unwrap_err();
+            assert!(err.to_string().contains("thickness not finite"), "{err}");
+            assert_eq!(shell.state(&x, &[]), state, "the state is left as it was");
         }
         // The frame's thickness field is the projected thickness: thinner than at rest.
         let fields = shell.face_fields(&pot, &x, &[]);

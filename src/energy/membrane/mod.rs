@@ -41,8 +41,8 @@ pub trait Membrane: Send + Sync + 'static {
 
     /// A projection after each accepted implicit step that moves the positions (default: none;
     /// see [`crate::energy::term::Term::project`]).
-    fn project(&self, _pot: &Potential, _x: &mut [Vec3]) -> Option<Real> {
-        None
+    fn project(&self, _pot: &Potential, _x: &mut [Vec3]) -> Result<Option<Real>, StateError> {
+        Ok(None)
     }
 
     /// The per-face state a restart needs, one value per face (default: none).

@@ -246,8 +246,13 @@ impl Prism {
     /// 1/2 to its virtual vertex; fixed vertices do not move), `n` the number of points. Then
     /// `h` is read back as the height of `x₄` over its moved face. `iterations` projections
     /// (1 in the seed). Moves `x` and the thickness state; returns `C/V_b⁰` before the first
-    /// projection.
-    pub fn project(&self, pot: &Potential, x: &mut [Vec3]) -> Real {
+    /// projection. A thickness that comes out non-positive or non-finite (the prism turned
+    /// inside out: `det F ≤ 0`) is an error naming the face, and the state is left as it was.
+    pub fn project(
+        &self,
+        pot: &Potential,
+        x: &mut [Vec3],
+    ) -> Result<Real, crate::energy::term::StateError> {
         let sc = pot.scene;
         let faces = &sc.mesh.faces;
         let nf = faces.len();
@@ -276,14 +281,15 @@ impl Prism {
             .collect();
         let n_points = (nv + nf) as Real;
         let w_sum: Real = w.iter().sum();
+        let mut h: Vec<Real> = (0..nf).map(|f| self.h(f)).collect();
         let mut first = 0.0;
         for it in 0..self.iterations.max(1) {
             // Virtual vertices at the current thickness.
-            let x4: Vec<Vec3> = (0..nf)
+            let mut x4: Vec<Vec3> = (0..nf)
                 .map(|f| {
                     let [p0, p1, p2] = faces[f].map(|v| x[v]);
                     let d = (p1 - p0).cross(&(p2 - p0)).normalize();
-                    (p0 + p1 + p2) / 3.0 + d * self.h(f)
+                    (p0 + p1 + p2) / 3.0 + d * h[f]
                 })
                 .collect();
             let mut grad = vec![Vec3::zeros(); nv + nf];
@@ -308,7 +314,6 @@ impl Prism {
                 break;
             }
             let s = c / g2;
-            let mut x4 = x4;
             for (i, g) in grad.iter().enumerate() {
                 let dx = g * (-(n_points * w[i] / w_sum) * s);
                 if i < nv {
@@ -320,11 +325,24 @@ impl Prism {
             for (f, p4) in x4.iter().enumerate() {
                 let [p0, p1, p2] = faces[f].map(|v| x[v]);
                 let d = (p1 - p0).cross(&(p2 - p0)).normalize();
-                let h = (p4 - (p0 + p1 + p2) / 3.0).dot(&d);
-                self.thickness[f].store(h.to_bits(), Ordering::Relaxed);
+                h[f] = (p4 - (p0 + p1 + p2) / 3.0).dot(&d);
             }
         }
-        first
+        if let Some(f) = h.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(crate::energy::term::StateError {
+                face: f,
+                reason: format!(
+                    "the position-based projection turned the prism inside out (thickness {}; \
+                     rest thickness {})",
+                    crate::math::sci(h[f]),
+                    crate::math::sci(sc.thickness[f])
+                ),
+            });
+        }
+        for (a, v) in self.thickness.iter().zip(&h) {
+            a.store(v.to_bits(), Ordering::Relaxed);
+        }
+        Ok(first)
     }
 
     /// Sets the thickness state (a restart), checking each value is positive and finite.
@@ -385,8 +403,15 @@ impl Membrane for Prism {
         vec![("skin_volume_ratio".into(), self.volume_ratio(pot, x))]
     }
 
-    fn project(&self, pot: &Potential, x: &mut [Vec3]) -> Option<Real> {
-        (self.mode == PrismThickness::Pbd).then(|| Prism::project(self, pot, x))
+    fn project(
+        &self,
+        pot: &Potential,
+        x: &mut [Vec3],
+    ) -> Result<Option<Real>, crate::energy::term::StateError> {
+        match self.mode {
+            PrismThickness::Pbd => Prism::project(self, pot, x).map(Some),
+            PrismThickness::Incompressible => Ok(None),
+        }
     }
 
     fn state_field(&self) -> Option<&'static str> {
