@@ -585,6 +585,9 @@ pub struct Solver {
     pub continuation_step: Real,
     /// Static mode: the increment below which continuation gives up (default: `1e-4`).
     pub min_continuation_step: Real,
+    /// Static mode: the largest increment of the dial factor (dimensionless, (0, 1], default:
+    /// `1.0`); with `output.continuation_frames`, the spacing of the frames along the path.
+    pub max_continuation_step: Real,
     /// Static mode: membrane continuation. The dial continuation runs with the stretching
     /// weight divided by a factor c (a sheet √c times thicker, relative to bending), then the
     /// weight is raised to its true value in warm-started solves (×10, ×100, … per solve). Thin
@@ -616,6 +619,7 @@ impl Default for Solver {
             hessian_projection: HessianProjection::Adaptive,
             continuation_step: 1.0,
             min_continuation_step: 1e-4,
+            max_continuation_step: 1.0,
             membrane_continuation: Softening::Auto(Auto::Auto),
             symmetry_breaking: 1e-3,
             seed: 1,
@@ -1268,6 +1272,12 @@ impl Settings {
             );
         }
         ck.pos("solver.min_continuation_step", s.min_continuation_step)?;
+        if !(s.max_continuation_step > 0.0 && s.max_continuation_step <= 1.0) {
+            return ck.inv(
+                "solver.max_continuation_step",
+                format!("must lie in (0, 1], got {:e}", s.max_continuation_step),
+            );
+        }
         if let Softening::Factor(c) = s.membrane_continuation {
             if !(c >= 1.0 && c.is_finite()) {
                 return ck.inv(

@@ -268,6 +268,10 @@ impl Term for Gas {
         vec![("pressure".into(), vec![st.gauge; pot.scene.num_faces()])]
     }
 
+    fn predicts(&self) -> bool {
+        self.control != GasControl::None
+    }
+
     /// Euler's predictor along the equilibrium path: the load's change moves the equilibrium by
     /// `dx = H⁻¹∇V · α`, with `α = Δn/V` (amount: the pressure's change at fixed volume), `Δp`
     /// (pressure) or `ΔV*/s`, `s = ∇Vᵀ H⁻¹ ∇V` (volume, whose multiplier moves by

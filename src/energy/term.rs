@@ -223,6 +223,11 @@ pub trait Term: Send + Sync {
         false
     }
 
+    /// Whether the term implements [`Term::predict`] (default: no).
+    fn predicts(&self) -> bool {
+        false
+    }
+
     /// Static continuation, before the solve at the new dial `pot.dial` from the equilibrium
     /// `(x, phi)` at dial `from`: a term that knows how its load moves the equilibrium may move
     /// `x` (and its own multiplier) along the tangent of the equilibrium path (Euler's predictor),

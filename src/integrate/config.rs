@@ -32,6 +32,8 @@ pub struct StaticConfig {
     pub first_step: Real,
     /// The run stops below this increment.
     pub min_step: Real,
+    /// Largest dial increment.
+    pub max_step: Real,
     /// Test the final equilibrium for a minimum.
     pub check_stability: bool,
     /// Perturb-and-resolve attempts at a saddle.
@@ -90,6 +92,7 @@ impl RunConfig {
             statics: StaticConfig {
                 first_step: st.continuation_step,
                 min_step: st.min_continuation_step,
+                max_step: st.max_continuation_step,
                 check_stability: st.check_stability,
                 max_saddle_escapes: st.max_saddle_escapes,
                 continuation_frames: s.output.continuation_frames,

@@ -426,11 +426,43 @@ impl<'a> Solver<'a> {
     /// Lets the terms predict the equilibrium at dial `pot.dial` from the one at `from`
     /// (see [`crate::energy::term::Term::predict`]) with the last factorisation.
     fn predict(&mut self, pot: &Potential, from: Real, state: &mut State) {
+        if !self.scene.terms.iter().any(|t| t.predicts()) {
+            return;
+        }
+        if !self.lin.is_factored() {
+            // The first step: the Hessian at the start (dial `from`).
+            let at = Potential { dial: from, ..*pot };
+            let mut values = vec![0.0; self.pattern.nnz()];
+            let mut g = vec![0.0; self.pattern.n];
+            at.eval(&state.x, &state.dofs, Want::Hessian, &mut g, &mut values);
+            let lr = at.low_rank(&state.x, &state.dofs);
+            let mut shifted = vec![0.0; values.len()];
+            if crate::solve::newton::exact_model(
+                &mut self.lin,
+                &at,
+                &values,
+                &mut shifted,
+                &lr,
+                1e-8,
+            )
+            .is_none()
+            {
+                return;
+            }
+        }
         let lin = &mut self.lin;
         let at = state.clone();
         let mut solve = |r: &mut [Real]| apply_inverse(lin, pot, &at, r);
+        let mut predicted = state.clone();
         for t in self.scene.terms.iter() {
-            t.predict(pot, from, &mut state.x, &state.dofs, &mut solve);
+            t.predict(pot, from, &mut predicted.x, &predicted.dofs, &mut solve);
+        }
+        // Safeguard: a linear prediction from a nearly singular Hessian (an unstressed membrane
+        // has soft modes) can land far off; keep it only when it lowers the potential.
+        let e = |s: &State| pot.eval(&s.x, &s.dofs, Want::Energy, &mut [], &mut []);
+        let ep = e(&predicted);
+        if ep.is_finite() && ep < e(state) {
+            state.copy_from(&predicted);
         }
     }
 

@@ -29,7 +29,14 @@ pub(super) fn run_static(
     // A restart solves at least once, even from a frame at dial 1 (the settings may differ).
     let mut need_solve = restart.is_some();
     // Halved on failure, doubled after an easy solve (≤ 5 Newton iterations).
-    let mut steps = StepControl::new(cf.first_step, min_step, 1.0, 2.0, 5, 1);
+    let mut steps = StepControl::new(
+        cf.first_step.min(cf.max_step),
+        min_step,
+        cf.max_step,
+        2.0,
+        5,
+        1,
+    );
     // Membrane continuation: the stretching weight starts at 1/softening and grows ×ratio per
     // solve once the dial is at 1 (see the module doc).
     let mut scale = 1.0 / cf.softening;

@@ -29,12 +29,19 @@ pub fn read_mesh(path: &Path) -> Result<Mesh, MeshError> {
         path: name.clone(),
         reason,
     };
-    let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
     let ext = path
         .extension()
         .and_then(|s| s.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
+    // An unknown extension is refused before the file is opened.
+    if !matches!(
+        ext.as_str(),
+        "vtk" | "vtu" | "vtp" | "off" | "obj" | "ply" | "stl"
+    ) {
+        return Err(err(mesh_from_bytes(&[], &ext).err().unwrap_or_default()));
+    }
+    let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
     let mut mesh = mesh_from_bytes(&bytes, &ext).map_err(err)?;
     mesh.source = Some(path.to_path_buf());
     Ok(mesh)
