@@ -60,6 +60,8 @@ pub struct LinearSolver {
     l_values: Vec<Real>,
     mem: MemBuffer,
     kind: Kind,
+    /// Negative pivots of the last factorisation (0 for Cholesky).
+    negative: usize,
 }
 
 impl LinearSolver {
@@ -94,6 +96,7 @@ impl LinearSolver {
             symbolic,
             mem,
             kind: Kind::None,
+            negative: 0,
         })
     }
 
@@ -105,6 +108,7 @@ impl LinearSolver {
     /// Numeric factorisation of the matrix with the pattern's structure and these values.
     pub fn factor(&mut self, values: &[Real]) -> Result<(), LinearError> {
         self.kind = Kind::None;
+        self.negative = 0;
         let mut l = std::mem::take(&mut self.l_values);
         let r = self.factor_to(values, &mut l);
         self.l_values = l;
@@ -149,7 +153,8 @@ impl LinearSolver {
             });
         }
         self.kind = Kind::Ldlt;
-        Ok(d.iter().filter(|&&v| v < 0.0).count())
+        self.negative = d.iter().filter(|&&v| v < 0.0).count();
+        Ok(self.negative)
     }
 
     /// The pivots `D` of the last LDLᵀ factorisation, in the permuted order.
@@ -189,9 +194,9 @@ impl LinearSolver {
         self.kind != Kind::None
     }
 
-    /// Whether the last factorisation was an LDLᵀ one (of an indefinite matrix).
+    /// Whether the last factorisation was of an indefinite matrix (LDLᵀ with negative pivots).
     pub fn is_indefinite(&self) -> bool {
-        self.kind == Kind::Ldlt
+        self.kind == Kind::Ldlt && self.negative > 0
     }
 
     /// Numeric factorisation into caller-owned storage `l` (resized to [`Self::factor_nnz`]), to

@@ -151,6 +151,8 @@ pub struct Workspace {
     shifted: Vec<Real>,
     step: Vec<Real>,
     trial: State,
+    /// Whether the last exact model needed LDLᵀ (its sparse part was indefinite).
+    indefinite: bool,
 }
 
 impl Workspace {
@@ -167,6 +169,7 @@ impl Workspace {
                 x: vec![Vec3::zeros(); pattern.num_vertices],
                 dofs: vec![0.0; pattern.num_edge_dofs],
             },
+            indefinite: false,
         }
     }
 
@@ -240,6 +243,28 @@ pub fn exact_model(
     lr: &[crate::energy::term::LowRank],
     tau_max: Real,
 ) -> Option<(Real, super::low_rank::Woodbury)> {
+    exact_model_from(lin, pot, values, shifted, lr, tau_max, false)
+}
+
+/// [`exact_model`], trying LDLᵀ first when `indefinite_first` (the previous iteration's sparse
+/// part was indefinite: one factorisation instead of a failed Cholesky and an LDLᵀ).
+fn exact_model_from(
+    lin: &mut LinearSolver,
+    pot: &Potential,
+    values: &[Real],
+    shifted: &mut [Real],
+    lr: &[crate::energy::term::LowRank],
+    tau_max: Real,
+    indefinite_first: bool,
+) -> Option<(Real, super::low_rank::Woodbury)> {
+    if indefinite_first && !lr.is_empty() {
+        if let Ok(negative) = lin.factor_indefinite(values) {
+            let wb = super::low_rank::Woodbury::new(lin, lr);
+            if wb.negative_eigenvalues(negative) == Some(0) {
+                return Some((0.0, wb));
+            }
+        }
+    }
     if let Some(t) = factor_with_shift_upto(lin, pot, values, shifted, tau_max, tau_max) {
         let wb = super::low_rank::Woodbury::new(lin, lr);
         if wb.keeps_positive_definite() {
@@ -353,7 +378,15 @@ pub fn newton(
             // definite (LDLᵀ and the inertia). If it is genuinely indefinite, use the
             // Gauss–Newton Hessian instead.
             let exact = if try_exact {
-                exact_model(lin, pot, &ws.values, &mut ws.shifted, &lr, tau0.min(1e-8))
+                exact_model_from(
+                    lin,
+                    pot,
+                    &ws.values,
+                    &mut ws.shifted,
+                    &lr,
+                    tau0.min(1e-8),
+                    ws.indefinite,
+                )
             } else {
                 None
             };
@@ -362,7 +395,8 @@ pub fn newton(
                     factored = true;
                     tau0 = t;
                     model = Some(wb);
-                    if lin.is_indefinite() {
+                    ws.indefinite = lin.is_indefinite();
+                    if ws.indefinite {
                         rep.indefinite_iterations += 1;
                     }
                 }
