@@ -1,7 +1,8 @@
 //! Criterion benches: the shell kernels per face (mid-edge average, edge-DOF sin, patch fit),
 //! assembly of ~100k faces on 1 and 2 threads, and one Newton iteration (assemble + numeric
 //! Cholesky + solve) on ~5k and ~20k-face meshes for every bending model, with the assembly and
-//! the factorisation also timed apart.
+//! the factorisation also timed apart; the moisture step; and a balloon frame at the size of
+//! seed 002's Table 1 (`balloon`).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use shellsim::assembly::{Pattern, Want};
@@ -413,12 +414,143 @@ fn coupled_step(c: &mut Criterion) {
     g.finish();
 }
 
+/// The balloon of seed 002's Table 1 size: the teddy of `settings/balloon_teddy.toml` at
+/// 11,562 vertices (the seed's is 11,090), its prism membrane (neo-Hookean, incompressible
+/// thickness) and its gas, one implicit step of 1/30 s at a state inflated by 20%: the prism
+/// kernel per face, the Hessian assembly on 1 and 2 threads, the factorisation, the rank-one
+/// part (the gas's `∇V` and its Sherman–Morrison preparation: one extra solve), one Newton
+/// iteration, and one frame (an implicit step of at most 3 Newton iterations).
+fn balloon(c: &mut Criterion) {
+    use shellsim::solve::potential::Inertia;
+    use shellsim::solve::{newton, NewtonOptions, State};
+    let mesh = shellsim::mesh::surfaces::closed_shape("teddy", 0.05, 0.0026).unwrap();
+    let settings = Settings::from_str_with(
+        "[material]\nmodel = \"prism\"\nbending = \"none\"\nyoung = 1e6\npoisson = 0.5\n\
+         thickness = 2e-4\nprism = { law = \"neo_hookean\" }\n[gas]\ncontrol = \"amount\"\n\
+         amount = 4.1\n[solver]\nmode = \"dynamic\"\n",
+        "bench",
+        &[],
+    )
+    .unwrap();
+    let sc = Scene::build(mesh, settings).unwrap();
+    let p = Pattern::for_scene(&sc);
+    let x: Vec<Vec3> = sc.mesh.positions.iter().map(|q| q * 1.2).collect();
+    let xhat = x.clone();
+    let pot = Potential {
+        dial: 0.5,
+        inertia: Some(Inertia {
+            inv_dt2: 900.0,
+            xhat: &xhat,
+        }),
+        ..Potential::new(&sc, &p)
+    };
+    let nf = sc.num_faces();
+    let mut g = c.benchmark_group("balloon_teddy");
+    g.sample_size(10);
+    g.bench_function("prism_kernel_per_face", |b| {
+        use shellsim::energy::membrane::prism::PrismFace;
+        use shellsim::energy::membrane::MembraneLaw;
+        use shellsim::settings::PrismLaw;
+        let abar = Sym2::new(1.0, 0.3, 0.9);
+        let face = PrismFace::new(PrismLaw::NeoHookean, &abar, 2e-4, 1e6, 0.5, None, 1.0);
+        let a = Sym2::new(1.5, 0.4, 1.3);
+        let (mut ga, mut haa) = (Sym2::zeros(), shellsim::math::Mat3::zeros());
+        b.iter(|| face.eval(black_box(&a), Some((&mut ga, &mut haa))))
+    });
+    bench_hessian_pot(&mut g, &format!("hessian_{nf}_faces"), &pot, &x);
+    let mut gr = vec![0.0; p.n];
+    let mut h = vec![0.0; p.nnz()];
+    pot.eval(&x, &[], Want::Hessian, &mut gr, &mut h);
+    let mut lin = LinearSolver::new(&p).unwrap();
+    println!(
+        "balloon: {} vertices, {nf} faces, {} DOFs, factor non-zeros {}",
+        sc.num_vertices(),
+        p.n,
+        lin.factor_nnz()
+    );
+    g.bench_function("factorisation", |b| {
+        b.iter(|| lin.factor(black_box(&h)).unwrap())
+    });
+    lin.factor(&h).unwrap();
+    g.bench_function("solve", |b| {
+        b.iter(|| {
+            let mut r = gr.clone();
+            lin.solve_in_place(&mut r);
+            black_box(r[0])
+        })
+    });
+    g.bench_function("rank_one", |b| {
+        b.iter(|| {
+            let lr = pot.low_rank(&x, &[]);
+            let wb = shellsim::solve::low_rank::Woodbury::new(&mut lin, &lr);
+            let mut r = gr.clone();
+            wb.solve_in_place(&mut lin, &mut r);
+            black_box(r[0])
+        })
+    });
+    g.bench_function("newton_iteration", |b| {
+        b.iter(|| {
+            pot.eval(&x, &[], Want::Hessian, &mut gr, &mut h);
+            lin.factor(&h).unwrap();
+            let lr = pot.low_rank(&x, &[]);
+            let wb = shellsim::solve::low_rank::Woodbury::new(&mut lin, &lr);
+            let mut r = gr.clone();
+            wb.solve_in_place(&mut lin, &mut r);
+            black_box(r[0])
+        })
+    });
+    let mut ws = shellsim::solve::newton::Workspace::new(&p);
+    for threads in [1usize, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        g.bench_with_input(BenchmarkId::new("frame", threads), &threads, |b, _| {
+            b.iter(|| {
+                pool.install(|| {
+                    let mut st = State {
+                        x: x.clone(),
+                        dofs: Vec::new(),
+                    };
+                    let opts = NewtonOptions {
+                        max_iter: 3,
+                        ..NewtonOptions::default()
+                    };
+                    black_box(newton(&pot, &mut lin, &mut ws, &mut st, opts).iterations)
+                })
+            })
+        });
+    }
+    g.finish();
+}
+
+/// The Hessian assembly of a potential at `x` on 1 and 2 threads, as `name/threads`.
+fn bench_hessian_pot(
+    g: &mut criterion::BenchmarkGroup<criterion::measurement::WallTime>,
+    name: &str,
+    pot: &Potential,
+    x: &[Vec3],
+) {
+    for threads in [1usize, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        g.bench_with_input(BenchmarkId::new(name, threads), &threads, |b, _| {
+            let mut gr = vec![0.0; pot.pattern.n];
+            let mut h = vec![0.0; pot.pattern.nnz()];
+            b.iter(|| pool.install(|| pot.eval(x, &[], Want::Hessian, &mut gr, &mut h)))
+        });
+    }
+}
+
 criterion_group!(
     benches,
     kernel,
     assembly,
     newton_iteration,
     moisture_step,
-    coupled_step
+    coupled_step,
+    balloon
 );
 criterion_main!(benches);

@@ -235,12 +235,14 @@ fn prism_stvk_sphere_follows_its_own_pressure_law() {
 
 /// A fixed amount of gas (isothermal against an outside pressure, and adiabatic): at every
 /// equilibrium frame the gas law's gauge pressure `n/V − p_e` (or `(n/V₀)(V₀/V)^γ − p_e`)
-/// equals the membrane's `p_el(λ)` within 0.5% (measured 0.05%).
+/// equals the membrane's `p_el(λ)` within 0.5% (measured 0.04% on 1442 vertices).
 #[test]
 fn gas_amount_equilibria_satisfy_the_gas_law_and_the_membrane_law() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let mesh = sphere(d, 8);
+    // 1442 vertices: the 642-vertex sphere leaves the spherical branch near λ = 1.58 (a
+    // discrete mode whose stiffness reaches 0 there; finer spheres do not have it).
+    let mesh = sphere(d, 12);
     for (process, pe) in [("isothermal", 1e5), ("adiabatic", 2e4)] {
         let rows = balloon(
             d,
@@ -636,4 +638,88 @@ fn bad_balloon_input_is_refused() {
             "{mesh}: nothing written"
         );
     }
+}
+
+/// A balloon's frames are bitwise the same on 1 and 2 threads (the gas's volume is summed in
+/// face order, its per-face part assembled like every element term).
+#[test]
+fn balloon_results_do_not_depend_on_the_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let teddy = root().join("meshes/balloon_teddy.vtk");
+    let s = root().join("settings/balloon_teddy.toml");
+    let mut frames = Vec::new();
+    for threads in ["1", "2"] {
+        let out = d.join(format!("t{threads}"));
+        shellsim(
+            &[
+                s.to_str().unwrap(),
+                teddy.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "-q",
+                "--threads",
+                threads,
+                "--set",
+                "time.end=0.3",
+            ],
+            d,
+        );
+        frames.push(common::finite_frames(&out, "vtu", threads));
+    }
+    assert_eq!(frames[0].len(), frames[1].len());
+    for (a, b) in frames[0].iter().zip(&frames[1]) {
+        assert_eq!(a.positions, b.positions);
+        assert_eq!(a.face_fields, b.face_fields);
+    }
+}
+
+/// A run with the seed's position-based thickness restarts from a frame: the thickness comes
+/// back from the frame's `thickness` field, and the restarted run ends where the uninterrupted
+/// one does.
+#[test]
+fn position_based_thickness_survives_a_restart() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let teddy = root().join("meshes/balloon_teddy.vtk");
+    let s = root().join("settings/balloon_thickness.toml");
+    let run = |out: &Path, extra: &[&str]| {
+        let mut a = vec![
+            s.to_str().unwrap().to_string(),
+            teddy.to_str().unwrap().to_string(),
+            "--out".into(),
+            out.to_str().unwrap().into(),
+            "-q".into(),
+            "--set".into(),
+            "time.end=0.4".into(),
+        ];
+        a.extend(extra.iter().map(|x| x.to_string()));
+        let o = Command::new(env!("CARGO_BIN_EXE_shellsim"))
+            .args(&a)
+            .current_dir(d)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let whole = d.join("whole");
+    run(&whole, &[]);
+    let again = d.join("again");
+    let frame = whole.join("frame_00002.vtu");
+    let err = run(&again, &["--restart", frame.to_str().unwrap()]);
+    assert!(
+        !err.contains("thickness"),
+        "the thickness is read back: {err}"
+    );
+    let a = common::finite_frames(&whole, "vtu", "whole");
+    let b = common::finite_frames(&again, "vtu", "again");
+    let (ea, eb) = (a.last().unwrap(), b.last().unwrap());
+    let diff = ea
+        .positions
+        .iter()
+        .zip(&eb.positions)
+        .map(|(p, q)| (p - q).norm())
+        .fold(0.0, f64::max);
+    assert!(diff < 1e-12, "restarted run ends {diff} m away");
+    assert_eq!(ea.face_fields["thickness"], eb.face_fields["thickness"]);
 }

@@ -1,5 +1,5 @@
 //! Reading and writing triangle meshes in VTK formats, and reading the formats shape
-//! collections use (OFF, OBJ, PLY, STL: [`super::shapes`]).
+//! collections use (OFF, OBJ, PLY, STL: `mesh/shapes.rs`).
 //!
 //! Read: legacy `.vtk` (ASCII or big-endian binary, versions 2.0–5.1; POLYDATA or
 //! UNSTRUCTURED_GRID of triangles) and XML `.vtu`/`.vtp` with inline (base64 or ASCII) data, which
@@ -48,7 +48,7 @@ pub fn read_mesh(path: &Path) -> Result<Mesh, MeshError> {
 }
 
 /// Parses mesh bytes of the format named by a file extension (`vtk`, `vtu`, `vtp`, and the
-/// shape-collection formats `off`, `obj`, `ply`, `stl`, [`super::shapes`]).
+/// shape-collection formats `off`, `obj`, `ply`, `stl`, `mesh/shapes.rs`).
 pub fn mesh_from_bytes(bytes: &[u8], ext: &str) -> Result<Mesh, String> {
     let raw = match ext {
         "vtk" => guard(|| super::legacy::parse(bytes))?,
