@@ -170,18 +170,7 @@ fn bench_hessian(
     phi: &[f64],
 ) {
     let p = Pattern::for_scene(sc);
-    for threads in [1usize, 2] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        g.bench_with_input(BenchmarkId::new(name, threads), &threads, |b, _| {
-            let pot = potential(sc, &p);
-            let mut gr = vec![0.0; p.n];
-            let mut h = vec![0.0; p.nnz()];
-            b.iter(|| pool.install(|| pot.eval(x, phi, Want::Hessian, &mut gr, &mut h)))
-        });
-    }
+    bench_hessian_pot(g, name, &potential(sc, &p), x, phi);
 }
 
 fn assembly(c: &mut Criterion) {
@@ -457,7 +446,7 @@ fn balloon(c: &mut Criterion) {
         let (mut ga, mut haa) = (Sym2::zeros(), shellsim::math::Mat3::zeros());
         b.iter(|| face.eval(black_box(&a), Some((&mut ga, &mut haa))))
     });
-    bench_hessian_pot(&mut g, &format!("hessian_{nf}_faces"), &pot, &x);
+    bench_hessian_pot(&mut g, &format!("hessian_{nf}_faces"), &pot, &x, &[]);
     let mut gr = vec![0.0; p.n];
     let mut h = vec![0.0; p.nnz()];
     pot.eval(&x, &[], Want::Hessian, &mut gr, &mut h);
@@ -524,12 +513,13 @@ fn balloon(c: &mut Criterion) {
     g.finish();
 }
 
-/// The Hessian assembly of a potential at `x` on 1 and 2 threads, as `name/threads`.
+/// The Hessian assembly of a potential at `(x, phi)` on 1 and 2 threads, as `name/threads`.
 fn bench_hessian_pot(
     g: &mut criterion::BenchmarkGroup<criterion::measurement::WallTime>,
     name: &str,
     pot: &Potential,
     x: &[Vec3],
+    phi: &[f64],
 ) {
     for threads in [1usize, 2] {
         let pool = rayon::ThreadPoolBuilder::new()
@@ -539,7 +529,7 @@ fn bench_hessian_pot(
         g.bench_with_input(BenchmarkId::new(name, threads), &threads, |b, _| {
             let mut gr = vec![0.0; pot.pattern.n];
             let mut h = vec![0.0; pot.pattern.nnz()];
-            b.iter(|| pool.install(|| pot.eval(x, &[], Want::Hessian, &mut gr, &mut h)))
+            b.iter(|| pool.install(|| pot.eval(x, phi, Want::Hessian, &mut gr, &mut h)))
         });
     }
 }

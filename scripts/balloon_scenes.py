@@ -31,6 +31,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 import vtkfield  # noqa: E402
+from paper_scenes import write_csv  # noqa: E402
 
 BIN = os.path.join(ROOT, "target", "release", "shellsim")
 
@@ -51,16 +52,6 @@ def run(settings, mesh, out, sets=()):
 def log(out):
     with open(os.path.join(out, "log.csv")) as f:
         return [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
-
-
-def write_csv(name, header, rows):
-    os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
-    path = os.path.join(HERE, "results", name)
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(header)
-        w.writerows(rows)
-    print("  wrote", os.path.relpath(path, ROOT))
 
 
 def scene(name):

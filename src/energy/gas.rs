@@ -177,27 +177,13 @@ impl Gas {
     }
 }
 
-fn stencil(scene: &Scene) -> Stencil {
-    let p = &scene.mesh.positions;
-    Stencil {
-        slot_dofs: vec![3; 3],
-        nodes: scene.mesh.faces.iter().flatten().copied().collect(),
-        anchors: scene
-            .mesh
-            .faces
-            .iter()
-            .map(|t| (p[t[0]] + p[t[1]] + p[t[2]]) / 3.0)
-            .collect(),
-    }
-}
-
 impl Term for Gas {
     fn name(&self) -> &'static str {
         "gas"
     }
 
     fn stencil(&self, scene: &Scene) -> Stencil {
-        stencil(scene)
+        Stencil::faces(&scene.mesh, 0..scene.num_faces())
     }
 
     fn eval(

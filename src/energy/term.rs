@@ -48,6 +48,23 @@ impl Stencil {
     pub fn is_empty(&self) -> bool {
         self.anchors.is_empty()
     }
+    /// The three-slot stencil of faces `faces` of `mesh` (their vertices; anchors at their
+    /// reference centroids).
+    pub fn faces(mesh: &crate::mesh::Mesh, faces: impl Iterator<Item = usize>) -> Stencil {
+        let p = &mesh.positions;
+        let (mut nodes, mut anchors) = (Vec::new(), Vec::new());
+        for f in faces {
+            let t = mesh.faces[f];
+            nodes.extend_from_slice(&t);
+            anchors.push((p[t[0]] + p[t[1]] + p[t[2]]) / 3.0);
+        }
+        Stencil {
+            slot_dofs: vec![3; 3],
+            nodes,
+            anchors,
+        }
+    }
+
     /// The one-slot stencil of every vertex (vertex terms).
     pub fn vertices(x: &[Vec3]) -> Stencil {
         Stencil {

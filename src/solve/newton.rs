@@ -257,12 +257,15 @@ fn exact_model_from(
     tau_max: Real,
     indefinite_first: bool,
 ) -> Option<(Real, super::low_rank::Woodbury)> {
+    // LDLᵀ of the unshifted sparse part, accepted when the whole is positive definite.
+    let by_ldlt = |lin: &mut LinearSolver| {
+        let negative = lin.factor_indefinite(values).ok()?;
+        let wb = super::low_rank::Woodbury::new(lin, lr);
+        (wb.negative_eigenvalues(negative) == Some(0)).then_some((0.0, wb))
+    };
     if indefinite_first && !lr.is_empty() {
-        if let Ok(negative) = lin.factor_indefinite(values) {
-            let wb = super::low_rank::Woodbury::new(lin, lr);
-            if wb.negative_eigenvalues(negative) == Some(0) {
-                return Some((0.0, wb));
-            }
+        if let Some(m) = by_ldlt(lin) {
+            return Some(m);
         }
     }
     if let Some(t) = factor_with_shift_upto(lin, pot, values, shifted, tau_max, tau_max) {
@@ -275,9 +278,7 @@ fn exact_model_from(
     if lr.is_empty() {
         return None;
     }
-    let negative = lin.factor_indefinite(values).ok()?;
-    let wb = super::low_rank::Woodbury::new(lin, lr);
-    (wb.negative_eigenvalues(negative) == Some(0)).then_some((0.0, wb))
+    by_ldlt(lin)
 }
 
 /// Whether the whole Hessian (sparse `values` + low-rank `lr`) shifted by `δ·mean|diag|`

@@ -49,19 +49,7 @@ impl ElementKernel<9, 3> for Pressure {
 }
 
 fn stencil(scene: &Scene, k: &Pressure) -> Stencil {
-    let p = &scene.mesh.positions;
-    let mut nodes = Vec::with_capacity(3 * k.faces.len());
-    let mut anchors = Vec::with_capacity(k.faces.len());
-    for &(f, _) in &k.faces {
-        let t = scene.mesh.faces[f];
-        nodes.extend_from_slice(&t);
-        anchors.push((p[t[0]] + p[t[1]] + p[t[2]]) / 3.0);
-    }
-    Stencil {
-        slot_dofs: vec![3; 3],
-        nodes,
-        anchors,
-    }
+    Stencil::faces(&scene.mesh, k.faces.iter().map(|&(f, _)| f))
 }
 
 /// The pressure term of a scene (`None` without pressure loads). A loaded region whose
