@@ -1,5 +1,6 @@
-//! A short run of the in-process fuzzer ([`shellsim::fuzz`], 10⁴ executions per input path) and
-//! the inputs earlier runs or reports found to crash, replayed from `tests/data/fuzz/`. The long
+//! A short run of the in-process fuzzer ([`shellsim::fuzz`], 10⁴ executions per input path, eight
+//! paths) and the inputs earlier runs or reports found to crash, replayed from
+//! `tests/data/fuzz/`. The long
 //! run is `scripts/fuzz.sh`.
 
 use shellsim::fuzz::{harnesses, Target};
