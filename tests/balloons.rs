@@ -103,6 +103,26 @@ fn curve(rows: &[std::collections::HashMap<String, f64>]) -> (Vec<(f64, f64)>, f
     (pts, r0)
 }
 
+/// The largest relative error of the points `(λ, p)` against the law `p(λ)`.
+fn worst(pts: &[(f64, f64)], law: impl Fn(f64) -> f64) -> f64 {
+    pts.iter()
+        .map(|&(l, p)| (p / law(l) - 1.0).abs())
+        .fold(0.0, f64::max)
+}
+
+/// Runs the binary in `dir` without asserting success: its exit code and stderr.
+fn run(args: &[&str], dir: &Path) -> (Option<i32>, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_shellsim"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
 /// The neo-Hookean sphere under volume control, λ from 1 to 3 (through the limit point), on a
 /// geodesic sphere of 2562 vertices: every frame within 0.1% of `p = (2μH₀/R₀)(1/λ − 1/λ⁷)`
 /// (measured 0.025%; 642 vertices: 0.10%, second order), and the limit point from a parabola
@@ -127,11 +147,7 @@ fn neo_hookean_sphere_follows_its_pressure_law_through_the_limit_point() {
     );
     let (pts, r0) = curve(&rows);
     let (mu, h) = (1e6, 0.01);
-    let mut worst: f64 = 0.0;
-    for &(l, p) in &pts {
-        let exact = 2.0 * mu * h / r0 * (1.0 / l - l.powi(-7));
-        worst = worst.max((p / exact - 1.0).abs());
-    }
+    let worst = worst(&pts, |l| 2.0 * mu * h / r0 * (1.0 / l - l.powi(-7)));
     println!(
         "neo-Hookean sphere, 2562 vertices: worst relative error {worst:.2e} over λ 1–{:.2}",
         pts.last().unwrap().0
@@ -185,14 +201,10 @@ fn koiter_sphere_follows_its_pressure_law() {
         "koiter",
     );
     let (pts, r0) = curve(&rows);
-    let mut worst: f64 = 0.0;
     for w in pts.windows(2) {
         assert!(w[1].1 > w[0].1, "monotonic: {pts:?}");
     }
-    for &(l, p) in &pts {
-        let exact = 1e6 * 0.01 * (l - 1.0 / l) / (0.7 * r0);
-        worst = worst.max((p / exact - 1.0).abs());
-    }
+    let worst = worst(&pts, |l| 1e6 * 0.01 * (l - 1.0 / l) / (0.7 * r0));
     println!("Koiter sphere, 2562 vertices: worst relative error {worst:.2e}");
     assert!(worst < 1e-2, "{worst}");
 }
@@ -220,14 +232,12 @@ fn prism_stvk_sphere_follows_its_own_pressure_law() {
     let (pts, r0) = curve(&rows);
     let mu = young / (2.0 * (1.0 + nu));
     let lam = young * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
-    let mut worst: f64 = 0.0;
-    for &(l, p) in &pts {
+    let worst = worst(&pts, |l| {
         let (e11, e33) = (0.5 * (l * l - 1.0), 0.5 * (l.powi(-4) - 1.0));
         let dpsi = mu * (4.0 * l * e11 - 4.0 * l.powi(-5) * e33)
             + 2.0 * lam * (2.0 * e11 + e33) * (l - l.powi(-5));
-        let exact = 0.01 * dpsi / (r0 * l * l);
-        worst = worst.max((p / exact - 1.0).abs());
-    }
+        0.01 * dpsi / (r0 * l * l)
+    });
     println!("prism St Venant–Kirchhoff sphere, 642 vertices: worst relative error {worst:.2e} to λ {:.2}", pts.last().unwrap().0);
     assert!(pts.last().unwrap().0 > 1.55);
     assert!(worst < 1e-2, "{worst}");
@@ -299,19 +309,17 @@ fn pressure_control_stops_at_the_limit_point() {
         ),
     );
     let out = d.join("above");
-    let o = Command::new(env!("CARGO_BIN_EXE_shellsim"))
-        .args([
+    let (code, err) = run(
+        &[
             s.to_str().unwrap(),
             &mesh,
             "--out",
             out.to_str().unwrap(),
             "-q",
-        ])
-        .current_dir(d)
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "{err}");
+        ],
+        d,
+    );
+    assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("limit point"), "{err}");
     let sm = summary(&out);
     assert_eq!(sm["converged"], false);
@@ -621,13 +629,9 @@ fn bad_balloon_input_is_refused() {
             args.push("--set".into());
             args.push(s.to_string());
         }
-        let o = Command::new(env!("CARGO_BIN_EXE_shellsim"))
-            .args(&args)
-            .current_dir(d)
-            .output()
-            .unwrap();
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{mesh} {sets:?}: {err}");
+        let args: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
+        let (code, err) = run(&args, d);
+        assert_eq!(code, Some(2), "{mesh} {sets:?}: {err}");
         assert!(
             err.contains(want),
             "{mesh} {sets:?}: '{err}' should say '{want}'"
@@ -683,30 +687,26 @@ fn position_based_thickness_survives_a_restart() {
     let d = dir.path();
     let teddy = root().join("meshes/balloon_teddy.vtk");
     let s = root().join("settings/balloon_thickness.toml");
-    let run = |out: &Path, extra: &[&str]| {
+    let go = |out: &Path, extra: &[&str]| {
         let mut a = vec![
-            s.to_str().unwrap().to_string(),
-            teddy.to_str().unwrap().to_string(),
-            "--out".into(),
-            out.to_str().unwrap().into(),
-            "-q".into(),
-            "--set".into(),
-            "time.end=0.4".into(),
+            s.to_str().unwrap(),
+            teddy.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+            "--set",
+            "time.end=0.4",
         ];
-        a.extend(extra.iter().map(|x| x.to_string()));
-        let o = Command::new(env!("CARGO_BIN_EXE_shellsim"))
-            .args(&a)
-            .current_dir(d)
-            .output()
-            .unwrap();
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        String::from_utf8_lossy(&o.stderr).into_owned()
+        a.extend_from_slice(extra);
+        let (code, err) = run(&a, d);
+        assert_eq!(code, Some(0), "{err}");
+        err
     };
     let whole = d.join("whole");
-    run(&whole, &[]);
+    go(&whole, &[]);
     let again = d.join("again");
     let frame = whole.join("frame_00002.vtu");
-    let err = run(&again, &["--restart", frame.to_str().unwrap()]);
+    let err = go(&again, &["--restart", frame.to_str().unwrap()]);
     assert!(
         !err.contains("thickness"),
         "the thickness is read back: {err}"

@@ -451,9 +451,9 @@ impl<'a> Solver<'a> {
             }
         }
         let lin = &mut self.lin;
-        let at = state.clone();
-        let mut solve = |r: &mut [Real]| apply_inverse(lin, pot, &at, r);
         let mut predicted = state.clone();
+        let at = &*state;
+        let mut solve = |r: &mut [Real]| apply_inverse(lin, pot, at, r);
         for t in self.scene.terms.iter() {
             t.predict(pot, from, &mut predicted.x, &predicted.dofs, &mut solve);
         }

@@ -10,7 +10,7 @@
 //! Write: `.vtu` (XML, inline base64) or legacy `.vtk` (big-endian binary), always through a
 //! temporary file renamed into place, so a reader never sees half a file.
 
-use super::{Field, Mesh, MeshError};
+use super::{Field, Mesh, MeshError, RawMesh};
 use std::collections::BTreeMap;
 use std::path::Path;
 use vtkio::model::{
@@ -35,12 +35,7 @@ pub fn read_mesh(path: &Path) -> Result<Mesh, MeshError> {
         .unwrap_or("")
         .to_ascii_lowercase();
     // An unknown extension is refused before the file is opened.
-    if !matches!(
-        ext.as_str(),
-        "vtk" | "vtu" | "vtp" | "off" | "obj" | "ply" | "stl"
-    ) {
-        return Err(err(mesh_from_bytes(&[], &ext).err().unwrap_or_default()));
-    }
+    parser(&ext).map_err(err)?;
     let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
     let mut mesh = mesh_from_bytes(&bytes, &ext).map_err(err)?;
     mesh.source = Some(path.to_path_buf());
@@ -50,21 +45,29 @@ pub fn read_mesh(path: &Path) -> Result<Mesh, MeshError> {
 /// Parses mesh bytes of the format named by a file extension (`vtk`, `vtu`, `vtp`, and the
 /// shape-collection formats `off`, `obj`, `ply`, `stl`, `mesh/shapes.rs`).
 pub fn mesh_from_bytes(bytes: &[u8], ext: &str) -> Result<Mesh, String> {
-    let raw = match ext {
-        "vtk" => guard(|| super::legacy::parse(bytes))?,
-        "vtu" | "vtp" => guard(|| super::xml::parse(bytes))?,
-        "off" => guard(|| super::shapes::parse_off(bytes))?,
-        "obj" => guard(|| super::shapes::parse_obj(bytes))?,
-        "ply" => guard(|| super::shapes::parse_ply(bytes))?,
-        "stl" => guard(|| super::shapes::parse_stl(bytes))?,
+    let parse = parser(ext)?;
+    guard(|| parse(bytes))?.into_mesh()
+}
+
+/// A reader of one file format: bytes to a raw mesh, or an error naming where.
+type Reader = fn(&[u8]) -> Result<RawMesh, String>;
+
+/// The reader of the format a file extension names.
+fn parser(ext: &str) -> Result<Reader, String> {
+    Ok(match ext {
+        "vtk" => super::legacy::parse,
+        "vtu" | "vtp" => super::xml::parse,
+        "off" => super::shapes::parse_off,
+        "obj" => super::shapes::parse_obj,
+        "ply" => super::shapes::parse_ply,
+        "stl" => super::shapes::parse_stl,
         other => {
             return Err(format!(
                 "unknown mesh extension '.{other}' (expected .vtk, .vtu, .vtp, .off, .obj, .ply \
                  or .stl)"
             ))
         }
-    };
-    raw.into_mesh()
+    })
 }
 
 thread_local! {

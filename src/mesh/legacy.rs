@@ -17,10 +17,12 @@ use std::collections::BTreeMap;
 /// A failure at a line of the file, in a section.
 type Fail = String;
 
-struct Lexer<'a> {
-    b: &'a [u8],
-    pos: usize,
-    line: usize,
+/// Whitespace-separated tokens of a byte buffer, with the line they are on (shared with the
+/// ASCII PLY reader).
+pub(super) struct Lexer<'a> {
+    pub(super) b: &'a [u8],
+    pub(super) pos: usize,
+    pub(super) line: usize,
 }
 
 impl<'a> Lexer<'a> {
@@ -40,7 +42,7 @@ impl<'a> Lexer<'a> {
     }
 
     /// The next whitespace-separated token, or `None` at the end of the file.
-    fn token(&mut self) -> Option<&'a str> {
+    pub(super) fn token(&mut self) -> Option<&'a str> {
         self.skip_ws();
         let start = self.pos;
         while self.pos < self.b.len() && !self.b[self.pos].is_ascii_whitespace() {

@@ -335,50 +335,38 @@ enum PlyFormat {
 
 /// Reads PLY values: ASCII tokens (with their line) or binary (with the byte offset).
 struct PlyReader<'a> {
-    b: &'a [u8],
-    pos: usize,
-    line: usize,
+    /// Position in the file (and, for ASCII, the tokens with their lines).
+    lex: super::legacy::Lexer<'a>,
     format: PlyFormat,
 }
 
 impl PlyReader<'_> {
     fn at(&self) -> String {
         match self.format {
-            PlyFormat::Ascii => format!("line {}", self.line),
-            _ => format!("byte offset {}", self.pos),
+            PlyFormat::Ascii => format!("line {}", self.lex.line),
+            _ => format!("byte offset {}", self.lex.pos),
         }
     }
 
     fn value(&mut self, ty: PlyType, what: &dyn Fn() -> String) -> Result<Real, String> {
         if self.format == PlyFormat::Ascii {
-            while let Some(&c) = self.b.get(self.pos) {
-                if c == b'\n' {
-                    self.line += 1;
-                } else if !c.is_ascii_whitespace() {
-                    break;
-                }
-                self.pos += 1;
-            }
-            let start = self.pos;
-            while self.pos < self.b.len() && !self.b[self.pos].is_ascii_whitespace() {
-                self.pos += 1;
-            }
-            if start == self.pos {
+            let Some(t) = self.lex.token() else {
                 return Err(format!(
                     "{}: the file ends where {} was expected",
                     self.at(),
                     what()
                 ));
-            }
-            let t = std::str::from_utf8(&self.b[start..self.pos]).unwrap_or("\u{fffd}");
+            };
             return t
                 .parse::<Real>()
                 .map_err(|_| format!("{}: {} must be a number, found '{t}'", self.at(), what()));
         }
         let n = ty.size();
+        let pos = self.lex.pos;
         let bytes = self
+            .lex
             .b
-            .get(self.pos..self.pos + n)
+            .get(pos..pos + n)
             .ok_or_else(|| format!("{}: the file ends inside {}", self.at(), what()))?;
         let mut a = [0u8; 8];
         if self.format == PlyFormat::Little {
@@ -388,7 +376,7 @@ impl PlyReader<'_> {
                 a[i] = c;
             }
         }
-        self.pos += n;
+        self.lex.pos += n;
         Ok(match ty {
             PlyType::I8 => a[0] as i8 as Real,
             PlyType::U8 => a[0] as Real,
@@ -486,9 +474,11 @@ pub(super) fn parse_ply(b: &[u8]) -> Result<RawMesh, String> {
     };
     let format = format.ok_or("the header has no 'format' line")?;
     let mut r = PlyReader {
-        b,
-        pos,
-        line: header_end + 1,
+        lex: super::legacy::Lexer {
+            b,
+            pos,
+            line: header_end + 1,
+        },
         format,
     };
     let mut points: Vec<Real> = Vec::new();

@@ -200,23 +200,9 @@ pub fn factor_with_shift_upto(
     tau0: Real,
     tau_max: Real,
 ) -> Option<Real> {
-    let n = pot.pattern.n;
-    let scale = {
-        let s: Real = (0..n).map(|i| values[pot.pattern.diag(i)].abs()).sum();
-        if s > 0.0 {
-            s / n as Real
-        } else {
-            1.0
-        }
-    };
     let mut tau = tau0;
     loop {
-        shifted.copy_from_slice(values);
-        if tau > 0.0 {
-            for i in 0..n {
-                shifted[pot.pattern.diag(i)] += tau * scale;
-            }
-        }
+        shift_into(pot, values, shifted, tau);
         match lin.factor(shifted) {
             Ok(()) => return Some(tau),
             Err(_) => {
@@ -225,6 +211,19 @@ pub fn factor_with_shift_upto(
                     return None;
                 }
             }
+        }
+    }
+}
+
+/// `shifted = values + τ·D`, `D` the mean |diagonal| of `values` (1 if it is all zero).
+fn shift_into(pot: &Potential, values: &[Real], shifted: &mut [Real], tau: Real) {
+    shifted.copy_from_slice(values);
+    if tau > 0.0 {
+        let n = pot.pattern.n;
+        let s: Real = (0..n).map(|i| values[pot.pattern.diag(i)].abs()).sum();
+        let scale = if s > 0.0 { s / n as Real } else { 1.0 };
+        for i in 0..n {
+            shifted[pot.pattern.diag(i)] += tau * scale;
         }
     }
 }
@@ -291,15 +290,8 @@ pub fn is_positive_definite(
     lr: &[crate::energy::term::LowRank],
     delta: Real,
 ) -> bool {
-    let n = pot.pattern.n;
-    let scale = (0..n)
-        .map(|i| values[pot.pattern.diag(i)].abs())
-        .sum::<Real>()
-        / (n.max(1) as Real);
-    let mut shifted = values.to_vec();
-    for i in 0..n {
-        shifted[pot.pattern.diag(i)] += delta * scale;
-    }
+    let mut shifted = vec![0.0; values.len()];
+    shift_into(pot, values, &mut shifted, delta);
     if lin.factor(&shifted).is_ok() {
         return super::low_rank::Woodbury::new(lin, lr).keeps_positive_definite();
     }
