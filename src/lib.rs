@@ -39,6 +39,7 @@ pub mod fuzz;
 pub mod geometry;
 pub mod growth;
 pub mod integrate;
+pub mod lce;
 pub mod math;
 pub mod mesh;
 pub mod output;

@@ -220,6 +220,35 @@ pub struct Summary {
     pub diffusion_direct_solves: usize,
     /// Warnings raised while loading.
     pub warnings: Vec<String>,
+    /// Explicit mode: its time step, time scales and cost.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub explicit: Option<ExplicitReport>,
+}
+
+/// What an explicit run reports in `summary.json` ([`crate::integrate`]'s explicit driver).
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct ExplicitReport {
+    /// The time step Δt (s).
+    pub time_step: Real,
+    /// The mesh's measured stability limit of `explicit.time_step_prefactor` (none when the
+    /// stiffness at the start has no positive eigenvalue).
+    pub stable_prefactor: Option<Real>,
+    /// The long time T (s).
+    pub long_time: Real,
+    /// The drag rate c while dialling (1/s).
+    pub damping_rate_dial: Real,
+    /// The drag rate c while waiting (1/s).
+    pub damping_rate_wait: Real,
+    /// The sample length L (reference perimeter, m).
+    pub sample_length: Real,
+    /// The smallest reference altitude a_min (m).
+    pub min_altitude: Real,
+    /// `"window"` or `"morphoshell"`.
+    pub equilibrium_test: String,
+    /// Wall time per face and step (µs), the whole loop included.
+    pub microseconds_per_face_step: Real,
+    /// Hold points at which equilibrium was reached.
+    pub holds_reached: usize,
 }
 
 /// Writes frames, the series, the log and the summary into one folder.

@@ -6,6 +6,7 @@
 use crate::geometry::{first_fundamental_form, midedge_average_b};
 use crate::math::{Mat2, Real, Sym2, Vec3};
 use crate::mesh::{topology::NONE, Mesh, MeshError, Topology};
+use crate::settings::DialOrder;
 
 /// Initial (dial 0) and target (dial 1) rest forms per face.
 #[derive(Clone, Debug)]
@@ -18,6 +19,11 @@ pub struct RestForms {
     pub abar1: Vec<Sym2>,
     /// b̄ at dial 1 (m).
     pub bbar1: Vec<Sym2>,
+    /// The order in which ā and b̄ are dialled.
+    pub order: DialOrder,
+    /// The director law per face, which dials ā through its stretch instead of linearly
+    /// (empty without it; [`crate::lce`]).
+    pub lce: Vec<crate::lce::LceFace>,
 }
 
 impl RestForms {
@@ -29,20 +35,35 @@ impl RestForms {
             bbar1: b0.clone(),
             abar0: a0,
             bbar0: b0,
+            order: DialOrder::Together,
+            lce: Vec::new(),
         }
     }
 
-    /// Rest forms at dial factor `s ∈ [0, 1]`: linear interpolation, as MorphoShell's dial
-    /// (convex combinations keep ā positive definite).
+    /// The dials `(s_a, s_b)` of ā and b̄ at the overall dial `s ∈ [0, 1]`: both `s`, or with
+    /// [`DialOrder::BbarFirst`] b̄ over `[0, ½]` and then ā over `[½, 1]`.
+    #[inline]
+    pub fn split(&self, s: Real) -> (Real, Real) {
+        match self.order {
+            DialOrder::Together => (s, s),
+            DialOrder::BbarFirst => ((2.0 * s - 1.0).clamp(0.0, 1.0), (2.0 * s).min(1.0)),
+        }
+    }
+
+    /// Rest forms at dial factor `s ∈ [0, 1]`: linear interpolation of each form at its own dial
+    /// ([`Self::split`]), as MorphoShell's dial (convex combinations keep ā positive definite);
+    /// under the director law ā follows its stretch instead ([`crate::lce`]).
     #[inline]
     pub fn at(&self, f: usize, s: Real) -> (Sym2, Sym2) {
         if s >= 1.0 {
             return (self.abar1[f], self.bbar1[f]);
         }
-        (
-            self.abar0[f] * (1.0 - s) + self.abar1[f] * s,
-            self.bbar0[f] * (1.0 - s) + self.bbar1[f] * s,
-        )
+        let (sa, sb) = self.split(s);
+        let a = match self.lce.get(f) {
+            Some(l) => l.metric(sa),
+            None => self.abar0[f] * (1.0 - sa) + self.abar1[f] * sa,
+        };
+        (a, self.bbar0[f] * (1.0 - sb) + self.bbar1[f] * sb)
     }
 
     /// Number of faces.

@@ -57,6 +57,7 @@ fn check_time(scene: &Scene, t: Real) -> Result<(), String> {
     let (what, hi) = match scene.settings.solver.mode {
         crate::settings::Mode::Static => ("dial", 1.0),
         crate::settings::Mode::Dynamic => ("time", scene.settings.time.end),
+        crate::settings::Mode::Explicit => ("time", Real::MAX),
     };
     if !(t.is_finite() && (0.0..=hi).contains(&t)) {
         return Err(format!(

@@ -179,7 +179,13 @@ impl Scene {
                 rest.abar1 = a1;
                 rest.bbar1 = b1;
             }
+            TargetForms::Lce => {
+                rest.lce = crate::lce::build(&mesh, &settings)?;
+                rest.abar1 = rest.lce.iter().map(|l| l.metric(1.0)).collect();
+                rest.bbar1 = vec![Sym2::zeros(); nf];
+            }
         }
+        rest.order = settings.dial.order;
 
         let growth = GrowthInputs::read(&mesh, &settings)?;
         if settings.growth.law != crate::settings::GrowthLaw::None {

@@ -82,6 +82,10 @@ pub struct Settings {
     pub solver: Solver,
     /// Time stepping (dynamic mode).
     pub time: Time,
+    /// Explicit damped dynamics (explicit mode): time step, damping, dial and equilibrium test.
+    pub explicit: Explicit,
+    /// How the rest forms are dialled: order and hold points (every mode).
+    pub dial: Dial,
     /// External loads.
     pub loads: Loads,
     /// An enclosed gas (closed meshes): amount, pressure or volume control.
@@ -313,6 +317,27 @@ pub enum TargetForms {
     /// Per-face `abar_info` (required) and `bbar_info` (optional, default 0) mesh fields, in
     /// reference Cartesian coordinates (MorphoShell's files).
     Mesh,
+    /// The liquid-crystal director law ([`crate::lce`]): per face a director angle θ, a stretch
+    /// λ and a ratio ν, from `[rest.lce]` or from the mesh's `abar_info` read as (θ, λ, ν).
+    Lce,
+}
+
+/// The director law's per-face values, numbers or expressions of the reference x, y (m) at each
+/// face's centroid.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LceSettings {
+    /// Director angle θ from the reference x axis (rad).
+    pub theta: Field,
+    /// Target stretch λ along the director (> 0).
+    pub lambda: Field,
+    /// Opto-thermal Poisson ratio ν (default: `0.5`).
+    #[serde(default = "half")]
+    pub nu: Field,
+}
+
+fn half() -> Field {
+    Field::Value(0.5)
 }
 
 /// Rest forms.
@@ -330,6 +355,8 @@ pub struct Rest {
     /// Dynamic mode: time over which the forms are dialled linearly from the input mesh's forms to
     /// the target (s, default: `0` = target from the start).
     pub dial_time: Real,
+    /// The director law's values for `target = "lce"` (default: none, read from the mesh).
+    pub lce: Option<LceSettings>,
 }
 
 impl Default for Rest {
@@ -339,6 +366,7 @@ impl Default for Rest {
             abar: [1.0.into(), 0.0.into(), 1.0.into()],
             bbar: [0.0.into(), 0.0.into(), 0.0.into()],
             dial_time: 0.0,
+            lce: None,
         }
     }
 }
@@ -563,6 +591,9 @@ pub enum Mode {
     Static,
     /// Implicit Euler dynamics with Kelvin–Voigt damping.
     Dynamic,
+    /// MorphoShell's explicit damped Newtonian dynamics (symplectic Euler, gradient only), run
+    /// until the equilibrium test fires (`[explicit]`).
+    Explicit,
 }
 
 /// Solver controls.
@@ -665,6 +696,99 @@ impl Default for Time {
             equilibrium_kinetic: 1e-10,
         }
     }
+}
+
+/// Which equilibrium test stops an explicit run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EquilibriumTest {
+    /// The force residual relative to the force scale, the kinetic energy, and the changes of
+    /// the energy and of the shape over a window of time (cannot fire while the shape moves).
+    #[default]
+    Window,
+    /// MorphoShell's: the largest node force below a fraction of μ t a_min and the largest node
+    /// speed below a fraction of √(μ/ρ), checked once per check interval.
+    Morphoshell,
+}
+
+/// Explicit damped dynamics (MorphoShell's integrator; [`crate::integrate`]'s explicit driver).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Explicit {
+    /// The time step's prefactor p in `dt = p · min(0.185 √(ρ/μ) a_min, √(ρt/D) a_min²/2π)`
+    /// (default: `0.8`, MorphoShell's common value; the run reports the mesh's stability limit).
+    pub time_step_prefactor: Real,
+    /// Damping while the forms are dialled, as a multiple of the critical damping of the longest
+    /// bending mode (default: `1.0`).
+    pub damping_prefactor_dial: Real,
+    /// Damping while waiting for equilibrium (default: `1.0`).
+    pub damping_prefactor_wait: Real,
+    /// Time to dial the forms from 0 to 1, in long times (default: `1.0`).
+    pub dial_long_times: Real,
+    /// Steps of gradient-descent (overdamped) dynamics before the Newtonian dynamics (default: `0`).
+    pub gradient_descent_steps: usize,
+    /// Frames per long time (default: `10`).
+    pub frames_per_long_time: Real,
+    /// The run stops, unconverged, after this many long times (default: `1000`).
+    pub max_long_times: Real,
+    /// `"window"` (default) or `"morphoshell"`.
+    pub equilibrium: EquilibriumTest,
+    /// Window test: the force residual ‖∇E‖∞ / F must be below this (default: `1e-7`).
+    pub force_tolerance: Real,
+    /// Window test: the largest vertex displacement over a window, over the sheet's size, must be
+    /// below this (default: `1e-7`).
+    pub shape_tolerance: Real,
+    /// Window test: the relative change of the elastic energy over a window (default: `1e-7`).
+    pub energy_tolerance: Real,
+    /// The window (and MorphoShell's check interval), in long times (default: `0.01`).
+    pub window_long_times: Real,
+    /// MorphoShell's test: largest force / (μ t a_min) (default: `1e-6`).
+    pub morphoshell_force_threshold: Real,
+    /// MorphoShell's test: largest speed / √(μ/ρ) (default: `1e-5`).
+    pub morphoshell_speed_threshold: Real,
+}
+
+impl Default for Explicit {
+    fn default() -> Self {
+        Explicit {
+            time_step_prefactor: 0.8,
+            damping_prefactor_dial: 1.0,
+            damping_prefactor_wait: 1.0,
+            dial_long_times: 1.0,
+            gradient_descent_steps: 0,
+            frames_per_long_time: 10.0,
+            max_long_times: 1000.0,
+            equilibrium: EquilibriumTest::Window,
+            force_tolerance: 1e-7,
+            shape_tolerance: 1e-7,
+            energy_tolerance: 1e-7,
+            window_long_times: 0.01,
+            morphoshell_force_threshold: 1e-6,
+            morphoshell_speed_threshold: 1e-5,
+        }
+    }
+}
+
+/// The order in which ā and b̄ are dialled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DialOrder {
+    /// Both together: dial s takes both from their initial to their target values.
+    #[default]
+    Together,
+    /// b̄ over the first half of the dial (ā at its initial value), then ā over the second half.
+    BbarFirst,
+}
+
+/// How the rest forms are dialled.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Dial {
+    /// `"together"` (default) or `"bbar_first"`.
+    pub order: DialOrder,
+    /// Dial factors in (0, 1) at which the dial stops until the sheet is at equilibrium, then
+    /// goes on (ascending; default: none).
+    pub holds: Vec<Real>,
 }
 
 /// External loads.
@@ -1172,6 +1296,7 @@ impl Settings {
         self.validate_growth(name)?;
         self.validate_moisture(name)?;
         self.validate_time(name)?;
+        self.validate_explicit(name)?;
         self.validate_loads(name)?;
         self.validate_gas(name)?;
         self.validate_contact(name)?;
@@ -1254,6 +1379,30 @@ impl Settings {
             }
         }
         ck.nonneg("rest.dial_time", r.dial_time)?;
+        if let Some(l) = &r.lce {
+            for (key, f) in [("theta", &l.theta), ("lambda", &l.lambda), ("nu", &l.nu)] {
+                let key = format!("rest.lce.{key}");
+                if let Err(e) = f.compile() {
+                    return ck.inv(&key, e.to_string());
+                }
+                if let Some(v) = f.constant() {
+                    if !v.is_finite() {
+                        return ck.inv(&key, format!("must be finite, got {v:e}"));
+                    }
+                }
+            }
+            if let Some(v) = l.lambda.constant() {
+                if v <= 0.0 {
+                    return ck.inv("rest.lce.lambda", format!("must be positive, got {v}"));
+                }
+            }
+            if r.target != TargetForms::Lce {
+                return ck.inv(
+                    "rest.lce",
+                    "is used only with rest.target = \"lce\"".into(),
+                );
+            }
+        }
         Ok(())
     }
 
@@ -1497,6 +1646,55 @@ impl Settings {
                     t.output_interval, t.dt_min
                 ),
             );
+        }
+        Ok(())
+    }
+
+    /// Validates `[explicit]` and `[dial]`.
+    pub fn validate_explicit(&self, name: &str) -> Result<(), SettingsError> {
+        let ck = Check(name);
+        let e = &self.explicit;
+        ck.pos("explicit.time_step_prefactor", e.time_step_prefactor)?;
+        ck.nonneg("explicit.damping_prefactor_dial", e.damping_prefactor_dial)?;
+        ck.nonneg("explicit.damping_prefactor_wait", e.damping_prefactor_wait)?;
+        ck.nonneg("explicit.dial_long_times", e.dial_long_times)?;
+        ck.pos("explicit.frames_per_long_time", e.frames_per_long_time)?;
+        ck.pos("explicit.max_long_times", e.max_long_times)?;
+        ck.pos("explicit.force_tolerance", e.force_tolerance)?;
+        ck.pos("explicit.shape_tolerance", e.shape_tolerance)?;
+        ck.pos("explicit.energy_tolerance", e.energy_tolerance)?;
+        ck.pos("explicit.window_long_times", e.window_long_times)?;
+        ck.pos("explicit.morphoshell_force_threshold", e.morphoshell_force_threshold)?;
+        ck.pos("explicit.morphoshell_speed_threshold", e.morphoshell_speed_threshold)?;
+        if e.max_long_times * e.frames_per_long_time > MAX_FRAMES {
+            return ck.inv(
+                "explicit.frames_per_long_time",
+                format!(
+                    "{} frames per long time over {} long times is more than {MAX_FRAMES:e} frames",
+                    e.frames_per_long_time, e.max_long_times
+                ),
+            );
+        }
+        let mut last = 0.0;
+        for (i, &h) in self.dial.holds.iter().enumerate() {
+            if !(h.is_finite() && h > last && h < 1.0) {
+                return ck.inv(
+                    &format!("dial.holds[{i}]"),
+                    format!("holds must ascend strictly inside (0, 1), got {h}"),
+                );
+            }
+            last = h;
+        }
+        if self.solver.mode == Mode::Explicit {
+            if self.material.bending.angle_variant().is_some() {
+                return ck.inv(
+                    "material.bending",
+                    "explicit mode integrates vertex positions only; the mid-edge angle models \
+                     carry edge rotations without inertia. Use \"patch_fit\" (MorphoShell's), \
+                     \"midedge_average\" or \"none\""
+                        .into(),
+                );
+            }
         }
         Ok(())
     }

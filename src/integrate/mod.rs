@@ -28,6 +28,7 @@
 
 pub mod config;
 mod dynamics;
+pub mod explicit;
 pub mod friction;
 mod moisture;
 mod statics;
@@ -321,6 +322,7 @@ impl<'a> Solver<'a> {
             mode: match config.mode {
                 Mode::Static => "static",
                 Mode::Dynamic => "dynamic",
+                Mode::Explicit => "explicit",
             }
             .into(),
             vertices: scene.num_vertices(),
@@ -621,6 +623,9 @@ pub fn run(
         Mode::Static => statics::run_static(&mut s, writer, progress, state, start),
         Mode::Dynamic => {
             dynamics::run_dynamic(&mut s, writer, progress, state, v, start.unwrap_or(0.0))
+        }
+        Mode::Explicit => {
+            explicit::run_explicit(&mut s, writer, progress, state, v, start.unwrap_or(0.0))
         }
     };
     match ran {

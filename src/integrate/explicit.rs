@@ -1,0 +1,505 @@
+//! The explicit driver: MorphoShell's damped Newtonian dynamics (seed 001 §2, §8, §17).
+//!
+//! Each vertex i of lumped mass `m_i` (ρ h A / 3, reference areas) moves under the elastic and
+//! external force `F_i = −∂Φ/∂x_i` and a linear viscous drag `−c m_i v_i`, integrated by
+//! semi-implicit (symplectic) Euler:
+//!
+//! `v ← v + Δt (F/m − c v)`,   `x ← x + Δt v`.
+//!
+//! Only the gradient is assembled; no Hessian is built and nothing is factorised.
+//!
+//! ## Time step (dispersion relations)
+//! With μ the smallest shear modulus, t the smallest thickness, ρ the density, ν Poisson's ratio,
+//! `D = μ t³ / (6(1 − ν))` the flexural rigidity (`E t³/(12(1−ν²))` with `E = 2μ(1+ν)`) and
+//! `a_min` the smallest altitude of the reference triangles:
+//!
+//! * in-plane waves travel at `c_s ~ √(μ/ρ)`; the shortest wave a mesh carries has a length of
+//!   order `a_min`, so its angular frequency is `ω_s ~ c_s / a_min` up to a mesh- and
+//!   convention-dependent factor;
+//! * bending waves obey `ρ t ω² = D k⁴`, so `ω_b = √(D/(ρt)) k²` with `k ~ 2π / a_min`.
+//!
+//! Symplectic Euler is stable while `ω_max Δt < 2`. shellsim takes MorphoShell's rule
+//!
+//! `Δt = p · min(0.185 √(ρ/μ) a_min, √(ρt/D) a_min² / 2π)`,
+//!
+//! whose 0.185 MorphoShell calibrated so that p need not change when the stretching rather than
+//! the bending bound is the smaller. The prefactor p (`explicit.time_step_prefactor`) absorbs
+//! the factors of order one; its true limit depends on the mesh. The driver measures it at the
+//! start: the largest eigenvalue `ω_max²` of `M⁻¹H` by power iteration on finite differences of
+//! the gradient (no Hessian), giving the limit `p* = 2 / (ω_max Δt(p = 1))`, reported in
+//! `summary.json` (`explicit.stable_prefactor`) and warned about when p exceeds it.
+//!
+//! ## Damping and time scales
+//! The longest bending mode has `k = 2π / L`, with L the reference perimeter (MorphoShell's
+//! sample length; for a closed surface, π × the bounding-box diagonal): `ω_L = √(D/(ρt)) k²`.
+//! Critical damping of that mode is `c = 2 ω_L`; the drag rate is `c = p_d · 2 ω_L` with the
+//! prefactor `p_d` of the phase (`damping_prefactor_dial` while the forms are dialled,
+//! `damping_prefactor_wait` while waiting for equilibrium). The long time is the period of the
+//! slowest mode, `T = max(2π/ω_L, L √(ρ/μ))`; the dial, the frame interval, the equilibrium
+//! window and the run's time limit are multiples of it.
+//!
+//! ## Gradient-descent start
+//! `explicit.gradient_descent_steps` steps of the overdamped limit `c m v = F` first
+//! (`x ← x + Δt_gd F/(c m)`, velocities discarded), with `Δt_gd = c Δt² / 2`: forward Euler on
+//! the overdamped dynamics is stable for `Δt_gd < 2c/ω_max²`, which `c Δt²/2` satisfies whenever
+//! `Δt < 2/ω_max`.
+//!
+//! ## Dial, holds and the equilibrium test
+//! The dial goes from 0 to 1 linearly over `dial_long_times` long times; at each of
+//! `dial.holds` it stops until the sheet is at equilibrium. After dial 1 the run waits for
+//! equilibrium and stops there. The default test (`"window"`) checks, once per window of
+//! `window_long_times` long times: the force residual `‖∇Φ‖∞ / F` (shellsim's force scale, the
+//! same as Newton's) below `force_tolerance`; the largest vertex displacement over the window
+//! below `shape_tolerance` × the sheet's size; the change of Φ over the window below
+//! `energy_tolerance` × |Φ|; and the kinetic energy below `energy_tolerance` × |Φ|. A shape
+//! that still creeps fails the displacement test, so the test cannot fire while the shape moves.
+//! `"morphoshell"` reproduces MorphoShell's test: the largest node force (drag included) below
+//! `morphoshell_force_threshold` × μ t a_min and the largest speed below
+//! `morphoshell_speed_threshold` × √(μ/ρ).
+//!
+//! ## Failure
+//! A state that is not finite, or a kinetic energy above 100 × μ t A (strains of order ten
+//! everywhere), stops the run: `summary.json` gives the reason and the last good frame, and the
+//! unstable state is never written.
+
+use super::{Progress, RunError, Solver};
+use crate::assembly::Want;
+use crate::math::{Real, Vec3};
+use crate::output::{ExplicitReport, Writer};
+use crate::scene::Scene;
+use crate::settings::EquilibriumTest;
+use crate::solve::{Potential, State};
+use std::f64::consts::PI;
+
+/// The time and force scales of a scene's explicit dynamics (module doc).
+#[derive(Clone, Copy, Debug)]
+pub struct Scales {
+    /// Density ρ (kg/m³).
+    pub rho: Real,
+    /// Smallest shear modulus μ (Pa).
+    pub mu: Real,
+    /// Smallest thickness t (m).
+    pub t: Real,
+    /// Flexural rigidity `μ t³ / (6(1 − ν))` (N·m).
+    pub flexural: Real,
+    /// Smallest altitude of the reference triangles (m).
+    pub a_min: Real,
+    /// The sample length L: the reference perimeter (m).
+    pub length: Real,
+    /// The time step at prefactor 1 (s).
+    pub dt_unit: Real,
+    /// Angular frequency of the longest bending mode, `√(D/(ρt)) (2π/L)²` (rad/s).
+    pub omega_long: Real,
+    /// The long time `max(2π/ω_L, L √(ρ/μ))` (s).
+    pub long_time: Real,
+}
+
+impl Scales {
+    /// The scales of `scene`.
+    pub fn of(scene: &Scene) -> Scales {
+        let m = &scene.settings.material;
+        let rho = m.density;
+        let mu = scene.lame.iter().map(|l| l.beta).fold(Real::INFINITY, Real::min);
+        let t = scene.thickness.iter().copied().fold(Real::INFINITY, Real::min);
+        let flexural = mu * t * t * t / (6.0 * (1.0 - m.poisson));
+        let mesh = &scene.mesh;
+        let mut a_min = Real::INFINITY;
+        for f in 0..mesh.faces.len() {
+            let [p0, p1, p2] = mesh.face_positions(f);
+            let twice_area = (p1 - p0).cross(&(p2 - p0)).norm();
+            for (a, b) in [(p0, p1), (p1, p2), (p2, p0)] {
+                a_min = a_min.min(twice_area / (b - a).norm());
+            }
+        }
+        let topo = &scene.topo;
+        let perimeter: Real = topo
+            .edges
+            .iter()
+            .zip(&topo.edge_faces)
+            .filter(|(_, ef)| ef[1] == crate::mesh::topology::NONE)
+            .map(|(e, _)| (mesh.positions[e[1]] - mesh.positions[e[0]]).norm())
+            .sum();
+        let length = if perimeter > 0.0 {
+            perimeter
+        } else {
+            PI * mesh.bbox_diagonal()
+        };
+        let dt_unit = (0.185 * (rho / mu).sqrt() * a_min)
+            .min((rho * t / flexural).sqrt() * a_min * a_min / (2.0 * PI));
+        let k = 2.0 * PI / length;
+        let omega_long = (flexural / (rho * t)).sqrt() * k * k;
+        let long_time = (2.0 * PI / omega_long).max(length * (rho / mu).sqrt());
+        Scales {
+            rho,
+            mu,
+            t,
+            flexural,
+            a_min,
+            length,
+            dt_unit,
+            omega_long,
+            long_time,
+        }
+    }
+}
+
+/// The largest eigenvalue `ω_max²` of `M⁻¹H` at `x` (1/s²), by power iteration on the
+/// mass-scaled Hessian `M^{-½} H M^{-½}` applied by central differences of the gradient
+/// (`iterations` gradient pairs). Fixed vertices and vertices without mass are left out.
+pub fn max_frequency_squared(pot: &Potential, x: &[Vec3], iterations: usize) -> Real {
+    let sc = pot.scene;
+    let n = x.len();
+    let free: Vec<bool> = (0..n).map(|v| !sc.node_fixed[v] && pot.mass[v] > 0.0).collect();
+    let inv_sqrt_m: Vec<Real> = (0..n)
+        .map(|v| if free[v] { 1.0 / pot.mass[v].sqrt() } else { 0.0 })
+        .collect();
+    // A deterministic start with every component nonzero.
+    let mut z: Vec<Vec3> = (0..n)
+        .map(|v| {
+            let s = (v as Real + 1.0) * 0.618_033_988_749_895;
+            let f = |k: Real| ((s * k).fract() - 0.5) * if free[v] { 1.0 } else { 0.0 };
+            Vec3::new(f(1.0), f(7.0), f(13.0))
+        })
+        .collect();
+    let size = sc.mesh.bbox_diagonal();
+    let (mut xp, mut xm) = (x.to_vec(), x.to_vec());
+    let (mut gp, mut gm) = (vec![0.0; 3 * n], vec![0.0; 3 * n]);
+    let mut lambda = 0.0;
+    for _ in 0..iterations {
+        let zn = z.iter().map(|v| v.norm_squared()).sum::<Real>().sqrt();
+        if zn == 0.0 {
+            return 0.0;
+        }
+        let zhat: Vec<Vec3> = z.iter().map(|z| z / zn).collect();
+        let u: Vec<Vec3> = zhat.iter().zip(&inv_sqrt_m).map(|(z, s)| z * *s).collect();
+        let un = u.iter().map(|u| u.amax()).fold(0.0, Real::max);
+        let eps = 1e-7 * size / un.max(Real::MIN_POSITIVE);
+        for v in 0..n {
+            xp[v] = x[v] + u[v] * eps;
+            xm[v] = x[v] - u[v] * eps;
+        }
+        gp.iter_mut().for_each(|g| *g = 0.0);
+        gm.iter_mut().for_each(|g| *g = 0.0);
+        pot.eval(&xp, &[], Want::Gradient, &mut gp, &mut []);
+        pot.eval(&xm, &[], Want::Gradient, &mut gm, &mut []);
+        let mut rq = 0.0;
+        for v in 0..n {
+            let hu = Vec3::new(
+                gp[3 * v] - gm[3 * v],
+                gp[3 * v + 1] - gm[3 * v + 1],
+                gp[3 * v + 2] - gm[3 * v + 2],
+            ) / (2.0 * eps);
+            z[v] = hu * inv_sqrt_m[v];
+            rq += z[v].dot(&zhat[v]);
+        }
+        // The Rayleigh quotient ẑᵀ M^{-½} H M^{-½} ẑ of the unit vector ẑ.
+        lambda = rq;
+    }
+    lambda
+}
+
+/// Where the dial is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Phase {
+    /// Dialling towards the next hold (or 1).
+    Dial,
+    /// Waiting for equilibrium at a hold (or at 1).
+    Wait,
+}
+
+/// Why the loop ended.
+enum Stop {
+    /// The equilibrium test fired at dial 1.
+    Converged,
+    /// The state blew up: it is not written.
+    Unstable(String),
+    /// Interrupted or out of time: the state reached is written.
+    Other(String),
+}
+
+/// A snapshot for the window test.
+struct Window {
+    x: Vec<Vec3>,
+    energy: Real,
+}
+
+pub(super) fn run_explicit(
+    s: &mut Solver,
+    writer: &mut Writer,
+    progress: &mut dyn Progress,
+    mut state: State,
+    v0: Option<Vec<Vec3>>,
+    t0: Real,
+) -> Result<(), RunError> {
+    let sc = s.scene;
+    let cf = sc.settings.explicit.clone();
+    let holds = sc.settings.dial.holds.clone();
+    let sca = Scales::of(sc);
+    let n = state.x.len();
+    let dt = cf.time_step_prefactor * sca.dt_unit;
+    let rate_dial = cf.damping_prefactor_dial * 2.0 * sca.omega_long;
+    let rate_wait = cf.damping_prefactor_wait * 2.0 * sca.omega_long;
+    let dial_time = cf.dial_long_times * sca.long_time;
+    let size = sc.mesh.bbox_diagonal();
+    let area: Real = (0..sc.num_faces())
+        .map(|f| {
+            let [a, b, c] = sc.mesh.face_positions(f);
+            0.5 * (b - a).cross(&(c - a)).norm()
+        })
+        .sum();
+    let blow_up = 100.0 * sca.mu * sca.t * area;
+    let mass = &sc.mass;
+    let inv_m: Vec<Real> = (0..n)
+        .map(|v| if !sc.node_fixed[v] && mass[v] > 0.0 { 1.0 / mass[v] } else { 0.0 })
+        .collect();
+
+    // The mesh's stability limit, measured at the start (gradient only).
+    let omega2 = {
+        let pot = s.potential(0.0);
+        max_frequency_squared(&pot, &state.x, 60)
+    };
+    let stable_prefactor = (omega2 > 0.0).then(|| 2.0 / (omega2.sqrt() * sca.dt_unit));
+    if let Some(p) = stable_prefactor {
+        if cf.time_step_prefactor > p {
+            s.summary.warnings.push(format!(
+                "explicit.time_step_prefactor = {} is above this mesh's stability limit {p:.3} \
+                 (measured at the start); the run will likely blow up",
+                cf.time_step_prefactor
+            ));
+        }
+    }
+    let mut report = ExplicitReport {
+        time_step: dt,
+        stable_prefactor,
+        long_time: sca.long_time,
+        damping_rate_dial: rate_dial,
+        damping_rate_wait: rate_wait,
+        sample_length: sca.length,
+        min_altitude: sca.a_min,
+        equilibrium_test: match cf.equilibrium {
+            EquilibriumTest::Window => "window",
+            EquilibriumTest::Morphoshell => "morphoshell",
+        }
+        .into(),
+        microseconds_per_face_step: 0.0,
+        holds_reached: 0,
+    };
+
+    // Dial from the start time (a restart resumes the linear dial; holds already passed stay
+    // passed).
+    let mut dial = if dial_time > 0.0 {
+        (t0 / dial_time).min(1.0)
+    } else {
+        1.0
+    };
+    let mut next_hold = holds.iter().position(|&h| h > dial);
+    let mut phase = if dial >= 1.0 { Phase::Wait } else { Phase::Dial };
+    if dial_time == 0.0 && next_hold.is_some() {
+        // Holds with an instant dial: jump to the first one and wait.
+        dial = holds[next_hold.unwrap_or(0)];
+        phase = Phase::Wait;
+    }
+    let mut v = v0.unwrap_or_else(|| vec![Vec3::zeros(); n]);
+    let mut g = vec![0.0; s.pattern.n];
+    let mut t = t0;
+    let frame_interval = sca.long_time / cf.frames_per_long_time;
+    let mut next_frame = t0 + frame_interval;
+    let window_steps = ((cf.window_long_times * sca.long_time / dt).round() as usize).max(1);
+    let t_max = cf.max_long_times * sca.long_time;
+    {
+        let pot = s.potential(dial);
+        s.frame(writer, &pot, &state, &v, t)?;
+    }
+    let mut window = Window {
+        x: state.x.clone(),
+        energy: Real::NAN,
+    };
+    let mut gd_left = cf.gradient_descent_steps;
+    let clock = std::time::Instant::now();
+    let mut steps: usize = 0;
+    let stop = loop {
+        if let Some(f) = super::interruption("t", t) {
+            break Stop::Other(f.to_string());
+        }
+        let pot = s.potential(dial);
+        sc.prescribe(&mut state.x, dial);
+        g.iter_mut().for_each(|x| *x = 0.0);
+        let energy = pot.eval(&state.x, &[], Want::Gradient, &mut g, &mut []);
+        let c = if phase == Phase::Dial {
+            rate_dial
+        } else {
+            rate_wait
+        };
+        // The equilibrium test, once per window (before the step, at the state the force
+        // belongs to).
+        if steps % window_steps == 0 && steps > 0 {
+            let healthy = energy.is_finite()
+                && state.x.iter().all(|p| p.iter().all(|c| c.is_finite()))
+                && v.iter().all(|p| p.iter().all(|c| c.is_finite()));
+            let kinetic: Real = v
+                .iter()
+                .zip(mass)
+                .map(|(v, m)| 0.5 * m * v.norm_squared())
+                .sum();
+            if !healthy || kinetic > blow_up {
+                break Stop::Unstable(format!(
+                    "the explicit dynamics went unstable at t = {t:.6e} s (energy {energy:e} J, \
+                     kinetic {kinetic:e} J): lower explicit.time_step_prefactor (now {}, this \
+                     mesh's measured limit {})",
+                    cf.time_step_prefactor,
+                    stable_prefactor.map_or("unknown".into(), |p| format!("{p:.3}"))
+                ));
+            }
+            let at_rest = phase == Phase::Wait
+                && match cf.equilibrium {
+                    EquilibriumTest::Window => {
+                        let r = pot.residual(&g);
+                        let moved = state
+                            .x
+                            .iter()
+                            .zip(&window.x)
+                            .map(|(a, b)| (a - b).norm())
+                            .fold(0.0, Real::max);
+                        let scale = energy.abs().max(Real::MIN_POSITIVE);
+                        r <= cf.force_tolerance
+                            && moved <= cf.shape_tolerance * size
+                            && (energy - window.energy).abs() <= cf.energy_tolerance * scale
+                            && kinetic <= cf.energy_tolerance * scale
+                    }
+                    EquilibriumTest::Morphoshell => {
+                        let (mut fmax, mut vmax): (Real, Real) = (0.0, 0.0);
+                        for i in 0..n {
+                            if inv_m[i] == 0.0 {
+                                continue;
+                            }
+                            let f = -Vec3::new(g[3 * i], g[3 * i + 1], g[3 * i + 2])
+                                - v[i] * (c * mass[i]);
+                            fmax = fmax.max(f.norm());
+                            vmax = vmax.max(v[i].norm());
+                        }
+                        fmax / (sca.mu * sca.t * sca.a_min) < cf.morphoshell_force_threshold
+                            && vmax / (sca.mu / sca.rho).sqrt() < cf.morphoshell_speed_threshold
+                    }
+                };
+            window.x.copy_from_slice(&state.x);
+            window.energy = energy;
+            if at_rest {
+                if dial >= 1.0 {
+                    break Stop::Converged;
+                }
+                report.holds_reached += 1;
+                phase = Phase::Dial;
+                let pot = s.potential(dial);
+                s.summary.residual = pot.residual(&g);
+                s.frame(writer, &pot, &state, &v, t)?;
+                next_frame = t + frame_interval;
+            }
+            if t >= t_max {
+                break Stop::Other(format!(
+                    "no equilibrium after explicit.max_long_times = {} long times ({t:.6e} s); \
+                     residual {:.3e}",
+                    cf.max_long_times,
+                    pot.residual(&g)
+                ));
+            }
+        }
+        // The step.
+        if gd_left > 0 {
+            let cg = c.max(Real::MIN_POSITIVE);
+            let h = cg * dt * dt / 2.0;
+            for i in 0..n {
+                let f = Vec3::new(g[3 * i], g[3 * i + 1], g[3 * i + 2]);
+                v[i] = -f * (inv_m[i] / cg);
+                state.x[i] += v[i] * h;
+            }
+            gd_left -= 1;
+            if gd_left == 0 {
+                v.iter_mut().for_each(|v| *v = Vec3::zeros());
+            }
+        } else {
+            for i in 0..n {
+                let f = Vec3::new(g[3 * i], g[3 * i + 1], g[3 * i + 2]);
+                let vi = v[i];
+                v[i] = vi + (-f * inv_m[i] - vi * c) * dt;
+                if inv_m[i] == 0.0 {
+                    v[i] = Vec3::zeros();
+                }
+                state.x[i] += v[i] * dt;
+            }
+        }
+        t += dt;
+        steps += 1;
+        s.summary.steps += 1;
+        if phase == Phase::Dial && dial < 1.0 {
+            dial = if dial_time > 0.0 {
+                (dial + dt / dial_time).min(1.0)
+            } else {
+                1.0
+            };
+            if let Some(k) = next_hold {
+                if dial >= holds[k] {
+                    dial = holds[k];
+                    next_hold = (k + 1 < holds.len()).then_some(k + 1);
+                    phase = Phase::Wait;
+                }
+            }
+            if dial >= 1.0 {
+                phase = Phase::Wait;
+            }
+        }
+        if t >= next_frame {
+            let pot = s.potential(dial);
+            let healthy = state.x.iter().all(|p| p.iter().all(|c| c.is_finite()));
+            if !healthy {
+                break Stop::Unstable(format!(
+                    "the explicit dynamics went unstable at t = {t:.6e} s (a position is not \
+                     finite): lower explicit.time_step_prefactor (now {})",
+                    cf.time_step_prefactor
+                ));
+            }
+            s.summary.residual = Real::NAN;
+            s.frame(writer, &pot, &state, &v, t)?;
+            next_frame += frame_interval;
+            progress.update(
+                if phase == Phase::Dial {
+                    0.5 * dial
+                } else {
+                    0.5 + 0.5 * (t / t_max).min(1.0)
+                },
+                &format!("t {t:.4e} s  dial {dial:.3}  E {energy:.4e}"),
+            );
+        }
+    };
+    let wall = clock.elapsed().as_secs_f64();
+    report.microseconds_per_face_step =
+        1e6 * wall / (steps.max(1) as Real * sc.num_faces() as Real);
+    let pot = s.potential(dial);
+    g.iter_mut().for_each(|x| *x = 0.0);
+    pot.eval(&state.x, &[], Want::Gradient, &mut g, &mut []);
+    s.summary.residual = pot.residual(&g);
+    s.summary.time = t;
+    s.summary.dial = dial;
+    s.summary.explicit = Some(report);
+    match stop {
+        Stop::Converged => {
+            s.summary.converged = true;
+            s.summary.energy = Writer::energies(&pot, &state, &v);
+            s.frame(writer, &pot, &state, &v, t)?;
+        }
+        Stop::Unstable(reason) => {
+            s.summary.converged = false;
+            s.summary.residual = Real::NAN;
+            s.summary.reason = format!(
+                "{reason}; the run stopped, last good frame {}",
+                writer.last_frame()
+            );
+        }
+        Stop::Other(reason) => {
+            s.summary.converged = false;
+            s.summary.reason = reason;
+            s.summary.energy = Writer::energies(&pot, &state, &v);
+            s.frame(writer, &pot, &state, &v, t)?;
+        }
+    }
+    Ok(())
+}
