@@ -85,7 +85,11 @@ pub fn build(mesh: &Mesh, settings: &Settings) -> Result<Vec<LceFace>, MeshError
                 .map(|f| {
                     let [a, b, c] = mesh.face_positions(f);
                     let m = (a + b + c) / 3.0;
-                    [e[0].eval(m.x, m.y), e[1].eval(m.x, m.y), e[2].eval(m.x, m.y)]
+                    [
+                        e[0].eval(m.x, m.y),
+                        e[1].eval(m.x, m.y),
+                        e[2].eval(m.x, m.y),
+                    ]
                 })
                 .collect()
         }

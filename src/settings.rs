@@ -1397,10 +1397,7 @@ impl Settings {
                 }
             }
             if r.target != TargetForms::Lce {
-                return ck.inv(
-                    "rest.lce",
-                    "is used only with rest.target = \"lce\"".into(),
-                );
+                return ck.inv("rest.lce", "is used only with rest.target = \"lce\"".into());
             }
         }
         Ok(())
@@ -1664,8 +1661,14 @@ impl Settings {
         ck.pos("explicit.shape_tolerance", e.shape_tolerance)?;
         ck.pos("explicit.energy_tolerance", e.energy_tolerance)?;
         ck.pos("explicit.window_long_times", e.window_long_times)?;
-        ck.pos("explicit.morphoshell_force_threshold", e.morphoshell_force_threshold)?;
-        ck.pos("explicit.morphoshell_speed_threshold", e.morphoshell_speed_threshold)?;
+        ck.pos(
+            "explicit.morphoshell_force_threshold",
+            e.morphoshell_force_threshold,
+        )?;
+        ck.pos(
+            "explicit.morphoshell_speed_threshold",
+            e.morphoshell_speed_threshold,
+        )?;
         if e.max_long_times * e.frames_per_long_time > MAX_FRAMES {
             return ck.inv(
                 "explicit.frames_per_long_time",
@@ -1685,16 +1688,14 @@ impl Settings {
             }
             last = h;
         }
-        if self.solver.mode == Mode::Explicit {
-            if self.material.bending.angle_variant().is_some() {
-                return ck.inv(
-                    "material.bending",
-                    "explicit mode integrates vertex positions only; the mid-edge angle models \
-                     carry edge rotations without inertia. Use \"patch_fit\" (MorphoShell's), \
-                     \"midedge_average\" or \"none\""
-                        .into(),
-                );
-            }
+        if self.solver.mode == Mode::Explicit && self.material.bending.angle_variant().is_some() {
+            return ck.inv(
+                "material.bending",
+                "explicit mode integrates vertex positions only; the mid-edge angle models carry \
+                 edge rotations without inertia. Use \"patch_fit\" (MorphoShell's), \
+                 \"midedge_average\" or \"none\""
+                    .into(),
+            );
         }
         Ok(())
     }

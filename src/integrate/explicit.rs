@@ -99,8 +99,16 @@ impl Scales {
     pub fn of(scene: &Scene) -> Scales {
         let m = &scene.settings.material;
         let rho = m.density;
-        let mu = scene.lame.iter().map(|l| l.beta).fold(Real::INFINITY, Real::min);
-        let t = scene.thickness.iter().copied().fold(Real::INFINITY, Real::min);
+        let mu = scene
+            .lame
+            .iter()
+            .map(|l| l.beta)
+            .fold(Real::INFINITY, Real::min);
+        let t = scene
+            .thickness
+            .iter()
+            .copied()
+            .fold(Real::INFINITY, Real::min);
         let flexural = mu * t * t * t / (6.0 * (1.0 - m.poisson));
         let mesh = &scene.mesh;
         let mut a_min = Real::INFINITY;
@@ -149,9 +157,17 @@ impl Scales {
 pub fn max_frequency_squared(pot: &Potential, x: &[Vec3], iterations: usize) -> Real {
     let sc = pot.scene;
     let n = x.len();
-    let free: Vec<bool> = (0..n).map(|v| !sc.node_fixed[v] && pot.mass[v] > 0.0).collect();
+    let free: Vec<bool> = (0..n)
+        .map(|v| !sc.node_fixed[v] && pot.mass[v] > 0.0)
+        .collect();
     let inv_sqrt_m: Vec<Real> = (0..n)
-        .map(|v| if free[v] { 1.0 / pot.mass[v].sqrt() } else { 0.0 })
+        .map(|v| {
+            if free[v] {
+                1.0 / pot.mass[v].sqrt()
+            } else {
+                0.0
+            }
+        })
         .collect();
     // A deterministic start with every component nonzero.
     let mut z: Vec<Vec3> = (0..n)
@@ -250,7 +266,13 @@ pub(super) fn run_explicit(
     let blow_up = 100.0 * sca.mu * sca.t * area;
     let mass = &sc.mass;
     let inv_m: Vec<Real> = (0..n)
-        .map(|v| if !sc.node_fixed[v] && mass[v] > 0.0 { 1.0 / mass[v] } else { 0.0 })
+        .map(|v| {
+            if !sc.node_fixed[v] && mass[v] > 0.0 {
+                1.0 / mass[v]
+            } else {
+                0.0
+            }
+        })
         .collect();
 
     // The mesh's stability limit, measured at the start (gradient only).
@@ -293,7 +315,11 @@ pub(super) fn run_explicit(
         1.0
     };
     let mut next_hold = holds.iter().position(|&h| h > dial);
-    let mut phase = if dial >= 1.0 { Phase::Wait } else { Phase::Dial };
+    let mut phase = if dial >= 1.0 {
+        Phase::Wait
+    } else {
+        Phase::Dial
+    };
     if dial_time == 0.0 && next_hold.is_some() {
         // Holds with an instant dial: jump to the first one and wait.
         dial = holds[next_hold.unwrap_or(0)];
@@ -332,7 +358,7 @@ pub(super) fn run_explicit(
         };
         // The equilibrium test, once per window (before the step, at the state the force
         // belongs to).
-        if steps % window_steps == 0 && steps > 0 {
+        if steps.is_multiple_of(window_steps) && steps > 0 {
             let healthy = energy.is_finite()
                 && state.x.iter().all(|p| p.iter().all(|c| c.is_finite()))
                 && v.iter().all(|p| p.iter().all(|c| c.is_finite()));
