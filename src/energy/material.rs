@@ -9,7 +9,7 @@
 //! bending term equals `D/2 Q(ā⁻¹(b − b̄))` with `D = Eh³/(12(1−ν²))` and its stretching term is
 //! the standard Koiter `Eh/(8(1−ν²)) Q(ā⁻¹(a − ā))`.
 
-use crate::math::{sym_det, sym_to_mat, Mat2, Mat3, Real, Sym2};
+use crate::math::{sym_det, Mat3, Real, Sym2};
 
 /// Plane-stress (2D) Lamé parameters (Pa).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -57,21 +57,26 @@ impl StretchConvention {
 /// `C = α/2 t tᵀ + β S`, `t = (Ā11, 2Ā12, Ā22)`, `S_pq = tr(Ā E_p Ā E_q)`, `Ā = ā⁻¹` and
 /// `E_p` the symmetric basis matrices. Units: Pa / m⁴ (a is in m²).
 pub fn sv_matrix(abar: &Sym2, lame: Lame2d) -> Mat3 {
-    let ainv = sym_to_mat(abar).try_inverse().unwrap_or_else(Mat2::zeros);
-    let t = crate::math::SVec::<3>::new(ainv[(0, 0)], 2.0 * ainv[(0, 1)], ainv[(1, 1)]);
-    let basis = [
-        Mat2::new(1.0, 0.0, 0.0, 0.0),
-        Mat2::new(0.0, 1.0, 1.0, 0.0),
-        Mat2::new(0.0, 0.0, 0.0, 1.0),
-    ];
-    let ae = basis.map(|e| ainv * e);
-    let mut c = t * t.transpose() * (0.5 * lame.alpha);
-    for p in 0..3 {
-        for q in 0..3 {
-            c[(p, q)] += lame.beta * (ae[p] * ae[q]).trace();
-        }
+    // Ā = ā⁻¹ = [[p, q], [q, r]] in closed form; a singular ā gives C = 0.
+    let det = abar[0] * abar[2] - abar[1] * abar[1];
+    if det == 0.0 || !det.is_finite() {
+        return Mat3::zeros();
     }
-    c
+    let (p, q, r) = (abar[2] / det, -abar[1] / det, abar[0] / det);
+    // S_pq = tr(Ā E_p Ā E_q) for E_0 = [[1,0],[0,0]], E_1 = [[0,1],[1,0]], E_2 = [[0,0],[0,1]].
+    let s = Mat3::new(
+        p * p,
+        2.0 * p * q,
+        q * q,
+        2.0 * p * q,
+        2.0 * (q * q + p * r),
+        2.0 * q * r,
+        q * q,
+        2.0 * q * r,
+        r * r,
+    );
+    let t = crate::math::SVec::<3>::new(p, 2.0 * q, r);
+    t * t.transpose() * (0.5 * lame.alpha) + s * lame.beta
 }
 
 /// An energy density of one face as a function of its fundamental forms `a` and `b`

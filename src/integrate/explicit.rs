@@ -343,11 +343,23 @@ pub(super) fn run_explicit(
     let mut gd_left = cf.gradient_descent_steps;
     let clock = std::time::Instant::now();
     let mut steps: usize = 0;
+    // The densities at a dial that stays put (holds, waiting), computed once.
+    let mut frozen: Option<(Real, Vec<crate::energy::material::KoiterDensity>)> = None;
     let stop = loop {
         if let Some(f) = super::interruption("t", t) {
             break Stop::Other(f.to_string());
         }
-        let pot = s.potential(dial);
+        if phase == Phase::Wait && frozen.as_ref().is_none_or(|(d, _)| *d != dial) {
+            let pot = s.potential(dial);
+            frozen = Some((dial, (0..sc.num_faces()).map(|f| pot.density(f)).collect()));
+        }
+        let pot = Potential {
+            frozen: frozen
+                .as_ref()
+                .filter(|(d, _)| *d == dial)
+                .map(|(_, v)| &v[..]),
+            ..s.potential(dial)
+        };
         sc.prescribe(&mut state.x, dial);
         g.iter_mut().for_each(|x| *x = 0.0);
         let energy = pot.eval(&state.x, &[], Want::Gradient, &mut g, &mut []);

@@ -76,6 +76,10 @@ pub struct Potential<'a> {
     /// Friction against the ground (the normal contact term is on whenever the scene has a
     /// ground).
     pub friction: Option<Friction<'a>>,
+    /// Per-face Koiter densities computed once for a fixed dial (the explicit driver's waiting
+    /// phase, where millions of gradient evaluations share one rest state); `None` computes
+    /// them per evaluation.
+    pub frozen: Option<&'a [KoiterDensity]>,
 }
 
 impl<'a> Potential<'a> {
@@ -93,6 +97,7 @@ impl<'a> Potential<'a> {
             rest_override: None,
             mass: &scene.mass,
             friction: None,
+            frozen: None,
         }
     }
 
@@ -108,6 +113,9 @@ impl<'a> Potential<'a> {
     /// Koiter elastic (+ damping) density of face `f`.
     #[inline]
     pub fn density(&self, f: usize) -> KoiterDensity {
+        if let Some(d) = self.frozen {
+            return d[f];
+        }
         let sc = self.scene;
         let (abar, bbar) = self.rest_forms(f);
         let (ws, wb) = KoiterDensity::weights(&abar, sc.thickness[f], sc.stretch_factor);

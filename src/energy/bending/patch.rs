@@ -41,10 +41,16 @@ pub fn patch_face<D: FaceDensity, const GN: bool>(
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PatchFit;
 
-/// The face normal and the weighted sums `s_q` kept for the Hessian contraction.
+/// What the gradient and the Hessian contraction need: the unit normal `N`, twice the area
+/// `r = |c|`, the edge vectors `e_a` opposite each face vertex (`∂c/∂x_a = [e_a]×`), the
+/// weighted sums `s_q`, and the normal's full Jacobian when a Hessian is wanted.
 pub struct PatchCache {
-    nf: UnitNormal,
+    w: PatchWeights,
+    n: Vec3,
+    r: Real,
+    e: [Vec3; 3],
     s: [Vec3; 3],
+    full: Option<UnitNormal>,
 }
 
 impl BendingModel<18, 6> for PatchFit {
@@ -57,24 +63,35 @@ impl BendingModel<18, 6> for PatchFit {
         scene.patches[f].weights
     }
 
-    /// `∇b_q`: node k gets `−Ŵ_qk N`; face vertex a also gets `−(∂N/∂x_a)ᵀ s_q`.
+    /// `b_q = −N·s_q`; with a Hessian, also `G = ∇b` (node k gets `−Ŵ_qk N`; face vertex a
+    /// also gets `−(∂N/∂x_a)ᵀ s_q`). A gradient alone needs no `G`: see
+    /// [`BendingModel::add_gradient`] below.
     #[inline(always)]
     fn eval(
         &self,
         w: &PatchWeights,
         x: &[Vec3; 6],
-        grad: bool,
-        _hess: bool,
+        _grad: bool,
+        hess: bool,
     ) -> BendingEval<18, PatchCache> {
-        let nf = UnitNormal::new(&[x[0], x[1], x[2]]);
-        let s: [Vec3; 3] = std::array::from_fn(|q| (0..6).map(|k| x[k] * w[(q, k)]).sum());
-        let b = Sym2::from_fn(|q, _| -nf.n.dot(&s[q]));
+        let c = (x[1] - x[0]).cross(&(x[2] - x[0]));
+        let r = c.norm();
+        let n = c / r;
+        let s: [Vec3; 3] = std::array::from_fn(|q| {
+            let mut acc = x[0] * w[(q, 0)];
+            for k in 1..6 {
+                acc += x[k] * w[(q, k)];
+            }
+            acc
+        });
+        let b = Sym2::new(-n.dot(&s[0]), -n.dot(&s[1]), -n.dot(&s[2]));
         let mut jac = SMat::<18, 3>::zeros();
-        if grad {
+        let full = hess.then(|| UnitNormal::new(&[x[0], x[1], x[2]]));
+        if let Some(nf) = &full {
             for q in 0..3 {
                 for k in 0..6 {
                     for c in 0..3 {
-                        jac[(3 * k + c, q)] -= w[(q, k)] * nf.n[c];
+                        jac[(3 * k + c, q)] -= w[(q, k)] * n[c];
                     }
                 }
                 for av in 0..3 {
@@ -88,7 +105,36 @@ impl BendingModel<18, 6> for PatchFit {
         BendingEval {
             b,
             jac,
-            cache: PatchCache { nf, s },
+            cache: PatchCache {
+                w: *w,
+                n,
+                r,
+                e: [x[2] - x[1], x[0] - x[2], x[1] - x[0]],
+                s,
+                full,
+            },
+        }
+    }
+
+    /// `Σ_q W_b,q ∇b_q` without forming `G`: node k gets `−(Σ_q W_b,q Ŵ_qk) N`, and with
+    /// `λ = Σ_q W_b,q s_q` and `μ = (I − N Nᵀ) λ / r`, face vertex a gets
+    /// `−(∂N/∂x_a)ᵀ λ = −[e_a]×ᵀ μ = e_a × μ`.
+    #[inline(always)]
+    fn add_gradient(&self, ev: &BendingEval<18, PatchCache>, wb: &Sym2, g: &mut SVec<18>) {
+        let PatchCache { w, n, r, e, s, .. } = &ev.cache;
+        let lam = s[0] * wb[0] + s[1] * wb[1] + s[2] * wb[2];
+        let mu = (lam - n * n.dot(&lam)) / *r;
+        for a in 0..3 {
+            let v = e[a].cross(&mu);
+            for c in 0..3 {
+                g[3 * a + c] += v[c];
+            }
+        }
+        for k in 0..6 {
+            let wk = wb[0] * w[(0, k)] + wb[1] * w[(1, k)] + wb[2] * w[(2, k)];
+            for c in 0..3 {
+                g[3 * k + c] -= wk * n[c];
+            }
         }
     }
 
@@ -103,7 +149,10 @@ impl BendingModel<18, 6> for PatchFit {
         lambda: &Sym2,
         h: &mut SMat<18, 18>,
     ) {
-        let PatchCache { nf, s } = &ev.cache;
+        let PatchCache { full, s, .. } = &ev.cache;
+        let Some(nf) = full else {
+            return; // evaluated without a Hessian
+        };
         let lam: Vec3 = s.iter().zip(lambda.iter()).map(|(sq, g)| sq * *g).sum();
         let hn = nf.hessian_contract(&lam);
         let mut top = h.fixed_view_mut::<9, 9>(0, 0);
