@@ -35,6 +35,7 @@ fn patch() -> ([Vec3; 6], KoiterDensity) {
         c: sv_matrix(&abar, Lame2d::from_young_poisson(1e6, 0.3)),
         stretch: [(ws, abar), (0.0, Sym2::zeros())],
         bend: [(wb, Sym2::new(0.3, 0.0, -0.2)), (0.0, Sym2::zeros())],
+        stiffen: 0.0,
     };
     (x, d)
 }

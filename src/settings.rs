@@ -132,6 +132,9 @@ pub struct Material {
     pub c1: Real,
     /// Mooney–Rivlin `c₂` (Pa, default: `0`, ≥ 0).
     pub c2: Real,
+    /// MorphoShell's bend stiffening γ: the bending density `W_b` becomes `W_b + W_b²/(γ μ t)`
+    /// (dimensionless, > 0; default: none = off; [`crate::energy::stiffening`]).
+    pub bend_stiffening: Option<Real>,
     /// Baraff–Witkin constants and warp direction.
     pub baraff_witkin: BaraffWitkinSettings,
     /// The prism element's density law and thickness mode.
@@ -298,6 +301,7 @@ impl Default for Material {
             model: MaterialModel::default(),
             c1: 0.0,
             c2: 0.0,
+            bend_stiffening: None,
             baraff_witkin: BaraffWitkinSettings::default(),
             prism: PrismSettings::default(),
         }
@@ -1310,6 +1314,9 @@ impl Settings {
         let ck = Check(name);
         let m = &self.material;
         ck.pos("material.young", m.young)?;
+        if let Some(g) = m.bend_stiffening {
+            ck.pos("material.bend_stiffening", g)?;
+        }
         if m.young > MAX_MODULUS {
             return ck.inv(
                 "material.young",

@@ -131,8 +131,12 @@ pub struct KoiterDensity {
     pub c: Mat3,
     /// Up to two quadratic wells in `a`: (weight, target).
     pub stretch: [(Real, Sym2); 2],
-    /// Up to two quadratic wells in `b`: (weight, target).
+    /// Up to two quadratic wells in `b`: (weight, target); the first (elastic) one stiffened
+    /// by `stiffen`.
     pub bend: [(Real, Sym2); 2],
+    /// Bend stiffening coefficient `s = 1/(A γ μ t)` of the elastic bending well (1/J; 0 = off;
+    /// [`crate::energy::stiffening`]).
+    pub stiffen: Real,
 }
 
 impl KoiterDensity {
@@ -165,17 +169,30 @@ impl FaceDensity for KoiterDensity {
                 ws += w;
             }
         }
-        for (w, t) in &self.bend {
+        d.hbb = Mat3::zeros();
+        for (k, (w, t)) in self.bend.iter().enumerate() {
             if *w != 0.0 {
                 let m = b - t;
                 let cm = self.c * m;
-                e += w * m.dot(&cm);
-                d.gb += cm * (2.0 * w);
-                wb += w;
+                let mut g = cm * (2.0 * w);
+                if k == 0 && self.stiffen != 0.0 {
+                    let mut h = self.c * (2.0 * w);
+                    e += crate::energy::stiffening::stiffen(
+                        self.stiffen,
+                        w * m.dot(&cm),
+                        &mut g,
+                        Some(&mut h),
+                    );
+                    d.hbb += h;
+                } else {
+                    e += w * m.dot(&cm);
+                    wb += w;
+                }
+                d.gb += g;
             }
         }
         d.haa = self.c * (2.0 * ws);
-        d.hbb = self.c * (2.0 * wb);
+        d.hbb += self.c * (2.0 * wb);
         e
     }
 
@@ -184,6 +201,10 @@ impl FaceDensity for KoiterDensity {
         let (ws, ta) = self.stretch[0];
         let (wb, tb) = self.bend[0];
         let (da, db) = (a - ta, b - tb);
-        (ws * da.dot(&(self.c * da)), wb * db.dot(&(self.c * db)))
+        let eb = wb * db.dot(&(self.c * db));
+        (
+            ws * da.dot(&(self.c * da)),
+            eb + self.stiffen * eb * eb,
+        )
     }
 }

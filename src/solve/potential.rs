@@ -130,6 +130,12 @@ impl<'a> Potential<'a> {
             c: sv_matrix(&abar, sc.lame[f]),
             stretch: [(ws, abar), (0.0, Sym2::zeros())],
             bend: [(wb, bbar), (0.0, Sym2::zeros())],
+            stiffen: crate::energy::stiffening::coefficient(
+                sc.settings.material.bend_stiffening,
+                0.5 * crate::math::sym_det(&abar).max(0.0).sqrt(),
+                sc.lame[f].beta,
+                sc.thickness[f],
+            ),
         };
         if let Some(dm) = &self.damping {
             d.stretch[1] = (ws * dm.eta_over_dt, dm.a_prev[f]);

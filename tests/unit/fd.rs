@@ -33,6 +33,7 @@ pub fn random_density(rng: &mut Rng, damping: bool) -> KoiterDensity {
         c: sv_matrix(&abar, lame),
         stretch: [(ws, abar), (0.0, Sym2::zeros())],
         bend: [(wb, bbar), (0.0, Sym2::zeros())],
+        stiffen: 0.0,
     };
     if damping {
         d.stretch[1] = (0.3 * ws, Sym2::new(1.1, 0.05, 0.9));
@@ -90,6 +91,36 @@ fn shell_face_derivatives_match_finite_differences() {
         assert!(ge < 1e-6, "trial {trial}: gradient rel. error {ge:e}");
         assert!(he < 1e-6, "trial {trial}: Hessian rel. error {he:e}");
     }
+}
+
+/// Bend stiffening `E_b + s E_b²` (MorphoShell's `W_b + W_b²/(γμt)`): the face's gradient and
+/// Hessian against central differences, with `s E_b` of order one so that the squared term
+/// matters, and its energy against the formula.
+#[test]
+fn stiffened_bending_derivatives_match_finite_differences() {
+    use shellsim::energy::material::FaceDensity;
+    let mut rng = Rng::new(17);
+    for trial in 0..20 {
+        let x = random_patch(&mut rng, 0.25);
+        let mut d = random_density(&mut rng, trial % 2 == 1);
+        let (_, eb) = d.elastic_parts(
+            &shellsim::geometry::first_fundamental_form(&[x[0], x[1], x[2]]),
+            &shell_face_b(&x),
+        );
+        d.stiffen = 2.0 / eb.max(1e-12);
+        let (ge, he) = fd_errors(&x, [true; 3], &d, 1e-6);
+        assert!(ge < 1e-6, "trial {trial}: gradient rel. error {ge:e}");
+        assert!(he < 1e-6, "trial {trial}: Hessian rel. error {he:e}");
+        let (_, es) = d.elastic_parts(
+            &shellsim::geometry::first_fundamental_form(&[x[0], x[1], x[2]]),
+            &shell_face_b(&x),
+        );
+        assert!((es - 3.0 * eb).abs() <= 1e-12 * es, "E_b + s E_b² = 3 E_b, got {es} vs {eb}");
+    }
+}
+
+fn shell_face_b(x: &[Vec3; 6]) -> Sym2 {
+    shellsim::energy::shell::face_forms(x, [true; 3]).1
 }
 
 #[test]

@@ -389,6 +389,7 @@ fn no_bending_wells() -> KoiterDensity {
         c: Mat3::zeros(),
         stretch: [(0.0, Sym2::zeros()); 2],
         bend: [(0.0, Sym2::zeros()); 2],
+        stiffen: 0.0,
     }
 }
 
