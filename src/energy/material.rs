@@ -202,9 +202,6 @@ impl FaceDensity for KoiterDensity {
         let (wb, tb) = self.bend[0];
         let (da, db) = (a - ta, b - tb);
         let eb = wb * db.dot(&(self.c * db));
-        (
-            ws * da.dot(&(self.c * da)),
-            eb + self.stiffen * eb * eb,
-        )
+        (ws * da.dot(&(self.c * da)), eb + self.stiffen * eb * eb)
     }
 }

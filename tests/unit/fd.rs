@@ -115,7 +115,10 @@ fn stiffened_bending_derivatives_match_finite_differences() {
             &shellsim::geometry::first_fundamental_form(&[x[0], x[1], x[2]]),
             &shell_face_b(&x),
         );
-        assert!((es - 3.0 * eb).abs() <= 1e-12 * es, "E_b + s E_b² = 3 E_b, got {es} vs {eb}");
+        assert!(
+            (es - 3.0 * eb).abs() <= 1e-12 * es,
+            "E_b + s E_b² = 3 E_b, got {es} vs {eb}"
+        );
     }
 }
 
