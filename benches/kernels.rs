@@ -535,8 +535,69 @@ fn bench_hessian_pot(
     }
 }
 
+/// One explicit step (gradient + symplectic Euler update) of MorphoShell's GCM cone with the
+/// patch fit, at the sizes MorphoShell was timed at (743–2060 triangles), on 1 and 2 threads:
+/// per step while the forms are dialled (densities recomputed) and while waiting (densities
+/// computed once). Report: time per step / faces = µs per triangle-step.
+fn explicit_step(c: &mut Criterion) {
+    use shellsim::integrate::explicit::{advance, gradient};
+    for edge in [0.085, 0.05] {
+        let mut mesh = shellsim::mesh::generate::annulus(
+            1.0,
+            1.4,
+            shellsim::cases::gcm_cone_sweep(),
+            edge,
+            Spacing::default(),
+        );
+        shellsim::cases::Case::GcmCone.program(&mut mesh);
+        let settings = shellsim::settings::Settings::from_str_with(
+            "[material]\nyoung = 3.0\npoisson = 0.5\ndensity = 1.0\nthickness = 0.01\n\
+             bending = \"patch_fit\"\n[rest]\ntarget = \"mesh\"\n[solver]\nmode = \"explicit\"\n",
+            "bench",
+            &[],
+        )
+        .unwrap();
+        let sc = Scene::build(mesh, settings).unwrap();
+        let p = Pattern::for_scene(&sc);
+        let nf = sc.num_faces();
+        let mut g = c.benchmark_group(format!("explicit_step_{nf}"));
+        g.throughput(Throughput::Elements(nf as u64));
+        let inv_m: Vec<f64> = sc.mass.iter().map(|m| 1.0 / m).collect();
+        let x0 = curved(&sc);
+        let frozen: Vec<KoiterDensity> = {
+            let pot = Potential::new(&sc, &p);
+            (0..nf).map(|f| pot.density(f)).collect()
+        };
+        for threads in [1usize, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            for (name, fr) in [("dialling", None), ("waiting", Some(&frozen[..]))] {
+                g.bench_with_input(BenchmarkId::new(name, threads), &threads, |b, _| {
+                    let pot = Potential {
+                        dial: if fr.is_some() { 1.0 } else { 0.5 },
+                        frozen: fr,
+                        ..Potential::new(&sc, &p)
+                    };
+                    let mut x = x0.clone();
+                    let mut v = vec![Vec3::zeros(); x.len()];
+                    let mut gr = vec![0.0; p.n];
+                    b.iter(|| {
+                        pool.install(|| {
+                            gradient(&pot, &x, &mut gr);
+                            advance(&mut x, &mut v, &gr, &inv_m, 1e-3, 1e-9);
+                        })
+                    })
+                });
+            }
+        }
+    }
+}
+
 criterion_group!(
     benches,
+    explicit_step,
     kernel,
     assembly,
     newton_iteration,

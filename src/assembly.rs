@@ -55,6 +55,25 @@ pub struct ElementMap {
     offsets: Vec<u32>,
     /// Blocks of elements grouped by colour; blocks of one colour share no stencil node.
     colours: Vec<Vec<Vec<usize>>>,
+    /// The gradient's gather: for node u, `gather[gather_ptr[u]..gather_ptr[u + 1]]` lists
+    /// where its entries sit in the per-element gradient buffer (element × `stride` + the slot's
+    /// local offset), in element order.
+    gather_ptr: Vec<usize>,
+    gather: Vec<u32>,
+    /// Per-element stride of that buffer: the element's DOFs plus its energy.
+    stride: usize,
+    /// Reused storage of the per-element gradients (`elements × N`).
+    scratch: Scratch,
+}
+
+/// A reusable buffer behind a lock (cloning gives an empty one).
+#[derive(Debug, Default)]
+struct Scratch(std::sync::Mutex<Vec<Real>>);
+
+impl Clone for Scratch {
+    fn clone(&self) -> Self {
+        Scratch::default()
+    }
 }
 
 /// Elements per block: large enough for cache locality and cheap scheduling, small enough that
@@ -156,6 +175,26 @@ impl Pattern {
                     }
                 }
                 let colours = colour_blocks(nodes, st, &morton_blocks(&st.anchors, positions));
+                let mut count = vec![0usize; nodes + 1];
+                for &u in &st.nodes {
+                    if u != NONE {
+                        count[u + 1] += 1;
+                    }
+                }
+                for u in 0..nodes {
+                    count[u + 1] += count[u];
+                }
+                let gather_ptr = count.clone();
+                let stride = st.slot_dofs.iter().sum::<usize>() + 1;
+                let mut gather = vec![0u32; st.nodes.len()];
+                for (k, &u) in st.nodes.iter().enumerate() {
+                    if u != NONE {
+                        let (e, slot) = (k / s.max(1), k % s.max(1));
+                        gather[count[u]] = (e * stride + local[slot]) as u32;
+                        count[u] += 1;
+                    }
+                }
+                gather.truncate(gather_ptr[nodes]);
                 ElementMap {
                     slots: s,
                     local,
@@ -163,6 +202,10 @@ impl Pattern {
                     num_vertices: nv,
                     offsets,
                     colours,
+                    gather_ptr,
+                    gather,
+                    stride,
+                    scratch: Scratch::default(),
                 }
             })
             .collect();
@@ -470,6 +513,9 @@ where
             .collect();
         return es.iter().sum();
     }
+    if want == Want::Gradient {
+        return gather_gradient::<N, S, K>(map, &kernel, fixed, grad);
+    }
     let mut local = [0usize; S];
     local.copy_from_slice(&map.local);
     let mut energies = vec![0.0; ne];
@@ -497,4 +543,92 @@ where
         });
     }
     energies.iter().sum()
+}
+
+/// Elements per parallel task of the gradient; nodes per task of its gather.
+const GRADIENT_CHUNK: usize = 64;
+
+/// The gradient of one element term without colouring: every element's local gradient into a
+/// buffer (one parallel pass over fixed chunks of elements), then every node gathers its
+/// entries in element order (one parallel pass over fixed chunks of nodes). Two synchronisations
+/// per call whatever the mesh, and each sum has a fixed order: bitwise identical for any number
+/// of threads. Returns the energy, summed in element order.
+fn gather_gradient<const N: usize, const S: usize, K>(
+    map: &ElementMap,
+    kernel: &K,
+    fixed: &[bool],
+    grad: &mut [Real],
+) -> Real
+where
+    K: Fn(usize, &[usize], Option<&mut SVec<N>>, Option<&mut SMat<N, N>>) -> Real + Sync,
+{
+    let ne = map.len();
+    assert_eq!(
+        map.stride,
+        N + 1,
+        "element map and kernel disagree on the DOFs"
+    );
+    let mut guard = map
+        .scratch
+        .0
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    let buf = &mut *guard;
+    buf.resize(ne * (N + 1), 0.0);
+    // Per element: N gradient entries, then its energy.
+    buf.par_chunks_mut(GRADIENT_CHUNK * (N + 1))
+        .enumerate()
+        .for_each(|(c, chunk)| {
+            let mut g = SVec::<N>::zeros();
+            for (i, out) in chunk.chunks_mut(N + 1).enumerate() {
+                let e = c * GRADIENT_CHUNK + i;
+                let mut st = [NONE; S];
+                st.copy_from_slice(map.element(e));
+                let en = kernel(e, &st, Some(&mut g), None);
+                out[..N].copy_from_slice(g.as_slice());
+                out[N] = en;
+            }
+        });
+    let buf = &*buf;
+    let nv = map.num_vertices;
+    let nodes = map.gather_ptr.len() - 1;
+    let gather_node = |u: usize, out: &mut [Real]| {
+        if fixed[u] {
+            return;
+        }
+        for &off in &map.gather[map.gather_ptr[u]..map.gather_ptr[u + 1]] {
+            let src = &buf[off as usize..off as usize + out.len()];
+            for (o, v) in out.iter_mut().zip(src) {
+                *o += v;
+            }
+        }
+    };
+    let (gv, ge) = grad.split_at_mut(3 * nv);
+    gv.par_chunks_mut(3 * GRADIENT_CHUNK)
+        .enumerate()
+        .for_each(|(c, chunk)| {
+            for (i, out) in chunk.chunks_exact_mut(3).enumerate() {
+                let u = c * GRADIENT_CHUNK + i;
+                if fixed[u] {
+                    continue;
+                }
+                let mut acc = [out[0], out[1], out[2]];
+                for &off in &map.gather[map.gather_ptr[u]..map.gather_ptr[u + 1]] {
+                    let o = off as usize;
+                    acc[0] += buf[o];
+                    acc[1] += buf[o + 1];
+                    acc[2] += buf[o + 2];
+                }
+                out.copy_from_slice(&acc);
+            }
+        });
+    ge[..nodes - nv]
+        .par_chunks_mut(GRADIENT_CHUNK)
+        .enumerate()
+        .for_each(|(c, chunk)| {
+            for (i, out) in chunk.chunks_mut(1).enumerate() {
+                gather_node(nv + c * GRADIENT_CHUNK + i, out);
+            }
+        });
+    (0..ne).map(|e| buf[e * (N + 1) + N]).sum()
 }

@@ -97,6 +97,12 @@ pub trait FaceDensity {
     }
     /// The elastic (stretching, bending) energies without damping (J).
     fn elastic_parts(&self, a: &Sym2, b: &Sym2) -> (Real, Real);
+    /// Energy and first derivatives only (`ga`, `gb`); the second derivatives may be left
+    /// stale. The default evaluates everything.
+    #[inline]
+    fn eval_gradient(&self, a: &Sym2, b: &Sym2, d: &mut DensityDerivs) -> Real {
+        self.eval(a, b, d)
+    }
 }
 
 /// Derivatives filled by [`FaceDensity::eval`].
@@ -193,6 +199,37 @@ impl FaceDensity for KoiterDensity {
         }
         d.haa = self.c * (2.0 * ws);
         d.hbb += self.c * (2.0 * wb);
+        e
+    }
+
+    /// The wells' energies and `ga`, `gb`, without the Hessians (the explicit dynamics' path).
+    #[inline]
+    fn eval_gradient(&self, a: &Sym2, b: &Sym2, d: &mut DensityDerivs) -> Real {
+        let mut e = 0.0;
+        d.ga = Sym2::zeros();
+        d.gb = Sym2::zeros();
+        for (w, t) in &self.stretch {
+            if *w != 0.0 {
+                let m = a - t;
+                let cm = self.c * m;
+                e += w * m.dot(&cm);
+                d.ga += cm * (2.0 * w);
+            }
+        }
+        for (k, (w, t)) in self.bend.iter().enumerate() {
+            if *w != 0.0 {
+                let m = b - t;
+                let cm = self.c * m;
+                let mut g = cm * (2.0 * w);
+                let eb = w * m.dot(&cm);
+                e += if k == 0 {
+                    crate::energy::stiffening::stiffen(self.stiffen, eb, &mut g, None)
+                } else {
+                    eb
+                };
+                d.gb += g;
+            }
+        }
         e
     }
 

@@ -58,6 +58,10 @@ pub fn shell_element<
 ) -> Real {
     let want_h = hess.is_some();
     let want_g = grad.is_some() || want_h;
+    let grad = match grad {
+        Some(gout) if !want_h => return shell_gradient::<D, B, N, S>(model, face, x, dens, gout),
+        other => other,
+    };
     // The bending evaluation (with its cache) stays in this frame: passed by reference, never
     // moved into an `Option`.
     if N > 9 && dens.uses_b() {
@@ -66,6 +70,42 @@ pub fn shell_element<
     } else {
         shell_element_with::<D, B, N, S, GN>(model, face, x, dens, None, grad, hess)
     }
+}
+
+/// The gradient alone (the explicit dynamics' path): `b` and the bending model's light data,
+/// the density's first derivatives, and `∇E = Jaᵀ W_a + Σ_q W_b,q ∇b_q` with `Jaᵀ W_a` in closed
+/// form (`e₁ = x₁ − x₀`, `e₂ = x₂ − x₀`: `∂E/∂x₁ = 2W_a,11 e₁ + W_a,12 e₂`,
+/// `∂E/∂x₂ = W_a,12 e₁ + 2W_a,22 e₂`, `∂E/∂x₀ = −∂E/∂x₁ − ∂E/∂x₂`). Returns the energy (J).
+#[inline(always)]
+fn shell_gradient<D: FaceDensity, B: BendingModel<N, S>, const N: usize, const S: usize>(
+    model: &B,
+    face: &B::Face,
+    x: &[Vec3; 6],
+    dens: &D,
+    gout: &mut SVec<N>,
+) -> Real {
+    let xf = [x[0], x[1], x[2]];
+    let a = first_fundamental_form(&xf);
+    let mut d = DensityDerivs::default();
+    let (e1, e2) = (x[1] - x[0], x[2] - x[0]);
+    *gout = SVec::<N>::zeros();
+    let e = if N > 9 && dens.uses_b() {
+        let (b, light) = model.light(face, x);
+        let e = dens.eval_gradient(&a, &b, &mut d);
+        model.add_gradient_light(face, &light, &d.gb, gout);
+        e
+    } else {
+        dens.eval_gradient(&a, &Sym2::zeros(), &mut d)
+    };
+    let g1 = e1 * (2.0 * d.ga[0]) + e2 * d.ga[1];
+    let g2 = e1 * d.ga[1] + e2 * (2.0 * d.ga[2]);
+    let g0 = -(g1 + g2);
+    for (k, v) in [g0, g1, g2].iter().enumerate() {
+        for c in 0..3 {
+            gout[3 * k + c] += v[c];
+        }
+    }
+    e
 }
 
 /// [`shell_element`] after the bending model's evaluation `ev` (`None` without bending).
@@ -91,10 +131,14 @@ fn shell_element_with<
     let want_g = grad.is_some() || want_h;
     let b = ev.map_or(Sym2::zeros(), |ev| ev.b);
     let mut d = DensityDerivs::default();
-    let e = dens.eval(&a, &b, &mut d);
     if !want_g {
-        return e;
+        return dens.eval(&a, &b, &mut d);
     }
+    let e = if want_h {
+        dens.eval(&a, &b, &mut d)
+    } else {
+        dens.eval_gradient(&a, &b, &mut d)
+    };
     if GN && want_h {
         dens.gauss_newton(&a, &b, &mut d);
     }
@@ -102,7 +146,7 @@ fn shell_element_with<
     let mut g = SVec::<N>::zeros();
     g.fixed_rows_mut::<9>(0).copy_from(&(ja.transpose() * d.ga));
     if let Some(ev) = ev {
-        model.add_gradient(ev, &d.gb, &mut g);
+        model.add_gradient(face, ev, &d.gb, &mut g);
     }
     if let Some(h) = hess {
         let lambda = (!GN).then_some(&d.gb);

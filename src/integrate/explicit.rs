@@ -214,6 +214,29 @@ pub fn max_frequency_squared(pot: &Potential, x: &[Vec3], iterations: usize) -> 
     lambda
 }
 
+/// The forces of one explicit step: `g ← ∇Φ(x)` (zeroed first; N), returning Φ (J).
+#[inline]
+pub fn gradient(pot: &Potential, x: &[Vec3], g: &mut [Real]) -> Real {
+    g.iter_mut().for_each(|v| *v = 0.0);
+    pot.eval(x, &[], Want::Gradient, g, &mut [])
+}
+
+/// One symplectic Euler step with drag rate `c` (1/s) and step `dt` (s):
+/// `v ← v + dt (−g/m − c v)`, `x ← x + dt v`, with `inv_m` the inverse lumped masses (0 for
+/// fixed vertices, which keep v = 0).
+#[inline]
+pub fn advance(x: &mut [Vec3], v: &mut [Vec3], g: &[Real], inv_m: &[Real], c: Real, dt: Real) {
+    for (i, (xi, vi)) in x.iter_mut().zip(v.iter_mut()).enumerate() {
+        if inv_m[i] == 0.0 {
+            *vi = Vec3::zeros();
+            continue;
+        }
+        let f = Vec3::new(g[3 * i], g[3 * i + 1], g[3 * i + 2]);
+        *vi += (-f * inv_m[i] - *vi * c) * dt;
+        *xi += *vi * dt;
+    }
+}
+
 /// Where the dial is.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Phase {
@@ -361,8 +384,7 @@ pub(super) fn run_explicit(
             ..s.potential(dial)
         };
         sc.prescribe(&mut state.x, dial);
-        g.iter_mut().for_each(|x| *x = 0.0);
-        let energy = pot.eval(&state.x, &[], Want::Gradient, &mut g, &mut []);
+        let energy = gradient(&pot, &state.x, &mut g);
         let c = if phase == Phase::Dial {
             rate_dial
         } else {
@@ -455,15 +477,7 @@ pub(super) fn run_explicit(
                 v.iter_mut().for_each(|v| *v = Vec3::zeros());
             }
         } else {
-            for i in 0..n {
-                let f = Vec3::new(g[3 * i], g[3 * i + 1], g[3 * i + 2]);
-                let vi = v[i];
-                v[i] = vi + (-f * inv_m[i] - vi * c) * dt;
-                if inv_m[i] == 0.0 {
-                    v[i] = Vec3::zeros();
-                }
-                state.x[i] += v[i] * dt;
-            }
+            advance(&mut state.x, &mut v, &g, &inv_m, c, dt);
         }
         t += dt;
         steps += 1;

@@ -111,7 +111,7 @@ impl<'a> Potential<'a> {
     }
 
     /// Koiter elastic (+ damping) density of face `f`.
-    #[inline]
+    #[inline(always)]
     pub fn density(&self, f: usize) -> KoiterDensity {
         if let Some(d) = self.frozen {
             return d[f];

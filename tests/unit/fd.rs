@@ -167,9 +167,15 @@ fn patch_face_derivatives_match_finite_differences() {
         let mut g = SVec::<18>::zeros();
         let mut h = SMat::<18, 18>::zeros();
         patch_face::<_, false>(&x, &w, &d, Some(&mut g), Some(&mut h));
+        // The gradient alone (the explicit path) forms Jaᵀ W_a in closed form: equal to the
+        // Hessian path's gradient up to round-off.
         let mut ggn = SVec::<18>::zeros();
         patch_face::<_, true>(&x, &w, &d, Some(&mut ggn), None);
-        assert_eq!(g, ggn);
+        assert!(
+            (g - ggn).amax() <= 1e-14 * g.amax(),
+            "{:e}",
+            (g - ggn).amax()
+        );
         let x0 = flat(&x);
         let eps = 1e-6;
         let mut gfd = SVec::<18>::zeros();

@@ -24,6 +24,7 @@ impl BendingModel<18, 6> for MidedgeAverage {
     type Face = [bool; 3];
     type Cache = AverageCache;
     const NAME: &'static str = "midedge_average";
+    crate::light_via_eval!(18);
 
     #[inline(always)]
     fn face(&self, _: &Scene, _: usize, nodes: &[usize], _: &[Real]) -> [bool; 3] {
@@ -56,7 +57,7 @@ impl BendingModel<18, 6> for MidedgeAverage {
         }
         BendingEval {
             b,
-            jac,
+            jac: Some(jac),
             cache: AverageCache { nf, qs },
         }
     }

@@ -212,6 +212,7 @@ impl BendingModel<21, 9> for MidedgeAngle {
     type Face = AngleFace;
     type Cache = AngleCache;
     const NAME: &'static str = "midedge_angle";
+    crate::light_via_eval!(21);
 
     #[inline(always)]
     fn face(&self, scene: &Scene, f: usize, nodes: &[usize], phi: &[Real]) -> AngleFace {
@@ -275,7 +276,7 @@ impl BendingModel<21, 9> for MidedgeAngle {
         BendingEval {
             b,
             // G is never formed: the gradient and Hessian go through the y variables.
-            jac: SMat::<21, 3>::zeros(),
+            jac: None,
             cache: AngleCache {
                 nf,
                 qs,
@@ -321,7 +322,13 @@ impl BendingModel<21, 9> for MidedgeAngle {
 
     /// `G W_b = Jyᵀ (Jqᵀ (Bᵀ W_b))`: three products of a vector, never the 21×3 `G`.
     #[inline(always)]
-    fn add_gradient(&self, ev: &BendingEval<21, AngleCache>, wb: &Sym2, g: &mut SVec<21>) {
+    fn add_gradient(
+        &self,
+        _face: &Self::Face,
+        ev: &BendingEval<21, AngleCache>,
+        wb: &Sym2,
+        g: &mut SVec<21>,
+    ) {
         let c = &ev.cache;
         *g += c.jy.transpose() * (c.jq.transpose() * (b_from_q_matrix().transpose() * wb));
     }

@@ -28,7 +28,7 @@ pub struct BendingEval<const N: usize, C> {
     pub b: Sym2,
     /// `G = ∂b/∂x` (column q is `∇b_q`), filled when a gradient was asked for, by models that
     /// use the default [`BendingModel::add_gradient`] (a model that overrides it may leave it 0).
-    pub jac: SMat<N, 3>,
+    pub jac: Option<SMat<N, 3>>,
     /// Scratch kept for [`BendingModel::add_hessian`].
     pub cache: C,
 }
@@ -55,6 +55,22 @@ pub trait BendingModel<const N: usize, const S: usize>: Send + Sync {
         hess: bool,
     ) -> BendingEval<N, Self::Cache>;
 
+    /// What [`BendingModel::add_gradient_light`] needs besides `b` (a model without a cheaper
+    /// gradient keeps its whole [`BendingEval`]).
+    type Light;
+
+    /// `b` and the data of a gradient without `G` (the explicit dynamics' path: no Hessian).
+    fn light(&self, face: &Self::Face, x: &[Vec3; 6]) -> (Sym2, Self::Light);
+
+    /// Adds `Σ_q W_b,q ∇b_q` from [`BendingModel::light`]'s data.
+    fn add_gradient_light(
+        &self,
+        face: &Self::Face,
+        light: &Self::Light,
+        wb: &Sym2,
+        g: &mut SVec<N>,
+    );
+
     /// Adds `Σ_q λ_q ∇²b_q` to `h`.
     fn add_hessian(
         &self,
@@ -67,8 +83,16 @@ pub trait BendingModel<const N: usize, const S: usize>: Send + Sync {
 
     /// Adds the bending part of the gradient, `G W_b`.
     #[inline(always)]
-    fn add_gradient(&self, ev: &BendingEval<N, Self::Cache>, wb: &Sym2, g: &mut SVec<N>) {
-        *g += ev.jac * wb;
+    fn add_gradient(
+        &self,
+        _face: &Self::Face,
+        ev: &BendingEval<N, Self::Cache>,
+        wb: &Sym2,
+        g: &mut SVec<N>,
+    ) {
+        if let Some(j) = &ev.jac {
+            *g += j * wb;
+        }
     }
 
     /// Adds the bending part of the chain rule, `G W_bb Gᵀ` and, with `lambda = Some(W_b)`,
@@ -84,7 +108,9 @@ pub trait BendingModel<const N: usize, const S: usize>: Send + Sync {
         lambda: Option<&Sym2>,
         h: &mut SMat<N, N>,
     ) {
-        *h += ev.jac * hbb * ev.jac.transpose();
+        if let Some(j) = &ev.jac {
+            *h += j * hbb * j.transpose();
+        }
         if let Some(l) = lambda {
             self.add_hessian(face, x, ev, l, h);
         }
@@ -116,4 +142,28 @@ pub trait BendingModel<const N: usize, const S: usize>: Send + Sync {
 pub fn has_extra(nodes: &[usize]) -> [bool; 3] {
     use crate::mesh::topology::NONE;
     [nodes[3] != NONE, nodes[4] != NONE, nodes[5] != NONE]
+}
+
+/// The light gradient path of a model that has none cheaper than its full evaluation: the
+/// [`BendingModel::light`] and [`BendingModel::add_gradient_light`] bodies of such models.
+#[macro_export]
+macro_rules! light_via_eval {
+    ($n:literal) => {
+        type Light = $crate::energy::bending::BendingEval<$n, Self::Cache>;
+        #[inline(always)]
+        fn light(&self, face: &Self::Face, x: &[Vec3; 6]) -> (Sym2, Self::Light) {
+            let ev = self.eval(face, x, true, false);
+            (ev.b, ev)
+        }
+        #[inline(always)]
+        fn add_gradient_light(
+            &self,
+            face: &Self::Face,
+            light: &Self::Light,
+            wb: &Sym2,
+            g: &mut $crate::math::SVec<$n>,
+        ) {
+            self.add_gradient(face, light, wb, g);
+        }
+    };
 }

@@ -14,6 +14,7 @@ impl BendingModel<9, 3> for NoBending {
     type Face = ();
     type Cache = ();
     const NAME: &'static str = "none";
+    crate::light_via_eval!(9);
 
     fn face(&self, _: &Scene, _: usize, _: &[usize], _: &[Real]) {}
 
@@ -21,7 +22,7 @@ impl BendingModel<9, 3> for NoBending {
     fn eval(&self, _: &(), _: &[Vec3; 6], _: bool, _: bool) -> BendingEval<9, ()> {
         BendingEval {
             b: Sym2::zeros(),
-            jac: SMat::<9, 3>::zeros(),
+            jac: None,
             cache: (),
         }
     }

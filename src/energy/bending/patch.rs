@@ -45,7 +45,6 @@ pub struct PatchFit;
 /// `r = |c|`, the edge vectors `e_a` opposite each face vertex (`∂c/∂x_a = [e_a]×`), the
 /// weighted sums `s_q`, and the normal's full Jacobian when a Hessian is wanted.
 pub struct PatchCache {
-    w: PatchWeights,
     n: Vec3,
     r: Real,
     e: [Vec3; 3],
@@ -53,10 +52,78 @@ pub struct PatchCache {
     full: Option<UnitNormal>,
 }
 
+/// [`BendingModel::light`]'s data: the unit normal, twice the area, the edges opposite each
+/// vertex and the weighted sums `s_q`.
+pub struct PatchLight {
+    n: Vec3,
+    r: Real,
+    e: [Vec3; 3],
+    s: [Vec3; 3],
+}
+
+/// `Σ_q W_b,q ∇b_q` (see [`BendingModel::add_gradient`] of [`PatchFit`]).
+#[inline(always)]
+fn patch_gradient(
+    w: &PatchWeights,
+    n: &Vec3,
+    r: Real,
+    e: &[Vec3; 3],
+    s: &[Vec3; 3],
+    wb: &Sym2,
+    g: &mut SVec<18>,
+) {
+    let lam = s[0] * wb[0] + s[1] * wb[1] + s[2] * wb[2];
+    let mu = (lam - n * n.dot(&lam)) / r;
+    for a in 0..3 {
+        let v = e[a].cross(&mu);
+        for c in 0..3 {
+            g[3 * a + c] += v[c];
+        }
+    }
+    for k in 0..6 {
+        let wk = wb[0] * w[(0, k)] + wb[1] * w[(1, k)] + wb[2] * w[(2, k)];
+        for c in 0..3 {
+            g[3 * k + c] -= wk * n[c];
+        }
+    }
+}
+
 impl BendingModel<18, 6> for PatchFit {
     type Face = PatchWeights;
     type Cache = PatchCache;
     const NAME: &'static str = "patch_fit";
+    type Light = PatchLight;
+
+    /// `b_q = −N·s_q` with the normal, twice the area, the edges and `s_q`: nothing else.
+    #[inline(always)]
+    fn light(&self, w: &PatchWeights, x: &[Vec3; 6]) -> (Sym2, PatchLight) {
+        let c = (x[1] - x[0]).cross(&(x[2] - x[0]));
+        let r = c.norm();
+        let n = c / r;
+        let s: [Vec3; 3] = std::array::from_fn(|q| {
+            let mut acc = x[0] * w[(q, 0)];
+            for k in 1..6 {
+                acc += x[k] * w[(q, k)];
+            }
+            acc
+        });
+        let b = Sym2::new(-n.dot(&s[0]), -n.dot(&s[1]), -n.dot(&s[2]));
+        (
+            b,
+            PatchLight {
+                n,
+                r,
+                e: [x[2] - x[1], x[0] - x[2], x[1] - x[0]],
+                s,
+            },
+        )
+    }
+
+    /// As [`BendingModel::add_gradient`], from the light data.
+    #[inline(always)]
+    fn add_gradient_light(&self, w: &PatchWeights, l: &PatchLight, wb: &Sym2, g: &mut SVec<18>) {
+        patch_gradient(w, &l.n, l.r, &l.e, &l.s, wb, g);
+    }
 
     #[inline(always)]
     fn face(&self, scene: &Scene, f: usize, _: &[usize], _: &[Real]) -> PatchWeights {
@@ -85,9 +152,9 @@ impl BendingModel<18, 6> for PatchFit {
             acc
         });
         let b = Sym2::new(-n.dot(&s[0]), -n.dot(&s[1]), -n.dot(&s[2]));
-        let mut jac = SMat::<18, 3>::zeros();
         let full = hess.then(|| UnitNormal::new(&[x[0], x[1], x[2]]));
-        if let Some(nf) = &full {
+        let jac = full.as_ref().map(|nf| {
+            let mut jac = SMat::<18, 3>::zeros();
             for q in 0..3 {
                 for k in 0..6 {
                     for c in 0..3 {
@@ -101,12 +168,12 @@ impl BendingModel<18, 6> for PatchFit {
                     }
                 }
             }
-        }
+            jac
+        });
         BendingEval {
             b,
             jac,
             cache: PatchCache {
-                w: *w,
                 n,
                 r,
                 e: [x[2] - x[1], x[0] - x[2], x[1] - x[0]],
@@ -120,22 +187,15 @@ impl BendingModel<18, 6> for PatchFit {
     /// `λ = Σ_q W_b,q s_q` and `μ = (I − N Nᵀ) λ / r`, face vertex a gets
     /// `−(∂N/∂x_a)ᵀ λ = −[e_a]×ᵀ μ = e_a × μ`.
     #[inline(always)]
-    fn add_gradient(&self, ev: &BendingEval<18, PatchCache>, wb: &Sym2, g: &mut SVec<18>) {
-        let PatchCache { w, n, r, e, s, .. } = &ev.cache;
-        let lam = s[0] * wb[0] + s[1] * wb[1] + s[2] * wb[2];
-        let mu = (lam - n * n.dot(&lam)) / *r;
-        for a in 0..3 {
-            let v = e[a].cross(&mu);
-            for c in 0..3 {
-                g[3 * a + c] += v[c];
-            }
-        }
-        for k in 0..6 {
-            let wk = wb[0] * w[(0, k)] + wb[1] * w[(1, k)] + wb[2] * w[(2, k)];
-            for c in 0..3 {
-                g[3 * k + c] -= wk * n[c];
-            }
-        }
+    fn add_gradient(
+        &self,
+        w: &PatchWeights,
+        ev: &BendingEval<18, PatchCache>,
+        wb: &Sym2,
+        g: &mut SVec<18>,
+    ) {
+        let PatchCache { n, r, e, s, .. } = &ev.cache;
+        patch_gradient(w, n, *r, e, s, wb, g);
     }
 
     /// `∇²b_q`: the cross blocks `−Ŵ_qk ∂N/∂x_a` (node k, face vertex a) and their transposes,

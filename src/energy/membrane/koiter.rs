@@ -12,7 +12,7 @@ pub struct Koiter;
 
 impl Membrane for Koiter {
     type Density = KoiterDensity;
-    #[inline]
+    #[inline(always)]
     fn density(&self, pot: &Potential, f: usize) -> KoiterDensity {
         pot.density(f)
     }

@@ -96,6 +96,15 @@ impl<L: MembraneLaw> FaceDensity for WithKoiterBending<L> {
         e + w
     }
 
+    #[inline]
+    fn eval_gradient(&self, a: &Sym2, b: &Sym2, d: &mut DensityDerivs) -> Real {
+        let e = self.koiter.eval_gradient(a, b, d);
+        let (mut ga, mut haa) = (Sym2::zeros(), Mat3::zeros());
+        let w = self.law.eval(a, Some((&mut ga, &mut haa)));
+        d.ga += ga;
+        e + w
+    }
+
     fn gauss_newton(&self, a: &Sym2, b: &Sym2, d: &mut DensityDerivs) {
         let mut dk = DensityDerivs::default();
         self.koiter.eval(a, b, &mut dk);
