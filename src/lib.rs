@@ -42,6 +42,7 @@ pub mod integrate;
 pub mod lce;
 pub mod math;
 pub mod mesh;
+pub mod morphoshell;
 pub mod output;
 pub mod rest;
 pub mod restart;

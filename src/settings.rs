@@ -92,6 +92,8 @@ pub struct Settings {
     pub gas: Gas,
     /// Ground contact with friction.
     pub contact: Contact,
+    /// Two horizontal glass slides squeezing the sheet (MorphoShell's).
+    pub slides: Slides,
     /// Fixed vertices.
     pub constraints: Constraints,
     /// Output files.
@@ -795,6 +797,63 @@ pub struct Dial {
     pub holds: Vec<Real>,
 }
 
+/// How the upper glass slide moves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SlideControl {
+    /// Down at `speed` until it has moved `travel`.
+    #[default]
+    Speed,
+    /// Pressed down by `force`, moving overdamped against the sheet's push.
+    Force,
+}
+
+/// Glass slides: two planes z = lower and z = upper (see [`crate::energy::slides`]).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Slides {
+    /// Build the slides (default: `false`).
+    pub enabled: bool,
+    /// Height of the fixed lower slide (m; default: the reference mesh's lowest z).
+    pub lower: Option<Real>,
+    /// Starting height of the upper slide (m; default: the reference mesh's highest z).
+    pub upper: Option<Real>,
+    /// MorphoShell's `slide_stiffness_prefactor` p_k: a vertex beyond a slide by d feels
+    /// `p_k μ t d` (N), μ and t the smallest shear modulus and thickness (default: `100`).
+    pub stiffness_prefactor: Real,
+    /// Coulomb friction coefficient of stick/slip friction on vertices in contact (default: `0`;
+    /// explicit mode).
+    pub friction: Real,
+    /// `"speed"` (default) or `"force"` (explicit mode).
+    pub control: SlideControl,
+    /// Speed control: downward speed of the upper slide (m/s; default: `0`).
+    pub speed: Real,
+    /// Speed control: the distance it moves before it stops (m; default: `0`).
+    pub travel: Real,
+    /// Force control: the downward force on the upper slide (N; default: `0`).
+    pub force: Real,
+    /// Force control: the slide's drag coefficient (N·s/m; default: the sheet's mass times its
+    /// waiting drag rate).
+    pub drag: Option<Real>,
+}
+
+impl Default for Slides {
+    fn default() -> Self {
+        Slides {
+            enabled: false,
+            lower: None,
+            upper: None,
+            stiffness_prefactor: 100.0,
+            friction: 0.0,
+            control: SlideControl::Speed,
+            speed: 0.0,
+            travel: 0.0,
+            force: 0.0,
+            drag: None,
+        }
+    }
+}
+
 /// External loads.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -1301,6 +1360,7 @@ impl Settings {
         self.validate_moisture(name)?;
         self.validate_time(name)?;
         self.validate_explicit(name)?;
+        self.validate_slides(name)?;
         self.validate_loads(name)?;
         self.validate_gas(name)?;
         self.validate_contact(name)?;
@@ -1650,6 +1710,59 @@ impl Settings {
                     t.output_interval, t.dt_min
                 ),
             );
+        }
+        Ok(())
+    }
+
+    /// Validates `[slides]`.
+    pub fn validate_slides(&self, name: &str) -> Result<(), SettingsError> {
+        let ck = Check(name);
+        let sl = &self.slides;
+        ck.pos("slides.stiffness_prefactor", sl.stiffness_prefactor)?;
+        ck.nonneg("slides.friction", sl.friction)?;
+        ck.nonneg("slides.travel", sl.travel)?;
+        for (k, v) in [("slides.speed", sl.speed), ("slides.force", sl.force)] {
+            if !v.is_finite() {
+                return ck.inv(k, format!("must be finite, got {v:e}"));
+            }
+        }
+        for (k, v) in [("slides.lower", sl.lower), ("slides.upper", sl.upper)] {
+            if let Some(v) = v {
+                if !v.is_finite() {
+                    return ck.inv(k, format!("must be finite, got {v:e}"));
+                }
+            }
+        }
+        if let Some(d) = sl.drag {
+            ck.pos("slides.drag", d)?;
+        }
+        if let (Some(l), Some(u)) = (sl.lower, sl.upper) {
+            if u <= l {
+                return ck.inv(
+                    "slides.upper",
+                    format!("the upper slide ({u}) must be above the lower one ({l})"),
+                );
+            }
+        }
+        if sl.enabled && self.solver.mode != Mode::Explicit {
+            let moving = (sl.control == SlideControl::Speed && sl.speed != 0.0 && sl.travel > 0.0)
+                || sl.control == SlideControl::Force;
+            if sl.friction > 0.0 {
+                return ck.inv(
+                    "slides.friction",
+                    "slide friction needs solver.mode = \"explicit\" (the implicit modes hold \
+                     frictionless slides still)"
+                        .into(),
+                );
+            }
+            if moving {
+                return ck.inv(
+                    "slides.control",
+                    "moving slides need solver.mode = \"explicit\" (the implicit modes hold the \
+                     slides still)"
+                        .into(),
+                );
+            }
         }
         Ok(())
     }

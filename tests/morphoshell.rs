@@ -367,3 +367,80 @@ fn morphoshell_mode_bad_input_is_named() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("material.bending"), "{err}");
 }
+
+/// A liquid-crystal cone squashed between fixed glass slides with friction (explicit mode):
+/// it reaches equilibrium inside the gap (penetrations of the penalty's order only), the slides'
+/// forces balance, and `log.csv` carries their heights, gap and forces. Slides that start
+/// intersecting the sheet, an upper slide below the lower one, and friction in an implicit
+/// mode are exit 2 naming the cause.
+#[test]
+fn slides_squeeze_a_cone_and_bad_slides_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    shellsim(
+        &[
+            "mesh", "disk", "--radius", "1", "--edge", "0.15", "-o", "disk.vtk",
+        ],
+        d,
+    );
+    write(
+        d,
+        "sl.toml",
+        "[material]\nyoung = 3.0\npoisson = 0.5\ndensity = 1.0\nthickness = 0.02\n\
+         bending = \"patch_fit\"\n[rest]\ntarget = \"lce\"\n[rest.lce]\n\
+         theta = \"atan2(y, x) + pi/2\"\nlambda = 0.9\nnu = 0.5\n[solver]\nmode = \"explicit\"\n\
+         [explicit]\ntime_step_prefactor = 0.6\ndial_long_times = 0.5\n\
+         damping_prefactor_dial = 2\ndamping_prefactor_wait = 2\n\
+         [slides]\nenabled = true\nlower = -0.1\nupper = 0.1\nfriction = 0.3\n",
+    );
+    shellsim(&["sl.toml", "disk.vtk", "--out", "o", "-q"], d);
+    let s = summary(&d.join("o"));
+    assert_eq!(s["converged"], true, "{}", s["reason"]);
+    let x = final_frame(&d.join("o")).positions;
+    // Free, the cone would be ~0.5 high; squashed, every vertex stays within the gap up to
+    // the penalty's give (force / k with k = 100 μ t = 2 N/m and forces ~1e-3 N).
+    let (lo, hi) = x
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p.z), b.max(p.z))
+        });
+    assert!(lo > -0.1 - 2e-3 && hi < 0.1 + 2e-3, "z range {lo} … {hi}");
+    assert!(hi - lo > 0.19, "the cone fills the gap: {lo} … {hi}");
+    let text = std::fs::read_to_string(d.join("o").join("log.csv")).unwrap();
+    let head: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let last: Vec<f64> = text
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap_or(f64::NAN))
+        .collect();
+    let col = |n: &str| last[head.iter().position(|h| *h == n).unwrap()];
+    assert_eq!(col("slide_gap"), 0.2);
+    let (up, down) = (col("slide_upper_force"), col("slide_lower_force"));
+    assert!(
+        up > 0.0 && (up - down).abs() < 1e-3 * up,
+        "forces {up} vs {down}"
+    );
+    for (extra, needle) in [
+        ("upper = 0.1\nlower = 0.05\n", "vertex"),
+        ("upper = -0.1\nlower = 0.1\n", "slides.upper"),
+    ] {
+        write(
+            d,
+            "bad.toml",
+            &format!("[material]\nbending = \"patch_fit\"\n[solver]\nmode = \"explicit\"\n[slides]\nenabled = true\n{extra}"),
+        );
+        let (code, err) = run(&["bad.toml", "disk.vtk", "--out", "b", "-q"], d);
+        assert_eq!(code, 2, "{extra}: {err}");
+        assert!(err.contains(needle), "{extra}: {err}");
+    }
+    write(
+        d,
+        "bad.toml",
+        "[slides]\nenabled = true\nlower = -1\nupper = 1\nfriction = 0.2\n",
+    );
+    let (code, err) = run(&["bad.toml", "disk.vtk", "--out", "b", "-q"], d);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("slides.friction"), "{err}");
+}

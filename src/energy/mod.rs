@@ -26,6 +26,7 @@ pub mod membrane;
 pub mod projection;
 pub mod registry;
 pub mod shell;
+pub mod slides;
 pub mod stiffening;
 pub mod term;
 

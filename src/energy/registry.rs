@@ -98,6 +98,7 @@ pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
         super::loads::pressure::term,
         super::loads::moment::term,
         super::gas::term,
+        super::slides::term,
     ] {
         t.extend(load(scene)?);
     }

@@ -240,6 +240,20 @@ pub trait Term: Send + Sync {
         false
     }
 
+    /// Explicit dynamics, after the gradient `g` at positions `x` with velocities `v` and before
+    /// the step `dt` (s): a term that acts on the step itself, beyond its energy, adjusts `g`
+    /// and `v` (stick/slip friction) and advances its own state (a moving slide). Default:
+    /// nothing.
+    fn explicit_step(
+        &self,
+        _pot: &Potential,
+        _x: &[Vec3],
+        _v: &mut [Vec3],
+        _g: &mut [Real],
+        _dt: Real,
+    ) {
+    }
+
     /// Whether the term implements [`Term::predict`] (default: no).
     fn predicts(&self) -> bool {
         false
@@ -344,6 +358,16 @@ pub trait VertexKernel: Send + Sync {
     fn observables(&self, _pot: &Potential, _x: &[Vec3]) -> Vec<(String, Real)> {
         Vec::new()
     }
+    /// See [`Term::explicit_step`] (default: nothing).
+    fn explicit_step(
+        &self,
+        _pot: &Potential,
+        _x: &[Vec3],
+        _v: &mut [Vec3],
+        _g: &mut [Real],
+        _dt: Real,
+    ) {
+    }
 }
 
 /// A [`VertexKernel`] as a [`Term`]. Fixed vertices contribute nothing to Φ (a constant);
@@ -361,6 +385,9 @@ pub struct VertexTerm<K> {
 impl<K: VertexKernel> Term for VertexTerm<K> {
     fn name(&self) -> &'static str {
         self.name
+    }
+    fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
+        self.kernel.explicit_step(pot, x, v, g, dt);
     }
     fn observables(&self, pot: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
         self.kernel.observables(pot, x)

@@ -385,6 +385,11 @@ pub(super) fn run_explicit(
         };
         sc.prescribe(&mut state.x, dial);
         let energy = gradient(&pot, &state.x, &mut g);
+        // Terms that act on the step itself (slide friction, a moving slide), before the
+        // equilibrium test sees the forces.
+        for term in sc.terms.iter() {
+            term.explicit_step(&pot, &state.x, &mut v, &mut g, dt);
+        }
         let c = if phase == Phase::Dial {
             rate_dial
         } else {

@@ -1,0 +1,213 @@
+//! Glass slides (seed 001 §12): two horizontal planes squeezing the sheet, the lower one fixed at
+//! `z = z_l`, the upper one at `z = z_u` moved at a prescribed speed or pressed by a prescribed
+//! force. A vertex beyond a slide by `d` feels a stiff spring, MorphoShell's per-node penalty
+//!
+//! `E_v = ½ k [(z − z_u)₊² + (z_l − z)₊²]`,   `k = p_k μ t`
+//!
+//! (μ, t the smallest shear modulus and thickness; N/m; gradient `k(z − z_u)₊ − k(z_l − z)₊`
+//! along z, Hessian `k` on zz while in contact). DOF order: `x[v]`.
+//!
+//! **Friction** (explicit mode, [`crate::energy::term::Term::explicit_step`]): MorphoShell's
+//! stick/slip rule. A vertex in contact with normal force `N = k d` and in-plane force `f_h`
+//! (the elastic and other forces, drag excluded) sticks when `|f_h| < μ_f N` (its in-plane force
+//! and velocity are set to 0), else slides with `f_h − μ_f N f_h/|f_h|`.
+//!
+//! **Motion** (explicit mode): speed control moves the upper slide down at `speed` until it has
+//! moved `travel`; force control moves it overdamped, `ζ dz_u/dt = F_up − F`, with `F_up` the
+//! sheet's push on it, F the prescribed downward force and ζ the drag (default: the sheet's mass
+//! times its waiting drag rate). The implicit modes hold both slides still (frictionless).
+//!
+//! `log.csv` gets the slides' heights, the gap and the forces on each, computed from the state
+//! of the frame (never accumulated across steps).
+
+use super::term::{VertexKernel, VertexTerm};
+use crate::math::{Mat3, Real, Vec3};
+use crate::mesh::MeshError;
+use crate::scene::Scene;
+use crate::settings::SlideControl;
+use crate::solve::Potential;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// The slides' kernel and the upper slide's state.
+pub struct Slides {
+    /// Spring constant k (N/m).
+    pub k: Real,
+    /// Lower slide height (m).
+    pub lower: Real,
+    /// Upper slide's starting height (m).
+    pub upper0: Real,
+    /// Upper slide height now (m), as f64 bits.
+    upper: AtomicU64,
+    /// Coulomb coefficient.
+    pub friction: Real,
+    /// Speed or force control.
+    pub control: SlideControl,
+    /// Downward speed (m/s) and the distance to travel (m).
+    pub speed: Real,
+    /// See `speed`.
+    pub travel: Real,
+    /// Downward force (N) and drag (N·s/m) of force control.
+    pub force: Real,
+    /// See `force`.
+    pub drag: Real,
+}
+
+impl Slides {
+    /// The upper slide's height now (m).
+    pub fn upper(&self) -> Real {
+        Real::from_bits(self.upper.load(Ordering::Relaxed))
+    }
+
+    fn set_upper(&self, z: Real) {
+        self.upper.store(z.to_bits(), Ordering::Relaxed);
+    }
+
+    /// Penetrations beyond the upper and the lower slide (m, ≥ 0).
+    #[inline]
+    fn depths(&self, z: Real) -> (Real, Real) {
+        ((z - self.upper()).max(0.0), (self.lower - z).max(0.0))
+    }
+
+    /// Total forces (N) the sheet exerts on the upper slide (upward) and on the lower one
+    /// (downward), at positions `x`.
+    pub fn forces(&self, x: &[Vec3], fixed: &[bool]) -> (Real, Real) {
+        let (mut up, mut down) = (0.0, 0.0);
+        for (v, p) in x.iter().enumerate() {
+            if !fixed[v] {
+                let (du, dl) = self.depths(p.z);
+                up += self.k * du;
+                down += self.k * dl;
+            }
+        }
+        (up, down)
+    }
+}
+
+impl VertexKernel for Slides {
+    #[inline]
+    fn eval(&self, _: &Potential, _: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
+        let (du, dl) = self.depths(x.z);
+        if du == 0.0 && dl == 0.0 {
+            return None;
+        }
+        let mut h = Mat3::zeros();
+        h[(2, 2)] = self.k;
+        Some((
+            0.5 * self.k * (du * du + dl * dl),
+            Vec3::new(0.0, 0.0, self.k * (du - dl)),
+            h,
+        ))
+    }
+
+    fn observables(&self, pot: &Potential, x: &[Vec3]) -> Vec<(String, Real)> {
+        let (up, down) = self.forces(x, &pot.scene.fixed);
+        vec![
+            ("slide_upper_z".into(), self.upper()),
+            ("slide_lower_z".into(), self.lower),
+            ("slide_gap".into(), self.upper() - self.lower),
+            ("slide_upper_force".into(), up),
+            ("slide_lower_force".into(), down),
+        ]
+    }
+
+    fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
+        let fixed = &pot.scene.fixed;
+        if self.friction > 0.0 {
+            for (i, p) in x.iter().enumerate() {
+                if fixed[i] {
+                    continue;
+                }
+                let (du, dl) = self.depths(p.z);
+                let normal = self.k * (du + dl);
+                if normal == 0.0 {
+                    continue;
+                }
+                let (fx, fy) = (-g[3 * i], -g[3 * i + 1]);
+                let fh = fx.hypot(fy);
+                let limit = self.friction * normal;
+                if fh < limit {
+                    g[3 * i] = 0.0;
+                    g[3 * i + 1] = 0.0;
+                    v[i].x = 0.0;
+                    v[i].y = 0.0;
+                } else {
+                    g[3 * i] += limit * fx / fh;
+                    g[3 * i + 1] += limit * fy / fh;
+                }
+            }
+        }
+        let z = self.upper();
+        let next = match self.control {
+            SlideControl::Speed => {
+                let bottom = self.upper0 - self.travel * self.speed.signum();
+                let z1 = z - self.speed * dt;
+                if self.speed > 0.0 {
+                    z1.max(bottom)
+                } else {
+                    z1.min(bottom)
+                }
+            }
+            SlideControl::Force => {
+                let (up, _) = self.forces(x, fixed);
+                z + dt * (up - self.force) / self.drag
+            }
+        };
+        // The upper slide never passes the lower one.
+        self.set_upper(next.max(self.lower + 1e-12 * (1.0 + self.lower.abs())));
+    }
+}
+
+/// The slides' term when `[slides]` is enabled. A vertex starting beyond a slide is an error
+/// naming it.
+pub fn term(scene: &Scene) -> Result<Option<Box<dyn super::term::Term>>, MeshError> {
+    let s = &scene.settings.slides;
+    if !s.enabled {
+        return Ok(None);
+    }
+    let mesh = &scene.mesh;
+    let (zmin, zmax) = mesh
+        .positions
+        .iter()
+        .fold((Real::INFINITY, Real::NEG_INFINITY), |(a, b), p| {
+            (a.min(p.z), b.max(p.z))
+        });
+    let lower = s.lower.unwrap_or(zmin);
+    let upper = s.upper.unwrap_or(zmax);
+    if upper <= lower {
+        return Err(mesh.invalid(format!(
+            "slides: the upper slide (z = {upper}) must be above the lower one (z = {lower})"
+        )));
+    }
+    for (v, p) in mesh.positions.iter().enumerate() {
+        if p.z > upper || p.z < lower {
+            return Err(mesh.invalid(format!(
+                "slides: vertex {v} (z = {}) starts outside the gap between the slides \
+                 (z = {lower} … {upper}); the slides must not start intersecting the sheet",
+                p.z
+            )));
+        }
+    }
+    let sc = crate::integrate::explicit::Scales::of(scene);
+    let drag = s.drag.unwrap_or_else(|| {
+        let mass: Real = scene.mass.iter().sum();
+        let rate = scene.settings.explicit.damping_prefactor_wait.max(1.0) * 2.0 * sc.omega_long;
+        mass * rate
+    });
+    let k = s.stiffness_prefactor * sc.mu * sc.t;
+    Ok(Some(Box::new(VertexTerm {
+        name: "slides",
+        report: true,
+        kernel: Slides {
+            k,
+            lower,
+            upper0: upper,
+            upper: AtomicU64::new(upper.to_bits()),
+            friction: s.friction,
+            control: s.control,
+            speed: s.speed,
+            travel: s.travel,
+            force: s.force,
+            drag,
+        },
+    })))
+}
