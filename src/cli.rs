@@ -68,6 +68,20 @@ enum Command {
     Mesh(MeshArgs),
     /// Error of a frame written by shellsim against an analytic case (prints JSON).
     Error(ErrorArgs),
+    /// Convert a MorphoShell settings file into a shellsim settings file with the same physics.
+    #[command(name = "import-morphoshell")]
+    ImportMorphoshell(ImportArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct ImportArgs {
+    /// MorphoShell settings file (`name = value;` lines in its reader's order).
+    settings: PathBuf,
+    /// The mesh the settings go with (needed only to convert a moving slide's speed).
+    mesh: Option<PathBuf>,
+    /// Output file (default: print to stdout).
+    #[arg(short, long)]
+    out: Option<PathBuf>,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
@@ -185,6 +199,7 @@ fn dispatch(cli: Cli) -> Result<u8> {
     match cli.command {
         Some(Command::Mesh(a)) => mesh_cmd(a).map(|_| 0),
         Some(Command::Error(a)) => error_cmd(a).map(|_| 0),
+        Some(Command::ImportMorphoshell(a)) => import_cmd(a).map(|_| 0),
         None => {
             let (Some(settings), Some(mesh)) = (cli.settings.clone(), cli.mesh.clone()) else {
                 bail!("usage: shellsim SETTINGS MESH [--out DIR]");
@@ -192,6 +207,35 @@ fn dispatch(cli: Cli) -> Result<u8> {
             run_cmd(&cli, settings, mesh)
         }
     }
+}
+
+/// `shellsim import-morphoshell`: parse, translate, check that shellsim accepts the result, and
+/// write it (nothing is written on an error).
+fn import_cmd(a: ImportArgs) -> Result<()> {
+    let name = a.settings.display().to_string();
+    let text =
+        std::fs::read_to_string(&a.settings).map_err(|e| anyhow!("{name}: cannot read: {e}"))?;
+    let m = crate::morphoshell::parse(&text, &name)?;
+    // A moving slide's speed is p × L / T_bend: from the mesh, with the translated material.
+    let speed = match &a.mesh {
+        Some(mp) if m.get("slide_speed_prefactor") != 0.0 => {
+            let draft = crate::morphoshell::to_toml(&m, &name, Some(0.0))?;
+            let settings = Settings::from_str_with(&draft, &name, &[])?;
+            let scene = Scene::build(read_mesh(mp)?, settings)?;
+            let sc = crate::integrate::explicit::Scales::of(&scene);
+            let t_bend = 2.0 * std::f64::consts::PI / sc.omega_long;
+            Some(m.get("slide_speed_prefactor") * sc.length / t_bend)
+        }
+        _ => None,
+    };
+    let toml = crate::morphoshell::to_toml(&m, &name, speed)?;
+    // The result must be a valid shellsim settings file.
+    Settings::from_str_with(&toml, &format!("{name} (converted)"), &[])?;
+    match a.out {
+        Some(p) => std::fs::write(&p, toml).map_err(|e| anyhow!("{}: {e}", p.display()))?,
+        None => print!("{toml}"),
+    }
+    Ok(())
 }
 
 struct Bar(indicatif::ProgressBar);

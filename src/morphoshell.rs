@@ -26,7 +26,7 @@ use crate::math::Real;
 use anyhow::{bail, Result};
 
 /// MorphoShell's entries in the order its reader expects them.
-pub const ENTRIES: [&str; 26] = [
+pub const ENTRIES: [&str; 24] = [
     "outputs_per_char_long_time",
     "dialling_from_ansatz_rather_than_ref_state",
     "patch_mat_dimless_conditioning_thresh",
@@ -51,9 +51,6 @@ pub const ENTRIES: [&str; 26] = [
     "initial_lower_slide_z_coord",
     "grav_field_strength",
     "num_steps_to_use_gradient_descent_dynamics_for_before_switching_to_newtonian_dynamics",
-    // Not in every version: the two below are optional at the end (see `parse`).
-    "",
-    "",
 ];
 
 /// The number of entries MorphoShell's reader requires.
@@ -122,7 +119,7 @@ pub fn parse(text: &str, file: &str) -> Result<MorphoSettings> {
     let st = statements(text, file)?;
     let mut values = Vec::new();
     for (k, s) in st.iter().enumerate() {
-        let Some(&expected) = ENTRIES.get(k).filter(|e| !e.is_empty()) else {
+        let Some(&expected) = ENTRIES.get(k) else {
             bail!(
                 "{file}:{}: unknown entry '{}' after the {REQUIRED} that MorphoShell reads",
                 s.line,
@@ -189,6 +186,13 @@ pub fn to_toml(m: &MorphoSettings, file: &str, slide_speed: Option<Real>) -> Res
         "# Converted by `shellsim import-morphoshell` from {file}: MorphoShell's physics and \
          prefactors."
     ));
+    if g("dialling_from_ansatz_rather_than_ref_state") != 0.0 {
+        line(
+            "# dialling_from_ansatz_rather_than_ref_state: shellsim dials from the reference \
+             mesh's own forms (restart from a shellsim frame with --restart)."
+                .into(),
+        );
+    }
     line("[material]".into());
     line("stretch_convention = \"morphoshell\"".into());
     line("bending = \"patch_fit\"".into());

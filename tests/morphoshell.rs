@@ -444,3 +444,86 @@ fn slides_squeeze_a_cone_and_bad_slides_are_named() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("slides.friction"), "{err}");
 }
+
+/// MorphoShell's GCM settings file (as in its repository, values by position) converts into a
+/// shellsim file that shellsim accepts, with the physics carried over; a file with too few
+/// entries, a non-numeric value or an entry out of order is exit 2 naming the line and entry.
+#[test]
+fn import_morphoshell_settings() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let names = shellsim::morphoshell::ENTRIES;
+    let values = [
+        "400.0",
+        "true",
+        "10.0",
+        "0.01",
+        "0.5",
+        "1.0",
+        "1.0",
+        "0.25",
+        "0.01",
+        "4.0",
+        "6.0",
+        "0.3",
+        "0.5",
+        "0.000001",
+        "0.00001",
+        "100000000000000000.0",
+        "0.0",
+        "0.0",
+        "0.0",
+        "false",
+        "12345.0",
+        "12345.0",
+        "0.0",
+        "0",
+    ];
+    let text: String = names
+        .iter()
+        .zip(values)
+        .map(|(n, v)| format!("{n} = {v}; // comment\n"))
+        .collect();
+    write(d, "ms.txt", &format!("// MorphoShell settings\n\n{text}"));
+    shellsim(&["import-morphoshell", "ms.txt", "-o", "ms.toml"], d);
+    let s = shellsim::settings::Settings::load(&d.join("ms.toml"), &[]).unwrap();
+    assert_eq!(s.solver.mode, shellsim::settings::Mode::Explicit);
+    assert_eq!(
+        s.material.stretch_convention,
+        shellsim::energy::material::StretchConvention::Morphoshell
+    );
+    assert_eq!(
+        s.material.bending,
+        shellsim::settings::BendingModel::PatchFit
+    );
+    assert!((s.material.young - 3.0).abs() < 1e-15, "E = 2μ(1+ν)");
+    assert_eq!(s.explicit.time_step_prefactor, 0.3);
+    assert_eq!(s.explicit.damping_prefactor_dial, 4.0);
+    assert_eq!(s.explicit.damping_prefactor_wait, 6.0);
+    assert_eq!(s.explicit.dial_long_times, 0.5, "0.25 per phase, 2 phases");
+    assert_eq!(s.dial.holds, vec![0.5]);
+    assert_eq!(s.material.bend_stiffening, Some(1e17));
+    // Bad files.
+    let lines: Vec<&str> = text.lines().collect();
+    for (bad, needle) in [
+        (
+            lines[..20].join("\n"),
+            "missing 'initial_upper_slide_z_coord'",
+        ),
+        (
+            text.replace("ref_density = 1.0", "ref_density = one"),
+            ":9: ref_density = 'one' is not a number",
+        ),
+        (
+            text.replace("ref_density", "density"),
+            "expects 'ref_density' here",
+        ),
+        (format!("{text}extra = 1;\n"), "unknown entry 'extra'"),
+    ] {
+        write(d, "bad.txt", &format!("// MorphoShell settings\n\n{bad}"));
+        let (code, err) = run(&["import-morphoshell", "bad.txt", "-o", "bad.toml"], d);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains(needle), "{needle}: {err}");
+        assert!(!d.join("bad.toml").exists());
+    }
+}
