@@ -41,14 +41,12 @@ pub fn patch_face<D: FaceDensity, const GN: bool>(
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PatchFit;
 
-/// What the gradient and the Hessian contraction need: the unit normal `N`, twice the area
-/// `r = |c|`, the edge vectors `e_a` opposite each face vertex (`∂c/∂x_a = [e_a]×`), the
-/// weighted sums `s_q`, and the normal's full Jacobian when a Hessian is wanted.
+/// What the gradient and the Hessian contraction need: the light data (the unit normal `N`,
+/// twice the area `r = |c|`, the edge vectors `e_a` opposite each face vertex, `∂c/∂x_a =
+/// [e_a]×`, and the weighted sums `s_q`), and the normal's full Jacobian when a Hessian is
+/// wanted.
 pub struct PatchCache {
-    n: Vec3,
-    r: Real,
-    e: [Vec3; 3],
-    s: [Vec3; 3],
+    light: PatchLight,
     full: Option<UnitNormal>,
 }
 
@@ -141,17 +139,8 @@ impl BendingModel<18, 6> for PatchFit {
         _grad: bool,
         hess: bool,
     ) -> BendingEval<18, PatchCache> {
-        let c = (x[1] - x[0]).cross(&(x[2] - x[0]));
-        let r = c.norm();
-        let n = c / r;
-        let s: [Vec3; 3] = std::array::from_fn(|q| {
-            let mut acc = x[0] * w[(q, 0)];
-            for k in 1..6 {
-                acc += x[k] * w[(q, k)];
-            }
-            acc
-        });
-        let b = Sym2::new(-n.dot(&s[0]), -n.dot(&s[1]), -n.dot(&s[2]));
+        let (b, light) = self.light(w, x);
+        let (n, s) = (light.n, light.s);
         let full = hess.then(|| UnitNormal::new(&[x[0], x[1], x[2]]));
         let jac = full.as_ref().map(|nf| {
             let mut jac = SMat::<18, 3>::zeros();
@@ -173,13 +162,7 @@ impl BendingModel<18, 6> for PatchFit {
         BendingEval {
             b,
             jac,
-            cache: PatchCache {
-                n,
-                r,
-                e: [x[2] - x[1], x[0] - x[2], x[1] - x[0]],
-                s,
-                full,
-            },
+            cache: PatchCache { light, full },
         }
     }
 
@@ -194,8 +177,7 @@ impl BendingModel<18, 6> for PatchFit {
         wb: &Sym2,
         g: &mut SVec<18>,
     ) {
-        let PatchCache { n, r, e, s, .. } = &ev.cache;
-        patch_gradient(w, n, *r, e, s, wb, g);
+        self.add_gradient_light(w, &ev.cache.light, wb, g);
     }
 
     /// `∇²b_q`: the cross blocks `−Ŵ_qk ∂N/∂x_a` (node k, face vertex a) and their transposes,
@@ -209,7 +191,8 @@ impl BendingModel<18, 6> for PatchFit {
         lambda: &Sym2,
         h: &mut SMat<18, 18>,
     ) {
-        let PatchCache { full, s, .. } = &ev.cache;
+        let PatchCache { full, light } = &ev.cache;
+        let s = &light.s;
         let Some(nf) = full else {
             return; // evaluated without a Hessian
         };
