@@ -197,6 +197,8 @@ pub struct Summary {
     pub time: Real,
     /// Final dial factor.
     pub dial: Real,
+    /// Hold points of `dial.holds` at which the run reached equilibrium.
+    pub holds_reached: usize,
     /// Final relative residual (left out when it is not finite).
     #[serde(skip_serializing_if = "not_finite")]
     pub residual: Real,

@@ -33,6 +33,20 @@ pub(super) fn run_dynamic(
             1.0
         }
     };
+    // The dial advances linearly in time, except that it stops at each hold until the
+    // equilibrium test passes (a restart resumes the linear dial at its time; holds already
+    // passed stay passed).
+    let holds = sc.settings.dial.holds.clone();
+    let mut dial_now = dial_at(t0);
+    let mut next_hold = holds.iter().position(|&h| h > dial_now);
+    let mut holding = false;
+    if dial_time == 0.0 {
+        if let Some(k) = next_hold {
+            dial_now = holds[k];
+            holding = true;
+        }
+    }
+    let mut holds_reached = 0usize;
     let n = state.x.len();
     let mut v = v0.unwrap_or_else(|| vec![Vec3::zeros(); n]);
     let mut xhat = state.x.clone();
@@ -52,7 +66,7 @@ pub(super) fn run_dynamic(
         m.publish(writer);
     }
     {
-        let pot = accepted(s.potential(dial_at(t0)), moisture.as_ref(), &targets);
+        let pot = accepted(s.potential(dial_now), moisture.as_ref(), &targets);
         s.frame(writer, &pot, &state, &v, t0)?;
     }
     // Friction: the lagged normal forces, carried from step to step.
@@ -70,7 +84,19 @@ pub(super) fn run_dynamic(
             break;
         }
         let h = clock.step_from(t, steps.step).min(tm.end - t);
-        let dial = dial_at(t + h);
+        let (dial, reaches_hold) = if holding {
+            (dial_now, false)
+        } else {
+            let d = if dial_time > 0.0 {
+                (dial_now + h / dial_time).min(1.0)
+            } else {
+                1.0
+            };
+            match next_hold {
+                Some(k) if d >= holds[k] => (holds[k], true),
+                _ => (d, false),
+            }
+        };
         for i in 0..n {
             xhat[i] = state.x[i] + v[i] * h;
         }
@@ -196,6 +222,10 @@ pub(super) fn run_dynamic(
         }
         t += h;
         s.summary.steps += 1;
+        dial_now = dial;
+        if reaches_hold {
+            holding = true;
+        }
         if damping {
             let (a, b) = sc.forms(&state.x, &state.dofs);
             a_prev = a;
@@ -211,20 +241,28 @@ pub(super) fn run_dynamic(
         );
         let at_output = clock.due(t, h, eps_t);
         let mut stop = false;
-        if tm.stop_at_equilibrium {
+        let mut released = false;
+        if tm.stop_at_equilibrium || holding {
             let pot = accepted(s.potential(dial), moisture.as_ref(), &targets);
             let mut g = vec![0.0; s.pattern.n];
             pot.eval(&state.x, &state.dofs, Want::Gradient, &mut g, &mut []);
             let r = pot.residual(&g);
             let en = Writer::energies(&pot, &state, &v);
-            stop = dial >= 1.0
-                && r <= tol
+            let calm = r <= tol
                 && en.kinetic
                     <= tm.equilibrium_kinetic
                         * (en.get("stretching").unwrap_or(0.0) + en.get("bending").unwrap_or(0.0))
                             .max(Real::MIN_POSITIVE);
+            if holding && calm {
+                // At equilibrium on a hold: write it and dial on.
+                holding = false;
+                released = true;
+                holds_reached += 1;
+                next_hold = next_hold.and_then(|k| (k + 1 < holds.len()).then_some(k + 1));
+            }
+            stop = tm.stop_at_equilibrium && dial >= 1.0 && calm;
         }
-        if at_output || stop || t >= tm.end - eps_t {
+        if at_output || stop || released || t >= tm.end - eps_t {
             if let Some(m) = &moisture {
                 m.publish(writer);
             }
@@ -237,10 +275,11 @@ pub(super) fn run_dynamic(
         }
     }
     s.summary.time = t;
-    s.summary.dial = dial_at(t);
+    s.summary.dial = dial_now;
+    s.summary.holds_reached = holds_reached;
     s.summary.converged = failure.is_none();
     s.summary.reason = failure.map(|f| f.to_string()).unwrap_or_default();
-    let pot = accepted(s.potential(dial_at(t)), moisture.as_ref(), &targets);
+    let pot = accepted(s.potential(dial_now), moisture.as_ref(), &targets);
     s.summary.energy = Writer::energies(&pot, &state, &v);
     if s.summary.reason.is_empty() {
         return Ok(());

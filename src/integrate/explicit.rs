@@ -453,6 +453,7 @@ pub(super) fn run_explicit(
                     break Stop::Converged;
                 }
                 report.holds_reached += 1;
+                s.summary.holds_reached += 1;
                 phase = Phase::Dial;
                 let pot = s.potential(dial);
                 s.summary.residual = pot.residual(&g);

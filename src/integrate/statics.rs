@@ -19,6 +19,8 @@ pub(super) fn run_static(
     let (min_step, sb, seed) = (cf.min_step, s.config.symmetry_breaking, s.config.seed);
     let (check, max_escapes) = (cf.check_stability, cf.max_saddle_escapes);
     let cont_frames = cf.continuation_frames;
+    // Hold points: the continuation lands on each, solves it to full accuracy and writes a frame.
+    let holds = s.scene.settings.dial.holds.clone();
     let zeros = vec![Vec3::zeros(); state.x.len()];
     let dial_start = restart.unwrap_or(0.0).clamp(0.0, 1.0);
     {
@@ -49,14 +51,17 @@ pub(super) fn run_static(
             break;
         }
         let (target, target_scale) = if dial < 1.0 {
-            ((dial + steps.step).min(1.0), scale)
+            let next = (dial + steps.step).min(1.0);
+            let hold = holds.iter().copied().find(|&h| h > dial && h < next);
+            (hold.unwrap_or(next), scale)
         } else {
             (1.0, (scale * ratio).min(1.0))
         };
         // Intermediate continuation steps need not be solved to full accuracy, unless they are
         // written: every frame (and its row of the load–displacement curve) is converged to
         // the tolerance.
-        let t = if (target < 1.0 || target_scale < 1.0) && !cont_frames {
+        let at_hold = holds.contains(&target) && target > dial;
+        let t = if (target < 1.0 || target_scale < 1.0) && !cont_frames && !at_hold {
             (tol * 1e3).min(1e-5).max(tol)
         } else {
             tol
@@ -102,7 +107,10 @@ pub(super) fn run_static(
                 dial,
                 &format!("dial {dial:.4} E {:.4e} r {:.1e}", rep.energy, rep.residual),
             );
-            if cont_frames && dial < 1.0 {
+            if at_hold {
+                s.summary.holds_reached += 1;
+            }
+            if (cont_frames || at_hold) && dial < 1.0 {
                 let pot = s.potential(dial);
                 s.frame(writer, &pot, &state, &zeros, dial)?;
             }
