@@ -253,8 +253,15 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
     let mut scene = Scene::build(mesh, settings)?;
     let initial = match &cli.restart {
         Some(p) => {
-            let (st, w) = crate::restart::read_restart(p, &scene)?;
+            let (mut st, w) = crate::restart::read_restart(p, &scene)?;
             scene.warnings.extend(w);
+            if scene.settings.dial.from == crate::settings::DialFrom::Start {
+                // Dial from the starting state's forms, from dial 0 (MorphoShell's dialling
+                // from an ansatz).
+                scene.dial_from_state(&st.state.x, &st.state.dofs);
+                st.time = 0.0;
+                st.dial = Some(0.0);
+            }
             Some(st)
         }
         None => None,

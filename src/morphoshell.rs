@@ -20,7 +20,10 @@
 //!   cannot fire early; `explicit.equilibrium = "morphoshell"` reproduces MorphoShell's stop);
 //! * bend stiffening γ, gravity, the glass slides (`slide_speed_prefactor` × L / T_bend, with L
 //!   the reference perimeter and T_bend the bending long time, needs the mesh: given, the speed
-//!   is computed; without it, a nonzero prefactor is an error that says so).
+//!   is computed; without it, a nonzero prefactor is an error that says so);
+//! * `dialling_from_ansatz_rather_than_ref_state`: `dial.from = "start"`, with the ansatz given
+//!   as `--restart` (MorphoShell's ansatz files are read as they are:
+//!   [`crate::restart::read_ansatz`]).
 
 use crate::math::Real;
 use anyhow::{bail, Result};
@@ -186,13 +189,6 @@ pub fn to_toml(m: &MorphoSettings, file: &str, slide_speed: Option<Real>) -> Res
         "# Converted by `shellsim import-morphoshell` from {file}: MorphoShell's physics and \
          prefactors."
     ));
-    if g("dialling_from_ansatz_rather_than_ref_state") != 0.0 {
-        line(
-            "# dialling_from_ansatz_rather_than_ref_state: shellsim dials from the reference \
-             mesh's own forms (restart from a shellsim frame with --restart)."
-                .into(),
-        );
-    }
     line("[material]".into());
     line("stretch_convention = \"morphoshell\"".into());
     line("bending = \"patch_fit\"".into());
@@ -270,10 +266,20 @@ pub fn to_toml(m: &MorphoSettings, file: &str, slide_speed: Option<Real>) -> Res
         .take_while(|&d| d < 1.0 - 1e-12)
         .map(|d| format!("{d:?}"))
         .collect();
-    if !holds.is_empty() {
+    let from_ansatz = g("dialling_from_ansatz_rather_than_ref_state") != 0.0;
+    if !holds.is_empty() || from_ansatz {
         line(String::new());
         line("[dial]".into());
+    }
+    if !holds.is_empty() {
         line(format!("holds = [{}]", holds.join(", ")));
+    }
+    if from_ansatz {
+        line(
+            "# Dial from the forms of the --restart file (a MorphoShell ansatz), from dial 0."
+                .into(),
+        );
+        line("from = \"start\"".into());
     }
     let grav = g("grav_field_strength");
     if grav != 0.0 {

@@ -21,8 +21,25 @@ const EDGE_ANGLE_TOLERANCE: Real = 1e-9;
 
 /// Reads a restart state for `scene` from `path`. Returns the state and any warnings.
 pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<String>), MeshError> {
-    let frame = read_mesh(path)?;
     let name = path.display().to_string();
+    if let Some((dial, positions)) = read_ansatz(path, scene.num_vertices())? {
+        let frame = crate::mesh::Mesh {
+            positions,
+            faces: scene.mesh.faces.clone(),
+            ..Default::default()
+        };
+        let (state, v, warnings) = restart_from_frame(frame, &name, scene)?;
+        return Ok((
+            InitialState {
+                state,
+                v,
+                time: 0.0,
+                dial: Some(dial),
+            },
+            warnings,
+        ));
+    }
+    let frame = read_mesh(path)?;
     let bad = |reason: String| MeshError::Invalid {
         path: name.clone(),
         reason,
@@ -46,6 +63,7 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
             state,
             v,
             time: time.unwrap_or(0.0),
+            dial: None,
         },
         warnings,
     ))
@@ -203,4 +221,124 @@ fn series_time(path: &Path) -> Option<Result<Real, String>> {
                 format!("series.pvd gives the frame the timestep '{v}', not a number")
             }))
         })
+}
+
+/// A MorphoShell ansatz file: legacy ASCII VTK whose title line reads
+/// `dial_factor = <s>[, stepcount = <n>]`, as MorphoShell writes its frames and reads its
+/// ansatz files (only that title and the `POINTS` block are read; what follows is ignored, as in
+/// MorphoShell). Returns `None` when `path` is not one (any other frame), else the dial factor
+/// and the positions; errors name the file and line.
+pub fn read_ansatz(path: &Path, vertices: usize) -> Result<Option<(Real, Vec<Vec3>)>, MeshError> {
+    let name = path.display().to_string();
+    let bad = |line: usize, reason: String| MeshError::Invalid {
+        path: if line > 0 {
+            format!("{name}:{line}")
+        } else {
+            name.clone()
+        },
+        reason,
+    };
+    let Ok(bytes) = std::fs::read(path) else {
+        return Ok(None); // read_mesh names the I/O error
+    };
+    // The title is the second line; a binary file or another title is not an ansatz.
+    let mut lines = bytes.split(|&b| b == b'\n');
+    let (_, Some(title)) = (lines.next(), lines.next()) else {
+        return Ok(None);
+    };
+    let Ok(title) = std::str::from_utf8(title) else {
+        return Ok(None);
+    };
+    let Some(rest) = title.trim_start().strip_prefix("dial_factor") else {
+        return Ok(None);
+    };
+    let Ok(text) = std::str::from_utf8(&bytes) else {
+        return Err(bad(
+            0,
+            "a MorphoShell ansatz file must be ASCII text".into(),
+        ));
+    };
+    let value = rest
+        .trim_start()
+        .strip_prefix('=')
+        .map(|r| r.split(',').next().unwrap_or("").trim());
+    let dial: Real = match value.map(str::parse) {
+        Some(Ok(d)) => d,
+        _ => {
+            return Err(bad(
+                2,
+                format!(
+                    "the title '{}' must read 'dial_factor = <number>, ...'",
+                    title.trim()
+                ),
+            ))
+        }
+    };
+    if !(0.0..=1.0).contains(&dial) {
+        return Err(bad(2, format!("dial_factor {dial} is outside [0, 1]")));
+    }
+    let all: Vec<&str> = text.lines().collect();
+    if all.get(2).map(|l| l.trim()) != Some("ASCII") {
+        return Err(bad(
+            3,
+            "a MorphoShell ansatz file is legacy VTK in ASCII (third line 'ASCII')".into(),
+        ));
+    }
+    let Some(at) = all
+        .iter()
+        .position(|l| l.trim_start().starts_with("POINTS"))
+    else {
+        return Err(bad(0, "no POINTS line".into()));
+    };
+    let n: usize = all[at]
+        .split_whitespace()
+        .nth(1)
+        .and_then(|t| t.parse().ok())
+        .ok_or_else(|| bad(at + 1, format!("'{}': no point count", all[at].trim())))?;
+    if n != vertices {
+        return Err(bad(
+            at + 1,
+            format!("{n} points; the mesh has {vertices} vertices (the ansatz must be of the same mesh)"),
+        ));
+    }
+    let mut coords = Vec::with_capacity(3 * n);
+    let mut line = at + 1;
+    while coords.len() < 3 * n {
+        let Some(l) = all.get(line) else {
+            return Err(bad(
+                line,
+                format!(
+                    "the file ends after {} of {} point coordinates",
+                    coords.len(),
+                    3 * n
+                ),
+            ));
+        };
+        for tok in l.split_whitespace() {
+            if coords.len() == 3 * n {
+                break;
+            }
+            let v: Real = tok
+                .parse()
+                .map_err(|_| bad(line + 1, format!("'{tok}' is not a coordinate")))?;
+            if !v.is_finite() || v.abs() > crate::mesh::MAX_COORDINATE {
+                return Err(bad(
+                    line + 1,
+                    format!(
+                        "coordinate {tok} is not finite or beyond ±{:e}",
+                        crate::mesh::MAX_COORDINATE
+                    ),
+                ));
+            }
+            coords.push(v);
+        }
+        line += 1;
+    }
+    Ok(Some((
+        dial,
+        coords
+            .chunks_exact(3)
+            .map(|c| Vec3::new(c[0], c[1], c[2]))
+            .collect(),
+    )))
 }

@@ -421,6 +421,17 @@ impl Scene {
         }
     }
 
+    /// Makes the forms of the state `(x, phi)` the dial's starting forms (`dial.from =
+    /// "start"`, MorphoShell's dialling from an ansatz): ā and b̄ then go linearly from the
+    /// start's a and b to their targets. The director law's stretch dial is replaced by that
+    /// linear dial to its target metric.
+    pub fn dial_from_state(&mut self, x: &[Vec3], phi: &[Real]) {
+        let (a, b) = self.forms(x, phi);
+        self.rest.abar0 = a;
+        self.rest.bbar0 = b;
+        self.rest.lce.clear();
+    }
+
     /// First and second fundamental forms of every face at `x` (edge DOFs `phi`, empty without
     /// them), with this scene's bending model.
     pub fn forms(&self, x: &[Vec3], phi: &[Real]) -> (Vec<Sym2>, Vec<Sym2>) {

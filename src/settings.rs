@@ -795,6 +795,21 @@ pub struct Dial {
     /// Dial factors in (0, 1) at which the dial stops until the sheet is at equilibrium, then
     /// goes on (ascending; default: none).
     pub holds: Vec<Real>,
+    /// Where the dial starts: `"reference"` (default) or `"start"`.
+    pub from: DialFrom,
+}
+
+/// The forms at dial 0.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DialFrom {
+    /// The reference mesh's own forms.
+    #[default]
+    Reference,
+    /// The forms of the state the run starts from (a `--restart` frame or MorphoShell ansatz,
+    /// as MorphoShell's `dialling_from_ansatz_rather_than_ref_state`); the dial starts at 0.
+    /// Without a restart this is the reference mesh.
+    Start,
 }
 
 /// How the upper glass slide moves.
@@ -1807,6 +1822,16 @@ impl Settings {
                 );
             }
             last = h;
+        }
+        if self.dial.from == DialFrom::Start
+            && (self.growth.law != GrowthLaw::None || self.moisture.enabled)
+        {
+            return ck.inv(
+                "dial.from",
+                "\"start\" dials rest.target's forms from the starting state; growth laws and \
+                 moisture set the rest forms from the reference mesh, so the two do not combine"
+                    .into(),
+            );
         }
         if self.solver.mode == Mode::Explicit && self.material.bending.angle_variant().is_some() {
             return ck.inv(

@@ -625,3 +625,163 @@ fn holds_in_the_implicit_drivers() {
         "the dial never goes back: {dials:?}"
     );
 }
+
+/// Writes `x` as MorphoShell writes a frame (its ansatz format): legacy ASCII polydata whose
+/// title carries the dial factor.
+fn write_ansatz(path: &Path, dial: &str, x: &[Vec3], faces: &[[usize; 3]]) {
+    let mut t = format!(
+        "# vtk DataFile Version 4.2\ndial_factor = {dial}, stepcount = 1234\nASCII\n\
+         DATASET POLYDATA\nPOINTS {} double\n",
+        x.len()
+    );
+    for p in x {
+        t += &format!("{:.14e} {:.14e} {:.14e}\n", p.x, p.y, p.z);
+    }
+    t += &format!("POLYGONS {} {}\n", faces.len(), 4 * faces.len());
+    for f in faces {
+        t += &format!("3 {} {} {}\n", f[0], f[1], f[2]);
+    }
+    std::fs::write(path, t).unwrap();
+}
+
+/// MorphoShell's ansatz files: a run restarts at the dial factor of the title from the
+/// positions, and reaches the same equilibrium as a run from the start; `dial.from = "start"`
+/// dials from the ansatz's own forms (from dial 0); bad ansatz files are named by line.
+#[test]
+fn morphoshell_ansatz_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    shellsim(
+        &[
+            "mesh",
+            "annulus",
+            "--inner",
+            "1",
+            "--radius",
+            "1.4",
+            "--sweep",
+            &format!("{}", shellsim::cases::gcm_cone_sweep().to_degrees()),
+            "--edge",
+            "0.25",
+            "--program",
+            "gcm_cone",
+            "-o",
+            "cone.vtk",
+        ],
+        d,
+    );
+    write(d, "ex.toml", CONE_EXPLICIT);
+    let st = |out: &str, extra: &[&str]| {
+        let mut a = vec!["ex.toml", "cone.vtk", "--out", out, "-q"];
+        a.extend_from_slice(&["--set", "solver.mode=static"]);
+        a.extend_from_slice(&["--set", "solver.tolerance=1e-12"]);
+        a.extend_from_slice(extra);
+        shellsim(&a, d);
+    };
+    st("plain", &[]);
+    st("held", &["--set", "dial.holds=[0.5]"]);
+    // The frame at the hold, written as a MorphoShell ansatz at dial 0.5.
+    let log = std::fs::read_to_string(d.join("held/log.csv")).unwrap();
+    let row = log
+        .lines()
+        .find(|l| l.split(',').nth(2) == Some("0.500000"));
+    let k: usize = row.unwrap().split(',').next().unwrap().parse().unwrap();
+    let half = shellsim::mesh::io::read_mesh(&d.join(format!("held/frame_{k:05}.vtu"))).unwrap();
+    write_ansatz(&d.join("half.vtk"), "0.5", &half.positions, &half.faces);
+    st("resumed", &["--restart", "half.vtk"]);
+    let dials = logged_dials(&d.join("resumed"));
+    assert_eq!(
+        dials[0], 0.5,
+        "the run starts at the ansatz's dial: {dials:?}"
+    );
+    let plain = final_frame(&d.join("plain")).positions;
+    let dist = shape_distance(&final_frame(&d.join("resumed")).positions, &plain);
+    assert!(dist < 1e-9, "resumed from the ansatz vs plain: {dist:e}");
+
+    // Dialling from the ansatz: from the final cone, the forms go from the cone's own (a, b),
+    // in which it is stress-free, to the targets, so the run ends on the same equilibrium. From
+    // the same positions at dial 0 of the reference forms (a flat disk's) it is far from
+    // stress-free.
+    write_ansatz(&d.join("cone1.vtk"), "1", &plain, &half.faces);
+    write_ansatz(&d.join("cone0.vtk"), "0", &plain, &half.faces);
+    st("from_reference", &["--restart", "cone0.vtk"]);
+    st(
+        "from_start",
+        &["--restart", "cone1.vtk", "--set", "dial.from=\"start\""],
+    );
+    let dials = logged_dials(&d.join("from_start"));
+    assert_eq!(
+        dials[0], 0.0,
+        "dialling from the ansatz starts at 0: {dials:?}"
+    );
+    let first_energy = |out: &str| -> Real {
+        let text = std::fs::read_to_string(d.join(out).join("log.csv")).unwrap();
+        let head: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+        let k = head.iter().position(|h| *h == "energy_total").unwrap();
+        text.lines()
+            .nth(1)
+            .unwrap()
+            .split(',')
+            .nth(k)
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let (e_start, e_ref) = (first_energy("from_start"), first_energy("from_reference"));
+    assert!(
+        e_start.abs() < 1e-12 * e_ref.abs(),
+        "energy at dial 0: {e_start:e} from the ansatz's forms, {e_ref:e} from the reference's"
+    );
+    let dist = shape_distance(&final_frame(&d.join("from_start")).positions, &plain);
+    assert!(dist < 1e-9, "dialled from the cone's own forms: {dist:e}");
+    eprintln!("dial.from = start, from the cone: {dist:e}");
+
+    // Bad ansatz files name the file and line.
+    let bad = |name: &str, text: &str, what: &str| {
+        write(d, name, text);
+        let (code, err) = run(
+            &[
+                "ex.toml",
+                "cone.vtk",
+                "--restart",
+                name,
+                "--out",
+                name,
+                "-q",
+            ],
+            d,
+        );
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(err.contains(name) && err.contains(what), "{name}: {err}");
+    };
+    let head = "# vtk DataFile Version 4.2\n";
+    bad(
+        "dial.vtk",
+        &format!("{head}dial_factor = 1.5, stepcount = 1\nASCII\nDATASET POLYDATA\nPOINTS 1 double\n0 0 0\n"),
+        "dial.vtk:2",
+    );
+    bad(
+        "title.vtk",
+        &format!("{head}dial_factor is half\nASCII\n"),
+        "title.vtk:2",
+    );
+    let n = plain.len();
+    bad(
+        "count.vtk",
+        &format!(
+            "{head}dial_factor = 0.5, stepcount = 1\nASCII\nDATASET POLYDATA\nPOINTS {} double\n",
+            n + 1
+        ),
+        "count.vtk:5",
+    );
+    bad(
+        "coord.vtk",
+        &format!("{head}dial_factor = 0.5, stepcount = 1\nASCII\nDATASET POLYDATA\nPOINTS {n} double\n0 0 zero\n"),
+        "coord.vtk:6",
+    );
+    bad(
+        "short.vtk",
+        &format!("{head}dial_factor = 0.5, stepcount = 1\nASCII\nDATASET POLYDATA\nPOINTS {n} double\n0 0 0\n"),
+        "of",
+    );
+}

@@ -19,6 +19,7 @@ pub(super) fn run_dynamic(
     mut state: State,
     v0: Option<Vec<Vec3>>,
     t0: Real,
+    dial0: Option<Real>,
 ) -> Result<(), RunError> {
     let sc = s.scene;
     let cf = s.config.dynamics.clone();
@@ -37,7 +38,7 @@ pub(super) fn run_dynamic(
     // equilibrium test passes (a restart resumes the linear dial at its time; holds already
     // passed stay passed).
     let holds = sc.settings.dial.holds.clone();
-    let mut dial_now = dial_at(t0);
+    let mut dial_now = dial0.unwrap_or_else(|| dial_at(t0));
     let mut next_hold = holds.iter().position(|&h| h > dial_now);
     let mut holding = false;
     if dial_time == 0.0 {

@@ -269,6 +269,7 @@ pub(super) fn run_explicit(
     mut state: State,
     v0: Option<Vec<Vec3>>,
     t0: Real,
+    dial0: Option<Real>,
 ) -> Result<(), RunError> {
     let sc = s.scene;
     let cf = sc.settings.explicit.clone();
@@ -332,10 +333,10 @@ pub(super) fn run_explicit(
 
     // Dial from the start time (a restart resumes the linear dial; holds already passed stay
     // passed).
-    let mut dial = if dial_time > 0.0 {
-        (t0 / dial_time).min(1.0)
-    } else {
-        1.0
+    let mut dial = match dial0 {
+        Some(d) => d,
+        None if dial_time > 0.0 => (t0 / dial_time).min(1.0),
+        None => 1.0,
     };
     let mut next_hold = holds.iter().position(|&h| h > dial);
     let mut phase = if dial >= 1.0 {

@@ -598,6 +598,9 @@ pub struct InitialState {
     pub v: Option<Vec<Vec3>>,
     /// Time (dynamics, s) or dial factor (statics) to resume from.
     pub time: Real,
+    /// The dial factor to resume from when the file gives it (a MorphoShell ansatz); otherwise
+    /// the dial follows from `time`.
+    pub dial: Option<Real>,
 }
 
 /// Runs a scene to completion from the reference mesh, or from `initial` (a restart), writing
@@ -611,21 +614,23 @@ pub fn run(
 ) -> Result<Summary, RunError> {
     let pattern = Pattern::for_scene(scene);
     let mut s = Solver::new(scene, &pattern, threads)?;
-    let (mut state, v, start) = match initial {
-        Some(st) => (st.state, st.v, Some(st.time)),
-        None => (State::reference(scene), None, None),
+    let (mut state, v, start, dial) = match initial {
+        Some(st) => (st.state, st.v, Some(st.time), st.dial),
+        None => (State::reference(scene), None, None, None),
     };
     let sb = s.config.symmetry_breaking;
     if sb > 0.0 && is_planar(scene, &state.x) {
         perturb(scene, &mut state.x, sb * scene.mean_edge, s.config.seed);
     }
     let ran = match s.config.mode {
-        Mode::Static => statics::run_static(&mut s, writer, progress, state, start),
+        Mode::Static => statics::run_static(&mut s, writer, progress, state, dial.or(start)),
         Mode::Dynamic => {
-            dynamics::run_dynamic(&mut s, writer, progress, state, v, start.unwrap_or(0.0))
+            let t0 = start.unwrap_or(0.0);
+            dynamics::run_dynamic(&mut s, writer, progress, state, v, t0, dial)
         }
         Mode::Explicit => {
-            explicit::run_explicit(&mut s, writer, progress, state, v, start.unwrap_or(0.0))
+            let t0 = start.unwrap_or(0.0);
+            explicit::run_explicit(&mut s, writer, progress, state, v, t0, dial)
         }
     };
     match ran {
