@@ -35,6 +35,7 @@ pub mod cli;
 pub mod diffusion;
 pub mod energy;
 pub mod expr;
+pub mod fields;
 pub mod fuzz;
 pub mod geometry;
 pub mod growth;

@@ -222,6 +222,9 @@ pub fn to_toml(m: &MorphoSettings, file: &str, slide_speed: Option<Real>) -> Res
     line("[solver]".into());
     line("mode = \"explicit\"".into());
     line(String::new());
+    line("[output]".into());
+    line("morphoshell_fields = true   # angle deficits, strain measure, Cauchy stresses".into());
+    line(String::new());
     line("[explicit]".into());
     line(format!(
         "time_step_prefactor = {:?}",

@@ -579,6 +579,9 @@ impl Writer {
                 Field::scalar(sc.patches.iter().map(|p| p.condition).collect()),
             );
         }
+        if sc.settings.output.morphoshell_fields {
+            morphoshell_fields(m, pot, x, phi, &a);
+        }
         let vf = &mut m.vertex_fields;
         let disp: Vec<Real> = x
             .iter()
@@ -710,4 +713,59 @@ impl Writer {
         let text = serde_json::to_string_pretty(summary).map_err(|e| ioerr(&path, e))?;
         write_atomic(&path, text.as_bytes()).map_err(|e| ioerr(&path, e))
     }
+}
+
+/// MorphoShell's derived fields ([`crate::fields`]) into the frame `m`: `angle_deficit` and
+/// `angle_deficit_gauss_curvature` per vertex; `strain_measure`, `cauchy_stress_eigval_1/2`
+/// (N/m, largest first), `dimless_cauchy_stress_eigval_1/2` (over μt, as MorphoShell writes
+/// them) and `cauchy_stress_eigvec_1/2` (unit 3-vectors) per face. Without a membrane term the
+/// stress fields are left out.
+fn morphoshell_fields(m: &mut Mesh, pot: &Potential, x: &[Vec3], phi: &[Real], a: &[Sym2]) {
+    let sc = pot.scene;
+    let (deficit, curvature) =
+        crate::fields::angle_deficits(x, &sc.mesh.faces, &sc.topo.boundary_vertex);
+    m.vertex_fields
+        .insert("angle_deficit".into(), Field::scalar(deficit));
+    m.vertex_fields.insert(
+        "angle_deficit_gauss_curvature".into(),
+        Field::scalar(curvature),
+    );
+    let strain = (0..sc.num_faces())
+        .map(|f| crate::fields::strain_measure(&a[f], &pot.rest_forms(f).0))
+        .collect();
+    m.face_fields
+        .insert("strain_measure".into(), Field::scalar(strain));
+    let Some(ga) = sc.terms.iter().find_map(|t| t.membrane_stress(pot, x, phi)) else {
+        return;
+    };
+    let nf = sc.num_faces();
+    let (mut l1, mut l2, mut d1, mut d2) = (
+        Vec::with_capacity(nf),
+        Vec::with_capacity(nf),
+        Vec::with_capacity(nf),
+        Vec::with_capacity(nf),
+    );
+    let (mut u1, mut u2) = (Vec::with_capacity(3 * nf), Vec::with_capacity(3 * nf));
+    for (f, face) in sc.mesh.faces.iter().enumerate() {
+        let (e1, e2) = (x[face[1]] - x[face[0]], x[face[2]] - x[face[0]]);
+        let (l, u) = crate::fields::cauchy_principal(&e1, &e2, &a[f], &ga[f]);
+        let mu_t = sc.lame[f].beta * sc.thickness[f];
+        l1.push(l[0]);
+        l2.push(l[1]);
+        d1.push(l[0] / mu_t);
+        d2.push(l[1] / mu_t);
+        u1.extend_from_slice(u[0].as_slice());
+        u2.extend_from_slice(u[1].as_slice());
+    }
+    let ff = &mut m.face_fields;
+    ff.insert("cauchy_stress_eigval_1".into(), Field::scalar(l1));
+    ff.insert("cauchy_stress_eigval_2".into(), Field::scalar(l2));
+    ff.insert("dimless_cauchy_stress_eigval_1".into(), Field::scalar(d1));
+    ff.insert("dimless_cauchy_stress_eigval_2".into(), Field::scalar(d2));
+    let vec3 = |d: Vec<Real>| Field {
+        components: 3,
+        data: d,
+    };
+    ff.insert("cauchy_stress_eigvec_1".into(), vec3(u1));
+    ff.insert("cauchy_stress_eigvec_2".into(), vec3(u2));
 }

@@ -1174,6 +1174,10 @@ pub struct Output {
     pub continuation_frames: bool,
     /// Basename of frame files, `{prefix}_{index:05}.{ext}` (default: `"frame"`).
     pub prefix: String,
+    /// Also write MorphoShell's derived fields: angle deficits and their Gauss curvature per
+    /// vertex, its strain measure and the principal Cauchy stresses per face
+    /// ([`crate::fields`]; default: `false`).
+    pub morphoshell_fields: bool,
 }
 
 impl Default for Output {
@@ -1182,6 +1186,7 @@ impl Default for Output {
             format: Format::Vtu,
             continuation_frames: false,
             prefix: "frame".into(),
+            morphoshell_fields: false,
         }
     }
 }

@@ -361,6 +361,33 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
         self.membrane.observables(pot, x)
     }
 
+    /// `∂W/∂a` of each face's density at the potential's rest forms (its elastic part: frames
+    /// are evaluated without the damping wells).
+    fn membrane_stress(&self, pot: &Potential, x: &[Vec3], phi: &[Real]) -> Option<Vec<Sym2>> {
+        use rayon::prelude::*;
+        let pattern = pot.pattern.faces();
+        Some(
+            (0..pot.scene.num_faces())
+                .into_par_iter()
+                .map(|f| {
+                    let nodes = pattern.element(f);
+                    let xs = gather(nodes, x);
+                    let face = self.bending.face(pot.scene, f, nodes, phi);
+                    let dens = self.membrane.density(pot, f);
+                    let a = first_fundamental_form(&[xs[0], xs[1], xs[2]]);
+                    let b = if N > 9 {
+                        self.bending.eval(&face, &xs, false, false).b
+                    } else {
+                        Sym2::zeros()
+                    };
+                    let mut d = crate::energy::material::DensityDerivs::default();
+                    dens.eval_gradient(&a, &b, &mut d);
+                    d.ga
+                })
+                .collect(),
+        )
+    }
+
     fn project(
         &self,
         pot: &Potential,

@@ -165,6 +165,19 @@ pub trait Term: Send + Sync {
         Vec::new()
     }
 
+    /// `∂W/∂a` of each face's stretching energy W (J) with respect to its barycentric first
+    /// fundamental form, in the stored components `[a11, a12, a22]` (J/m²), for the frames'
+    /// Cauchy stress ([`crate::fields::cauchy_principal`]). Default: `None`, no membrane
+    /// energy.
+    fn membrane_stress(
+        &self,
+        _pot: &Potential,
+        _x: &[Vec3],
+        _phi: &[Real],
+    ) -> Option<Vec<crate::math::Sym2>> {
+        None
+    }
+
     /// The name of the per-face field that carries the state this term tracks across steps
     /// (default: none). Frames hold it as a 3-vector per face in the face's edge order (like
     /// `edge_angles`), and a restart hands it back to [`Term::restore`].
