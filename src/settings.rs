@@ -850,6 +850,9 @@ pub struct Slides {
     /// Force control: the slide's drag coefficient (N·s/m; default: the sheet's mass times its
     /// waiting drag rate).
     pub drag: Option<Real>,
+    /// The upper slide stays still until the dial has reached 1 (default: `false`: it moves
+    /// from the start).
+    pub after_dial: bool,
 }
 
 impl Default for Slides {
@@ -865,6 +868,7 @@ impl Default for Slides {
             travel: 0.0,
             force: 0.0,
             drag: None,
+            after_dial: false,
         }
     }
 }

@@ -885,3 +885,100 @@ fn morphoshell_output_fields() {
         k[k.len() - 1]
     );
 }
+
+/// A cone pressed by a force-controlled slide (frictionless, after the dial) settles where the
+/// sheet carries the load: at the default equilibrium test both slides carry the applied force
+/// (the upper slide's backward-Euler update balances it exactly; the lower one through the
+/// sheet), and the cone is squashed below its free height.
+#[test]
+fn force_controlled_slide_squashes_a_cone_to_the_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    shellsim(
+        &[
+            "mesh", "disk", "--radius", "1", "--edge", "0.25", "-o", "disk.vtk",
+        ],
+        d,
+    );
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = root.join("settings/cone_squeezed.toml");
+    shellsim(
+        &[scene.to_str().unwrap(), "disk.vtk", "--out", "o", "-q"],
+        d,
+    );
+    let s = summary(&d.join("o"));
+    assert_eq!(s["converged"], true, "{}", s["reason"]);
+    let text = std::fs::read_to_string(d.join("o/log.csv")).unwrap();
+    let head: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let last: Vec<f64> = text
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap_or(f64::NAN))
+        .collect();
+    let col = |n: &str| last[head.iter().position(|h| *h == n).unwrap()];
+    let (up, down, gap) = (
+        col("slide_upper_force"),
+        col("slide_lower_force"),
+        col("slide_gap"),
+    );
+    eprintln!("squeezed cone: forces {up:e} / {down:e} N, gap {gap}");
+    // At the test's force residual (1e-7 of E h × edge per node) the forces balance to ~1e-6.
+    assert!((up - 0.002).abs() < 1e-5 * 0.002, "upper force {up}");
+    assert!((down - 0.002).abs() < 1e-4 * 0.002, "lower force {down}");
+    assert!(
+        gap > 0.0 && gap < 0.3,
+        "squashed below the free cone's ~0.55: gap {gap}"
+    );
+}
+
+/// The bilayer strip under the explicit dynamics (patch fit, 80 faces) stops by the default
+/// test (the target is compatible: Φ relaxes to round-off, so the energy test is relative to
+/// the target's starting energy) on the shape of the static solve of the same energy.
+#[test]
+fn explicit_bilayer_strip_stops_at_the_static_solution() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    shellsim(
+        &[
+            "mesh",
+            "rectangle",
+            "--lx",
+            "1",
+            "--ly",
+            "0.1",
+            "--edge",
+            "0.05",
+            "--program",
+            "bilayer_strip",
+            "-o",
+            "strip.vtk",
+        ],
+        d,
+    );
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = root.join("settings/bilayer_strip_explicit.toml");
+    let scene = scene.to_str().unwrap();
+    shellsim(&[scene, "strip.vtk", "--out", "ex", "-q"], d);
+    shellsim(
+        &[
+            scene,
+            "strip.vtk",
+            "--out",
+            "st",
+            "-q",
+            "--set",
+            "solver.mode=static",
+        ],
+        d,
+    );
+    let s = summary(&d.join("ex"));
+    assert_eq!(s["converged"], true, "{}", s["reason"]);
+    let dist = shape_distance(
+        &final_frame(&d.join("ex")).positions,
+        &final_frame(&d.join("st")).positions,
+    );
+    eprintln!("bilayer strip explicit vs static: {dist:e}");
+    assert!(dist < 5e-4, "explicit vs static: {dist:e} of the size");
+}

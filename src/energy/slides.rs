@@ -10,12 +10,15 @@
 //! **Friction** (explicit mode, [`crate::energy::term::Term::explicit_step`]): MorphoShell's
 //! stick/slip rule. A vertex in contact with normal force `N = k d` and in-plane force `f_h`
 //! (the elastic and other forces, drag excluded) sticks when `|f_h| < μ_f N` (its in-plane force
-//! and velocity are set to 0), else slides with `f_h − μ_f N f_h/|f_h|`.
+//! and velocity are set to 0), else slides with `f_h − μ_f N f_h/|f_h|`. (A rule with kinetic
+//! friction opposing the velocity was tried: on a cone squeezed by a force-controlled slide it
+//! chattered 20× more.)
 //!
-//! **Motion** (explicit mode): speed control moves the upper slide down at `speed` until it has
-//! moved `travel`; force control moves it overdamped, `ζ dz_u/dt = F_up − F`, with `F_up` the
+//! **Motion** (explicit mode; with `after_dial` only once the dial has reached 1): speed control
+//! moves the upper slide down at `speed` until it has moved `travel`; force control moves it overdamped, `ζ dz_u/dt = F_up − F`, with `F_up` the
 //! sheet's push on it, F the prescribed downward force and ζ the drag (default: the sheet's mass
-//! times its waiting drag rate). The implicit modes hold both slides still (frictionless).
+//! times its waiting drag rate), integrated by backward Euler (unconditionally stable; the
+//! explicit update pumps energy into the sheet once the contact is stiff against ζ/Δt). The implicit modes hold both slides still (frictionless).
 //!
 //! `log.csv` gets the slides' heights, the gap and the forces on each, computed from the state
 //! of the frame (never accumulated across steps).
@@ -50,6 +53,8 @@ pub struct Slides {
     pub force: Real,
     /// See `force`.
     pub drag: Real,
+    /// The upper slide stays still until the dial reaches 1.
+    pub after_dial: bool,
 }
 
 impl Slides {
@@ -83,6 +88,36 @@ impl Slides {
     }
 }
 
+impl Slides {
+    /// The force-controlled slide's next height: backward Euler of `ζ dz/dt = F_up(z) − F`
+    /// over `dt` with the sheet at `x`, `F_up(z) = Σ k (x_z − z)₊`. Forward Euler is unstable
+    /// once `dt Σk/ζ > 2` (a few nodes in contact with MorphoShell's stiffness suffice), and the
+    /// slide then pumps energy into the sheet. `h(z) = ζ(z − z₀)/dt − F_up(z) + F` is increasing
+    /// and concave (F_up is convex, piecewise linear), so Newton from `z₀` lands left of the
+    /// root after one step and then climbs to it monotonically, exactly after as many steps as
+    /// contact changes.
+    fn pressed(&self, x: &[Vec3], fixed: &[bool], z0: Real, dt: Real) -> Real {
+        let rate = self.drag / dt;
+        let mut z = z0;
+        for _ in 0..64 {
+            let (mut push, mut slope) = (0.0, rate);
+            for (p, &f) in x.iter().zip(fixed) {
+                if !f && p.z > z {
+                    push += self.k * (p.z - z);
+                    slope += self.k;
+                }
+            }
+            let h = rate * (z - z0) - push + self.force;
+            let step = h / slope;
+            z -= step;
+            if step.abs() <= 1e-15 * (1.0 + z.abs()) {
+                break;
+            }
+        }
+        z
+    }
+}
+
 impl VertexKernel for Slides {
     #[inline]
     fn eval(&self, _: &Potential, _: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
@@ -110,7 +145,14 @@ impl VertexKernel for Slides {
         ]
     }
 
-    fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
+    fn explicit_step(
+        &self,
+        pot: &Potential,
+        x: &[Vec3],
+        v: &mut [Vec3],
+        g: &mut [Real],
+        _dt: Real,
+    ) {
         let fixed = &pot.scene.fixed;
         if self.friction > 0.0 {
             for (i, p) in x.iter().enumerate() {
@@ -136,6 +178,16 @@ impl VertexKernel for Slides {
                 }
             }
         }
+    }
+
+    /// The upper slide's motion over the step, from the positions the gradient is taken at (no
+    /// lag between the slide and the sheet: a slide moved from the previous positions drives a
+    /// slow limit cycle through the contact).
+    fn explicit_begin(&self, pot: &Potential, x: &[Vec3], dt: Real) {
+        let fixed = &pot.scene.fixed;
+        if self.after_dial && pot.dial < 1.0 {
+            return;
+        }
         let z = self.upper();
         let next = match self.control {
             SlideControl::Speed => {
@@ -147,10 +199,7 @@ impl VertexKernel for Slides {
                     z1.min(bottom)
                 }
             }
-            SlideControl::Force => {
-                let (up, _) = self.forces(x, fixed);
-                z + dt * (up - self.force) / self.drag
-            }
+            SlideControl::Force => self.pressed(x, fixed, z, dt),
         };
         // The upper slide never passes the lower one.
         self.set_upper(next.max(self.lower + 1e-12 * (1.0 + self.lower.abs())));
@@ -208,6 +257,7 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn super::term::Term>>, MeshErr
             travel: s.travel,
             force: s.force,
             drag,
+            after_dial: s.after_dial,
         },
     })))
 }

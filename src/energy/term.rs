@@ -253,10 +253,14 @@ pub trait Term: Send + Sync {
         false
     }
 
+    /// Explicit dynamics, before the gradient at positions `x` of a step `dt` (s): a term with
+    /// a state of its own that follows the sheet (a moving slide) advances it to these
+    /// positions, so that the gradient sees the two consistent. Default: nothing.
+    fn explicit_begin(&self, _pot: &Potential, _x: &[Vec3], _dt: Real) {}
+
     /// Explicit dynamics, after the gradient `g` at positions `x` with velocities `v` and before
     /// the step `dt` (s): a term that acts on the step itself, beyond its energy, adjusts `g`
-    /// and `v` (stick/slip friction) and advances its own state (a moving slide). Default:
-    /// nothing.
+    /// and `v` (stick/slip friction). Default: nothing.
     fn explicit_step(
         &self,
         _pot: &Potential,
@@ -371,6 +375,8 @@ pub trait VertexKernel: Send + Sync {
     fn observables(&self, _pot: &Potential, _x: &[Vec3]) -> Vec<(String, Real)> {
         Vec::new()
     }
+    /// See [`Term::explicit_begin`] (default: nothing).
+    fn explicit_begin(&self, _pot: &Potential, _x: &[Vec3], _dt: Real) {}
     /// See [`Term::explicit_step`] (default: nothing).
     fn explicit_step(
         &self,
@@ -398,6 +404,9 @@ pub struct VertexTerm<K> {
 impl<K: VertexKernel> Term for VertexTerm<K> {
     fn name(&self) -> &'static str {
         self.name
+    }
+    fn explicit_begin(&self, pot: &Potential, x: &[Vec3], dt: Real) {
+        self.kernel.explicit_begin(pot, x, dt);
     }
     fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
         self.kernel.explicit_step(pot, x, v, g, dt);
