@@ -199,6 +199,30 @@ fn bbar_first_dials_bbar_then_abar() {
     assert!((b - b1 * 0.25).amax() < 1e-15);
 }
 
+/// The Gauss–Codazzi–Mainardi cone's annular sector as `d/cone.vtk` at edge length `edge`.
+fn gcm_cone_mesh(d: &Path, edge: &str) {
+    let sweep = format!("{}", shellsim::cases::gcm_cone_sweep().to_degrees());
+    shellsim(
+        &[
+            "mesh",
+            "annulus",
+            "--inner",
+            "1",
+            "--radius",
+            "1.4",
+            "--sweep",
+            &sweep,
+            "--edge",
+            edge,
+            "--program",
+            "gcm_cone",
+            "-o",
+            "cone.vtk",
+        ],
+        d,
+    );
+}
+
 const CONE_EXPLICIT: &str = "[material]\nyoung = 3.0\npoisson = 0.5\ndensity = 1.0\n\
     thickness = 0.01\nbending = \"patch_fit\"\n[rest]\ntarget = \"mesh\"\n\
     [solver]\nmode = \"explicit\"\n[explicit]\ntime_step_prefactor = 0.6\n\
@@ -211,25 +235,7 @@ const CONE_EXPLICIT: &str = "[material]\nyoung = 3.0\npoisson = 0.5\ndensity = 1
 fn explicit_gcm_cone_stops_at_the_static_solution() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    shellsim(
-        &[
-            "mesh",
-            "annulus",
-            "--inner",
-            "1",
-            "--radius",
-            "1.4",
-            "--sweep",
-            &format!("{}", shellsim::cases::gcm_cone_sweep().to_degrees()),
-            "--edge",
-            "0.17",
-            "--program",
-            "gcm_cone",
-            "-o",
-            "cone.vtk",
-        ],
-        d,
-    );
+    gcm_cone_mesh(d, "0.17");
     write(d, "ex.toml", CONE_EXPLICIT);
     shellsim(&["ex.toml", "cone.vtk", "--out", "ex", "-q"], d);
     shellsim(
@@ -546,25 +552,7 @@ fn logged_dials(out: &Path) -> Vec<Real> {
 fn holds_in_the_implicit_drivers() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    shellsim(
-        &[
-            "mesh",
-            "annulus",
-            "--inner",
-            "1",
-            "--radius",
-            "1.4",
-            "--sweep",
-            &format!("{}", shellsim::cases::gcm_cone_sweep().to_degrees()),
-            "--edge",
-            "0.25",
-            "--program",
-            "gcm_cone",
-            "-o",
-            "cone.vtk",
-        ],
-        d,
-    );
+    gcm_cone_mesh(d, "0.25");
     write(d, "ex.toml", CONE_EXPLICIT);
     let st = |out: &str, extra: &[&str]| {
         let mut a = vec!["ex.toml", "cone.vtk", "--out", out, "-q"];
@@ -651,25 +639,7 @@ fn write_ansatz(path: &Path, dial: &str, x: &[Vec3], faces: &[[usize; 3]]) {
 fn morphoshell_ansatz_files() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    shellsim(
-        &[
-            "mesh",
-            "annulus",
-            "--inner",
-            "1",
-            "--radius",
-            "1.4",
-            "--sweep",
-            &format!("{}", shellsim::cases::gcm_cone_sweep().to_degrees()),
-            "--edge",
-            "0.25",
-            "--program",
-            "gcm_cone",
-            "-o",
-            "cone.vtk",
-        ],
-        d,
-    );
+    gcm_cone_mesh(d, "0.25");
     write(d, "ex.toml", CONE_EXPLICIT);
     let st = |out: &str, extra: &[&str]| {
         let mut a = vec!["ex.toml", "cone.vtk", "--out", out, "-q"];

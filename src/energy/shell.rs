@@ -279,8 +279,14 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Shell<M
         }
     }
 
-    /// Per-face elastic (stretching, bending) energies (J) at `x`, `phi`, without damping.
-    pub fn face_energies(&self, pot: &Potential, x: &[Vec3], phi: &[Real]) -> Vec<(Real, Real)> {
+    /// `out(density, a, b)` of every face at `x`, `phi` (in parallel, in face order).
+    fn per_face<T: Send>(
+        &self,
+        pot: &Potential,
+        x: &[Vec3],
+        phi: &[Real],
+        out: impl Fn(&M::Density, &Sym2, &Sym2) -> T + Sync,
+    ) -> Vec<T> {
         use rayon::prelude::*;
         let pattern = pot.pattern.faces();
         (0..pot.scene.num_faces())
@@ -296,9 +302,14 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Shell<M
                 } else {
                     Sym2::zeros()
                 };
-                dens.elastic_parts(&a, &b)
+                out(&dens, &a, &b)
             })
             .collect()
+    }
+
+    /// Per-face elastic (stretching, bending) energies (J) at `x`, `phi`, without damping.
+    pub fn face_energies(&self, pot: &Potential, x: &[Vec3], phi: &[Real]) -> Vec<(Real, Real)> {
+        self.per_face(pot, x, phi, |dens, a, b| dens.elastic_parts(a, b))
     }
 }
 
@@ -364,28 +375,11 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
     /// `∂W/∂a` of each face's density at the potential's rest forms (its elastic part: frames
     /// are evaluated without the damping wells).
     fn membrane_stress(&self, pot: &Potential, x: &[Vec3], phi: &[Real]) -> Option<Vec<Sym2>> {
-        use rayon::prelude::*;
-        let pattern = pot.pattern.faces();
-        Some(
-            (0..pot.scene.num_faces())
-                .into_par_iter()
-                .map(|f| {
-                    let nodes = pattern.element(f);
-                    let xs = gather(nodes, x);
-                    let face = self.bending.face(pot.scene, f, nodes, phi);
-                    let dens = self.membrane.density(pot, f);
-                    let a = first_fundamental_form(&[xs[0], xs[1], xs[2]]);
-                    let b = if N > 9 {
-                        self.bending.eval(&face, &xs, false, false).b
-                    } else {
-                        Sym2::zeros()
-                    };
-                    let mut d = crate::energy::material::DensityDerivs::default();
-                    dens.eval_gradient(&a, &b, &mut d);
-                    d.ga
-                })
-                .collect(),
-        )
+        Some(self.per_face(pot, x, phi, |dens, a, b| {
+            let mut d = crate::energy::material::DensityDerivs::default();
+            dens.eval_gradient(a, b, &mut d);
+            d.ga
+        }))
     }
 
     fn project(
