@@ -238,12 +238,24 @@ pub fn read_ansatz(path: &Path, vertices: usize) -> Result<Option<(Real, Vec<Vec
         },
         reason,
     };
-    let Ok(bytes) = std::fs::read(path) else {
-        return Ok(None); // read_mesh names the I/O error
+    // The title is the second line; a binary file or another title is not an ansatz. Only the
+    // first two lines (at most 4 KiB) are read to tell: a shellsim frame is read once, by
+    // read_mesh.
+    let head = {
+        use std::io::{BufRead, Read};
+        let Ok(file) = std::fs::File::open(path) else {
+            return Ok(None); // read_mesh names the I/O error
+        };
+        let mut r = std::io::BufReader::new(file.take(4096));
+        let mut head = Vec::new();
+        for _ in 0..2 {
+            if r.read_until(b'\n', &mut head).is_err() {
+                return Ok(None);
+            }
+        }
+        head
     };
-    // The title is the second line; a binary file or another title is not an ansatz.
-    let mut lines = bytes.split(|&b| b == b'\n');
-    let (_, Some(title)) = (lines.next(), lines.next()) else {
+    let Some(title) = head.split(|&b| b == b'\n').nth(1) else {
         return Ok(None);
     };
     let Ok(title) = std::str::from_utf8(title) else {
@@ -252,6 +264,7 @@ pub fn read_ansatz(path: &Path, vertices: usize) -> Result<Option<(Real, Vec<Vec
     let Some(rest) = title.trim_start().strip_prefix("dial_factor") else {
         return Ok(None);
     };
+    let bytes = std::fs::read(path).map_err(|e| bad(0, e.to_string()))?;
     let Ok(text) = std::str::from_utf8(&bytes) else {
         return Err(bad(
             0,
