@@ -412,16 +412,7 @@ fn slides_squeeze_a_cone_and_bad_slides_are_named() {
         });
     assert!(lo > -0.1 - 2e-3 && hi < 0.1 + 2e-3, "z range {lo} … {hi}");
     assert!(hi - lo > 0.19, "the cone fills the gap: {lo} … {hi}");
-    let text = std::fs::read_to_string(d.join("o").join("log.csv")).unwrap();
-    let head: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let last: Vec<f64> = text
-        .lines()
-        .last()
-        .unwrap()
-        .split(',')
-        .map(|v| v.parse().unwrap_or(f64::NAN))
-        .collect();
-    let col = |n: &str| last[head.iter().position(|h| *h == n).unwrap()];
+    let col = |n: &str| *log_column(&d.join("o"), n).last().unwrap();
     assert_eq!(col("slide_gap"), 0.2);
     let (up, down) = (col("slide_upper_force"), col("slide_lower_force"));
     assert!(
@@ -534,15 +525,20 @@ fn import_morphoshell_settings() {
     }
 }
 
-/// The dial's rows of `log.csv` (one per frame).
-fn logged_dials(out: &Path) -> Vec<Real> {
+/// The column `name` of a run's `log.csv` (one row per frame).
+fn log_column(out: &Path, name: &str) -> Vec<Real> {
     let text = std::fs::read_to_string(out.join("log.csv")).unwrap();
     let mut lines = text.lines();
     let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let k = head.iter().position(|h| *h == "dial").unwrap();
+    let k = head.iter().position(|h| *h == name).unwrap();
     lines
         .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
         .collect()
+}
+
+/// The dial's rows of `log.csv`.
+fn logged_dials(out: &Path) -> Vec<Real> {
+    log_column(out, "dial")
 }
 
 /// Hold points in the implicit drivers: the static continuation lands on each hold, solves it to
@@ -651,11 +647,8 @@ fn morphoshell_ansatz_files() {
     st("plain", &[]);
     st("held", &["--set", "dial.holds=[0.5]"]);
     // The frame at the hold, written as a MorphoShell ansatz at dial 0.5.
-    let log = std::fs::read_to_string(d.join("held/log.csv")).unwrap();
-    let row = log
-        .lines()
-        .find(|l| l.split(',').nth(2) == Some("0.500000"));
-    let k: usize = row.unwrap().split(',').next().unwrap().parse().unwrap();
+    let row = logged_dials(&d.join("held")).iter().position(|&s| s == 0.5);
+    let k = log_column(&d.join("held"), "frame")[row.unwrap()] as usize;
     let half = shellsim::mesh::io::read_mesh(&d.join(format!("held/frame_{k:05}.vtu"))).unwrap();
     write_ansatz(&d.join("half.vtk"), "0.5", &half.positions, &half.faces);
     st("resumed", &["--restart", "half.vtk"]);
@@ -684,19 +677,7 @@ fn morphoshell_ansatz_files() {
         dials[0], 0.0,
         "dialling from the ansatz starts at 0: {dials:?}"
     );
-    let first_energy = |out: &str| -> Real {
-        let text = std::fs::read_to_string(d.join(out).join("log.csv")).unwrap();
-        let head: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-        let k = head.iter().position(|h| *h == "energy_total").unwrap();
-        text.lines()
-            .nth(1)
-            .unwrap()
-            .split(',')
-            .nth(k)
-            .unwrap()
-            .parse()
-            .unwrap()
-    };
+    let first_energy = |out: &str| log_column(&d.join(out), "energy_total")[0];
     let (e_start, e_ref) = (first_energy("from_start"), first_energy("from_reference"));
     assert!(
         e_start.abs() < 1e-12 * e_ref.abs(),
@@ -878,16 +859,7 @@ fn force_controlled_slide_squashes_a_cone_to_the_load() {
     );
     let s = summary(&d.join("o"));
     assert_eq!(s["converged"], true, "{}", s["reason"]);
-    let text = std::fs::read_to_string(d.join("o/log.csv")).unwrap();
-    let head: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let last: Vec<f64> = text
-        .lines()
-        .last()
-        .unwrap()
-        .split(',')
-        .map(|v| v.parse().unwrap_or(f64::NAN))
-        .collect();
-    let col = |n: &str| last[head.iter().position(|h| *h == n).unwrap()];
+    let col = |n: &str| *log_column(&d.join("o"), n).last().unwrap();
     let (up, down, gap) = (
         col("slide_upper_force"),
         col("slide_lower_force"),
