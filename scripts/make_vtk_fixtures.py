@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Writes tests/data/vtk/: one small triangle mesh saved by VTK's own writers in every variant
 shellsim reads (legacy 4.2 and 5.1, ASCII and binary; XML ascii, base64, zlib-compressed, UInt64
-headers, big-endian; UnstructuredGrid and PolyData), plus raw appended XML, which shellsim
-refuses. The reader tests compare every file with the mesh defined here (see
+headers, big-endian; UnstructuredGrid and PolyData; XML with appended data, raw or base64, with
+every compressor VTK has (none, zlib, LZ4, LZMA), in both byte orders and header types). The reader tests compare every file with the mesh defined here (see
 tests/unit/io.rs). Needs `pip install vtk`; the files are committed, so the tests do not.
 
     python3 scripts/make_vtk_fixtures.py
@@ -72,7 +72,8 @@ def poly():
     return p
 
 
-def xml(writer, data, name, mode, compress=True, header64=False, big=False):
+def xml(writer, data, name, mode, compress=True, header64=False, big=False, compressor="zlib",
+        encode=False):
     w = writer()
     w.SetInputData(data)
     w.SetFileName(os.path.join(OUT, name))
@@ -80,8 +81,14 @@ def xml(writer, data, name, mode, compress=True, header64=False, big=False):
      "appended": w.SetDataModeToAppended}[mode]()
     if not compress:
         w.SetCompressorTypeToNone()
+    else:
+        {"zlib": w.SetCompressorTypeToZLib, "lz4": w.SetCompressorTypeToLZ4,
+         "lzma": w.SetCompressorTypeToLZMA}[compressor]()
     if header64:
         w.SetHeaderTypeToUInt64()
+    else:
+        w.SetHeaderTypeToUInt32()
+    w.SetEncodeAppendedData(1 if encode else 0)
     if big:
         w.SetByteOrderToBigEndian()
     assert w.Write() == 1, name
@@ -111,7 +118,17 @@ def main():
     xml(U, g, "base64_bigendian.vtu", "binary", compress=False, big=True)
     xml(P, p, "zlib.vtp", "binary")
     xml(P, p, "ascii.vtp", "ascii")
-    xml(U, g, "appended.vtu", "appended")
+    # ParaView's default: raw appended data, zlib, UInt64 headers.
+    xml(U, g, "appended.vtu", "appended", header64=True)
+    xml(U, g, "appended_none.vtu", "appended", compress=False)
+    xml(U, g, "appended_lz4.vtu", "appended", compressor="lz4")
+    xml(U, g, "appended_lzma.vtu", "appended", compressor="lzma", header64=True)
+    xml(U, g, "appended_bigendian.vtu", "appended", big=True, header64=True)
+    xml(U, g, "appended_bigendian_none.vtu", "appended", compress=False, big=True)
+    xml(U, g, "appended_base64.vtu", "appended", encode=True)
+    xml(U, g, "appended_base64_none.vtu", "appended", compress=False, encode=True)
+    xml(P, p, "appended.vtp", "appended", header64=True)
+    xml(P, p, "appended_bigendian_lz4.vtp", "appended", big=True, compressor="lz4")
     LU, LP = vtk.vtkUnstructuredGridWriter, vtk.vtkPolyDataWriter
     legacy(LU, g, "ascii_51.vtk", False, 51)
     legacy(LU, g, "binary_51.vtk", True, 51)

@@ -2,8 +2,8 @@
 //! collections use (OFF, OBJ, PLY, STL: `mesh/shapes.rs`).
 //!
 //! Read: legacy `.vtk` (ASCII or big-endian binary, versions 2.0–5.1; POLYDATA or
-//! UNSTRUCTURED_GRID of triangles) and XML `.vtu`/`.vtp` with inline (base64 or ASCII) data, which
-//! is what shellsim writes. CELL_DATA / POINT_DATA become face / vertex fields, whether stored as
+//! UNSTRUCTURED_GRID of triangles) and XML `.vtu`/`.vtp`, inline or appended, raw or base64, with
+//! any of VTK's compressors (`mesh/xml.rs`). CELL_DATA / POINT_DATA become face / vertex fields, whether stored as
 //! FIELD arrays or as SCALARS / VECTORS / NORMALS / TENSORS. MorphoShell input files work
 //! unchanged.
 //!

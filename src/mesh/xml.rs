@@ -1,17 +1,20 @@
-//! Reader for VTK XML `UnstructuredGrid` (`.vtu`) and `PolyData` (`.vtp`) files of triangles with
-//! inline data: `format="ascii"` or `format="binary"` (base64), uncompressed or compressed with
-//! zlib (`compressor="vtkZLibDataCompressor"`, ParaView's default), `header_type` UInt32 or
-//! UInt64, either byte order. Raw appended data is refused with a message saying how to save a
-//! readable file.
+//! Reader for VTK XML `UnstructuredGrid` (`.vtu`) and `PolyData` (`.vtp`) files of triangles:
+//! inline data (`format="ascii"` or `"binary"`, base64) and appended data (`<AppendedData
+//! encoding="raw">`, ParaView's default, or `encoding="base64"`), uncompressed or compressed with
+//! any of VTK's compressors (zlib, LZ4, LZMA), `header_type` UInt32 or UInt64, either byte
+//! order.
 //!
 //! Written here rather than taken from vtkio so that every error names the byte offset and the
 //! element it is in, compressed-data headers are checked against the data before anything is
 //! allocated or sliced, and no input can panic.
 //!
 //! Format: <https://docs.vtk.org/en/latest/design_documents/VTKFileFormats.html> (XML part).
-//! Binary inline data is base64 of a header (the byte count; for compressed data the block
-//! count, block size, last block size and each block's compressed size) followed by the data;
-//! VTK encodes the two separately, other writers as one stream. Both are read.
+//! Binary data is a header (the byte count; for compressed data the block count, block size,
+//! last block size and each block's compressed size) followed by the data. Inline, it is base64
+//! (VTK encodes the header and the data apart, other writers as one stream; both are read);
+//! appended, each array sits at its `offset` in the bytes after the `_` marker, raw or base64.
+//! Raw data is not XML: the XML before `<AppendedData>` is parsed, and the block is sliced by
+//! offset.
 
 use super::RawMesh;
 use crate::math::Real;
@@ -134,11 +137,36 @@ fn parse_tree(bytes: &[u8]) -> Result<Node<'_>, Fail> {
         .ok_or_else(|| "no <VTKFile> element: not a VTK XML file".to_string())
 }
 
+/// The compressors VTK writes (`compressor` attribute of `<VTKFile>`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Compressor {
+    None,
+    /// `vtkZLibDataCompressor` (zlib streams).
+    Zlib,
+    /// `vtkLZ4DataCompressor` (LZ4 block format).
+    Lz4,
+    /// `vtkLZMADataCompressor` (xz streams).
+    Lzma,
+}
+
+/// The `<AppendedData>` block: the bytes after its `_` marker up to `</AppendedData>`.
+struct Appended<'a> {
+    data: &'a [u8],
+    /// File byte offset of `data[0]`.
+    start: usize,
+    /// `encoding="base64"` (else raw bytes).
+    base64: bool,
+    /// The offsets of every appended array, sorted: with base64, an array's text ends where
+    /// the next one starts.
+    offsets: Vec<usize>,
+}
+
 /// How the file encodes binary data.
-struct Encoding {
+struct Encoding<'a> {
     little: bool,
     header_bytes: usize,
-    zlib: bool,
+    compressor: Compressor,
+    appended: Option<Appended<'a>>,
 }
 
 /// Element types: (bytes, kind) with kind 0 signed integer, 1 unsigned, 2 float.
@@ -189,7 +217,9 @@ fn header_num(b: &[u8], enc: &Encoding) -> u64 {
     decode_value(&b[..enc.header_bytes], 1, enc.little) as u64
 }
 
-/// The raw bytes of a binary DataArray holding `expect` bytes.
+/// The raw bytes of a base64 binary array holding `expect` bytes: the header and the data are
+/// decoded (VTK encodes the two apart; other writers, uncompressed, as one stream) into the
+/// raw layout [`raw_bytes`] reads.
 fn binary_bytes(text: &[u8], enc: &Encoding, expect: usize) -> Result<Vec<u8>, Fail> {
     let hb = enc.header_bytes;
     let h64 = 4 * hb.div_ceil(3);
@@ -199,47 +229,80 @@ fn binary_bytes(text: &[u8], enc: &Encoding, expect: usize) -> Result<Vec<u8>, F
         ));
     }
     let first = b64(&text[..h64])?;
-    if !enc.zlib {
-        let n = header_num(&first, enc);
+    let raw = if enc.compressor == Compressor::None {
+        if text[h64 - 1] == b'=' {
+            let mut raw = first[..hb.min(first.len())].to_vec();
+            raw.extend(b64(&text[h64..])?);
+            raw
+        } else {
+            b64(text)?
+        }
+    } else {
+        // Compressed: [blocks, block size, last block size, compressed size of each block].
+        let nb = header_num(&first, enc);
+        let too_many =
+            || format!("compression header announces {nb} blocks, more than the data holds");
+        let full = usize::try_from(nb)
+            .ok()
+            .and_then(|nb| nb.checked_add(3))
+            .and_then(|k| k.checked_mul(hb))
+            .ok_or_else(too_many)?;
+        let f64_ = 4 * full.div_ceil(3);
+        if f64_ > text.len() {
+            return Err(too_many());
+        }
+        let mut raw = b64(&text[..f64_]).map_err(|e| format!("compression header: {e}"))?;
+        if raw.len() < full {
+            return Err(String::from("compression header truncated"));
+        }
+        raw.truncate(full);
+        raw.extend(b64(&text[f64_..]).map_err(|e| format!("compressed data: {e}"))?);
+        raw
+    };
+    raw_bytes(&raw, enc, expect)
+}
+
+/// The bytes of an array holding `expect` bytes from its raw binary form `d` (inline base64
+/// decoded, or appended data from the array's offset on): a header of the byte count, then
+/// the data; compressed, a header of the block count, the block size, the last block's size
+/// (0: a full block) and each block's compressed size, then the blocks. Every size is checked
+/// against the data before anything is sliced, and nothing is allocated from a header alone.
+fn raw_bytes(d: &[u8], enc: &Encoding, expect: usize) -> Result<Vec<u8>, Fail> {
+    let hb = enc.header_bytes;
+    let num = |i: usize| -> Result<u64, Fail> {
+        i.checked_mul(hb)
+            .and_then(|a| d.get(a..a.checked_add(hb)?))
+            .map(|b| header_num(b, enc))
+            .ok_or_else(|| {
+                format!(
+                    "the data ends inside its header ({} bytes, header entry {i}; truncated?)",
+                    d.len()
+                )
+            })
+    };
+    if enc.compressor == Compressor::None {
+        let n = num(0)?;
         if n != expect as u64 {
             return Err(format!(
                 "the binary header announces {n} bytes, but the array needs {expect}"
             ));
         }
-        let data = if text[h64 - 1] == b'=' {
-            // Header and data encoded apart (VTK).
-            b64(&text[h64..])?
-        } else {
-            let mut all = b64(text)?;
-            all.drain(..hb.min(all.len()));
-            all
-        };
-        if data.len() != expect {
-            return Err(format!(
+        return d.get(hb..hb + expect).map(<[u8]>::to_vec).ok_or_else(|| {
+            format!(
                 "binary data holds {} bytes, expected {expect} (truncated?)",
-                data.len()
-            ));
-        }
-        return Ok(data);
+                d.len() - hb
+            )
+        });
     }
-    // Compressed: [blocks, block size, last block size, compressed size of each block].
-    let nb = header_num(&first, enc);
+    let nb = num(0)?;
     let too_many = || format!("compression header announces {nb} blocks, more than the data holds");
     let nb_usize = usize::try_from(nb).map_err(|_| too_many())?;
     let full = nb_usize
         .checked_add(3)
         .and_then(|k| k.checked_mul(hb))
+        .filter(|&f| f <= d.len())
         .ok_or_else(too_many)?;
-    let f64_ = 4 * full.div_ceil(3);
-    if f64_ > text.len() {
-        return Err(too_many());
-    }
-    let head = b64(&text[..f64_]).map_err(|e| format!("compression header: {e}"))?;
-    if head.len() < full {
-        return Err(String::from("compression header truncated"));
-    }
-    let num = |i: usize| header_num(&head[i * hb..], enc);
-    let (block, last) = (num(1), num(2));
+    let (block, last) = (num(1)?, num(2)?);
     let last = if last == 0 { block } else { last };
     let total = if nb == 0 {
         0
@@ -255,26 +318,20 @@ fn binary_bytes(text: &[u8], enc: &Encoding, expect: usize) -> Result<Vec<u8>, F
              {last}), but the array needs {expect}"
         ));
     }
-    let data = b64(&text[f64_..]).map_err(|e| format!("compressed data: {e}"))?;
-    let mut out = Vec::with_capacity(expect);
-    let mut at = 0usize;
+    let mut out = Vec::with_capacity(expect.min(1 << 26));
+    let mut at = full;
     for i in 0..nb_usize {
-        let c = usize::try_from(num(3 + i)).unwrap_or(usize::MAX);
-        let end = at
-            .checked_add(c)
-            .filter(|&e| e <= data.len())
-            .ok_or_else(|| {
-                format!(
-                    "compressed block {i} of {c} bytes runs past the {} bytes of data (truncated?)",
-                    data.len()
-                )
-            })?;
+        let c = usize::try_from(num(3 + i)?).unwrap_or(usize::MAX);
+        let end = at.checked_add(c).filter(|&e| e <= d.len()).ok_or_else(|| {
+            format!(
+                "compressed block {i} of {c} bytes runs past the {} bytes of data (truncated?)",
+                d.len() - full
+            )
+        })?;
         let want = if i + 1 == nb_usize { last } else { block } as usize;
         let before = out.len();
-        flate2::read::ZlibDecoder::new(&data[at..end])
-            .take(want as u64 + 1)
-            .read_to_end(&mut out)
-            .map_err(|e| format!("compressed block {i}: {e}"))?;
+        inflate(enc.compressor, &d[at..end], want, &mut out)
+            .map_err(|e| format!("compressed block {i} (data byte {}): {e}", at - full))?;
         if out.len() - before != want {
             return Err(format!(
                 "compressed block {i} inflates to {} bytes, its header says {want}",
@@ -284,6 +341,73 @@ fn binary_bytes(text: &[u8], enc: &Encoding, expect: usize) -> Result<Vec<u8>, F
         at = end;
     }
     Ok(out)
+}
+
+/// Appends the decompression of one block (at most `want` + 1 bytes) to `out`.
+fn inflate(c: Compressor, src: &[u8], want: usize, out: &mut Vec<u8>) -> Result<(), String> {
+    let limit = want as u64 + 1;
+    match c {
+        Compressor::None => out.extend_from_slice(src),
+        Compressor::Zlib => {
+            flate2::read::ZlibDecoder::new(src)
+                .take(limit)
+                .read_to_end(out)
+                .map_err(|e| e.to_string())?;
+        }
+        Compressor::Lzma => {
+            xz2::read::XzDecoder::new(src)
+                .take(limit)
+                .read_to_end(out)
+                .map_err(|e| e.to_string())?;
+        }
+        Compressor::Lz4 => {
+            // An LZ4 block expands at most 255×: a larger claim is refused before allocating.
+            if want > src.len().saturating_mul(255).saturating_add(16) {
+                return Err(format!(
+                    "{} compressed bytes cannot hold the {want} bytes the header announces",
+                    src.len()
+                ));
+            }
+            let before = out.len();
+            out.resize(before + want, 0);
+            let n = lz4_flex::block::decompress_into(src, &mut out[before..])
+                .map_err(|e| e.to_string())?;
+            out.truncate(before + n);
+        }
+    }
+    Ok(())
+}
+
+/// The bytes of an appended array at `offset` holding `expect` bytes.
+fn appended_bytes(
+    ap: &Appended,
+    enc: &Encoding,
+    offset: usize,
+    expect: usize,
+) -> Result<Vec<u8>, Fail> {
+    if offset >= ap.data.len() {
+        return Err(format!(
+            "the offset is past the end of the {} bytes of appended data (truncated?)",
+            ap.data.len()
+        ));
+    }
+    if ap.base64 {
+        let end = ap
+            .offsets
+            .iter()
+            .find(|&&o| o > offset)
+            .copied()
+            .unwrap_or(ap.data.len())
+            .min(ap.data.len());
+        let text: Vec<u8> = ap.data[offset..end]
+            .iter()
+            .copied()
+            .filter(|c| !c.is_ascii_whitespace())
+            .collect();
+        binary_bytes(&text, enc, expect)
+    } else {
+        raw_bytes(&ap.data[offset..], enc, expect)
+    }
 }
 
 /// A DataArray's values as reals; `entries × components` of them, checked.
@@ -346,11 +470,26 @@ fn array(
                 .collect()
         }
         "appended" => {
-            return Err(at(
-                "raw appended data is not supported; save it from ParaView as legacy \
-                 .vtk, or as XML with 'Data Mode: Ascii' or 'Binary' (inline base64)"
-                    .into(),
-            ))
+            let ap = enc.appended.as_ref().ok_or_else(|| {
+                at("format=\"appended\", but the file has no <AppendedData>".into())
+            })?;
+            let off = node
+                .attr("offset")
+                .and_then(|o| o.trim().parse::<usize>().ok())
+                .ok_or_else(|| at("an appended array needs an offset (a byte count)".into()))?;
+            let expect = n
+                .checked_mul(size)
+                .ok_or_else(|| at("the array size overflows".into()))?;
+            let bytes = appended_bytes(ap, enc, off, expect).map_err(|m| {
+                at(format!(
+                    "appended data at offset {off} (file byte {}): {m}",
+                    ap.start + off
+                ))
+            })?;
+            bytes
+                .chunks_exact(size)
+                .map(|c| decode_value(c, kind, enc.little))
+                .collect()
         }
         other => return Err(at(format!("unknown format '{other}'"))),
     };
@@ -459,9 +598,71 @@ fn attributes(
     Ok(out)
 }
 
+/// Offsets of the appended arrays under `node`.
+fn collect_offsets(node: &Node, out: &mut Vec<usize>) {
+    for c in &node.children {
+        if c.name == "DataArray" && c.attr("format") == Some("appended") {
+            if let Some(o) = c.attr("offset").and_then(|o| o.trim().parse().ok()) {
+                out.push(o);
+            }
+        }
+        collect_offsets(c, out);
+    }
+}
+
+fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
+    hay.windows(needle.len()).position(|w| w == needle)
+}
+
+/// A file with `<AppendedData>` split into the XML before it (closed with `</VTKFile>`, so
+/// that it parses as XML; raw data is not XML) and the block: its file byte offset, its bytes
+/// after the `_` marker up to the last `</AppendedData>`, and whether it is base64.
+#[allow(clippy::type_complexity)]
+fn split_appended(bytes: &[u8]) -> Result<(Cow<'_, [u8]>, Option<(usize, &[u8], bool)>), Fail> {
+    let Some(p) = find(bytes, b"<AppendedData") else {
+        return Ok((Cow::Borrowed(bytes), None));
+    };
+    let q = p + find(&bytes[p..], b">")
+        .ok_or_else(|| format!("byte {p}: the <AppendedData> tag never closes (truncated?)"))?;
+    let tag = String::from_utf8_lossy(&bytes[p..=q]);
+    let base64 = if tag.contains("encoding=\"base64\"") {
+        true
+    } else if tag.contains("encoding=\"raw\"") {
+        false
+    } else {
+        return Err(format!(
+            "byte {p}: <AppendedData> needs encoding=\"raw\" or \"base64\""
+        ));
+    };
+    let u = q
+        + 1
+        + bytes[q + 1..]
+            .iter()
+            .position(|c| !c.is_ascii_whitespace())
+            .ok_or_else(|| format!("byte {q}: the file ends after <AppendedData> (truncated?)"))?;
+    if bytes[u] != b'_' {
+        return Err(format!(
+            "byte {u}: appended data must start with '_', found {:?}",
+            bytes[u] as char
+        ));
+    }
+    let start = u + 1;
+    let end = bytes[start..]
+        .windows(b"</AppendedData>".len())
+        .rposition(|w| w == b"</AppendedData>")
+        .map(|e| start + e)
+        .ok_or_else(|| {
+            format!("byte {start}: no </AppendedData> after the appended data (truncated?)")
+        })?;
+    let mut head = bytes[..p].to_vec();
+    head.extend_from_slice(b"</VTKFile>");
+    Ok((Cow::Owned(head), Some((start, &bytes[start..end], base64))))
+}
+
 /// Parses a VTK XML file of triangles into points, triangles and fields.
 pub fn parse(bytes: &[u8]) -> Result<RawMesh, Fail> {
-    let root = parse_tree(bytes)?;
+    let (head, appended) = split_appended(bytes)?;
+    let root = parse_tree(&head)?;
     let kind = root.attr("type").unwrap_or("");
     let little = match root.attr("byte_order").unwrap_or("LittleEndian") {
         "LittleEndian" => true,
@@ -473,26 +674,38 @@ pub fn parse(bytes: &[u8]) -> Result<RawMesh, Fail> {
         "UInt64" => 8,
         o => return Err(root.at(format!("unknown header_type '{o}'"))),
     };
-    let zlib = match root.attr("compressor") {
-        None | Some("") => false,
-        Some("vtkZLibDataCompressor") => true,
+    let compressor = match root.attr("compressor") {
+        None | Some("") => Compressor::None,
+        Some("vtkZLibDataCompressor") => Compressor::Zlib,
+        Some("vtkLZ4DataCompressor") => Compressor::Lz4,
+        Some("vtkLZMADataCompressor") => Compressor::Lzma,
         Some(o) => {
             return Err(root.at(format!(
-                "compressor '{o}' is not supported (zlib is; or save without compression)"
+                "unknown compressor '{o}' (VTK's are vtkZLibDataCompressor, vtkLZ4DataCompressor \
+                 and vtkLZMADataCompressor)"
             )))
+        }
+    };
+    let appended = match appended {
+        None => None,
+        Some((start, data, base64)) => {
+            let mut offsets = Vec::new();
+            collect_offsets(&root, &mut offsets);
+            offsets.sort_unstable();
+            Some(Appended {
+                data,
+                start,
+                base64,
+                offsets,
+            })
         }
     };
     let enc = Encoding {
         little,
         header_bytes,
-        zlib,
+        compressor,
+        appended,
     };
-    if root.child("AppendedData").is_some() {
-        return Err(root.at(
-            "XML with raw appended data is not supported; save it from ParaView as legacy .vtk, or \
-             as XML with 'Data Mode: Ascii' or 'Binary' (inline base64)",
-        ));
-    }
     let (grid, ds) = match kind {
         "UnstructuredGrid" => (true, root.child("UnstructuredGrid")),
         "PolyData" => (false, root.child("PolyData")),

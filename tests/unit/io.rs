@@ -119,18 +119,65 @@ fn generated_meshes_are_valid_and_oriented() {
     }
 }
 
+/// A corrupt appended block is an error naming the array and the byte, never a panic: a
+/// truncated file, a header claiming more than the data, a bad marker, a missing offset.
 #[test]
-fn raw_appended_xml_gets_a_clear_message() {
+fn corrupt_appended_data_names_the_byte() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/vtk");
     let d = tempfile::tempdir().unwrap();
-    let p = d.path().join("paraview.vtu");
-    std::fs::write(
-        &p,
-        "<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=\"3\" NumberOfCells=\"1\">\
-         </Piece></UnstructuredGrid><AppendedData encoding=\"raw\">_</AppendedData></VTKFile>",
-    )
-    .unwrap();
-    let e = read_mesh(&p).unwrap_err().to_string();
-    assert!(e.contains("paraview.vtu") && e.contains("appended"), "{e}");
+    let read = |name: &str, bytes: &[u8]| {
+        let p = d.path().join(name);
+        std::fs::write(&p, bytes).unwrap();
+        read_mesh(&p).map(|_| ()).unwrap_err().to_string()
+    };
+    for src in [
+        "appended.vtu",
+        "appended_none.vtu",
+        "appended_lz4.vtu",
+        "appended_lzma.vtu",
+    ] {
+        let good = std::fs::read(dir.join(src)).unwrap();
+        let start = good
+            .windows(14)
+            .position(|w| w == b"<AppendedData ")
+            .unwrap();
+        let marker = start + good[start..].iter().position(|&c| c == b'_').unwrap();
+        let end = good.len() - 40;
+        // Cut the data short (keep the closing tags).
+        let mut cut = good[..marker + 60].to_vec();
+        cut.extend_from_slice(b"\n</AppendedData>\n</VTKFile>\n");
+        let e = read(src, &cut);
+        assert!(
+            e.contains(src) && e.contains("appended data at offset"),
+            "{src}: {e}"
+        );
+        assert!(e.contains("file byte"), "{src}: {e}");
+        // Flip bytes inside the data: a wrong size or a broken stream, never a panic.
+        for k in (marker + 1..end).step_by(37) {
+            let mut bad = good.clone();
+            bad[k] ^= 0xA5;
+            let _ = read_mesh(&{
+                let p = d.path().join(src);
+                std::fs::write(&p, &bad).unwrap();
+                p
+            });
+        }
+        // No '_' marker.
+        let mut bad = good.clone();
+        bad[marker] = b'#';
+        let e = read(src, &bad);
+        assert!(e.contains("must start with '_'"), "{src}: {e}");
+        // No closing tag.
+        let e = read(src, &good[..marker + 100]);
+        assert!(e.contains("no </AppendedData>"), "{src}: {e}");
+    }
+    let e = read(
+        "no_block.vtu",
+        b"<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=\"3\" \
+          NumberOfCells=\"1\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" \
+          format=\"appended\" offset=\"0\"/></Points></Piece></UnstructuredGrid></VTKFile>",
+    );
+    assert!(e.contains("no <AppendedData>"), "{e}");
 }
 
 #[test]
@@ -217,6 +264,16 @@ fn files_written_by_vtk_itself_are_read_in_every_variant() {
         "binary_42.vtk",
         "poly_ascii_51.vtk",
         "poly_binary_42.vtk",
+        "appended.vtu",
+        "appended_none.vtu",
+        "appended_lz4.vtu",
+        "appended_lzma.vtu",
+        "appended_bigendian.vtu",
+        "appended_bigendian_none.vtu",
+        "appended_base64.vtu",
+        "appended_base64_none.vtu",
+        "appended.vtp",
+        "appended_bigendian_lz4.vtp",
     ];
     for name in files {
         let m = read_mesh(&dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -248,10 +305,6 @@ fn files_written_by_vtk_itself_are_read_in_every_variant() {
         );
         m.validate().unwrap();
     }
-    let e = read_mesh(&dir.join("appended.vtu"))
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("appended") && e.contains("Ascii"), "{e}");
 }
 
 /// Bad input gets an error naming the place, never a panic: a first vertex index out of range,
