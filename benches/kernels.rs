@@ -597,9 +597,149 @@ fn explicit_step(c: &mut Criterion) {
     }
 }
 
+/// Writing one frame of a ~100k-face sheet (the benchmark square on the unit sphere, every
+/// field a run writes, in double): shellsim's writer in its variants against the writer it
+/// replaced (vtkio's XML writer: inline base64, uncompressed Float64). Prints bytes per face of
+/// each. Report: ms per frame and bytes per face.
+fn frame_write(c: &mut Criterion) {
+    use shellsim::mesh::io::{mesh_to_bytes_with, Format};
+    use shellsim::mesh::vtu::{Compression, Encoding, VtuOptions};
+    let sc = scene::scene_with_material(0.0048, "midedge_sin", "koiter");
+    let p = Pattern::for_scene(&sc);
+    let pot = Potential::new(&sc, &p);
+    let state = shellsim::solve::State {
+        x: curved(&sc),
+        dofs: vec![0.0; p.n - 3 * sc.num_vertices()],
+    };
+    let v = vec![Vec3::new(1e-3, -2e-3, 5e-4); sc.num_vertices()];
+    // One real frame, every field in double, read back: the mesh the variants write.
+    let dir = tempfile::tempdir().unwrap();
+    let mut s2 = sc.settings.clone();
+    s2.output.precision = shellsim::settings::Precision::Double;
+    s2.output.fields = vec!["all".into()];
+    let sc2 = Scene::build(sc.mesh.clone(), s2).unwrap();
+    let mut w = shellsim::output::Writer::new(dir.path(), &sc2, true).unwrap();
+    let pot2 = Potential::new(&sc2, &p);
+    w.frame(&pot2, &state, &v, Default::default()).unwrap();
+    let frame = shellsim::mesh::io::read_mesh(&dir.path().join("frame_00000.vtu")).unwrap();
+    let nf = frame.faces.len();
+    let restart = ["velocity", "edge_angles", "displacement"];
+    let single = |n: &str| !restart.contains(&n);
+    let out = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/frame_write");
+    let mut g = c.benchmark_group(format!("frame_write_{nf}"));
+    g.sample_size(10);
+    let variants = [
+        (
+            "zlib_appended_single",
+            Compression::Zlib,
+            Encoding::Appended,
+            true,
+        ),
+        (
+            "zlib_appended_double",
+            Compression::Zlib,
+            Encoding::Appended,
+            false,
+        ),
+        (
+            "lz4_appended_single",
+            Compression::Lz4,
+            Encoding::Appended,
+            true,
+        ),
+        (
+            "none_appended_single",
+            Compression::None,
+            Encoding::Appended,
+            true,
+        ),
+        (
+            "zlib_base64_single",
+            Compression::Zlib,
+            Encoding::Base64,
+            true,
+        ),
+    ];
+    for (name, compression, encoding, sp) in variants {
+        let o = VtuOptions {
+            compression,
+            encoding,
+        };
+        let f = |n: &str| sp && single(n);
+        let bytes = mesh_to_bytes_with(&frame, Format::Vtu, "", &o, &f).unwrap();
+        eprintln!("{name}: {:.1} bytes/face", bytes.len() as f64 / nf as f64);
+        // Kept for `scripts/vtk_read_time.py` (VTK's read time of each variant).
+        let _ = std::fs::create_dir_all(&out);
+        let _ = std::fs::write(out.join(format!("{name}.vtu")), &bytes);
+        g.bench_function(name, |b| {
+            b.iter(|| black_box(mesh_to_bytes_with(&frame, Format::Vtu, "", &o, &f).unwrap()))
+        });
+    }
+    let old = || vtkio_inline_base64(&frame);
+    eprintln!(
+        "vtkio_base64_double (before): {:.1} bytes/face",
+        old().len() as f64 / nf as f64
+    );
+    let _ = std::fs::write(out.join("vtkio_base64_double_before.vtu"), old());
+    g.bench_function("vtkio_base64_double_before", |b| {
+        b.iter(|| black_box(old()))
+    });
+    let _ = pot;
+}
+
+/// The frame writer shellsim had before its own: vtkio's XML writer, inline base64, Float64.
+fn vtkio_inline_base64(mesh: &shellsim::mesh::Mesh) -> Vec<u8> {
+    use vtkio::model::*;
+    let attrs = |f: &std::collections::BTreeMap<String, shellsim::mesh::Field>| {
+        f.iter()
+            .map(|(name, fl)| {
+                Attribute::DataArray(DataArray {
+                    name: name.clone(),
+                    elem: ElementType::Generic(fl.components as u32),
+                    data: IOBuffer::F64(fl.data.clone()),
+                })
+            })
+            .collect()
+    };
+    let piece = UnstructuredGridPiece {
+        points: IOBuffer::F64(
+            mesh.positions
+                .iter()
+                .flat_map(|p| [p.x, p.y, p.z])
+                .collect(),
+        ),
+        cells: Cells {
+            cell_verts: VertexNumbers::XML {
+                connectivity: mesh
+                    .faces
+                    .iter()
+                    .flat_map(|f| f.map(|v| v as u64))
+                    .collect(),
+                offsets: (1..=mesh.faces.len() as u64).map(|i| 3 * i).collect(),
+            },
+            types: vec![CellType::Triangle; mesh.faces.len()],
+        },
+        data: Attributes {
+            point: attrs(&mesh.vertex_fields),
+            cell: attrs(&mesh.face_fields),
+        },
+    };
+    let vtk = Vtk {
+        version: Version::new_xml(1, 0),
+        title: String::new(),
+        byte_order: ByteOrder::BigEndian,
+        file_path: None,
+        data: DataSet::inline(piece),
+    };
+    let mut out = Vec::new();
+    vtk.write_xml(&mut out).unwrap();
+    out
+}
+
 criterion_group!(
     benches,
     explicit_step,
+    frame_write,
     kernel,
     assembly,
     newton_iteration,

@@ -251,6 +251,7 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
     let settings = Settings::load(&settings_path, &cli.set)?;
     let mesh = read_mesh(&mesh_path)?;
     let mut scene = Scene::build(mesh, settings)?;
+    crate::output::check_fields(&scene, &settings_path.display().to_string())?;
     let initial = match &cli.restart {
         Some(p) => {
             let (mut st, w) = crate::restart::read_restart(p, &scene)?;

@@ -16,7 +16,7 @@
 
 use crate::geometry::curvatures;
 use crate::math::{Mat2, Real, Sym2, Vec3};
-use crate::mesh::io::{mesh_to_bytes, write_atomic, Format};
+use crate::mesh::io::{write_atomic, Format};
 use crate::mesh::{Field, Mesh};
 use crate::rest::{push_forward, reference_frame};
 use crate::scene::Scene;
@@ -122,7 +122,7 @@ impl Serialize for Energies {
 }
 
 /// One row of the per-frame log.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Default, Serialize)]
 pub struct LogRow {
     /// Frame index.
     pub frame: usize,
@@ -264,8 +264,82 @@ pub struct Writer {
     frames_t: Vec<Mat2>,
     /// Extra per-face fields written into every following frame (moisture).
     extra: std::collections::BTreeMap<String, Vec<Real>>,
-    /// The folder's lock, released when the writer is dropped.
-    _lock: Lock,
+    /// `.vtu` compression and encoding.
+    vtu: crate::mesh::vtu::VtuOptions,
+    /// Derived fields as Float32.
+    single: bool,
+    /// `[output]`: which fields are written.
+    selection: crate::settings::Output,
+    /// The fields a restart reads: always written, always Float64.
+    restart_fields: std::collections::BTreeSet<String>,
+    /// The folder's lock, released when the writer is dropped (`None`: a writer that only
+    /// builds fields, [`check_fields`]).
+    _lock: Option<Lock>,
+}
+
+/// The fields a restart of `scene` reads from a frame: the velocity (dynamic modes), the edge
+/// angles (edge-DOF bending) and the terms' states.
+pub fn restart_fields(scene: &Scene) -> std::collections::BTreeSet<String> {
+    let mut r = std::collections::BTreeSet::new();
+    if scene.settings.solver.mode != crate::settings::Mode::Static {
+        r.insert("velocity".to_string());
+    }
+    if scene.has_edge_dofs() {
+        r.insert("edge_angles".to_string());
+    }
+    for t in scene.terms.iter() {
+        if let Some(f) = t.state_field() {
+            r.insert(f.to_string());
+        }
+    }
+    r
+}
+
+/// Checks the names in `output.fields` against the fields this scene's frames carry (built
+/// once on the reference state, without touching the disk, and only when names are given): an
+/// unknown name is an error listing the fields there are. Every field a restart reads is
+/// written whatever the selection.
+pub fn check_fields(
+    scene: &Scene,
+    settings_name: &str,
+) -> Result<(), crate::settings::SettingsError> {
+    let out = &scene.settings.output;
+    if out.fields.iter().all(|f| f == "all" || f == "default") {
+        return Ok(());
+    }
+    let pattern = crate::assembly::Pattern::for_scene(scene);
+    let pot = Potential::new(scene, &pattern);
+    let state = State {
+        x: scene.mesh.positions.clone(),
+        dofs: vec![0.0; pattern.n - 3 * scene.num_vertices()],
+    };
+    let v = vec![Vec3::zeros(); scene.num_vertices()];
+    let mut w = Writer::detached(scene);
+    w.fill(&pot, &state.x, &state.dofs, &v);
+    let mut names: Vec<String> = w
+        .frame_mesh
+        .face_fields
+        .keys()
+        .chain(w.frame_mesh.vertex_fields.keys())
+        .cloned()
+        .collect();
+    if scene.settings.moisture.enabled {
+        names.extend(crate::integrate::moisture::FRAME_FIELDS.map(String::from));
+    }
+    names.sort();
+    for f in &out.fields {
+        if f != "default" && !names.contains(f) {
+            return Err(crate::settings::SettingsError::Invalid {
+                path: settings_name.to_string(),
+                key: "output.fields".into(),
+                reason: format!(
+                    "this scene's frames have no field '{f}'; they have: {}",
+                    names.join(", ")
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// `.shellsim.lock` in an output folder: created exclusively, holding the process id, removed
@@ -406,6 +480,15 @@ impl Writer {
         let probe = dir.join(".shellsim-write-test");
         std::fs::write(&probe, b"").map_err(|e| ioerr(dir, format!("not writable: {e}")))?;
         let _ = std::fs::remove_file(&probe);
+        Ok(Writer {
+            dir: dir.to_path_buf(),
+            _lock: Some(lock),
+            ..Writer::detached(scene)
+        })
+    }
+
+    /// A writer that builds frames' fields but writes nothing (no folder, no lock).
+    fn detached(scene: &Scene) -> Self {
         let mesh = &scene.mesh;
         let mut frame_mesh = Mesh {
             positions: mesh.positions.clone(),
@@ -420,17 +503,28 @@ impl Writer {
                 .vertex_fields
                 .insert("node_tags".into(), t.clone());
         }
-        Ok(Writer {
-            dir: dir.to_path_buf(),
-            format: scene.settings.output.format,
-            prefix: scene.settings.output.prefix.clone(),
+        let out = &scene.settings.output;
+        let restart_fields = restart_fields(scene);
+        Writer {
+            dir: PathBuf::new(),
+            format: out.format,
+            prefix: out.prefix.clone(),
             frames: Vec::new(),
             log: Vec::new(),
             frames_t: output_frames(mesh),
             frame_mesh,
             extra: Default::default(),
-            _lock: lock,
-        })
+            vtu: crate::mesh::vtu::VtuOptions {
+                compression: out
+                    .compression
+                    .unwrap_or(crate::mesh::vtu::Compression::Zlib),
+                encoding: out.encoding.unwrap_or(crate::mesh::vtu::Encoding::Appended),
+            },
+            single: out.precision == crate::settings::Precision::Single,
+            selection: out.clone(),
+            restart_fields,
+            _lock: None,
+        }
     }
 
     /// Sets an extra per-face scalar field written into the following frames.
@@ -473,18 +567,16 @@ impl Writer {
         }
     }
 
-    /// Writes one frame and appends its log row; rewrites the series and the log.
-    pub fn frame(
+    /// Builds every field of a frame at `x`, `phi`, `v` into `frame_mesh`; returns the terms'
+    /// energies.
+    fn fill(
         &mut self,
         pot: &Potential,
-        state: &State,
+        x: &[Vec3],
+        phi: &[Real],
         v: &[Vec3],
-        mut row: LogRow,
-    ) -> Result<(), OutputError> {
-        let (x, phi) = (&state.x[..], &state.dofs[..]);
+    ) -> Vec<(&'static str, Real)> {
         let sc = pot.scene;
-        let index = self.frames.len();
-        row.frame = index;
         let nf = sc.num_faces();
         let (a, b) = sc.forms(x, phi);
         let mut term_energies = Vec::new();
@@ -494,12 +586,6 @@ impl Writer {
             term_energies.extend(e);
             term_fields.extend(f);
         }
-        row.energy = Self::energies_of(pot, term_energies, v);
-        row.observables = sc
-            .terms
-            .iter()
-            .flat_map(|t| t.observables(pot, x, phi))
-            .collect();
         let mut fa = Vec::with_capacity(3 * nf);
         let mut fb = Vec::with_capacity(3 * nf);
         let mut fab = Vec::with_capacity(3 * nf);
@@ -597,6 +683,33 @@ impl Writer {
             "constraint_indicators".into(),
             Field::scalar(sc.fixed.iter().map(|&b| b as u8 as Real).collect()),
         );
+        term_energies
+    }
+
+    /// Writes one frame and appends its log row; rewrites the series and the log.
+    pub fn frame(
+        &mut self,
+        pot: &Potential,
+        state: &State,
+        v: &[Vec3],
+        mut row: LogRow,
+    ) -> Result<(), OutputError> {
+        let (x, phi) = (&state.x[..], &state.dofs[..]);
+        let sc = pot.scene;
+        let index = self.frames.len();
+        row.frame = index;
+        let term_energies = self.fill(pot, x, phi, v);
+        row.energy = Self::energies_of(pot, term_energies, v);
+        row.observables = sc
+            .terms
+            .iter()
+            .flat_map(|t| t.observables(pot, x, phi))
+            .collect();
+        let m = &mut self.frame_mesh;
+        let (sel, restart) = (&self.selection, &self.restart_fields);
+        let keep = |n: &String| sel.selects(n) || restart.contains(n);
+        m.face_fields.retain(|n, _| keep(n));
+        m.vertex_fields.retain(|n, _| keep(n));
         // Never write NaN.
         if let Some(p) = m
             .positions
@@ -643,10 +756,16 @@ impl Writer {
         }
         let name = format!("{}_{index:05}.{}", self.prefix, self.format.extension());
         let path = self.dir.join(&name);
-        let bytes = mesh_to_bytes(
+        let restart = &self.restart_fields;
+        let single = self.single;
+        // The displacement gives the reference positions (positions − displacement), which
+        // `shellsim error` and scripts measure against: Float64 like the positions.
+        let bytes = crate::mesh::io::mesh_to_bytes_with(
             m,
             self.format,
             &format!("shellsim frame {index} t={}", row.time),
+            &self.vtu,
+            &|n| single && n != "displacement" && !restart.contains(n),
         )
         .map_err(|e| ioerr(&path, e))?;
         write_atomic(&path, &bytes).map_err(|e| ioerr(&path, e))?;

@@ -1182,6 +1182,35 @@ pub struct Output {
     /// vertex, its strain measure and the principal Cauchy stresses per face
     /// ([`crate::fields`]; default: `false`).
     pub morphoshell_fields: bool,
+    /// `.vtu` frames: compression of every array, `"zlib"`, `"lz4"` or `"none"` (default:
+    /// `"zlib"`).
+    pub compression: Option<crate::mesh::vtu::Compression>,
+    /// `.vtu` frames: `"appended"` (raw bytes after the XML, ParaView's default) or `"base64"`
+    /// (inline, valid XML) (default: `"appended"`).
+    pub encoding: Option<crate::mesh::vtu::Encoding>,
+    /// `"single"` or `"double"`: the precision of derived fields (curvatures, forms, stresses,
+    /// energy densities, …). Positions, the displacement (which gives the reference positions)
+    /// and the fields a restart reads are always double (default: `"single"`).
+    pub precision: Precision,
+    /// The fields frames carry: names, and the keywords `"default"` (every field but the
+    /// current forms `a` and `b`, which the positions determine) and `"all"` (default:
+    /// `["default"]`). The fields a restart reads (velocity in the dynamic modes, edge angles,
+    /// term states) are always written.
+    pub fields: Vec<String>,
+}
+
+/// The fields `output.fields = ["default"]` leaves out: the current fundamental forms, which
+/// the positions determine.
+pub const NOT_DEFAULT_FIELDS: [&str; 2] = ["a", "b"];
+
+/// Floating-point precision of derived output fields.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Precision {
+    /// Float64.
+    Double,
+    /// Float32: half the bytes, 7 significant digits.
+    Single,
 }
 
 impl Default for Output {
@@ -1191,7 +1220,25 @@ impl Default for Output {
             continuation_frames: false,
             prefix: "frame".into(),
             morphoshell_fields: false,
+            compression: None,
+            encoding: None,
+            precision: Precision::Single,
+            fields: vec!["default".into()],
         }
+    }
+}
+
+impl Output {
+    /// Whether frames carry every field.
+    pub fn all_fields(&self) -> bool {
+        self.fields.iter().any(|f| f == "all")
+    }
+
+    /// Whether a field named `name` is written (the restart's fields aside).
+    pub fn selects(&self, name: &str) -> bool {
+        self.all_fields()
+            || self.fields.iter().any(|f| f == name)
+            || (self.fields.iter().any(|f| f == "default") && !NOT_DEFAULT_FIELDS.contains(&name))
     }
 }
 
@@ -2034,6 +2081,35 @@ impl Settings {
             return ck.inv(
                 "output.prefix",
                 "must be a plain, non-empty file name".into(),
+            );
+        }
+        let o = &self.output;
+        if o.format != Format::Vtu {
+            for (key, set) in [
+                ("output.compression", o.compression.is_some()),
+                ("output.encoding", o.encoding.is_some()),
+            ] {
+                if set {
+                    return ck.inv(
+                        key,
+                        format!(
+                            "applies to .vtu frames only (output.format = \"{}\")",
+                            o.format.name()
+                        ),
+                    );
+                }
+            }
+        }
+        if o.fields.is_empty() {
+            return ck.inv(
+                "output.fields",
+                "is empty: list field names, or [\"all\"]".into(),
+            );
+        }
+        if o.all_fields() && o.fields.len() > 1 {
+            return ck.inv(
+                "output.fields",
+                "\"all\" cannot be combined with other entries".into(),
             );
         }
         Ok(())

@@ -741,7 +741,8 @@ fn morphoshell_ansatz_files() {
 /// metric ā = q I shrunk is flat and uniformly strained: both principal Cauchy stresses are
 /// E t (1 − q) / (2 q (1 − ν)) (St Venant–Kirchhoff, plane stress, at a = I) and the strain
 /// measure is (1 − q)/2. On a sphere the angle deficits sum to 4π (discrete Gauss–Bonnet,
-/// exact) and their Gauss curvature is 1/R² to the barycentric cell's accuracy.
+/// exact) and their Gauss curvature is 1/R² to the barycentric cell's accuracy. The frames are
+/// written in double: the checks are far below Float32's 6e-8.
 #[test]
 fn morphoshell_output_fields() {
     let dir = tempfile::tempdir().unwrap();
@@ -762,7 +763,7 @@ fn morphoshell_output_fields() {
              [constraints]\nfix_boxes = [{{ min = [-1, -1, -1], max = [-0.45, 1, 1] }}, \
              {{ min = [0.45, -1, -1], max = [1, 1, 1] }}, {{ min = [-1, -1, -1], max = [1, -0.45, 1] }}, \
              {{ min = [-1, 0.45, -1], max = [1, 1, 1] }}]\n\
-             [output]\nmorphoshell_fields = true\n"
+             [output]\nmorphoshell_fields = true\nprecision = \"double\"\n"
         ),
     );
     shellsim(&["flat.toml", "sq.vtk", "--out", "flat", "-q"], d);
@@ -812,7 +813,8 @@ fn morphoshell_output_fields() {
     write(
         d,
         "sph.toml",
-        "[material]\nyoung = 1000.0\nthickness = 0.01\n[output]\nmorphoshell_fields = true\n",
+        "[material]\nyoung = 1000.0\nthickness = 0.01\n[output]\nmorphoshell_fields = true\n\
+         precision = \"double\"\n",
     );
     shellsim(&["sph.toml", "sph.vtk", "--out", "sph", "-q"], d);
     let m = final_frame(&d.join("sph"));

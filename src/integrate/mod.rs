@@ -30,7 +30,7 @@ pub mod config;
 mod dynamics;
 pub mod explicit;
 pub mod friction;
-mod moisture;
+pub(crate) mod moisture;
 mod statics;
 
 use crate::assembly::{Pattern, Want};

@@ -7,6 +7,9 @@ use crate::output::Writer;
 use crate::scene::Scene;
 use crate::solve::Potential;
 
+/// The per-face fields moisture adds to frames: the content at the top and the bottom face.
+pub const FRAME_FIELDS: [&str; 2] = ["moisture_top", "moisture_bottom"];
+
 /// The moisture diffusion of a dynamic run and the rest forms it drives.
 pub(super) struct Moisture {
     pub(super) diffusion: crate::diffusion::Diffusion,
@@ -256,8 +259,9 @@ impl Moisture {
             top.push(a);
             bottom.push(b);
         }
-        writer.set_face_field("moisture_top", top);
-        writer.set_face_field("moisture_bottom", bottom);
+        let [t, b] = FRAME_FIELDS;
+        writer.set_face_field(t, top);
+        writer.set_face_field(b, bottom);
     }
 }
 

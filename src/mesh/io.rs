@@ -14,8 +14,8 @@ use super::{Field, Mesh, MeshError, RawMesh};
 use std::collections::BTreeMap;
 use std::path::Path;
 use vtkio::model::{
-    Attribute, Attributes, ByteOrder, CellType, Cells, DataArray, DataSet, ElementType, IOBuffer,
-    UnstructuredGridPiece, Version, VertexNumbers, Vtk,
+    Attribute, Attributes, ByteOrder, CellType, Cells, DataSet, IOBuffer, UnstructuredGridPiece,
+    Version, VertexNumbers, Vtk,
 };
 
 /// Reads a triangle mesh and its fields. Validation of geometry happens in [`Mesh::validate`].
@@ -120,6 +120,15 @@ pub enum Format {
 }
 
 impl Format {
+    /// The settings name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Vtu => "vtu",
+            Format::Vtk => "vtk",
+            Format::VtkAscii => "vtk_ascii",
+        }
+    }
+
     /// File extension without the dot.
     pub fn extension(self) -> &'static str {
         match self {
@@ -129,64 +138,63 @@ impl Format {
     }
 }
 
-fn fields_to_attributes(fields: &BTreeMap<String, Field>, legacy: bool) -> Vec<Attribute> {
-    if legacy {
-        // FIELD arrays keep any component count and are what MorphoShell reads.
-        if fields.is_empty() {
-            return Vec::new();
-        }
-        let arrays = fields
-            .iter()
-            .map(|(name, f)| vtkio::model::FieldArray {
-                name: name.clone(),
-                elem: f.components as u32,
-                data: IOBuffer::F64(f.data.clone()),
-            })
-            .collect();
-        vec![Attribute::Field {
-            name: "FieldData".into(),
-            data_array: arrays,
-        }]
-    } else {
-        fields
-            .iter()
-            .map(|(name, f)| {
-                Attribute::DataArray(DataArray {
-                    name: name.clone(),
-                    elem: ElementType::Generic(f.components as u32),
-                    data: IOBuffer::F64(f.data.clone()),
-                })
-            })
-            .collect()
+/// Legacy FIELD arrays (any component count; what MorphoShell reads), Float32 where
+/// `single(name)`.
+fn fields_to_attributes(
+    fields: &BTreeMap<String, Field>,
+    single: &dyn Fn(&str) -> bool,
+) -> Vec<Attribute> {
+    if fields.is_empty() {
+        return Vec::new();
     }
+    let arrays = fields
+        .iter()
+        .map(|(name, f)| vtkio::model::FieldArray {
+            name: name.clone(),
+            elem: f.components as u32,
+            data: if single(name) {
+                IOBuffer::F32(f.data.iter().map(|&x| x as f32).collect())
+            } else {
+                IOBuffer::F64(f.data.clone())
+            },
+        })
+        .collect();
+    vec![Attribute::Field {
+        name: "FieldData".into(),
+        data_array: arrays,
+    }]
 }
 
-/// Serialises a mesh with fields to bytes in the given format.
+/// Serialises a mesh with fields to bytes in the given format (`.vtu`: zlib-compressed raw
+/// appended data, every field Float64).
 pub fn mesh_to_bytes(mesh: &Mesh, format: Format, title: &str) -> Result<Vec<u8>, vtkio::Error> {
-    let legacy = format != Format::Vtu;
+    mesh_to_bytes_with(mesh, format, title, &Default::default(), &|_| false)
+}
+
+/// [`mesh_to_bytes`] with `.vtu` options, and the fields written as Float32 where
+/// `single(name)`.
+pub fn mesh_to_bytes_with(
+    mesh: &Mesh,
+    format: Format,
+    title: &str,
+    vtu: &super::vtu::VtuOptions,
+    single: &dyn Fn(&str) -> bool,
+) -> Result<Vec<u8>, vtkio::Error> {
+    if format == Format::Vtu {
+        return Ok(super::vtu::vtu_bytes(mesh, vtu, single));
+    }
     let points: Vec<f64> = mesh
         .positions
         .iter()
         .flat_map(|p| [p.x, p.y, p.z])
         .collect();
-    let cells = if legacy {
-        VertexNumbers::Legacy {
-            num_cells: mesh.faces.len() as u32,
-            vertices: mesh
-                .faces
-                .iter()
-                .flat_map(|f| [3u32, f[0] as u32, f[1] as u32, f[2] as u32])
-                .collect(),
-        }
-    } else {
-        VertexNumbers::XML {
-            connectivity: mesh
-                .faces
-                .iter()
-                .flat_map(|f| f.map(|v| v as u64))
-                .collect(),
-            offsets: (1..=mesh.faces.len() as u64).map(|i| 3 * i).collect(),
-        }
+    let cells = VertexNumbers::Legacy {
+        num_cells: mesh.faces.len() as u32,
+        vertices: mesh
+            .faces
+            .iter()
+            .flat_map(|f| [3u32, f[0] as u32, f[1] as u32, f[2] as u32])
+            .collect(),
     };
     let piece = UnstructuredGridPiece {
         points: IOBuffer::F64(points),
@@ -195,30 +203,24 @@ pub fn mesh_to_bytes(mesh: &Mesh, format: Format, title: &str) -> Result<Vec<u8>
             types: vec![CellType::Triangle; mesh.faces.len()],
         },
         data: Attributes {
-            point: fields_to_attributes(&mesh.vertex_fields, legacy),
-            cell: fields_to_attributes(&mesh.face_fields, legacy),
+            point: fields_to_attributes(&mesh.vertex_fields, single),
+            cell: fields_to_attributes(&mesh.face_fields, single),
         },
     };
     let vtk = Vtk {
-        version: if legacy {
-            Version::new_legacy(4, 2)
-        } else {
-            Version::new_xml(1, 0)
-        },
+        version: Version::new_legacy(4, 2),
         title: title.to_string(),
         byte_order: ByteOrder::BigEndian,
         file_path: None,
         data: DataSet::inline(piece),
     };
     let mut out = Vec::new();
-    match format {
-        Format::Vtu => vtk.write_xml(&mut out)?,
-        Format::Vtk => vtk.write_legacy(&mut out)?,
-        Format::VtkAscii => {
-            let mut s = String::new();
-            vtk.write_legacy_ascii(&mut s)?;
-            out = s.into_bytes();
-        }
+    if format == Format::VtkAscii {
+        let mut s = String::new();
+        vtk.write_legacy_ascii(&mut s)?;
+        out = s.into_bytes();
+    } else {
+        vtk.write_legacy(&mut out)?;
     }
     Ok(out)
 }

@@ -12,6 +12,7 @@ mod legacy;
 mod shapes;
 pub mod surfaces;
 pub mod topology;
+pub mod vtu;
 mod xml;
 
 pub use topology::Topology;
