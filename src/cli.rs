@@ -56,6 +56,10 @@ pub struct Cli {
     /// No progress bar even on a terminal.
     #[arg(long, short)]
     quiet: bool,
+    /// Print every Newton iteration (energy, residual, shift, step length) to stderr, in place
+    /// of the progress bar.
+    #[arg(long, short)]
+    verbose: bool,
     /// Start from a frame of an earlier run on the same mesh (positions, velocities, edge DOFs;
     /// time or dial from the series.pvd next to it).
     #[arg(long, value_name = "FRAME")]
@@ -71,6 +75,36 @@ enum Command {
     /// Convert a MorphoShell settings file into a shellsim settings file with the same physics.
     #[command(name = "import-morphoshell")]
     ImportMorphoshell(ImportArgs),
+    /// Expand a sweep file (a grid or a list of --set overrides) into one run folder per point,
+    /// with a job list for GNU parallel (run.sh) and a SLURM job array (slurm.sh).
+    Sweep(SweepArgs),
+    /// Gather the overrides and summary.json fields of runs into one CSV table.
+    Collect(CollectArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct SweepArgs {
+    /// Sweep file (TOML: settings, mesh, [grid], [[points]], out, args).
+    file: PathBuf,
+    /// Sweep folder (default: the file's `out`, else its name without .toml).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Replace a sweep already in the folder.
+    #[arg(long)]
+    overwrite: bool,
+    /// Also run the jobs now (run.sh: GNU parallel if installed, else one after another).
+    #[arg(long)]
+    run: bool,
+}
+
+#[derive(clap::Args, Debug)]
+struct CollectArgs {
+    /// Run folders, or folders of runs (a sweep folder).
+    #[arg(required = true)]
+    dirs: Vec<PathBuf>,
+    /// Output file (default: print to stdout).
+    #[arg(short, long)]
+    out: Option<PathBuf>,
 }
 
 #[derive(clap::Args, Debug)]
@@ -200,6 +234,16 @@ fn dispatch(cli: Cli) -> Result<u8> {
         Some(Command::Mesh(a)) => mesh_cmd(a).map(|_| 0),
         Some(Command::Error(a)) => error_cmd(a).map(|_| 0),
         Some(Command::ImportMorphoshell(a)) => import_cmd(a).map(|_| 0),
+        Some(Command::Sweep(a)) => sweep_cmd(a),
+        Some(Command::Collect(a)) => {
+            let table = crate::sweep::collect(&a.dirs)?;
+            match a.out {
+                Some(p) => crate::mesh::io::write_atomic(&p, table.as_bytes())
+                    .map_err(|e| anyhow!("{}: {e}", p.display()))?,
+                None => print!("{table}"),
+            }
+            Ok(0)
+        }
         None => {
             let (Some(settings), Some(mesh)) = (cli.settings.clone(), cli.mesh.clone()) else {
                 bail!("usage: shellsim SETTINGS MESH [--out DIR]");
@@ -207,6 +251,27 @@ fn dispatch(cli: Cli) -> Result<u8> {
             run_cmd(&cli, settings, mesh)
         }
     }
+}
+
+/// `shellsim sweep`: writes the sweep folder; with `--run`, runs its jobs and exits 1 unless
+/// every run converged.
+fn sweep_cmd(a: SweepArgs) -> Result<u8> {
+    let (dir, n) = crate::sweep::sweep(&a.file, a.out.as_deref(), a.overwrite)?;
+    eprintln!(
+        "{n} runs in {}: run them with {}/run.sh (GNU parallel, else one by one) or sbatch \
+         slurm.sh there; then shellsim collect {}",
+        dir.display(),
+        dir.display(),
+        dir.display()
+    );
+    if !a.run {
+        return Ok(0);
+    }
+    let status = std::process::Command::new("sh")
+        .arg(dir.join("run.sh"))
+        .status()
+        .map_err(|e| anyhow!("cannot start {}/run.sh: {e}", dir.display()))?;
+    Ok(if status.success() { 0 } else { 1 })
 }
 
 /// `shellsim import-morphoshell`: parse, translate, check that shellsim accepts the result, and
@@ -252,6 +317,7 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
     let mesh = read_mesh(&mesh_path)?;
     let mut scene = Scene::build(mesh, settings)?;
     crate::output::check_fields(&scene, &settings_path.display().to_string())?;
+    crate::solve::newton::VERBOSE.store(cli.verbose, std::sync::atomic::Ordering::Relaxed);
     let initial = match &cli.restart {
         Some(p) => {
             let (mut st, w) = crate::restart::read_restart(p, &scene)?;
@@ -291,11 +357,13 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
         .map_err(|e| anyhow!("cannot install signal handlers: {e}"))?;
     let mut writer = Writer::new(&cli.out, &scene, cli.overwrite)?;
     let summary = pool.install(|| {
-        if !cli.quiet && std::io::stderr().is_terminal() {
+        if !cli.quiet && !cli.verbose && std::io::stderr().is_terminal() {
             let pb = indicatif::ProgressBar::new(1000);
             pb.set_style(
-                indicatif::ProgressStyle::with_template("{bar:30} {percent:>3}% {elapsed} {msg}")
-                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+                indicatif::ProgressStyle::with_template(
+                    "{bar:30} {percent:>3}% {elapsed} eta {eta} {msg}",
+                )
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
             );
             let mut bar = Bar(pb);
             let r = run(&scene, &mut writer, &mut bar, threads, initial);

@@ -50,3 +50,4 @@ pub mod restart;
 pub mod scene;
 pub mod settings;
 pub mod solve;
+pub mod sweep;

@@ -222,9 +222,32 @@ pub struct Summary {
     pub diffusion_direct_solves: usize,
     /// Warnings raised while loading.
     pub warnings: Vec<String>,
+    /// Where the wall time went (s).
+    pub timing: Timing,
     /// Explicit mode: its time step, time scales and cost.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub explicit: Option<ExplicitReport>,
+}
+
+/// Where a run's wall time went (s): Newton's parts (explicit mode: the force evaluations under
+/// `assembly`), the moisture diffusion, writing frames, and the rest (setup, predictors,
+/// bookkeeping).
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct Timing {
+    /// Energy, gradient and Hessian evaluations.
+    pub assembly: Real,
+    /// Numeric factorisations.
+    pub factorisation: Real,
+    /// Triangular solves.
+    pub solve: Real,
+    /// Line searches.
+    pub line_search: Real,
+    /// Moisture diffusion and the rest forms it sets.
+    pub diffusion: Real,
+    /// Building and writing frames, the series and the log.
+    pub output: Real,
+    /// The wall time not in the above.
+    pub other: Real,
 }
 
 /// What an explicit run reports in `summary.json` ([`crate::integrate`]'s explicit driver).

@@ -107,6 +107,9 @@ pub(super) fn run_dynamic(
         trial.x.copy_from_slice(&xhat);
         trial.dofs.copy_from_slice(&state.dofs);
         let moisture_clock = Instant::now();
+        if moisture.is_some() {
+            progress.update(t / tm.end, &format!("diffusion  t {t:.4e} s"));
+        }
         if let Some(m) = &mut moisture {
             // Diffuse over the step, then set the rest forms from the new surface moisture.
             if let Err(e) = m.update_ground(sc, &state.x) {
@@ -238,7 +241,10 @@ pub(super) fn run_dynamic(
         steps.accepted(rep.iterations, calm);
         progress.update(
             t / tm.end,
-            &format!("t {t:.4e} s  E {:.4e}  r {:.1e}", rep.energy, rep.residual),
+            &format!(
+                "step  t {t:.4e} s  E {:.4e} J  r {:.1e}",
+                rep.energy, rep.residual
+            ),
         );
         let at_output = clock.due(t, h, eps_t);
         let mut stop = false;

@@ -396,7 +396,9 @@ pub(super) fn run_explicit(
         for term in sc.terms.iter() {
             term.explicit_begin(&pot, &state.x, dt);
         }
+        let clock = std::time::Instant::now();
         let energy = gradient(&pot, &state.x, &mut g);
+        s.summary.timing.assembly += clock.elapsed().as_secs_f64();
         // Terms that act on the step itself (slide friction), before the equilibrium test sees
         // the forces.
         for term in sc.terms.iter() {
@@ -536,7 +538,14 @@ pub(super) fn run_explicit(
                 } else {
                     0.5 + 0.5 * (t / t_max).min(1.0)
                 },
-                &format!("t {t:.4e} s  dial {dial:.3}  E {energy:.4e}"),
+                &format!(
+                    "explicit {}  t {t:.4e} s  dial {dial:.3}  E {energy:.4e} J",
+                    if phase == Phase::Dial {
+                        "dialling"
+                    } else {
+                        "waiting"
+                    }
+                ),
             );
         }
     };

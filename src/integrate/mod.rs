@@ -362,6 +362,11 @@ impl<'a> Solver<'a> {
         self.summary.gauss_newton_iterations += rep.gauss_newton_iterations;
         self.summary.indefinite_iterations += rep.indefinite_iterations;
         self.summary.residual = rep.residual;
+        let t = &mut self.summary.timing;
+        t.assembly += rep.timing.assembly;
+        t.factorisation += rep.timing.factorisation;
+        t.solve += rep.timing.solve;
+        t.line_search += rep.timing.line_search;
     }
 
     /// Newton on `pot` from `state`, then the terms' multiplier updates (a prescribed volume's
@@ -421,7 +426,10 @@ impl<'a> Solver<'a> {
             wall_seconds: self.start.elapsed().as_secs_f64(),
         };
         self.at_last_frame = now;
-        writer.frame(pot, state, v, row)?;
+        let clock = Instant::now();
+        let r = writer.frame(pot, state, v, row);
+        self.summary.timing.output += clock.elapsed().as_secs_f64();
+        r?;
         Ok(())
     }
 
@@ -663,6 +671,11 @@ pub fn run(
     s.summary.wall_seconds = s.start.elapsed().as_secs_f64();
     s.summary.frames = writer.num_frames();
     s.summary.final_frame = writer.last_frame();
+    let t = &mut s.summary.timing;
+    t.diffusion = s.summary.moisture_seconds;
+    t.other = (s.summary.wall_seconds
+        - (t.assembly + t.factorisation + t.solve + t.line_search + t.diffusion + t.output))
+        .max(0.0);
     writer.summary(&s.summary)?;
     Ok(s.summary)
 }

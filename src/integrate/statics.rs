@@ -105,7 +105,10 @@ pub(super) fn run_static(
             s.summary.steps += 1;
             progress.update(
                 dial,
-                &format!("dial {dial:.4} E {:.4e} r {:.1e}", rep.energy, rep.residual),
+                &format!(
+                    "continuation  dial {dial:.4}  E {:.4e} J  r {:.1e}",
+                    rep.energy, rep.residual
+                ),
             );
             if at_hold {
                 s.summary.holds_reached += 1;

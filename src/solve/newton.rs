@@ -17,6 +17,7 @@ use super::state::State;
 use crate::assembly::Want;
 use crate::energy::HessianProjection;
 use crate::math::{Real, Vec3};
+use std::time::Instant;
 
 /// Controls of one Newton solve.
 #[derive(Clone, Copy, Debug)]
@@ -51,9 +52,37 @@ pub struct NewtonReport {
     pub indefinite_iterations: usize,
     /// Total step halvings in line searches.
     pub line_search_cuts: usize,
+    /// Wall time of its parts.
+    pub timing: NewtonTiming,
     /// Why it stopped, when it did not converge.
     pub failure: Option<SolveError>,
 }
+
+/// Wall time (s) of the parts of Newton solves.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct NewtonTiming {
+    /// Energy, gradient and Hessian evaluations (and low-rank parts).
+    pub assembly: Real,
+    /// Numeric factorisations (with their shifts and inertia checks).
+    pub factorisation: Real,
+    /// Triangular solves (and the low-rank capacitance).
+    pub solve: Real,
+    /// Energy evaluations of the backtracking line search.
+    pub line_search: Real,
+}
+
+impl NewtonTiming {
+    /// Adds another solve's times.
+    pub fn add(&mut self, o: &NewtonTiming) {
+        self.assembly += o.assembly;
+        self.factorisation += o.factorisation;
+        self.solve += o.solve;
+        self.line_search += o.line_search;
+    }
+}
+
+/// Whether `newton` prints one line per iteration to stderr (`shellsim -v`).
+pub static VERBOSE: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
 /// Why a Newton solve stopped without converging.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -127,6 +156,7 @@ impl NewtonReport {
         self.gauss_newton_iterations += later.gauss_newton_iterations;
         self.indefinite_iterations += later.indefinite_iterations;
         self.line_search_cuts += later.line_search_cuts;
+        self.timing.add(&later.timing);
         self.failure.clone_from(&later.failure);
     }
 
@@ -326,6 +356,7 @@ pub fn newton(
             HessianProjection::Adaptive => HessianProjection::None,
             m => m,
         };
+        let clock = Instant::now();
         let e = pot.eval_projected(
             &state.x,
             &state.dofs,
@@ -334,6 +365,7 @@ pub fn newton(
             &mut ws.grad,
             &mut ws.values,
         );
+        rep.timing.assembly += clock.elapsed().as_secs_f64();
         rep.energy = e;
         rep.residual = pot.residual(&ws.grad);
         if !e.is_finite() || !rep.residual.is_finite() {
@@ -342,6 +374,12 @@ pub fn newton(
         }
         if rep.residual <= opts.tol {
             rep.converged = true;
+            if VERBOSE.load(std::sync::atomic::Ordering::Relaxed) {
+                eprintln!(
+                    "newton {:>3}: energy {e:+.9e} J  residual {:.3e}  converged",
+                    rep.iterations, rep.residual
+                );
+            }
             return rep;
         }
         if rep.iterations >= opts.max_iter {
@@ -362,7 +400,10 @@ pub fn newton(
         };
         // Dense low-rank Hessian parts (an enclosed gas's stiffness): solved by the Woodbury
         // identity on the sparse factor, never densified.
+        let clock = Instant::now();
         let lr = pot.low_rank(&state.x, &state.dofs);
+        rep.timing.assembly += clock.elapsed().as_secs_f64();
+        let clock = Instant::now();
         let mut model: Option<super::low_rank::Woodbury> = None;
         let mut factored = false;
         if mode == HessianProjection::Adaptive {
@@ -397,6 +438,7 @@ pub fn newton(
                     if try_exact {
                         // The assembled exact Hessian is indefinite; `first` was already
                         // Gauss–Newton otherwise.
+                        let c = Instant::now();
                         pot.eval_projected(
                             &state.x,
                             &state.dofs,
@@ -405,6 +447,10 @@ pub fn newton(
                             &mut ws.grad,
                             &mut ws.values,
                         );
+                        // Assembly, not factorisation.
+                        let a = c.elapsed().as_secs_f64();
+                        rep.timing.assembly += a;
+                        rep.timing.factorisation -= a;
                     }
                     rep.gauss_newton_iterations += 1;
                     projected = true;
@@ -423,6 +469,8 @@ pub fn newton(
                 }
             }
         };
+        rep.timing.factorisation += clock.elapsed().as_secs_f64();
+        let clock = Instant::now();
         tau_prev = tau;
         if tau > 0.0 {
             rep.shifted_iterations += 1;
@@ -439,6 +487,8 @@ pub fn newton(
             rep.failure = Some(SolveError::LowRankSingular);
             return rep;
         }
+        rep.timing.solve += clock.elapsed().as_secs_f64();
+        let clock = Instant::now();
         rep.iterations += 1;
         let slope: Real = ws.step.iter().zip(&ws.grad).map(|(d, g)| d * g).sum();
         if slope.is_nan() || slope >= 0.0 {
@@ -459,6 +509,23 @@ pub fn newton(
             }
             alpha *= 0.5;
             rep.line_search_cuts += 1;
+        }
+        rep.timing.line_search += clock.elapsed().as_secs_f64();
+        if VERBOSE.load(std::sync::atomic::Ordering::Relaxed) {
+            eprintln!(
+                "newton {:>3}: energy {:+.9e} J  residual {:.3e}  shift {:.1e}  step {:.4}{}{}",
+                rep.iterations,
+                e,
+                rep.residual,
+                tau,
+                alpha,
+                if projected { "  gauss-newton" } else { "" },
+                if accepted {
+                    ""
+                } else {
+                    "  (line search stalled)"
+                }
+            );
         }
         if !accepted {
             rep.failure = Some(SolveError::LineSearchStalled {
