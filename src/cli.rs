@@ -80,6 +80,26 @@ enum Command {
     Sweep(SweepArgs),
     /// Gather the overrides and summary.json fields of runs into one CSV table.
     Collect(CollectArgs),
+    /// Draw a frame as a shaded surface coloured by a field, with a colour bar, into a PNG.
+    Render(RenderArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct RenderArgs {
+    /// A frame (or any mesh file shellsim reads).
+    frame: PathBuf,
+    /// Output PNG (default: the frame's name with .png).
+    #[arg(short, long)]
+    out: Option<PathBuf>,
+    /// Field to colour by (default: mean_curvature if there is one; vectors by their norm).
+    #[arg(long)]
+    field: Option<String>,
+    /// iso, top, bottom, front, back, side, or AZIMUTH,ELEVATION in degrees.
+    #[arg(long, default_value = "iso")]
+    view: String,
+    /// Picture size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768")]
+    size: String,
 }
 
 #[derive(clap::Args, Debug)]
@@ -235,6 +255,7 @@ fn dispatch(cli: Cli) -> Result<u8> {
         Some(Command::Error(a)) => error_cmd(a).map(|_| 0),
         Some(Command::ImportMorphoshell(a)) => import_cmd(a).map(|_| 0),
         Some(Command::Sweep(a)) => sweep_cmd(a),
+        Some(Command::Render(a)) => render_cmd(a).map(|_| 0),
         Some(Command::Collect(a)) => {
             let table = crate::sweep::collect(&a.dirs)?;
             match a.out {
@@ -251,6 +272,33 @@ fn dispatch(cli: Cli) -> Result<u8> {
             run_cmd(&cli, settings, mesh)
         }
     }
+}
+
+/// `shellsim render`: reads the frame, draws it, writes the PNG (nothing on an error).
+fn render_cmd(a: RenderArgs) -> Result<()> {
+    let (w, h) = a
+        .size
+        .split_once(['x', '×'])
+        .and_then(|(w, h)| {
+            Some((
+                w.trim().parse::<usize>().ok()?,
+                h.trim().parse::<usize>().ok()?,
+            ))
+        })
+        .ok_or_else(|| anyhow!("--size '{}': expected WIDTHxHEIGHT, e.g. 1024x768", a.size))?;
+    let mesh = read_mesh(&a.frame)?;
+    let field = match a.field {
+        Some(f) => Some(f),
+        None => ["mean_curvature"]
+            .into_iter()
+            .map(String::from)
+            .find(|f| mesh.face_fields.contains_key(f)),
+    };
+    let name = a.frame.display().to_string();
+    let canvas = crate::render::render(&mesh, field.as_deref(), &a.view, w, h)
+        .map_err(|e| anyhow!("{name}: {e}"))?;
+    let out = a.out.unwrap_or_else(|| a.frame.with_extension("png"));
+    canvas.save_png(&out)
 }
 
 /// `shellsim sweep`: writes the sweep folder; with `--run`, runs its jobs and exits 1 unless
