@@ -82,6 +82,26 @@ enum Command {
     Collect(CollectArgs),
     /// Draw a frame as a shaded surface coloured by a field, with a colour bar, into a PNG.
     Render(RenderArgs),
+    /// Plot columns of a run's log.csv over time, dial or frame into a PNG.
+    Plot(PlotArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct PlotArgs {
+    /// A run folder (its log.csv is read) or a log.csv.
+    run: PathBuf,
+    /// Output PNG (default: plot.png in the run folder).
+    #[arg(short, long)]
+    out: Option<PathBuf>,
+    /// Columns to plot, comma-separated.
+    #[arg(long, default_value = "energy_total")]
+    y: String,
+    /// The column along the horizontal axis (time, dial, frame, …).
+    #[arg(long, default_value = "time")]
+    x: String,
+    /// Picture size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768")]
+    size: String,
 }
 
 #[derive(clap::Args, Debug)]
@@ -256,6 +276,7 @@ fn dispatch(cli: Cli) -> Result<u8> {
         Some(Command::ImportMorphoshell(a)) => import_cmd(a).map(|_| 0),
         Some(Command::Sweep(a)) => sweep_cmd(a),
         Some(Command::Render(a)) => render_cmd(a).map(|_| 0),
+        Some(Command::Plot(a)) => plot_cmd(a).map(|_| 0),
         Some(Command::Collect(a)) => {
             let table = crate::sweep::collect(&a.dirs)?;
             match a.out {
@@ -274,18 +295,80 @@ fn dispatch(cli: Cli) -> Result<u8> {
     }
 }
 
-/// `shellsim render`: reads the frame, draws it, writes the PNG (nothing on an error).
-fn render_cmd(a: RenderArgs) -> Result<()> {
-    let (w, h) = a
-        .size
-        .split_once(['x', '×'])
+/// `--size WIDTHxHEIGHT`.
+fn picture_size(size: &str) -> Result<(usize, usize)> {
+    size.split_once(['x', '×'])
         .and_then(|(w, h)| {
             Some((
                 w.trim().parse::<usize>().ok()?,
                 h.trim().parse::<usize>().ok()?,
             ))
         })
-        .ok_or_else(|| anyhow!("--size '{}': expected WIDTHxHEIGHT, e.g. 1024x768", a.size))?;
+        .ok_or_else(|| anyhow!("--size '{size}': expected WIDTHxHEIGHT, e.g. 1024x768"))
+}
+
+/// `shellsim plot`: reads log.csv, plots the columns, writes the PNG (nothing on an error).
+fn plot_cmd(a: PlotArgs) -> Result<()> {
+    let (w, h) = picture_size(&a.size)?;
+    let log = if a.run.is_dir() {
+        a.run.join("log.csv")
+    } else {
+        a.run.clone()
+    };
+    let name = log.display().to_string();
+    let text = std::fs::read_to_string(&log).map_err(|e| anyhow!("{name}: {e}"))?;
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines
+        .next()
+        .ok_or_else(|| anyhow!("{name}: empty"))?
+        .split(',')
+        .map(str::trim)
+        .collect();
+    let col = |c: &str| {
+        head.iter()
+            .position(|h| *h == c)
+            .ok_or_else(|| anyhow!("{name}: no column '{c}'; it has: {}", head.join(", ")))
+    };
+    let xi = col(a.x.trim())?;
+    let ys: Vec<(String, usize)> =
+        a.y.split(',')
+            .map(str::trim)
+            .filter(|c| !c.is_empty())
+            .map(|c| col(c).map(|i| (c.to_string(), i)))
+            .collect::<Result<_>>()?;
+    if ys.is_empty() {
+        bail!("--y names no column");
+    }
+    let rows: Vec<Vec<Real>> = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.trim().parse::<Real>().unwrap_or(Real::NAN))
+                .collect()
+        })
+        .collect();
+    let get = |r: &Vec<Real>, i: usize| r.get(i).copied().unwrap_or(Real::NAN);
+    let series: Vec<(String, Vec<[Real; 2]>)> = ys
+        .iter()
+        .map(|(n, i)| {
+            (
+                n.clone(),
+                rows.iter().map(|r| [get(r, xi), get(r, *i)]).collect(),
+            )
+        })
+        .collect();
+    let canvas =
+        crate::render::plot(a.x.trim(), &series, w, h).map_err(|e| anyhow!("{name}: {e}"))?;
+    let out = a.out.unwrap_or_else(|| {
+        log.parent()
+            .map(|d| d.join("plot.png"))
+            .unwrap_or_else(|| PathBuf::from("plot.png"))
+    });
+    canvas.save_png(&out)
+}
+
+/// `shellsim render`: reads the frame, draws it, writes the PNG (nothing on an error).
+fn render_cmd(a: RenderArgs) -> Result<()> {
+    let (w, h) = picture_size(&a.size)?;
     let mesh = read_mesh(&a.frame)?;
     let field = match a.field {
         Some(f) => Some(f),

@@ -62,7 +62,7 @@ fn glyph(c: char) -> [u8; 7] {
         'd' => [1, 1, 15, 17, 17, 17, 15],
         'e' => [0, 0, 14, 17, 31, 16, 14],
         'f' => [6, 9, 8, 28, 8, 8, 8],
-        'g' => [0, 15, 17, 17, 15, 1, 14],
+        'g' => [0, 0, 15, 17, 15, 1, 14],
         'h' => [16, 16, 22, 25, 17, 17, 17],
         'i' => [4, 0, 12, 4, 4, 4, 14],
         'j' => [2, 0, 6, 2, 2, 18, 12],
@@ -439,4 +439,188 @@ fn colour_bar(cv: &mut Canvas, name: &str, lo: Real, hi: Real) {
     // Centred over the bar, kept off the picture (a long name runs off the right edge).
     let tx = (bx + bw / 2 - tw / 2).min(w - tw - 2).max(w * 4 / 5);
     cv.text(tx, by0 - 14 * s, name, s, black);
+}
+
+/// Colours of plotted series, in order (Okabe–Ito's colour-blind-safe palette).
+const SERIES: [[Real; 3]; 7] = [
+    [0.0, 114.0, 178.0],
+    [213.0, 94.0, 0.0],
+    [0.0, 158.0, 115.0],
+    [204.0, 121.0, 167.0],
+    [230.0, 159.0, 0.0],
+    [86.0, 180.0, 233.0],
+    [20.0, 20.0, 20.0],
+];
+
+/// "Nice" tick values covering [lo, hi]: steps of 1, 2 or 5 × 10ᵏ, about `n` of them.
+pub fn ticks(lo: Real, hi: Real, n: usize) -> Vec<Real> {
+    if !(hi > lo) {
+        return vec![lo];
+    }
+    let raw = (hi - lo) / n.max(1) as Real;
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * mag);
+    let first = (lo / step).ceil() as i64;
+    let last = (hi / step).floor() as i64;
+    (first..=last).map(|k| k as Real * step).collect()
+}
+
+/// A tick label with as many decimals as the tick step needs (scientific notation for steps
+/// below 1e-3 or values from 1e5 up).
+pub fn tick_label(v: Real, step: Real) -> String {
+    if v.abs() < 1e-9 * step.abs() {
+        return "0".into();
+    }
+    if step >= 1e-3 && v.abs() < 1e5 {
+        let d = (-step.log10().floor()).max(0.0) as usize;
+        format!("{v:.d$}")
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
+impl Canvas {
+    /// A line `t` pixels thick from `a` to `b` (pixel coordinates).
+    pub fn line(&mut self, a: [Real; 2], b: [Real; 2], t: isize, c: [Real; 3]) {
+        let n = ((b[0] - a[0]).abs().max((b[1] - a[1]).abs()).ceil() as usize).clamp(1, 100_000);
+        for k in 0..=n {
+            let s = k as Real / n as Real;
+            let x = (a[0] + s * (b[0] - a[0])).round() as isize;
+            let y = (a[1] + s * (b[1] - a[1])).round() as isize;
+            self.rect(x - t / 2, y - t / 2, x - t / 2 + t, y - t / 2 + t, c);
+        }
+    }
+}
+
+/// A line plot of `series` (name, points) against `x_name`, into a `w × h` canvas: axes with
+/// nice ticks, a legend. Non-finite points are skipped (a gap).
+pub fn plot(
+    x_name: &str,
+    series: &[(String, Vec<[Real; 2]>)],
+    w: usize,
+    h: usize,
+) -> Result<Canvas> {
+    if w < 200 || h < 150 || w > 16384 || h > 16384 {
+        bail!("--size {w}x{h}: the width must lie in 200–16384 and the height in 150–16384 pixels");
+    }
+    let mut cv = Canvas::new(w, h);
+    let pts = series
+        .iter()
+        .flat_map(|(_, p)| p.iter())
+        .filter(|p| p[0].is_finite() && p[1].is_finite());
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        Real::INFINITY,
+        Real::NEG_INFINITY,
+        Real::INFINITY,
+        Real::NEG_INFINITY,
+    );
+    for p in pts {
+        x0 = x0.min(p[0]);
+        x1 = x1.max(p[0]);
+        y0 = y0.min(p[1]);
+        y1 = y1.max(p[1]);
+    }
+    if !x0.is_finite() {
+        bail!("nothing to plot: no finite values");
+    }
+    let pad = |lo: Real, hi: Real| {
+        if hi > lo {
+            (lo - 0.04 * (hi - lo), hi + 0.04 * (hi - lo))
+        } else {
+            let d = 0.5 * lo.abs().max(1e-300);
+            (lo - d, hi + d)
+        }
+    };
+    let (x0, x1) = pad(x0, x1);
+    let (y0, y1) = pad(y0, y1);
+    let s: isize = if h >= 600 { 2 } else { 1 };
+    let black = [20.0, 20.0, 20.0];
+    let light = [225.0, 225.0, 225.0];
+    // Plot area: room for tick labels left and below, the legend above.
+    let left = (12 * 6 * s + 12) as Real;
+    let right = w as Real - 16.0;
+    let top = (10 * s + 12) as Real + (series.len() as Real * 10.0 * s as Real);
+    let bottom = h as Real - (24 * s) as Real;
+    if right - left < 50.0 || bottom - top < 50.0 {
+        bail!(
+            "--size {w}x{h} leaves no room for the plot of {} series",
+            series.len()
+        );
+    }
+    let sx = |x: Real| left + (x - x0) / (x1 - x0) * (right - left);
+    let sy = |y: Real| bottom - (y - y0) / (y1 - y0) * (bottom - top);
+    let step = |t: &[Real]| if t.len() > 1 { t[1] - t[0] } else { 1.0 };
+    let tx = ticks(x0, x1, 6);
+    for &t in &tx {
+        let x = sx(t);
+        cv.line([x, top], [x, bottom], 1, light);
+        let l = tick_label(t, step(&tx));
+        cv.text(
+            x as isize - Canvas::text_width(&l, s) / 2,
+            bottom as isize + 4 * s,
+            &l,
+            s,
+            black,
+        );
+    }
+    let ty = ticks(y0, y1, 6);
+    for &t in &ty {
+        let y = sy(t);
+        cv.line([left, y], [right, y], 1, light);
+        let l = tick_label(t, step(&ty));
+        cv.text(
+            left as isize - Canvas::text_width(&l, s) - 4 * s,
+            y as isize - 3 * s,
+            &l,
+            s,
+            black,
+        );
+    }
+    cv.line([left, bottom], [right, bottom], s, black);
+    cv.line([left, top], [left, bottom], s, black);
+    let xl = Canvas::text_width(x_name, s);
+    cv.text(
+        (right as isize) - xl,
+        bottom as isize + 14 * s,
+        x_name,
+        s,
+        black,
+    );
+    for (k, (name, p)) in series.iter().enumerate() {
+        let c = SERIES[k % SERIES.len()];
+        let mut prev: Option<[Real; 2]> = None;
+        for q in p {
+            if !(q[0].is_finite() && q[1].is_finite()) {
+                prev = None;
+                continue;
+            }
+            let here = [sx(q[0]), sy(q[1])];
+            if let Some(a) = prev {
+                cv.line(a, here, 2 * s, c);
+            } else {
+                cv.rect(
+                    here[0] as isize - s,
+                    here[1] as isize - s,
+                    here[0] as isize + s,
+                    here[1] as isize + s,
+                    c,
+                );
+            }
+            prev = Some(here);
+        }
+        let ly = 6 * s + k as isize * 10 * s;
+        cv.rect(
+            left as isize,
+            ly + 2 * s,
+            left as isize + 14 * s,
+            ly + 4 * s,
+            c,
+        );
+        cv.text(left as isize + 18 * s, ly, name, s, black);
+    }
+    Ok(cv)
 }

@@ -116,3 +116,56 @@ fn render_draws_the_frame_where_the_view_puts_it() {
         assert!(!p.join("bad.png").exists(), "{extra:?} wrote a picture");
     }
 }
+
+/// `shellsim plot`: each series is drawn in its palette colour inside the axes, and a missing
+/// column is an error listing the columns there are, with no picture written.
+#[test]
+fn plot_draws_log_columns_and_names_missing_ones() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path();
+    std::fs::write(
+        p.join("log.csv"),
+        "frame,time,energy_total,energy_bending\n0,0.0,1.0,0.0\n1,0.5,0.5,0.25\n2,1.0,0.0,0.5\n",
+    )
+    .unwrap();
+    let (c, e) = run(
+        &[
+            "plot",
+            ".",
+            "--y",
+            "energy_total,energy_bending",
+            "--size",
+            "400x300",
+        ],
+        p,
+    );
+    assert_eq!(c, 0, "{e}");
+    let (w, h, px) = decode(&p.join("plot.png"));
+    assert_eq!((w, h), (400, 300));
+    let count = |c: [u8; 3]| px.iter().filter(|&&q| q == c).count();
+    // Two diagonal lines across the plot, each about as long as the plot is wide, 2 px thick.
+    let (blue, orange) = (count([0, 114, 178]), count([213, 94, 0]));
+    assert!(blue > 2 * 250 && orange > 2 * 250, "{blue} {orange}");
+    // The first series falls: its leftmost pixel is above (smaller y) its rightmost.
+    let (mut first, mut last) = ((w, 0), (0, 0));
+    for y in 40..h {
+        for x in 0..w {
+            if px[y * w + x] == [0, 114, 178] {
+                if x < first.0 {
+                    first = (x, y);
+                }
+                if x > last.0 {
+                    last = (x, y);
+                }
+            }
+        }
+    }
+    assert!(first.1 + 100 < last.1, "{first:?} {last:?}");
+    let (c, e) = run(&["plot", ".", "--y", "energy_stretch", "-o", "bad.png"], p);
+    assert_eq!(c, 2, "{e}");
+    assert!(
+        e.contains("energy_bending") && e.contains("energy_stretch"),
+        "{e}"
+    );
+    assert!(!p.join("bad.png").exists());
+}
