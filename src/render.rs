@@ -454,7 +454,7 @@ const SERIES: [[Real; 3]; 7] = [
 
 /// "Nice" tick values covering [lo, hi]: steps of 1, 2 or 5 × 10ᵏ, about `n` of them.
 pub fn ticks(lo: Real, hi: Real, n: usize) -> Vec<Real> {
-    if !(hi > lo) {
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         return vec![lo];
     }
     let raw = (hi - lo) / n.max(1) as Real;
