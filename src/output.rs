@@ -291,8 +291,10 @@ pub struct Writer {
     vtu: crate::mesh::vtu::VtuOptions,
     /// Derived fields as Float32.
     single: bool,
-    /// `[output]`: which fields are written.
+    /// `[output]`: which fields are written, snapshots.
     selection: crate::settings::Output,
+    /// Whether `frame_mesh` holds the frame last written.
+    built_is_written: bool,
     /// The fields a restart reads: always written, always Float64.
     restart_fields: std::collections::BTreeSet<String>,
     /// The folder's lock, released when the writer is dropped (`None`: a writer that only
@@ -327,7 +329,7 @@ pub fn check_fields(
     settings_name: &str,
 ) -> Result<(), crate::settings::SettingsError> {
     let out = &scene.settings.output;
-    if out.fields.iter().all(|f| f == "all" || f == "default") {
+    if out.fields.iter().all(|f| f == "all" || f == "default") && out.snapshot_field.is_none() {
         return Ok(());
     }
     let pattern = crate::assembly::Pattern::for_scene(scene);
@@ -350,15 +352,30 @@ pub fn check_fields(
         names.extend(crate::integrate::moisture::FRAME_FIELDS.map(String::from));
     }
     names.sort();
-    for f in &out.fields {
-        if f != "default" && !names.contains(f) {
+    let keys = out
+        .fields
+        .iter()
+        .filter(|f| *f != "default" && *f != "all")
+        .map(|f| ("output.fields", f))
+        .chain(
+            out.snapshot_field
+                .iter()
+                .map(|f| ("output.snapshot_field", f)),
+        );
+    for (key, f) in keys {
+        let written = key == "output.fields" || out.selects(f) || restart_fields(scene).contains(f);
+        if !names.contains(f) || !written {
             return Err(crate::settings::SettingsError::Invalid {
                 path: settings_name.to_string(),
-                key: "output.fields".into(),
-                reason: format!(
-                    "this scene's frames have no field '{f}'; they have: {}",
-                    names.join(", ")
-                ),
+                key: key.into(),
+                reason: if names.contains(f) {
+                    format!("'{f}' is not among output.fields")
+                } else {
+                    format!(
+                        "this scene's frames have no field '{f}'; they have: {}",
+                        names.join(", ")
+                    )
+                },
             });
         }
     }
@@ -412,8 +429,8 @@ impl Drop for Lock {
     }
 }
 
-/// Files of an earlier run in `dir`: its summary, series and log, frames `PREFIX_NNNNN.vtu|vtk`
-/// and temporary files left by an interrupted write.
+/// Files of an earlier run in `dir`: its summary, series and log, frames `PREFIX_NNNNN.vtu|vtk`,
+/// their snapshots `PREFIX_NNNNN.png` and temporary files left by an interrupted write.
 fn previous_outputs(dir: &Path, prefix: &str) -> std::io::Result<Vec<std::path::PathBuf>> {
     let mut out = Vec::new();
     for e in std::fs::read_dir(dir)? {
@@ -428,7 +445,7 @@ fn previous_outputs(dir: &Path, prefix: &str) -> std::io::Result<Vec<std::path::
             .is_some_and(|(n, ext)| {
                 !n.is_empty()
                     && n.bytes().all(|c| c.is_ascii_digit())
-                    && (ext == "vtu" || ext == "vtk")
+                    && (ext == "vtu" || ext == "vtk" || ext == "png")
             });
         let ours = matches!(name, "summary.json" | "series.pvd" | "log.csv")
             || frame
@@ -545,6 +562,7 @@ impl Writer {
             },
             single: out.precision == crate::settings::Precision::Single,
             selection: out.clone(),
+            built_is_written: false,
             restart_fields,
             _lock: None,
         }
@@ -721,6 +739,7 @@ impl Writer {
         let sc = pot.scene;
         let index = self.frames.len();
         row.frame = index;
+        self.built_is_written = false;
         let term_energies = self.fill(pot, x, phi, v);
         row.energy = Self::energies_of(pot, term_energies, v);
         row.observables = sc
@@ -792,10 +811,33 @@ impl Writer {
         )
         .map_err(|e| ioerr(&path, e))?;
         write_atomic(&path, &bytes).map_err(|e| ioerr(&path, e))?;
+        self.built_is_written = true;
+        if self.selection.snapshots == crate::settings::Snapshots::All {
+            self.snapshot(index)?;
+        }
         self.frames.push((row.time, name));
         self.log.push(row);
         self.write_series()?;
         self.write_log()
+    }
+
+    /// `PREFIX_NNNNN.png` beside frame `index`, drawn from the frame last built
+    /// (`output.snapshot_field`, `snapshot_view`, `snapshot_size`; [`crate::render`]).
+    fn snapshot(&self, index: usize) -> Result<(), OutputError> {
+        let o = &self.selection;
+        let path = self.dir.join(format!("{}_{index:05}.png", self.prefix));
+        let m = &self.frame_mesh;
+        let field = match &o.snapshot_field {
+            Some(f) => Some(f.as_str()),
+            None => m
+                .face_fields
+                .contains_key("mean_curvature")
+                .then_some("mean_curvature"),
+        };
+        let [w, h] = o.snapshot_size;
+        crate::render::render(m, field, &o.snapshot_view, w, h)
+            .and_then(|c| c.save_png(&path))
+            .map_err(|e| ioerr(&path, format!("{e:#}")))
     }
 
     fn write_series(&self) -> Result<(), OutputError> {
@@ -853,7 +895,13 @@ impl Writer {
     pub fn summary(&self, summary: &Summary) -> Result<(), OutputError> {
         let path = self.dir.join("summary.json");
         let text = serde_json::to_string_pretty(summary).map_err(|e| ioerr(&path, e))?;
-        write_atomic(&path, text.as_bytes()).map_err(|e| ioerr(&path, e))
+        write_atomic(&path, text.as_bytes()).map_err(|e| ioerr(&path, e))?;
+        // The last frame's picture, when the frame last built is the one last written (not a
+        // refused non-finite state).
+        if self.selection.snapshots == crate::settings::Snapshots::Final && self.built_is_written {
+            self.snapshot(self.frames.len() - 1)?;
+        }
+        Ok(())
     }
 }
 

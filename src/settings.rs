@@ -1197,6 +1197,28 @@ pub struct Output {
     /// `["default"]`). The fields a restart reads (velocity in the dynamic modes, edge angles,
     /// term states) are always written.
     pub fields: Vec<String>,
+    /// PNG pictures beside frames ([`crate::render`]): `"none"`, `"all"` (beside every frame) or
+    /// `"final"` (beside the last one) (default: `"none"`).
+    pub snapshots: Snapshots,
+    /// The field the snapshots are coloured by (default: `mean_curvature`).
+    pub snapshot_field: Option<String>,
+    /// The snapshots' view: `iso`, `top`, `bottom`, `front`, `back`, `side` or `"AZ,EL"`
+    /// (default: `"iso"`).
+    pub snapshot_view: String,
+    /// The snapshots' size in pixels (default: `[1024, 768]`).
+    pub snapshot_size: [usize; 2],
+}
+
+/// Which frames get a PNG snapshot.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Snapshots {
+    /// None.
+    None,
+    /// Every frame.
+    All,
+    /// The last frame, written when the run ends.
+    Final,
 }
 
 /// The fields `output.fields = ["default"]` leaves out: the current fundamental forms, which
@@ -1224,6 +1246,10 @@ impl Default for Output {
             encoding: None,
             precision: Precision::Single,
             fields: vec!["default".into()],
+            snapshots: Snapshots::None,
+            snapshot_field: None,
+            snapshot_view: "iso".into(),
+            snapshot_size: [1024, 768],
         }
     }
 }
@@ -2098,6 +2124,18 @@ impl Settings {
                         ),
                     );
                 }
+            }
+        }
+        if o.snapshots != Snapshots::None {
+            crate::render::view(&o.snapshot_view)
+                .map(|_| ())
+                .or_else(|e| ck.inv("output.snapshot_view", format!("{e:#}")))?;
+            let [w, h] = o.snapshot_size;
+            if !(64..=16384).contains(&w) || !(64..=16384).contains(&h) {
+                return ck.inv(
+                    "output.snapshot_size",
+                    format!("[{w}, {h}]: each side must lie in 64–16384 pixels"),
+                );
             }
         }
         if o.fields.is_empty() {

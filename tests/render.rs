@@ -169,3 +169,63 @@ fn plot_draws_log_columns_and_names_missing_ones() {
     );
     assert!(!p.join("bad.png").exists());
 }
+
+/// `output.snapshots`: a PNG beside every frame (`"all"`) or beside the last one (`"final"`),
+/// of the asked size; a snapshot field that the frames do not carry is refused before the run.
+#[test]
+fn snapshots_are_written_beside_frames() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path();
+    let (c, e) = run(
+        &[
+            "mesh", "square", "--size", "1", "--edge", "0.2", "-o", "sq.vtk",
+        ],
+        p,
+    );
+    assert_eq!(c, 0, "{e}");
+    std::fs::write(
+        p.join("s.toml"),
+        "[material]\nyoung = 1.0e6\nthickness = 0.01\n[rest]\ntarget = \"uniform\"\n\
+         bbar = [2.0, 0.0, 0.0]\n[solver]\nmax_continuation_step = 0.5\n\
+         [output]\ncontinuation_frames = true\nsnapshot_size = [160, 120]\n",
+    )
+    .unwrap();
+    for (mode, out) in [("all", "a"), ("final", "f")] {
+        let set = format!("output.snapshots={mode}");
+        let (c, e) = run(&["s.toml", "sq.vtk", "--out", out, "-q", "--set", &set], p);
+        assert_eq!(c, 0, "{e}");
+        let frames: Vec<_> = (0..)
+            .take_while(|k| p.join(out).join(format!("frame_{k:05}.vtu")).exists())
+            .collect();
+        assert!(frames.len() >= 3, "{frames:?}");
+        for &k in &frames {
+            let png = p.join(out).join(format!("frame_{k:05}.png"));
+            let want = mode == "all" || k == *frames.last().unwrap();
+            assert_eq!(png.exists(), want, "{mode}: frame {k}");
+            if want {
+                let (w, h, _) = decode(&png);
+                assert_eq!((w, h), (160, 120));
+            }
+        }
+    }
+    let (c, e) = run(
+        &[
+            "s.toml",
+            "sq.vtk",
+            "--out",
+            "x",
+            "-q",
+            "--set",
+            "output.snapshots=all",
+            "--set",
+            "output.snapshot_field=nothing",
+        ],
+        p,
+    );
+    assert_eq!(c, 2, "{e}");
+    assert!(
+        e.contains("snapshot_field") && e.contains("mean_curvature"),
+        "{e}"
+    );
+    assert!(!p.join("x").exists());
+}
