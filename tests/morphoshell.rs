@@ -6,7 +6,6 @@ mod common;
 use common::shellsim;
 use shellsim::math::{Real, Sym2, Vec3};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn summary(out: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
@@ -20,15 +19,8 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 
 /// Runs shellsim and returns (exit code, stderr).
 fn run(args: &[&str], dir: &Path) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_shellsim"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let (c, _, e) = common::run_status(args, dir);
+    (c, e)
 }
 
 fn final_frame(out: &Path) -> shellsim::mesh::Mesh {

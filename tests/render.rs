@@ -4,18 +4,12 @@
 //! exists and writes no picture.
 
 use std::path::Path;
-use std::process::Command;
+
+mod common;
 
 fn run(args: &[&str], dir: &Path) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_shellsim"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let (c, _, e) = common::run_status(args, dir);
+    (c, e)
 }
 
 /// Width, height and RGB pixels of a PNG.

@@ -2,21 +2,8 @@
 //! expanded, run by its own `run.sh` (GNU parallel when installed, else one run after another)
 //! and collected into one CSV table; bad sweep files are named errors that write nothing.
 
-use std::path::Path;
-use std::process::Command;
-
-fn run(args: &[&str], dir: &Path) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_shellsim"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod common;
+use common::run_status as run;
 
 const SETTINGS: &str = "[material]\nyoung = 1.0e6\nthickness = 0.01\ndensity = 1000.0\n\
     [rest]\ntarget = \"uniform\"\n[loads]\ngravity = [0.0, 0.0, -9.81]\n\

@@ -5,6 +5,7 @@ use std::process::Command;
 
 /// Runs the binary in `dir`, asserts success (with its stderr in the message) and returns its
 /// stdout.
+#[allow(dead_code)] // not every test crate runs the binary this way
 pub fn shellsim(args: &[&str], dir: &Path) -> String {
     let out = Command::new(env!("CARGO_BIN_EXE_shellsim"))
         .args(args)
@@ -17,6 +18,22 @@ pub fn shellsim(args: &[&str], dir: &Path) -> String {
         String::from_utf8_lossy(&out.stderr)
     );
     String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// Runs the binary in `dir` and returns its exit code (−1 when killed by a signal), stdout and
+/// stderr, whatever the outcome.
+#[allow(dead_code)] // not every test crate checks failures
+pub fn run_status(args: &[&str], dir: &Path) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_shellsim"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
 }
 
 /// Reads `frame_00000.EXT`, `frame_00001.EXT`, … from the run folder `out` until one is
