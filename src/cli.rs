@@ -120,6 +120,9 @@ struct RenderArgs {
     /// Picture size in pixels, WIDTHxHEIGHT.
     #[arg(long, default_value = "1024x768")]
     size: String,
+    /// Colour range LOW,HIGH (default: the field's minimum and maximum).
+    #[arg(long, allow_hyphen_values = true)]
+    range: Option<String>,
 }
 
 #[derive(clap::Args, Debug)]
@@ -377,8 +380,22 @@ fn render_cmd(a: RenderArgs) -> Result<()> {
             .map(String::from)
             .find(|f| mesh.face_fields.contains_key(f)),
     };
+    let range = match &a.range {
+        None => None,
+        Some(r) => Some(
+            r.split_once(',')
+                .and_then(|(l, h)| {
+                    Some((
+                        l.trim().parse::<Real>().ok()?,
+                        h.trim().parse::<Real>().ok()?,
+                    ))
+                })
+                .filter(|(l, h)| l.is_finite() && h.is_finite() && h > l)
+                .ok_or_else(|| anyhow!("--range '{r}': expected LOW,HIGH with LOW < HIGH"))?,
+        ),
+    };
     let name = a.frame.display().to_string();
-    let canvas = crate::render::render(&mesh, field.as_deref(), &a.view, w, h)
+    let canvas = crate::render::render(&mesh, field.as_deref(), &a.view, w, h, range)
         .map_err(|e| anyhow!("{name}: {e}"))?;
     let out = a.out.unwrap_or_else(|| a.frame.with_extension("png"));
     canvas.save_png(&out)

@@ -324,13 +324,15 @@ pub fn field_values(mesh: &Mesh, name: &str) -> Result<(Vec<Real>, bool)> {
     ))
 }
 
-/// Renders `mesh` coloured by `field` (or plain grey) into a `w × h` canvas.
+/// Renders `mesh` coloured by `field` (or plain grey) into a `w × h` canvas; the colours span
+/// `range`, or the field's minimum to maximum.
 pub fn render(
     mesh: &Mesh,
     field: Option<&str>,
     view_spec: &str,
     w: usize,
     h: usize,
+    range: Option<(Real, Real)>,
 ) -> Result<Canvas> {
     if w < 64 || h < 64 || w > 16384 || h > 16384 {
         bail!("--size {w}x{h}: each side must lie in 64–16384 pixels");
@@ -348,7 +350,11 @@ pub fn render(
                 (a.min(x), b.max(x))
             })
     });
-    let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (0.0, 0.0) };
+    let (lo, hi) = match range {
+        Some(r) => r,
+        None if lo.is_finite() => (lo, hi),
+        None => (0.0, 0.0),
+    };
     let span = if hi > lo { hi - lo } else { 1.0 };
     // Supersampled canvas; the picture takes the left 80% (with a colour bar) or all of it.
     let ss = 2;

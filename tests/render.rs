@@ -95,8 +95,9 @@ fn render_draws_the_frame_where_the_view_puts_it() {
     assert!(near(bottom, [68, 1, 84]), "bar bottom {bottom:?}");
 
     // Bad input: exit 2, what exists named, no picture.
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 5] = [
         (&["--field", "curvature_of_nothing"], "mean_curvature"),
+        (&["--range", "1,0"], "LOW < HIGH"),
         (&["--size", "10x10"], "64"),
         (&["--size", "big"], "WIDTHxHEIGHT"),
         (&["--view", "sideways"], "iso"),
