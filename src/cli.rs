@@ -300,14 +300,14 @@ fn dispatch(cli: Cli) -> Result<u8> {
 
 /// `--size WIDTHxHEIGHT`.
 fn picture_size(size: &str) -> Result<(usize, usize)> {
-    size.split_once(['x', '×'])
-        .and_then(|(w, h)| {
-            Some((
-                w.trim().parse::<usize>().ok()?,
-                h.trim().parse::<usize>().ok()?,
-            ))
-        })
+    number_pair(size, &['x', '×'])
         .ok_or_else(|| anyhow!("--size '{size}': expected WIDTHxHEIGHT, e.g. 1024x768"))
+}
+
+/// Two numbers separated by one of `seps` (`1024x768`, `0,3`).
+fn number_pair<T: std::str::FromStr>(s: &str, seps: &[char]) -> Option<(T, T)> {
+    let (a, b) = s.split_once(seps)?;
+    Some((a.trim().parse().ok()?, b.trim().parse().ok()?))
 }
 
 /// `shellsim plot`: reads log.csv, plots the columns, writes the PNG (nothing on an error).
@@ -383,13 +383,7 @@ fn render_cmd(a: RenderArgs) -> Result<()> {
     let range = match &a.range {
         None => None,
         Some(r) => Some(
-            r.split_once(',')
-                .and_then(|(l, h)| {
-                    Some((
-                        l.trim().parse::<Real>().ok()?,
-                        h.trim().parse::<Real>().ok()?,
-                    ))
-                })
+            number_pair::<Real>(r, &[','])
                 .filter(|(l, h)| l.is_finite() && h.is_finite() && h > l)
                 .ok_or_else(|| anyhow!("--range '{r}': expected LOW,HIGH with LOW < HIGH"))?,
         ),

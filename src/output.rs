@@ -234,14 +234,9 @@ pub struct Summary {
 /// bookkeeping).
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
 pub struct Timing {
-    /// Energy, gradient and Hessian evaluations.
-    pub assembly: Real,
-    /// Numeric factorisations.
-    pub factorisation: Real,
-    /// Triangular solves.
-    pub solve: Real,
-    /// Line searches.
-    pub line_search: Real,
+    /// Assembly, factorisation, solve and line search, summed over the Newton solves.
+    #[serde(flatten)]
+    pub newton: crate::solve::newton::NewtonTiming,
     /// Moisture diffusion and the rest forms it sets.
     pub diffusion: Real,
     /// Building and writing frames, the series and the log.
@@ -289,8 +284,6 @@ pub struct Writer {
     extra: std::collections::BTreeMap<String, Vec<Real>>,
     /// `.vtu` compression and encoding.
     vtu: crate::mesh::vtu::VtuOptions,
-    /// Derived fields as Float32.
-    single: bool,
     /// `[output]`: which fields are written, snapshots.
     selection: crate::settings::Output,
     /// Whether `frame_mesh` holds the frame last written.
@@ -363,7 +356,7 @@ pub fn check_fields(
                 .map(|f| ("output.snapshot_field", f)),
         );
     for (key, f) in keys {
-        let written = key == "output.fields" || out.selects(f) || restart_fields(scene).contains(f);
+        let written = key == "output.fields" || Writer::writes(&w.selection, &w.restart_fields, f);
         if !names.contains(f) || !written {
             return Err(crate::settings::SettingsError::Invalid {
                 path: settings_name.to_string(),
@@ -527,6 +520,15 @@ impl Writer {
         })
     }
 
+    /// Whether frames carry the field `name`: selected by `[output]`, or read by a restart.
+    fn writes(
+        selection: &crate::settings::Output,
+        restart_fields: &std::collections::BTreeSet<String>,
+        name: &str,
+    ) -> bool {
+        selection.selects(name) || restart_fields.contains(name)
+    }
+
     /// A writer that builds frames' fields but writes nothing (no folder, no lock).
     fn detached(scene: &Scene) -> Self {
         let mesh = &scene.mesh;
@@ -560,7 +562,6 @@ impl Writer {
                     .unwrap_or(crate::mesh::vtu::Compression::Zlib),
                 encoding: out.encoding.unwrap_or(crate::mesh::vtu::Encoding::Appended),
             },
-            single: out.precision == crate::settings::Precision::Single,
             selection: out.clone(),
             built_is_written: false,
             restart_fields,
@@ -748,8 +749,7 @@ impl Writer {
             .flat_map(|t| t.observables(pot, x, phi))
             .collect();
         let m = &mut self.frame_mesh;
-        let (sel, restart) = (&self.selection, &self.restart_fields);
-        let keep = |n: &String| sel.selects(n) || restart.contains(n);
+        let keep = |n: &String| Self::writes(&self.selection, &self.restart_fields, n);
         m.face_fields.retain(|n, _| keep(n));
         m.vertex_fields.retain(|n, _| keep(n));
         // Never write NaN.
@@ -799,7 +799,7 @@ impl Writer {
         let name = format!("{}_{index:05}.{}", self.prefix, self.format.extension());
         let path = self.dir.join(&name);
         let restart = &self.restart_fields;
-        let single = self.single;
+        let single = self.selection.precision == crate::settings::Precision::Single;
         // The displacement gives the reference positions (positions − displacement), which
         // `shellsim error` and scripts measure against: Float64 like the positions.
         let bytes = crate::mesh::io::mesh_to_bytes_with(

@@ -398,7 +398,7 @@ pub(super) fn run_explicit(
         }
         let clock = std::time::Instant::now();
         let energy = gradient(&pot, &state.x, &mut g);
-        s.summary.timing.assembly += clock.elapsed().as_secs_f64();
+        s.summary.timing.newton.assembly += clock.elapsed().as_secs_f64();
         // Terms that act on the step itself (slide friction), before the equilibrium test sees
         // the forces.
         for term in sc.terms.iter() {

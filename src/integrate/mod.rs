@@ -362,11 +362,7 @@ impl<'a> Solver<'a> {
         self.summary.gauss_newton_iterations += rep.gauss_newton_iterations;
         self.summary.indefinite_iterations += rep.indefinite_iterations;
         self.summary.residual = rep.residual;
-        let t = &mut self.summary.timing;
-        t.assembly += rep.timing.assembly;
-        t.factorisation += rep.timing.factorisation;
-        t.solve += rep.timing.solve;
-        t.line_search += rep.timing.line_search;
+        self.summary.timing.newton.add(&rep.timing);
     }
 
     /// Newton on `pot` from `state`, then the terms' multiplier updates (a prescribed volume's
@@ -673,8 +669,9 @@ pub fn run(
     s.summary.final_frame = writer.last_frame();
     let t = &mut s.summary.timing;
     t.diffusion = s.summary.moisture_seconds;
+    let n = t.newton;
     t.other = (s.summary.wall_seconds
-        - (t.assembly + t.factorisation + t.solve + t.line_search + t.diffusion + t.output))
+        - (n.assembly + n.factorisation + n.solve + n.line_search + t.diffusion + t.output))
         .max(0.0);
     writer.summary(&s.summary)?;
     Ok(s.summary)

@@ -98,12 +98,12 @@ impl Values<'_> {
 }
 
 /// An array's encoded form: its header (UInt64 sizes) and its (compressed) data.
-fn encode(bytes: &[u8], compression: Compression) -> (Vec<u8>, Vec<u8>) {
+fn encode(bytes: Vec<u8>, compression: Compression) -> (Vec<u8>, Vec<u8>) {
     let mut head = Vec::new();
     let put = |head: &mut Vec<u8>, n: usize| head.extend_from_slice(&(n as u64).to_le_bytes());
     if compression == Compression::None {
         put(&mut head, bytes.len());
-        return (head, bytes.to_vec());
+        return (head, bytes);
     }
     let blocks: Vec<Vec<u8>> = bytes
         .par_chunks(BLOCK)
@@ -187,7 +187,7 @@ pub fn vtu_bytes(mesh: &Mesh, opts: &VtuOptions, single: &dyn Fn(&str) -> bool) 
 
     let encoded: Vec<(Vec<u8>, Vec<u8>)> = arrays
         .iter()
-        .map(|(_, _, _, v)| encode(&v.bytes(), opts.compression))
+        .map(|(_, _, _, v)| encode(v.bytes(), opts.compression))
         .collect();
 
     let mut x = String::with_capacity(4096);
