@@ -348,7 +348,7 @@ fn moisture_step(c: &mut Criterion) {
     g.finish();
 }
 
-/// The whole coupled loop (issue 4): the first 0.2 s of the wetted paper strip
+/// The whole coupled loop (moisture and mechanics): the first 0.2 s of the wetted paper strip
 /// (settings/paper_strip_cd.toml, 1 200 faces, edge DOFs; Δt ≤ 0.05 s, cut by
 /// `moisture.max_change` to about 16 steps): diffusion, rest forms, moisture masses and the
 /// Newton solve, on 1 and 2 threads. The summary's `moisture_seconds` splits the

@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
-"""Convergence study of the bending models (issue 3).
+"""Convergence study of the bending models.
 
 Every bending model x mesh kind (regular, Delaunay of random points, jittered by 25% of the
 edge length) x case (cylinder, Gauss-Codazzi-Mainardi cone, spherical cap, bilayer strip) x
 3-4 resolutions, through the real command line: `shellsim mesh ... --program CASE`, a static
 solve, and `shellsim error CASE FRAME`. Writes one CSV row per run, then prints the observed
-orders and a markdown table (the one in the README).
+orders and a markdown table (the one in docs/accuracy.md).
 
     scripts/convergence_study.py [--out CSV] [--threads N] [--quick] [--table-only]
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Runs the issue-4 scenes of settings/ at full size and prints the numbers the README quotes.
+"""Runs the environment-driven scenes of settings/ at full size and prints the numbers docs/scenes.md quotes.
 
     python3 scripts/paper_scenes.py [strip|annulus|disk|cap|walker ...] [--out DIR]
 
@@ -26,7 +26,7 @@ BIN = os.path.join(ROOT, "target", "release", "shellsim")
 
 def run(scene, mesh, out, sets=()):
     args = [BIN, os.path.join(ROOT, "settings", scene + ".toml"), os.path.join(ROOT, mesh),
-            "--out", out, "-q"]
+            "--out", out, "-q", "--set", "output.format=vtk_ascii"]
     for s in sets:
         args += ["--set", s]
     t = time.time()

@@ -5,7 +5,7 @@
 #
 #   scripts/speed_vs_error.sh [OUT.csv] [THREADS] [BENDING]
 #
-# BENDING is the bending model (default: midedge_average, seed 000's own, which the README's
+# BENDING is the bending model (default: midedge_average, seed 000's own, which docs/accuracy.md's
 # Table 1 section documents; scripts/convergence_study.py compares all models).
 #
 # Columns: case, mesh, edge, vertices, faces, threads, wall_seconds, newton_iterations,
@@ -41,7 +41,7 @@ for case in enlarged_square spherical_cap hyperboloid rhombus cylinder cone; do
 done
 echo "wrote $out"
 
-# Coupled moisture + mechanics (issue 4): the wetted paper strip on three meshes, 2 s of
+# Coupled moisture + mechanics: the wetted paper strip on three meshes, 2 s of
 # simulated time. The summary's moisture_seconds is the wall time of the diffusion solve and the
 # rest forms; the coupled step costs wall / (wall − moisture_seconds) of the mechanics alone on
 # the same steps.

@@ -11,7 +11,7 @@
 //! | `rhombus` | [[2, 1], [1, 2]] | 0 | (F (x, y), 0) with F = √ā |
 //! | `cylinder` | I | diag(1, 0) | (sin x, y, cos x − 1) (radius 1, axis ∥ y) |
 //!
-//! Beyond Table 1 (issue 3's convergence study):
+//! Beyond Table 1 (the bending models' convergence study):
 //!
 //! | case | domain | ā | b̄ | exact surface |
 //! |---|---|---|---|---|

@@ -1,8 +1,8 @@
 //! Seed 000 Table 1 through the real pipeline: generate a programmed unit-square mesh, run the
 //! binary to static equilibrium, measure the frame with `shellsim error`. Coarse (edge 0.1),
 //! fine (0.05) and non-uniform (graded 2.5× and jittered 20%, edge 0.05) meshes; thickness 0.05.
-//! The Table 1 test pins seed 000's own bending model (the mid-edge average); issue 3's
-//! convergence study (`bending_models_converge_on_irregular_meshes` and the cone and bilayer
+//! The Table 1 test pins seed 000's own bending model (the mid-edge average); the bending
+//! models' convergence study (`bending_models_converge_on_irregular_meshes` and the cone and bilayer
 //! tests) covers the others.
 //!
 //! Bounds are the errors measured when the test was written plus about 20%; the flat cases are
@@ -495,7 +495,7 @@ fn order(coarse: (f64, u64), fine: (f64, u64)) -> f64 {
     (coarse.0 / fine.0).ln() / (0.5 * (fine.1 as f64 / coarse.1 as f64).ln())
 }
 
-/// Issue 3's study at small size: the cylinder (ā = I, b̄ = diag(1, 0)) on meshes jittered by
+/// The bending models' convergence study at small size: the cylinder (ā = I, b̄ = diag(1, 0)) on meshes jittered by
 /// 25% of the edge and on Delaunay meshes of random points, 200–256 and 800–1016 faces, h = 0.01.
 /// The models that claim convergence (edge DOFs sin/tan, patch fit) must show order ≥ 1.5 and a
 /// max material-point error ≤ 1e-4 of the size at the finer mesh (measured 5.3e-5 to 8.2e-5,
@@ -551,8 +551,8 @@ fn bending_models_converge_on_irregular_meshes() {
 
 /// MorphoShell's Gauss–Codazzi–Mainardi cone (ā = I, b̄ = θ̂θ̂ᵀ/(2r) on the sector 1 ≤ r ≤ 1.4 of
 /// angle 2π sin(atan 2)) on meshes jittered by 25%, 842 and 3371 faces, h = 0.01. The edge-DOF
-/// model meets issue 3's numbers: ≤ 0.05% at ~1k faces (measured 0.0077%), order ≥ 1.5
-/// (measured 1.73), and ≤ 3e-5 at 3.4k (measured 2.3e-5; the issue asks ≤ 0.005% at ~12k, where
+/// model meets the study's targets: ≤ 0.05% at ~1k faces (measured 0.0077%), order ≥ 1.5
+/// (measured 1.73), and ≤ 3e-5 at 3.4k (measured 2.3e-5; the target is ≤ 0.005% at ~12k, where
 /// the study measures 7.2e-6). The mid-edge average stays near 3% (its floor).
 #[test]
 fn gcm_cone_converges_with_edge_dofs() {
@@ -645,7 +645,7 @@ fn bilayer_strip_matches_timoshenko() {
     assert!(rows[1].0 < 1e-5, "max error {:.3e}", rows[1].0);
 }
 
-/// Isotropic (conformal) growth toward a sphere (issue 4's accuracy check): the unit disk with
+/// Isotropic (conformal) growth toward a sphere (the conformal cap's accuracy check): the unit disk with
 /// ā = η² I, η = 1/(1 + ρ²/4) and b̄ = ā/R (R = 1), jittered by 25%, grows into the spherical cap
 /// given by inverse stereographic projection. Measured with seed 1: max error 4.4e-4 → 8.4e-5
 /// → 2.0e-5 of the size (629 / 2514 / 10053 faces), Hausdorff 0.20% → 0.053% → 0.014%.
@@ -666,7 +666,7 @@ fn conformal_growth_reaches_the_spherical_cap() {
     assert!(p >= 1.5, "order {p:.2}");
 }
 
-/// Coulomb friction on an incline (ground contact, issue 4): a free sheet resting on the ground
+/// Coulomb friction on an incline (ground contact): a free sheet resting on the ground
 /// under gravity tilted by θ = 30° slides with a = g (sin θ − μ cos θ) when tan θ > μ, and
 /// implicit Euler gives v = a t exactly for a constant force (measured: 2e-5 relative, from the
 /// first step settling the sheet onto the ground by √(2δσ/k) ≈ 13 µm). With μ > tan θ it sticks:

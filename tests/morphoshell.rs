@@ -84,7 +84,7 @@ fn cone_half_angle(reference: &[Vec3], x: &[Vec3], r_min: Real) -> Real {
 /// The liquid-crystal director law on a disk with a circumferential director: the half-angle
 /// and the rim's perimeter against the closed form `sin α = λ^(1+ν)`, `P = 2πλR`. The tolerance
 /// is what this coarse mesh (edge R/12, ~900 faces) reaches: the half-angle converges under
-/// refinement (README, "MorphoShell mode"), and the rim length is set by the metric alone.
+/// refinement (docs/morphoshell.md), and the rim length is set by the metric alone.
 #[test]
 fn lce_disk_with_circumferential_director_becomes_the_closed_form_cone() {
     let dir = tempfile::tempdir().unwrap();

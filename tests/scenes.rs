@@ -1,7 +1,7 @@
-//! The example scenes of issue 4 (settings/paper_*.toml, gel_disk_hyperbolic.toml,
+//! The environment-driven example scenes (settings/paper_*.toml, gel_disk_hyperbolic.toml,
 //! conformal_cap.toml), run from their settings files at small size, with their qualitative
 //! outcome and, where there is one, a closed-form number checked. `scripts/paper_scenes.py` runs
-//! them at full size and prints the README's numbers.
+//! them at full size and prints the numbers of docs/scenes.md.
 
 mod common;
 use common::shellsim;
@@ -32,7 +32,7 @@ fn run_scene(dir: &Path, scene: &str, mesh: &Path, sets: &[&str]) -> Vec<Mesh> {
     }
     let args: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
     shellsim(&args, dir);
-    let frames = common::finite_frames(&out, "vtk", scene);
+    let frames = common::finite_frames(&out, "vtu", scene);
     assert!(frames.len() >= 2, "{scene}: no frames");
     frames
 }
@@ -241,7 +241,7 @@ fn conformal_growth_scene_reaches_the_cap() {
     let frames = run_scene(d.path(), "conformal_cap", &m, &[]);
     assert_eq!(frames.len(), 2);
     let out = Command::new(env!("CARGO_BIN_EXE_shellsim"))
-        .args(["error", "conformal_cap", "conformal_cap/frame_00001.vtk"])
+        .args(["error", "conformal_cap", "conformal_cap/frame_00001.vtu"])
         .current_dir(d.path())
         .output()
         .unwrap();
