@@ -229,20 +229,6 @@ impl Canvas {
     }
 }
 
-/// A compact number label: 4 significant digits.
-pub fn label(v: Real) -> String {
-    if v == 0.0 {
-        return "0".into();
-    }
-    let a = v.abs();
-    if (1e-2..1e4).contains(&a) {
-        let digits = (3 - a.log10().floor() as i32).max(0) as usize;
-        format!("{v:.digits$}")
-    } else {
-        format!("{v:.3e}")
-    }
-}
-
 /// Viewing direction: the unit vector from the scene toward the eye, and the screen's up.
 pub fn view(spec: &str) -> Result<(Vec3, Vec3)> {
     let (az, el): (Real, Real) = match spec {
@@ -439,7 +425,13 @@ fn colour_bar(cv: &mut Canvas, name: &str, lo: Real, hi: Real) {
         cv.rect(bx, y, bx + bw, y + 1, colour(t));
     }
     for (y, v) in [(by0, hi), ((by0 + by1) / 2, 0.5 * (lo + hi)), (by1 - 1, lo)] {
-        cv.text(bx + bw + 5 * s, y - 3 * s, &label(v), s, black);
+        cv.text(
+            bx + bw + 5 * s,
+            y - 3 * s,
+            &number(v, (hi - lo) / 20.0),
+            s,
+            black,
+        );
     }
     let tw = Canvas::text_width(name, s);
     // Centred over the bar, kept off the picture (a long name runs off the right edge).
@@ -475,17 +467,27 @@ pub fn ticks(lo: Real, hi: Real, n: usize) -> Vec<Real> {
     (first..=last).map(|k| k as Real * step).collect()
 }
 
-/// A tick label with as many decimals as the tick step needs (scientific notation for steps
-/// below 1e-3 or values from 1e5 up).
-pub fn tick_label(v: Real, step: Real) -> String {
-    if v.abs() < 1e-9 * step.abs() {
+/// A number with the digits that resolve `step` (a tick step, or a colour bar's resolution):
+/// fixed decimals for steps from 1e-6 and values below 1e5, else scientific notation with the
+/// mantissa digits that `step` needs. A zero or non-finite step means 1e-3 of the value.
+pub fn number(v: Real, step: Real) -> String {
+    let step = if step > 0.0 && step.is_finite() {
+        step
+    } else if v != 0.0 {
+        1e-3 * v.abs()
+    } else {
+        1.0
+    };
+    if v.abs() < 1e-9 * step {
         return "0".into();
     }
-    if step >= 1e-3 && v.abs() < 1e5 {
-        let d = (-step.log10().floor()).max(0.0) as usize;
+    let decimals = -step.log10().floor();
+    if decimals <= 6.0 && v.abs() < 1e5 {
+        let d = decimals.max(0.0) as usize;
         format!("{v:.d$}")
     } else {
-        format!("{v:.2e}")
+        let m = (v.abs().log10().floor() + decimals).clamp(1.0, 12.0) as usize;
+        format!("{v:.m$e}")
     }
 }
 
@@ -564,7 +566,7 @@ pub fn plot(
     for &t in &tx {
         let x = sx(t);
         cv.line([x, top], [x, bottom], 1, light);
-        let l = tick_label(t, step(&tx));
+        let l = number(t, step(&tx));
         cv.text(
             x as isize - Canvas::text_width(&l, s) / 2,
             bottom as isize + 4 * s,
@@ -577,7 +579,7 @@ pub fn plot(
     for &t in &ty {
         let y = sy(t);
         cv.line([left, y], [right, y], 1, light);
-        let l = tick_label(t, step(&ty));
+        let l = number(t, step(&ty));
         cv.text(
             left as isize - Canvas::text_width(&l, s) - 4 * s,
             y as isize - 3 * s,
