@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Runs the balloon scenes of settings/ at full size and prints the numbers the README quotes.
+"""Runs the balloon scenes of settings/ at full size and prints the numbers docs/balloons.md quotes.
 
     python3 scripts/balloon_scenes.py [sphere|accuracy|teddy|thickness|table ...] [--out DIR]
 

@@ -821,7 +821,7 @@ fn absorbed_water_adds_mass() {
     }
 }
 
-/// Bad growth and moisture input (issue 4): per-face fields of the wrong length, NaN (the reader
+/// Bad growth and moisture input: per-face fields of the wrong length, NaN (the reader
 /// names the line), a zero
 /// machine direction, swelling that makes ā non-positive, a ground exchange without a ground,
 /// a broken expression, a zero contact normal, a mesh that starts inside the ground. Each is
@@ -1330,4 +1330,64 @@ fn huge_restart_velocities_are_bad_input() {
         r.stderr
     );
     assert_eq!(frames(&p.join("b")), 0);
+}
+
+/// The README's first screen: its example command (everything after `cargo run --release --`)
+/// runs to convergence from the repository's files, the caption's `render` command draws its
+/// frame, and its test command is the line `.ci/run` runs.
+#[test]
+fn readme_commands_work() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let block = readme
+        .split("```sh\n")
+        .nth(1)
+        .and_then(|b| b.split("```").next())
+        .expect("README has a sh block");
+    let lines: Vec<&str> = block
+        .lines()
+        .map(|l| l.split(" # ").next().unwrap().trim())
+        .collect();
+    assert_eq!(lines.len(), 2, "README's first block: {block}");
+    let example = lines[0]
+        .strip_prefix("cargo run --release -- ")
+        .expect("the example is `cargo run --release -- …`");
+    let dir = tmp();
+    // Repository paths resolve from the root; the output folder goes into the temporary one.
+    let args: Vec<String> = example
+        .split_whitespace()
+        .map(|a| {
+            let p = root.join(a);
+            if !a.starts_with('-') && p.exists() {
+                p.to_str().unwrap().to_string()
+            } else {
+                a.to_string()
+            }
+        })
+        .collect();
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let r = run(&args, dir.path());
+    assert_eq!(r.code, 0, "{example}: {}", r.stderr);
+    let out = args[args.iter().position(|a| *a == "--out").unwrap() + 1];
+    assert!(dir.path().join(out).join("series.pvd").exists());
+
+    let caption = readme
+        .split("`shellsim render ")
+        .nth(1)
+        .and_then(|c| c.split('`').next())
+        .expect("the caption's render command");
+    let mut render = vec!["render"];
+    render.extend(caption.split_whitespace());
+    render.extend(["-o", "picture.png"]);
+    let r = run(&render, dir.path());
+    assert_eq!(r.code, 0, "render {caption}: {}", r.stderr);
+    let png = std::fs::read(dir.path().join("picture.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+
+    let ci = std::fs::read_to_string(root.join(".ci/run")).unwrap();
+    assert!(
+        ci.lines().any(|l| l.trim() == lines[1]),
+        ".ci/run does not run the README's test command `{}`",
+        lines[1]
+    );
 }

@@ -147,3 +147,19 @@ fn bad_sweep_files_are_named_and_write_nothing() {
     assert_eq!(c, 2);
     assert!(e.contains("nowhere"), "{e}");
 }
+
+/// Every sweep file in `settings/sweeps/` expands: its settings, mesh and overrides are valid.
+#[test]
+fn the_example_sweeps_expand() {
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut n = 0;
+    for entry in std::fs::read_dir(root.join("settings/sweeps")).unwrap() {
+        let f = entry.unwrap().path();
+        let d = tempfile::tempdir().unwrap();
+        let (c, _, e) = run(&["sweep", f.to_str().unwrap(), "--out", "sweep"], d.path());
+        assert_eq!(c, 0, "{}: {e}", f.display());
+        assert!(d.path().join("sweep/jobs.txt").exists());
+        n += 1;
+    }
+    assert!(n > 0, "no example sweep");
+}
