@@ -536,12 +536,13 @@ fn bench_hessian_pot(
 }
 
 /// One explicit step (gradient + symplectic Euler update) of MorphoShell's GCM cone with the
-/// patch fit, at the sizes MorphoShell was timed at (743–2060 triangles), on 1 and 2 threads:
+/// patch fit, at the sizes MorphoShell was timed at (743–2060 triangles) and at ~8.6k, on 1 and
+/// 2 threads:
 /// per step while the forms are dialled (densities recomputed) and while waiting (densities
 /// computed once). Report: time per step / faces = µs per triangle-step.
 fn explicit_step(c: &mut Criterion) {
     use shellsim::integrate::explicit::{advance, gradient};
-    for edge in [0.085, 0.05] {
+    for edge in [0.085, 0.05, 0.025] {
         let mut mesh = shellsim::mesh::generate::annulus(
             1.0,
             1.4,
