@@ -592,8 +592,8 @@ impl Parts {
         }
         let mut elements: Vec<Vec<u32>> = vec![Vec::new(); count];
         let mut last = vec![u32::MAX; count];
-        for e in 0..ne {
-            let h = home[e] as usize;
+        for (e, &h) in home.iter().enumerate() {
+            let h = h as usize;
             let parts = map
                 .element(e)
                 .iter()
