@@ -145,14 +145,7 @@ impl VertexKernel for Slides {
         ]
     }
 
-    fn explicit_step(
-        &self,
-        pot: &Potential,
-        x: &[Vec3],
-        v: &mut [Vec3],
-        g: &mut [Real],
-        _dt: Real,
-    ) {
+    fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
         let fixed = &pot.scene.fixed;
         if self.friction > 0.0 {
             for (i, p) in x.iter().enumerate() {
@@ -164,17 +157,22 @@ impl VertexKernel for Slides {
                 if normal == 0.0 {
                     continue;
                 }
-                let (fx, fy) = (-g[3 * i], -g[3 * i + 1]);
-                let fh = fx.hypot(fy);
                 let limit = self.friction * normal;
-                if fh < limit {
+                let m = pot.scene.mass[i];
+                // The in-plane velocity the step would reach without friction.
+                let px = v[i].x - dt * g[3 * i] / m;
+                let py = v[i].y - dt * g[3 * i + 1] / m;
+                let ps = px.hypot(py);
+                if ps <= dt * limit / m {
+                    // Friction stops the vertex within the step: it sticks.
                     g[3 * i] = 0.0;
                     g[3 * i + 1] = 0.0;
                     v[i].x = 0.0;
                     v[i].y = 0.0;
                 } else {
-                    g[3 * i] += limit * fx / fh;
-                    g[3 * i + 1] += limit * fy / fh;
+                    // It slides, and friction opposes that velocity.
+                    g[3 * i] += limit * px / ps;
+                    g[3 * i + 1] += limit * py / ps;
                 }
             }
         }
