@@ -705,3 +705,73 @@ fn low_rank_term_solves_like_the_dense_matrix() {
     // but k is large: wᵀx is close to c.
     assert!((s - 0.3).abs() < 0.05, "wᵀx = {s}");
 }
+
+/// Slide friction (explicit mode) on a strip pressed 0.01 into the lower slide, normal force
+/// N = k · 0.01 per vertex with k = 100 μ t = 2 N/m, limit μ_f N: a vertex at rest with an
+/// in-plane force below the limit sticks (force and velocity zeroed); at rest above it, it slides
+/// with friction of exactly the limit against the force; moving against a force above the limit,
+/// friction opposes the velocity (it dissipates), where a rule opposing the force would push.
+#[test]
+fn slide_friction_sticks_at_rest_and_brakes_sliding() {
+    let sc = strip_scene(
+        "[material]\nyoung = 3.0\npoisson = 0.5\ndensity = 1.0\nthickness = 0.02\n\
+         bending = \"patch_fit\"\n[solver]\nmode = \"explicit\"\n\
+         [slides]\nenabled = true\nlower = -0.1\nupper = 0.1\nfriction = 0.5\n",
+    );
+    let p = Pattern::for_scene(&sc);
+    let pot = Potential::new(&sc, &p);
+    let slides = sc
+        .terms
+        .iter()
+        .find(|t| t.name() == "slides")
+        .expect("the slides term");
+    let limit = 0.5 * 2.0 * 0.01;
+    let n = sc.num_vertices();
+    let x: Vec<Vec3> = sc
+        .mesh
+        .positions
+        .iter()
+        .map(|q| Vec3::new(q.x, q.y, -0.11))
+        .collect();
+    let force = |i: usize| match i % 3 {
+        0 => Vec3::new(0.5 * limit, 0.0, 0.0),
+        1 => Vec3::new(0.0, 2.0 * limit, 0.0),
+        _ => Vec3::new(2.0 * limit, 0.0, 0.0),
+    };
+    let v0 = |i: usize| {
+        if i % 3 == 2 {
+            Vec3::new(-1.0, 0.0, 0.0)
+        } else {
+            Vec3::zeros()
+        }
+    };
+    let mut v: Vec<Vec3> = (0..n).map(v0).collect();
+    let mut g = vec![0.0; p.n];
+    for i in 0..n {
+        let f = force(i);
+        g[3 * i..3 * i + 3].copy_from_slice(&[-f.x, -f.y, -f.z]);
+    }
+    let dt = 1e-4;
+    slides.explicit_step(&pot, &x, &mut v, &mut g, dt);
+    for i in 0..n {
+        let after = -Vec3::new(g[3 * i], g[3 * i + 1], g[3 * i + 2]);
+        let friction = after - force(i);
+        match i % 3 {
+            0 => {
+                assert_eq!((after.x, after.y), (0.0, 0.0), "vertex {i} sticks");
+                assert_eq!(v[i], Vec3::zeros(), "vertex {i} stays at rest");
+            }
+            1 => assert!(
+                (friction - Vec3::new(0.0, -limit, 0.0)).norm() < 1e-15,
+                "vertex {i}: friction {friction:?} against the force"
+            ),
+            _ => {
+                assert!(
+                    (friction - Vec3::new(limit, 0.0, 0.0)).norm() < 1e-15,
+                    "vertex {i}: friction {friction:?} against the velocity"
+                );
+                assert!(friction.dot(&v[i]) < 0.0, "vertex {i}: friction dissipates");
+            }
+        }
+    }
+}
