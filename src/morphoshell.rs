@@ -297,6 +297,7 @@ pub fn to_toml(m: &MorphoSettings, file: &str, slide_speed: Option<Real>) -> Res
         line("enabled = true".into());
         line(format!("stiffness_prefactor = {k:?}"));
         line(format!("friction = {:?}", g("slide_friction_coefficent")));
+        line("contact_damping = 0.0   # MorphoShell's contact is undamped".into());
         if g("using_initial_glass_slide_z_coords_from_settings_file") != 0.0 {
             line(format!("upper = {:?}", g("initial_upper_slide_z_coord")));
             line(format!("lower = {:?}", g("initial_lower_slide_z_coord")));

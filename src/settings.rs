@@ -839,6 +839,11 @@ pub struct Slides {
     /// Coulomb friction coefficient of stick/slip friction on vertices in contact (default: `0`;
     /// explicit mode).
     pub friction: Real,
+    /// Damping of the contact along the normal, as a fraction of the critical damping
+    /// `2√(k m)` of a vertex of mass m on the penalty spring k (default: `1`, critical;
+    /// MorphoShell's contact is undamped, `0`; explicit mode). It dissipates only while a vertex
+    /// moves into or out of a slide, so equilibria are unchanged.
+    pub contact_damping: Option<Real>,
     /// `"speed"` (default) or `"force"` (explicit mode).
     pub control: SlideControl,
     /// Speed control: downward speed of the upper slide (m/s; default: `0`).
@@ -863,6 +868,7 @@ impl Default for Slides {
             upper: None,
             stiffness_prefactor: 100.0,
             friction: 0.0,
+            contact_damping: None,
             control: SlideControl::Speed,
             speed: 0.0,
             travel: 0.0,
@@ -1817,6 +1823,9 @@ impl Settings {
         let sl = &self.slides;
         ck.pos("slides.stiffness_prefactor", sl.stiffness_prefactor)?;
         ck.nonneg("slides.friction", sl.friction)?;
+        if let Some(z) = sl.contact_damping {
+            ck.nonneg("slides.contact_damping", z)?;
+        }
         ck.nonneg("slides.travel", sl.travel)?;
         for (k, v) in [("slides.speed", sl.speed), ("slides.force", sl.force)] {
             if !v.is_finite() {
@@ -1849,6 +1858,14 @@ impl Settings {
                     "slides.friction",
                     "slide friction needs solver.mode = \"explicit\" (the implicit modes hold \
                      frictionless slides still)"
+                        .into(),
+                );
+            }
+            if sl.contact_damping.is_some_and(|z| z > 0.0) {
+                return ck.inv(
+                    "slides.contact_damping",
+                    "contact damping needs solver.mode = \"explicit\" (the implicit modes hold \
+                     the slides still, without damping)"
                         .into(),
                 );
             }

@@ -7,12 +7,18 @@
 //! (μ, t the smallest shear modulus and thickness; N/m; gradient `k(z − z_u)₊ − k(z_l − z)₊`
 //! along z, Hessian `k` on zz while in contact). DOF order: `x[v]`.
 //!
-//! **Friction** (explicit mode, [`crate::energy::term::Term::explicit_step`]): MorphoShell's
-//! stick/slip rule. A vertex in contact with normal force `N = k d` and in-plane force `f_h`
-//! (the elastic and other forces, drag excluded) sticks when `|f_h| < μ_f N` (its in-plane force
-//! and velocity are set to 0), else slides with `f_h − μ_f N f_h/|f_h|`. (A rule with kinetic
-//! friction opposing the velocity was tried: on a cone squeezed by a force-controlled slide it
-//! chattered 20× more.)
+//! **Friction** (explicit mode, [`crate::energy::term::Term::explicit_step`]): Coulomb
+//! stick/slip on a vertex in contact, normal force `N = k d`, mass m. With `v*` the in-plane
+//! velocity the step would reach without friction (elastic and other forces, drag excluded), the
+//! vertex sticks when friction can stop it within the step, `|v*| ≤ Δt μ_f N / m` (its in-plane
+//! force and velocity are set to 0; at rest this is MorphoShell's `|f_h| < μ_f N`), else it
+//! slides with the force `μ_f N v*/|v*|` against that velocity, so friction only dissipates.
+//!
+//! **Contact damping** (explicit mode, optional): a dashpot `c = ζ 2√(k m)` on the normal
+//! velocity of a vertex in contact, ζ the fraction of critical damping of the vertex on its
+//! penalty spring, applied implicitly (`v_z' = v_z*/(1 + Δt c/m)`, stable for any ζ). It acts
+//! only on motion into or out of a slide, so equilibria are unchanged; it damps the stiff
+//! vertical oscillations that the global drag, tuned to the slowest bending mode, leaves alive.
 //!
 //! **Motion** (explicit mode; with `after_dial` only once the dial has reached 1): speed control
 //! moves the upper slide down at `speed` until it has moved `travel`; force control moves it overdamped, `ζ dz_u/dt = F_up − F`, with `F_up` the
@@ -41,8 +47,12 @@ pub struct Slides {
     pub upper0: Real,
     /// Upper slide height now (m), as f64 bits.
     upper: AtomicU64,
+    /// Upper slide's velocity over the current step (m/s), as f64 bits.
+    upper_velocity: AtomicU64,
     /// Coulomb coefficient.
     pub friction: Real,
+    /// Normal contact damping, a fraction of critical.
+    pub contact_damping: Real,
     /// Speed or force control.
     pub control: SlideControl,
     /// Downward speed (m/s) and the distance to travel (m).
@@ -146,19 +156,34 @@ impl VertexKernel for Slides {
     }
 
     fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
+        if self.friction == 0.0 && self.contact_damping == 0.0 {
+            return;
+        }
         let fixed = &pot.scene.fixed;
-        if self.friction > 0.0 {
-            for (i, p) in x.iter().enumerate() {
-                if fixed[i] {
-                    continue;
-                }
-                let (du, dl) = self.depths(p.z);
-                let normal = self.k * (du + dl);
-                if normal == 0.0 {
-                    continue;
-                }
+        for (i, p) in x.iter().enumerate() {
+            if fixed[i] {
+                continue;
+            }
+            let (du, dl) = self.depths(p.z);
+            let normal = self.k * (du + dl);
+            if normal == 0.0 {
+                continue;
+            }
+            let m = pot.scene.mass[i];
+            if self.contact_damping > 0.0 {
+                // The dashpot c = ζ 2√(km) on the normal velocity relative to the slide that
+                // the step reaches, taken implicitly, w' = w*/(1 + Δt c/m): stable for any ζ.
+                let c = self.contact_damping * 2.0 * (self.k * m).sqrt();
+                let slide = if du > 0.0 {
+                    Real::from_bits(self.upper_velocity.load(Ordering::Relaxed))
+                } else {
+                    0.0
+                };
+                let w = (v[i].z - slide - dt * g[3 * i + 2] / m) / (1.0 + dt * c / m);
+                g[3 * i + 2] += c * w;
+            }
+            if self.friction > 0.0 {
                 let limit = self.friction * normal;
-                let m = pot.scene.mass[i];
                 // The in-plane velocity the step would reach without friction.
                 let px = v[i].x - dt * g[3 * i] / m;
                 let py = v[i].y - dt * g[3 * i + 1] / m;
@@ -184,6 +209,8 @@ impl VertexKernel for Slides {
     fn explicit_begin(&self, pot: &Potential, x: &[Vec3], dt: Real) {
         let fixed = &pot.scene.fixed;
         if self.after_dial && pot.dial < 1.0 {
+            self.upper_velocity
+                .store(0.0f64.to_bits(), Ordering::Relaxed);
             return;
         }
         let z = self.upper();
@@ -200,7 +227,10 @@ impl VertexKernel for Slides {
             SlideControl::Force => self.pressed(x, fixed, z, dt),
         };
         // The upper slide never passes the lower one.
-        self.set_upper(next.max(self.lower + 1e-12 * (1.0 + self.lower.abs())));
+        let next = next.max(self.lower + 1e-12 * (1.0 + self.lower.abs()));
+        self.upper_velocity
+            .store(((next - z) / dt).to_bits(), Ordering::Relaxed);
+        self.set_upper(next);
     }
 }
 
@@ -249,7 +279,9 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn super::term::Term>>, MeshErr
             lower,
             upper0: upper,
             upper: AtomicU64::new(upper.to_bits()),
+            upper_velocity: AtomicU64::new(0.0f64.to_bits()),
             friction: s.friction,
+            contact_damping: s.contact_damping.unwrap_or(1.0),
             control: s.control,
             speed: s.speed,
             travel: s.travel,

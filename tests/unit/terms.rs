@@ -775,3 +775,105 @@ fn slide_friction_sticks_at_rest_and_brakes_sliding() {
         }
     }
 }
+
+/// Contact damping (explicit mode, ζ = 1): on a vertex in contact the dashpot `c = 2√(k m)`
+/// acts on the normal velocity relative to the slide that the step reaches, implicitly: after
+/// the step's update `v_z' = v_z − Δt g_z/m` equals `w = (v_z − v_slide − Δt g_z⁰/m)/(1 + Δt c/m)`
+/// plus the slide's velocity, and the added force opposes `w` (it dissipates). Tolerances:
+/// round-off of velocities of order 1 m/s, and of the slide's velocity from its heights. A vertex riding
+/// the moving upper slide at the slide's speed feels none; one out of contact feels none.
+#[test]
+fn slide_contact_damping_is_an_implicit_dashpot_relative_to_the_slide() {
+    let sc = strip_scene(
+        "[material]\nyoung = 3.0\npoisson = 0.5\ndensity = 1.0\nthickness = 0.02\n\
+         bending = \"patch_fit\"\n[solver]\nmode = \"explicit\"\n\
+         [slides]\nenabled = true\nlower = -0.1\nupper = 0.1\ncontrol = \"speed\"\n\
+         speed = 2.0\ntravel = 0.05\ncontact_damping = 1\n",
+    );
+    let p = Pattern::for_scene(&sc);
+    let pot = Potential::new(&sc, &p);
+    let slides = sc
+        .terms
+        .iter()
+        .find(|t| t.name() == "slides")
+        .expect("the slides term");
+    let (k, dt, speed) = (2.0, 1e-3, 2.0);
+    let n = sc.num_vertices();
+    // Vertex kinds: 0 pressed into the lower slide, moving down; 1 riding the upper slide at its
+    // speed; 2 in contact with the upper slide, moving up into it; 3 free in the gap.
+    let z = |i: usize| match i % 4 {
+        0 => -0.11,
+        1 | 2 => 0.1 - speed * dt + 0.005,
+        _ => 0.0,
+    };
+    let vz = |i: usize| match i % 4 {
+        0 => -1.0,
+        1 => -speed,
+        2 => 0.5,
+        _ => 0.7,
+    };
+    let x: Vec<Vec3> = sc
+        .mesh
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(i, q)| Vec3::new(q.x, q.y, z(i)))
+        .collect();
+    slides.explicit_begin(&pot, &x, dt);
+    let mut v: Vec<Vec3> = (0..n).map(|i| Vec3::new(0.0, 0.0, vz(i))).collect();
+    // The penalty's own gradient along z, and an in-plane force that must stay untouched.
+    let g0: Vec<Real> = (0..n)
+        .flat_map(|i| {
+            let gz = match i % 4 {
+                0 => -k * 0.01,
+                2 => k * 0.005,
+                _ => 0.0,
+            };
+            [0.3, -0.2, gz]
+        })
+        .collect();
+    let mut g = g0.clone();
+    slides.explicit_step(&pot, &x, &mut v, &mut g, dt);
+    for i in 0..n {
+        let m = sc.mass[i];
+        let c = 2.0 * (k * m).sqrt();
+        assert_eq!(
+            (g[3 * i], g[3 * i + 1]),
+            (0.3, -0.2),
+            "vertex {i}: in-plane force"
+        );
+        let added = g[3 * i + 2] - g0[3 * i + 2];
+        let slide = if i % 4 == 1 || i % 4 == 2 {
+            -speed
+        } else {
+            0.0
+        };
+        match i % 4 {
+            3 => assert_eq!(added, 0.0, "vertex {i} is out of contact"),
+            _ => {
+                let w = (vz(i) - slide - dt * g0[3 * i + 2] / m) / (1.0 + dt * c / m);
+                let after = vz(i) - dt * g[3 * i + 2] / m;
+                assert!(
+                    (after - slide - w).abs() <= 1e-12 * (1.0 + w.abs()),
+                    "vertex {i}: relative velocity {} after the step, implicit {w}",
+                    after - slide
+                );
+                assert!(
+                    (added - c * w).abs() <= 1e-12 * c * (1.0 + w.abs()),
+                    "vertex {i}: dashpot {added} vs {}",
+                    c * w
+                );
+                if i % 4 == 1 {
+                    // Riding the slide with no net force: no relative motion, no damping, up to
+                    // the round-off of the slide's velocity, (z₁ − z₀)/Δt ~ ε·0.1/Δt = 1e-14 m/s.
+                    assert!(
+                        added.abs() <= 1e-12 * c,
+                        "vertex {i} rides the slide: {added}"
+                    );
+                } else {
+                    assert!(-added * w < 0.0, "vertex {i}: the dashpot dissipates");
+                }
+            }
+        }
+    }
+}
