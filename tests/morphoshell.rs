@@ -844,34 +844,41 @@ fn morphoshell_output_fields() {
     );
 }
 
+/// Runs `settings/cone_squeezed.toml` on a unit disk of edge `edge` with `sets` overrides;
+/// returns the run's final (upper force, lower force, gap) after asserting it converged.
+fn squeeze_cone(edge: &str, sets: &[&str]) -> (Real, Real, Real) {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    shellsim(
+        &[
+            "mesh", "disk", "--radius", "1", "--edge", edge, "-o", "disk.vtk",
+        ],
+        d,
+    );
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = root.join("settings/cone_squeezed.toml");
+    let mut args = vec![scene.to_str().unwrap(), "disk.vtk", "--out", "o", "-q"];
+    for s in sets {
+        args.extend(["--set", s]);
+    }
+    shellsim(&args, d);
+    let s = summary(&d.join("o"));
+    assert_eq!(s["converged"], true, "{}", s["reason"]);
+    let col = |n: &str| *log_column(&d.join("o"), n).last().unwrap();
+    (
+        col("slide_upper_force"),
+        col("slide_lower_force"),
+        col("slide_gap"),
+    )
+}
+
 /// A cone pressed by a force-controlled slide (frictionless, after the dial) settles where the
 /// sheet carries the load: at the default equilibrium test both slides carry the applied force
 /// (the upper slide's backward-Euler update balances it exactly; the lower one through the
 /// sheet), and the cone is squashed below its free height.
 #[test]
 fn force_controlled_slide_squashes_a_cone_to_the_load() {
-    let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
-    shellsim(
-        &[
-            "mesh", "disk", "--radius", "1", "--edge", "0.25", "-o", "disk.vtk",
-        ],
-        d,
-    );
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let scene = root.join("settings/cone_squeezed.toml");
-    shellsim(
-        &[scene.to_str().unwrap(), "disk.vtk", "--out", "o", "-q"],
-        d,
-    );
-    let s = summary(&d.join("o"));
-    assert_eq!(s["converged"], true, "{}", s["reason"]);
-    let col = |n: &str| *log_column(&d.join("o"), n).last().unwrap();
-    let (up, down, gap) = (
-        col("slide_upper_force"),
-        col("slide_lower_force"),
-        col("slide_gap"),
-    );
+    let (up, down, gap) = squeeze_cone("0.25", &[]);
     eprintln!("squeezed cone: forces {up:e} / {down:e} N, gap {gap}");
     // At the test's force residual (1e-7 of E h × edge per node) the forces balance to ~1e-6.
     assert!((up - 0.002).abs() < 1e-5 * 0.002, "upper force {up}");
@@ -889,43 +896,15 @@ fn force_controlled_slide_squashes_a_cone_to_the_load() {
 /// slides carry the same force (the sheet is in equilibrium between them).
 #[test]
 fn slide_with_friction_squashing_a_cone_comes_to_rest() {
-    let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
-    shellsim(
+    let (up, down, gap) = squeeze_cone(
+        "0.2",
         &[
-            "mesh", "disk", "--radius", "1", "--edge", "0.2", "-o", "disk.vtk",
-        ],
-        d,
-    );
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let scene = root.join("settings/cone_squeezed.toml");
-    shellsim(
-        &[
-            scene.to_str().unwrap(),
-            "disk.vtk",
-            "--out",
-            "o",
-            "-q",
-            "--set",
             "slides.control=\"speed\"",
-            "--set",
             "slides.speed=0.005",
-            "--set",
             "slides.travel=0.70",
-            "--set",
             "slides.friction=0.3",
-            "--set",
             "explicit.max_long_times=4",
         ],
-        d,
-    );
-    let s = summary(&d.join("o"));
-    assert_eq!(s["converged"], true, "{}", s["reason"]);
-    let col = |n: &str| *log_column(&d.join("o"), n).last().unwrap();
-    let (up, down, gap) = (
-        col("slide_upper_force"),
-        col("slide_lower_force"),
-        col("slide_gap"),
     );
     assert!((gap - 0.11).abs() < 1e-12, "the slide stopped at gap {gap}");
     // At the test's force residual the vertical forces balance to ~1e-6 of the load.

@@ -706,6 +706,15 @@ fn low_rank_term_solves_like_the_dense_matrix() {
     assert!((s - 0.3).abs() < 0.05, "wᵀx = {s}");
 }
 
+/// The scene's slides term.
+fn slides_term(sc: &Scene) -> &dyn Term {
+    sc.terms
+        .iter()
+        .find(|t| t.name() == "slides")
+        .expect("the slides term")
+        .as_ref()
+}
+
 /// Slide friction (explicit mode) on a strip pressed 0.01 into the lower slide, normal force
 /// N = k · 0.01 per vertex with k = 100 μ t = 2 N/m, limit μ_f N: a vertex at rest with an
 /// in-plane force below the limit sticks (force and velocity zeroed); at rest above it, it slides
@@ -720,11 +729,7 @@ fn slide_friction_sticks_at_rest_and_brakes_sliding() {
     );
     let p = Pattern::for_scene(&sc);
     let pot = Potential::new(&sc, &p);
-    let slides = sc
-        .terms
-        .iter()
-        .find(|t| t.name() == "slides")
-        .expect("the slides term");
+    let slides = slides_term(&sc);
     let limit = 0.5 * 2.0 * 0.01;
     let n = sc.num_vertices();
     let x: Vec<Vec3> = sc
@@ -792,11 +797,7 @@ fn slide_contact_damping_is_an_implicit_dashpot_relative_to_the_slide() {
     );
     let p = Pattern::for_scene(&sc);
     let pot = Potential::new(&sc, &p);
-    let slides = sc
-        .terms
-        .iter()
-        .find(|t| t.name() == "slides")
-        .expect("the slides term");
+    let slides = slides_term(&sc);
     let (k, dt, speed) = (2.0, 1e-3, 2.0);
     let n = sc.num_vertices();
     // Vertex kinds: 0 pressed into the lower slide, moving down; 1 riding the upper slide at its
