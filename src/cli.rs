@@ -115,7 +115,7 @@ struct RenderArgs {
     #[arg(long)]
     field: Option<String>,
     /// iso, top, bottom, front, back, side, or AZIMUTH,ELEVATION in degrees.
-    #[arg(long, default_value = "iso")]
+    #[arg(long, default_value = "iso", allow_hyphen_values = true)]
     view: String,
     /// Picture size in pixels, WIDTHxHEIGHT.
     #[arg(long, default_value = "1024x768")]

@@ -94,6 +94,22 @@ fn render_draws_the_frame_where_the_view_puts_it() {
     assert!(near(top, [253, 231, 37]), "bar top {top:?}");
     assert!(near(bottom, [68, 1, 84]), "bar bottom {bottom:?}");
 
+    // A negative azimuth is a value, not a flag, written either way.
+    for view in [&["--view", "-60,15"][..], &["--view=-60,15"][..]] {
+        let mut args = vec![
+            "render",
+            "o/frame_00001.vtu",
+            "-o",
+            "neg.png",
+            "--size",
+            "200x150",
+        ];
+        args.extend_from_slice(view);
+        let (c, e) = run(&args, p);
+        assert_eq!(c, 0, "{view:?}: {e}");
+        assert_eq!(decode(&p.join("neg.png")).0, 200);
+    }
+
     // Bad input: exit 2, what exists named, no picture.
     let cases: [(&[&str], &str); 5] = [
         (&["--field", "curvature_of_nothing"], "mean_curvature"),
