@@ -1,6 +1,8 @@
 //! CLI tests: run the real binary in a temporary folder and check exit codes, messages and the
 //! files written (or not written).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -15,15 +17,11 @@ struct Run {
 }
 
 fn run(args: &[&str], dir: &Path) -> Run {
-    let out = bin()
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("binary runs");
+    let (code, stdout, stderr) = common::run_status(args, dir);
     Run {
-        code: out.status.code().unwrap_or(-1),
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        code,
+        stderr,
+        stdout,
     }
 }
 
