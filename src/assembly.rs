@@ -569,18 +569,22 @@ where
 }
 
 impl Parts {
-    /// Splits the elements of `map` into `count` ranges of equal length along their Morton
-    /// order (an element's *home* part); a node belongs to the home of the first element in that
-    /// order that holds it. Each part evaluates the elements that hold one of its nodes, plus
-    /// those it is home to (for the energy): elements across a part boundary are evaluated by
-    /// each part that needs them.
-    fn new(map: &ElementMap, count: usize) -> Parts {
+    /// Splits the elements of `map` into `count = cuts.len() − 1` ranges along their Morton
+    /// order, part p taking ranks `cuts[p]..cuts[p + 1]` (an element's *home* part); a node
+    /// belongs to the home of the first element in that order that holds it. Each part
+    /// evaluates the elements that hold one of its nodes, plus those it is home to (for the
+    /// energy): elements across a part boundary are evaluated by each part that needs them.
+    fn new(map: &ElementMap, cuts: Vec<usize>) -> Parts {
         let ne = map.len();
+        let count = cuts.len() - 1;
+        debug_assert!(cuts[0] == 0 && cuts[count] == ne && cuts.is_sorted());
         let num_nodes = map.gather_ptr.len() - 1;
         let stride = map.stride;
         let mut home = vec![0u32; ne];
-        for (r, &e) in map.morton.iter().enumerate() {
-            home[e as usize] = (r * count / ne.max(1)) as u32;
+        for p in 0..count {
+            for &e in &map.morton[cuts[p]..cuts[p + 1]] {
+                home[e as usize] = p as u32;
+            }
         }
         let mut owner = vec![u32::MAX; num_nodes];
         for &e in &map.morton {
@@ -636,6 +640,49 @@ impl Parts {
             energy_at,
         }
     }
+
+    /// Per part, a zeroed buffer for its elements' outputs (`map.stride` each) and its nodes'
+    /// sums.
+    fn buffers(&self, map: &ElementMap) -> Vec<Vec<Real>> {
+        (0..self.count)
+            .map(|p| {
+                let sums: usize = self.nodes[p]
+                    .iter()
+                    .map(|&u| node_dofs(map.num_vertices, u as usize).1)
+                    .sum();
+                vec![0.0; self.elements[p].len() * map.stride + sums]
+            })
+            .collect()
+    }
+
+    /// Equal home ranges of `ne` elements for `count` parts.
+    fn even_cuts(ne: usize, count: usize) -> Vec<usize> {
+        (0..=count).map(|p| p * ne / count).collect()
+    }
+}
+
+impl ElementMap {
+    /// Installs the gradient partition with home ranges `cuts` (Morton ranks, `cuts[0] = 0`,
+    /// last = the element count, increasing): for tests that check that the gradient does not
+    /// depend on the partition. It stays until the part count changes.
+    #[doc(hidden)]
+    pub fn set_gradient_partition(&self, cuts: &[usize]) {
+        assert!(
+            cuts.len() >= 2
+                && cuts[0] == 0
+                && *cuts.last().unwrap() == self.len()
+                && cuts.windows(2).all(|w| w[0] < w[1]),
+            "bad cuts {cuts:?} for {} elements",
+            self.len()
+        );
+        let parts = Parts::new(self, cuts.to_vec());
+        let bufs = parts.buffers(self);
+        *self
+            .scratch
+            .0
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner()) = Some((parts, bufs));
+    }
 }
 
 /// The gradient of one element term without colouring, owner-computes: the nodes are split
@@ -667,17 +714,11 @@ where
         .0
         .lock()
         .unwrap_or_else(|poisoned| poisoned.into_inner());
-    if guard.as_ref().map(|(p, _)| p.count) != Some(count) {
-        let parts = Parts::new(map, count);
-        let bufs = (0..count)
-            .map(|p| {
-                let sums: usize = parts.nodes[p]
-                    .iter()
-                    .map(|&u| node_dofs(map.num_vertices, u as usize).1)
-                    .sum();
-                vec![0.0; parts.elements[p].len() * (N + 1) + sums]
-            })
-            .collect();
+    let cuts =
+        (guard.as_ref().map(|(p, _)| p.count) != Some(count)).then(|| Parts::even_cuts(ne, count));
+    if let Some(cuts) = cuts {
+        let parts = Parts::new(map, cuts);
+        let bufs = parts.buffers(map);
         *guard = Some((parts, bufs));
     }
     let (parts, bufs) = guard.as_mut().expect("the partition was just built");

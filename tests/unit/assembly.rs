@@ -119,6 +119,64 @@ fn bitwise_identical(model: &str) {
     assert_eq!(one, eval(4));
 }
 
+/// The gradient-only assembly (owner-computes, one part per thread) gives the same bits for
+/// any partition of the elements into parts: even ones for 1–4 threads, skewed ones installed
+/// by hand (a part of 1 element, a part of nearly all, quadratically growing parts). Patch fit
+/// (vertices only) and mid-edge (edge DOFs).
+#[test]
+fn gradient_is_bitwise_identical_for_any_partition() {
+    for model in [MODELS[1], MODELS[2]] {
+        let sc = scene_with_edge(
+            &format!("[material]\n{model}\n[rest]\ntarget = \"mesh\"\n"),
+            Some(Case::SphericalCap),
+            0.05,
+        );
+        let p = pattern(&sc);
+        let x = bumpy(&sc);
+        let phi = angles(&sc);
+        let pot = Potential {
+            dial: 0.7,
+            ..Potential::new(&sc, &p)
+        };
+        let grad = || {
+            let mut g = vec![0.0; p.n];
+            let e = pot.eval(&x, &phi, Want::Gradient, &mut g, &mut []);
+            (
+                e.to_bits(),
+                g.iter().map(|v| v.to_bits()).collect::<Vec<u64>>(),
+            )
+        };
+        let pool = |t: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build()
+                .unwrap()
+        };
+        let one = pool(1).install(grad);
+        for t in [2, 3, 4] {
+            let pl = pool(t);
+            assert!(pl.install(grad) == one, "{model}: {t} threads, even parts");
+            let ne = p.maps.iter().map(|m| m.len()).max().unwrap();
+            let skews: Vec<Vec<usize>> = vec![
+                (0..=t).map(|k| if k == t { ne } else { k }).collect(),
+                (0..=t)
+                    .map(|k| if k == 0 { 0 } else { ne - (t - k) })
+                    .collect(),
+                (0..=t).map(|k| k * k * ne / (t * t)).collect(),
+            ];
+            for cuts in &skews {
+                for m in p.maps.iter().filter(|m| m.len() == ne) {
+                    m.set_gradient_partition(cuts);
+                }
+                assert!(
+                    pl.install(grad) == one,
+                    "{model}: {t} threads, parts {cuts:?}"
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn assembled_derivatives_match_finite_differences() {
     for model in MODELS {
