@@ -14,11 +14,12 @@
 //! force and velocity are set to 0; at rest this is MorphoShell's `|f_h| < μ_f N`), else it
 //! slides with the force `μ_f N v*/|v*|` against that velocity, so friction only dissipates.
 //!
-//! **Contact damping** (explicit mode, optional): a dashpot `c = ζ 2√(k m)` on the normal
-//! velocity of a vertex in contact, ζ the fraction of critical damping of the vertex on its
-//! penalty spring, applied implicitly (`v_z' = v_z*/(1 + Δt c/m)`, stable for any ζ). It acts
-//! only on motion into or out of a slide, so equilibria are unchanged; it damps the stiff
-//! vertical oscillations that the global drag, tuned to the slowest bending mode, leaves alive.
+//! **Contact damping** (explicit mode; `contact_damping` ζ, default 1): a dashpot
+//! `c = ζ 2√(k m)` on the normal velocity `w = v_z − v_slide` of a vertex in contact relative to
+//! the slide it touches, ζ the fraction of critical damping of the vertex on its penalty spring,
+//! applied implicitly (`w' = w*/(1 + Δt c/m)`, stable for any ζ). It acts only on motion into
+//! or out of a slide, so equilibria are unchanged; it damps the stiff vertical oscillations
+//! that the global drag, tuned to the slowest bending mode, leaves alive.
 //!
 //! **Motion** (explicit mode; with `after_dial` only once the dial has reached 1): speed control
 //! moves the upper slide down at `speed` until it has moved `travel`; force control moves it overdamped, `ζ dz_u/dt = F_up − F`, with `F_up` the

@@ -84,21 +84,30 @@ fn assembly_is_bitwise_identical_for_any_thread_count() {
     }
 }
 
-fn bitwise_identical(model: &str) {
-    let sc = scene_with_edge(
+/// The spherical cap programmed by its mesh, with bending `model`, at edge length `edge`.
+fn cap_scene(model: &str, edge: f64) -> Scene {
+    scene_with_edge(
         &format!("[material]\n{model}\n[rest]\ntarget = \"mesh\"\n"),
         Some(Case::SphericalCap),
-        0.02,
-    );
+        edge,
+    )
+}
+
+/// A rayon pool of `threads` threads.
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+}
+
+fn bitwise_identical(model: &str) {
+    let sc = cap_scene(model, 0.02);
     let p = pattern(&sc);
     let x = bumpy(&sc);
     let phi = angles(&sc);
     let eval = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        pool(threads).install(|| {
             let pot = Potential {
                 dial: 0.7,
                 gravity: Vec3::new(0.0, 0.0, -9.81),
@@ -126,11 +135,7 @@ fn bitwise_identical(model: &str) {
 #[test]
 fn gradient_is_bitwise_identical_for_any_partition() {
     for model in [MODELS[1], MODELS[2]] {
-        let sc = scene_with_edge(
-            &format!("[material]\n{model}\n[rest]\ntarget = \"mesh\"\n"),
-            Some(Case::SphericalCap),
-            0.05,
-        );
+        let sc = cap_scene(model, 0.05);
         let p = pattern(&sc);
         let x = bumpy(&sc);
         let phi = angles(&sc);
@@ -145,12 +150,6 @@ fn gradient_is_bitwise_identical_for_any_partition() {
                 e.to_bits(),
                 g.iter().map(|v| v.to_bits()).collect::<Vec<u64>>(),
             )
-        };
-        let pool = |t: usize| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(t)
-                .build()
-                .unwrap()
         };
         let one = pool(1).install(grad);
         for t in [2, 3, 4] {
