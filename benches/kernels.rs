@@ -584,12 +584,16 @@ fn explicit_step(c: &mut Criterion) {
                     let mut x = x0.clone();
                     let mut v = vec![Vec3::zeros(); x.len()];
                     let mut gr = vec![0.0; p.n];
-                    // The whole loop runs inside the pool, as a run does (`cli` installs the
-                    // pool once): the per-step cost includes no hand-off into the pool.
+                    // The whole loop runs inside the pool with a team of as many threads, as
+                    // a run does (`cli` installs the pool once, the explicit driver starts
+                    // the team): the per-step cost includes no hand-off into either.
                     pool.install(|| {
-                        b.iter(|| {
-                            gradient(&pot, &x, &mut gr);
-                            advance(&mut x, &mut v, &gr, &inv_m, 1e-3, 1e-9);
+                        let team = shellsim::team::Team::new(threads);
+                        team.activate(|| {
+                            b.iter(|| {
+                                gradient(&pot, &x, &mut gr);
+                                advance(&mut x, &mut v, &gr, &inv_m, 1e-3, 1e-9);
+                            })
                         })
                     })
                 });

@@ -87,7 +87,10 @@ struct Parts {
     /// part's buffer, in element order.
     ptr: Vec<Vec<u32>>,
     offsets: Vec<Vec<u32>>,
-    /// Per element, the part whose buffer holds its energy and its position in that part.
+    /// Per part, the positions in `elements` of the elements it is home to, in element order:
+    /// their energies are copied into the compact tail of the part's buffer.
+    home: Vec<Vec<u32>>,
+    /// Per element, its home part and its index in that part's compact energies.
     energy_at: Vec<(u32, u32)>,
 }
 
@@ -614,12 +617,14 @@ impl Parts {
         let mut ptr: Vec<Vec<u32>> = vec![vec![0]; count];
         let mut offsets: Vec<Vec<u32>> = vec![Vec::new(); count];
         let mut energy_at = vec![(0u32, 0u32); ne];
+        let mut homes: Vec<Vec<u32>> = vec![Vec::new(); count];
         let mut pos = vec![0u32; ne];
         for p in 0..count {
             for (k, &e) in elements[p].iter().enumerate() {
                 pos[e as usize] = k as u32;
                 if home[e as usize] as usize == p {
-                    energy_at[e as usize] = (p as u32, k as u32);
+                    energy_at[e as usize] = (p as u32, homes[p].len() as u32);
+                    homes[p].push(k as u32);
                 }
             }
             for u in (0..num_nodes).filter(|&u| owner[u] as usize == p) {
@@ -637,12 +642,13 @@ impl Parts {
             nodes,
             ptr,
             offsets,
+            home: homes,
             energy_at,
         }
     }
 
-    /// Per part, a zeroed buffer for its elements' outputs (`map.stride` each) and its nodes'
-    /// sums.
+    /// Per part, a zeroed buffer for its elements' outputs (`map.stride` each), its nodes'
+    /// sums and its home elements' energies.
     fn buffers(&self, map: &ElementMap) -> Vec<Vec<Real>> {
         (0..self.count)
             .map(|p| {
@@ -650,7 +656,7 @@ impl Parts {
                     .iter()
                     .map(|&u| node_dofs(map.num_vertices, u as usize).1)
                     .sum();
-                vec![0.0; self.elements[p].len() * map.stride + sums]
+                vec![0.0; self.elements[p].len() * map.stride + sums + self.home[p].len()]
             })
             .collect()
     }
@@ -691,6 +697,8 @@ impl ElementMap {
 /// nodes' entries there, each in element order; then one sequential pass adds the sums into
 /// `grad`. One synchronisation per call and no memory written by two threads; elements on a
 /// part boundary are evaluated more than once (2–3% of them on the explicit bench's meshes).
+/// The parts run on the calling thread's active [`crate::team::Team`] when there is one (one
+/// part per team thread), otherwise on rayon's pool.
 /// Every entry is the same sum in the same order whatever the partition, so results are
 /// bitwise identical for any number of threads. Returns the energy, summed in element order.
 fn gather_gradient<const N: usize, const S: usize, K>(
@@ -702,13 +710,31 @@ fn gather_gradient<const N: usize, const S: usize, K>(
 where
     K: Fn(usize, &[usize], Option<&mut SVec<N>>, Option<&mut SMat<N, N>>) -> Real + Sync,
 {
-    let ne = map.len();
     assert_eq!(
         map.stride,
         N + 1,
         "element map and kernel disagree on the DOFs"
     );
-    let count = rayon::current_num_threads().clamp(1, ne.max(1));
+    crate::team::with_active(|team| {
+        let threads = team.map_or_else(rayon::current_num_threads, |t| t.threads());
+        gather_gradient_on::<N, S, K>(map, kernel, fixed, grad, team, threads)
+    })
+}
+
+/// [`gather_gradient`] in `threads` parts, run by `team` when there is one, else by rayon.
+fn gather_gradient_on<const N: usize, const S: usize, K>(
+    map: &ElementMap,
+    kernel: &K,
+    fixed: &[bool],
+    grad: &mut [Real],
+    team: Option<&crate::team::Team>,
+    threads: usize,
+) -> Real
+where
+    K: Fn(usize, &[usize], Option<&mut SVec<N>>, Option<&mut SMat<N, N>>) -> Real + Sync,
+{
+    let ne = map.len();
+    let count = threads.clamp(1, ne.max(1));
     let mut guard = map
         .scratch
         .0
@@ -737,6 +763,13 @@ where
         // into `grad`, whose lines the parts share, would make the cores fight over them.
         let (own, ptr, offsets) = (&parts.nodes[p], &parts.ptr[p], &parts.offsets[p]);
         let (buf, sums) = buf.split_at_mut(parts.elements[p].len() * (N + 1));
+        // The home elements' energies, packed at the end: the caller reads them, and reading
+        // them in place would share one line per element with the part's next writes.
+        let homes = &parts.home[p];
+        let (sums, energies) = sums.split_at_mut(sums.len() - homes.len());
+        for (en, &k) in energies.iter_mut().zip(homes) {
+            *en = buf[k as usize * (N + 1) + N];
+        }
         let mut at = 0;
         for (k, &u) in own.iter().enumerate() {
             let dofs = node_dofs(nv, u as usize).1;
@@ -752,6 +785,13 @@ where
     };
     if parts.count == 1 {
         work(0, &mut bufs[0]);
+    } else if let Some(team) = team.filter(|t| t.threads() == parts.count) {
+        let shared: Vec<Shared> = bufs.iter_mut().map(|b| Shared::new(b)).collect();
+        team.run(&|p| {
+            let Shared(ptr, len) = shared[p];
+            // SAFETY: part p alone touches buffer p, and `run` returns after every part.
+            work(p, unsafe { std::slice::from_raw_parts_mut(ptr, len) });
+        });
     } else {
         bufs.par_iter_mut()
             .enumerate()
@@ -773,6 +813,9 @@ where
     parts
         .energy_at
         .iter()
-        .map(|&(p, k)| bufs[p as usize][k as usize * (N + 1) + N])
+        .map(|&(p, c)| {
+            let buf = &bufs[p as usize];
+            buf[buf.len() - parts.home[p as usize].len() + c as usize]
+        })
         .sum()
 }

@@ -52,3 +52,4 @@ pub mod scene;
 pub mod settings;
 pub mod solve;
 pub mod sweep;
+pub mod team;

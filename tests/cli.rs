@@ -378,6 +378,41 @@ fn results_do_not_depend_on_the_thread_count() {
     let b = std::fs::read(p.join("o2/frame_00001.vtu")).unwrap();
     let c = std::fs::read(p.join("o3/frame_00001.vtu")).unwrap();
     assert!(a == b && b == c, "frames differ between thread counts");
+    // The explicit driver, whose steps run on a team of spinning threads: every frame of a
+    // run cut short after two long times (exit 1: no equilibrium yet).
+    write(
+        p,
+        "e.toml",
+        "[material]\nthickness = 0.05\nbending = \"patch_fit\"\n[rest]\ntarget = \"mesh\"\n\
+         [solver]\nmode = \"explicit\"\n[explicit]\nmax_long_times = 2\n",
+    );
+    let frames = |t: &str| {
+        let r = run(
+            &["e.toml", "m.vtk", "--out", &format!("e{t}"), "--threads", t],
+            p,
+        );
+        assert_eq!(r.code, 1, "{}", r.stderr);
+        let mut names: Vec<_> = std::fs::read_dir(p.join(format!("e{t}")))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|f| f.extension().is_some_and(|x| x == "vtu"))
+            .collect();
+        names.sort();
+        assert!(names.len() > 10, "{names:?}");
+        names
+            .iter()
+            .map(|f| std::fs::read(f).unwrap())
+            .collect::<Vec<_>>()
+    };
+    let one = frames("1");
+    assert!(
+        frames("2") == one,
+        "explicit frames differ between 1 and 2 threads"
+    );
+    assert!(
+        frames("3") == one,
+        "explicit frames differ between 1 and 3 threads"
+    );
 }
 
 #[test]

@@ -217,7 +217,6 @@ pub fn max_frequency_squared(pot: &Potential, x: &[Vec3], iterations: usize) -> 
 /// The forces of one explicit step: `g ← ∇Φ(x)` (zeroed first; N), returning Φ (J).
 #[inline]
 pub fn gradient(pot: &Potential, x: &[Vec3], g: &mut [Real]) -> Real {
-    g.iter_mut().for_each(|v| *v = 0.0);
     pot.eval(x, &[], Want::Gradient, g, &mut [])
 }
 
@@ -376,179 +375,185 @@ pub(super) fn run_explicit(
     let mut steps: usize = 0;
     // The densities at a dial that stays put (holds, waiting), computed once.
     let mut frozen: Option<(Real, Vec<crate::energy::material::KoiterDensity>)> = None;
-    let stop = loop {
-        if let Some(f) = super::interruption("t", t) {
-            break Stop::Other(f.to_string());
-        }
-        if phase == Phase::Wait && frozen.as_ref().is_none_or(|(d, _)| *d != dial) {
-            let pot = s.potential(dial);
-            frozen = Some((dial, (0..sc.num_faces()).map(|f| pot.density(f)).collect()));
-        }
-        let pot = Potential {
-            frozen: frozen
-                .as_ref()
-                .filter(|(d, _)| *d == dial)
-                .map(|(_, v)| &v[..]),
-            ..s.potential(dial)
-        };
-        sc.prescribe(&mut state.x, dial);
-        // Terms whose own state follows the sheet (a moving slide) catch up with it first.
-        for term in sc.terms.iter() {
-            term.explicit_begin(&pot, &state.x, dt);
-        }
-        let clock = std::time::Instant::now();
-        let energy = gradient(&pot, &state.x, &mut g);
-        s.summary.timing.newton.assembly += clock.elapsed().as_secs_f64();
-        // Terms that act on the step itself (slide friction), before the equilibrium test sees
-        // the forces.
-        for term in sc.terms.iter() {
-            term.explicit_step(&pot, &state.x, &mut v, &mut g, dt);
-        }
-        let c = if phase == Phase::Dial {
-            rate_dial
-        } else {
-            rate_wait
-        };
-        // The equilibrium test, once per window (before the step, at the state the force
-        // belongs to).
-        if steps.is_multiple_of(window_steps) && steps > 0 {
-            let healthy = energy.is_finite()
-                && state.x.iter().all(|p| p.iter().all(|c| c.is_finite()))
-                && v.iter().all(|p| p.iter().all(|c| c.is_finite()));
-            let kinetic: Real = v
-                .iter()
-                .zip(mass)
-                .map(|(v, m)| 0.5 * m * v.norm_squared())
-                .sum();
-            if !healthy || kinetic > blow_up {
-                break Stop::Unstable(format!(
+    // The steps' gradients run on a team of spinning threads: a step is too short for rayon's
+    // sleeping workers to be woken twice per step (`crate::team`).
+    let team = crate::team::Team::new(rayon::current_num_threads());
+    let stop = team.activate(|| -> Result<Stop, RunError> {
+        Ok(loop {
+            if let Some(f) = super::interruption("t", t) {
+                break Stop::Other(f.to_string());
+            }
+            if phase == Phase::Wait && frozen.as_ref().is_none_or(|(d, _)| *d != dial) {
+                let pot = s.potential(dial);
+                frozen = Some((dial, (0..sc.num_faces()).map(|f| pot.density(f)).collect()));
+            }
+            let pot = Potential {
+                frozen: frozen
+                    .as_ref()
+                    .filter(|(d, _)| *d == dial)
+                    .map(|(_, v)| &v[..]),
+                ..s.potential(dial)
+            };
+            sc.prescribe(&mut state.x, dial);
+            // Terms whose own state follows the sheet (a moving slide) catch up with it first.
+            for term in sc.terms.iter() {
+                term.explicit_begin(&pot, &state.x, dt);
+            }
+            let clock = std::time::Instant::now();
+            let energy = gradient(&pot, &state.x, &mut g);
+            s.summary.timing.newton.assembly += clock.elapsed().as_secs_f64();
+            // Terms that act on the step itself (slide friction), before the equilibrium test sees
+            // the forces.
+            for term in sc.terms.iter() {
+                term.explicit_step(&pot, &state.x, &mut v, &mut g, dt);
+            }
+            let c = if phase == Phase::Dial {
+                rate_dial
+            } else {
+                rate_wait
+            };
+            // The equilibrium test, once per window (before the step, at the state the force
+            // belongs to).
+            if steps.is_multiple_of(window_steps) && steps > 0 {
+                let healthy = energy.is_finite()
+                    && state.x.iter().all(|p| p.iter().all(|c| c.is_finite()))
+                    && v.iter().all(|p| p.iter().all(|c| c.is_finite()));
+                let kinetic: Real = v
+                    .iter()
+                    .zip(mass)
+                    .map(|(v, m)| 0.5 * m * v.norm_squared())
+                    .sum();
+                if !healthy || kinetic > blow_up {
+                    break Stop::Unstable(format!(
                     "the explicit dynamics went unstable at t = {t:.6e} s (energy {energy:e} J, \
                      kinetic {kinetic:e} J): lower explicit.time_step_prefactor (now {}, this \
                      mesh's measured limit {})",
                     cf.time_step_prefactor,
                     stable_prefactor.map_or("unknown".into(), |p| format!("{p:.3}"))
                 ));
-            }
-            let at_rest = phase == Phase::Wait
-                && match cf.equilibrium {
-                    EquilibriumTest::Window => {
-                        let r = pot.residual(&g);
-                        let moved = state
-                            .x
-                            .iter()
-                            .zip(&window.x)
-                            .map(|(a, b)| (a - b).norm())
-                            .fold(0.0, Real::max);
-                        let scale = energy.abs().max(energy_floor).max(Real::MIN_POSITIVE);
-                        r <= cf.force_tolerance
-                            && moved <= cf.shape_tolerance * size
-                            && (energy - window.energy).abs() <= cf.energy_tolerance * scale
-                            && kinetic <= cf.energy_tolerance * scale
-                    }
-                    EquilibriumTest::Morphoshell => {
-                        let (mut fmax, mut vmax): (Real, Real) = (0.0, 0.0);
-                        for i in 0..n {
-                            if inv_m[i] == 0.0 {
-                                continue;
-                            }
-                            let f = -Vec3::new(g[3 * i], g[3 * i + 1], g[3 * i + 2])
-                                - v[i] * (c * mass[i]);
-                            fmax = fmax.max(f.norm());
-                            vmax = vmax.max(v[i].norm());
-                        }
-                        fmax / (sca.mu * sca.t * sca.a_min) < cf.morphoshell_force_threshold
-                            && vmax / (sca.mu / sca.rho).sqrt() < cf.morphoshell_speed_threshold
-                    }
-                };
-            window.x.copy_from_slice(&state.x);
-            window.energy = energy;
-            if at_rest {
-                if dial >= 1.0 {
-                    break Stop::Converged;
                 }
-                report.holds_reached += 1;
-                s.summary.holds_reached += 1;
-                phase = Phase::Dial;
-                let pot = s.potential(dial);
-                s.summary.residual = pot.residual(&g);
-                s.frame(writer, &pot, &state, &v, t)?;
-                next_frame = t + frame_interval;
-            }
-            if t >= t_max {
-                break Stop::Other(format!(
+                let at_rest = phase == Phase::Wait
+                    && match cf.equilibrium {
+                        EquilibriumTest::Window => {
+                            let r = pot.residual(&g);
+                            let moved = state
+                                .x
+                                .iter()
+                                .zip(&window.x)
+                                .map(|(a, b)| (a - b).norm())
+                                .fold(0.0, Real::max);
+                            let scale = energy.abs().max(energy_floor).max(Real::MIN_POSITIVE);
+                            r <= cf.force_tolerance
+                                && moved <= cf.shape_tolerance * size
+                                && (energy - window.energy).abs() <= cf.energy_tolerance * scale
+                                && kinetic <= cf.energy_tolerance * scale
+                        }
+                        EquilibriumTest::Morphoshell => {
+                            let (mut fmax, mut vmax): (Real, Real) = (0.0, 0.0);
+                            for i in 0..n {
+                                if inv_m[i] == 0.0 {
+                                    continue;
+                                }
+                                let f = -Vec3::new(g[3 * i], g[3 * i + 1], g[3 * i + 2])
+                                    - v[i] * (c * mass[i]);
+                                fmax = fmax.max(f.norm());
+                                vmax = vmax.max(v[i].norm());
+                            }
+                            fmax / (sca.mu * sca.t * sca.a_min) < cf.morphoshell_force_threshold
+                                && vmax / (sca.mu / sca.rho).sqrt() < cf.morphoshell_speed_threshold
+                        }
+                    };
+                window.x.copy_from_slice(&state.x);
+                window.energy = energy;
+                if at_rest {
+                    if dial >= 1.0 {
+                        break Stop::Converged;
+                    }
+                    report.holds_reached += 1;
+                    s.summary.holds_reached += 1;
+                    phase = Phase::Dial;
+                    let pot = s.potential(dial);
+                    s.summary.residual = pot.residual(&g);
+                    s.frame(writer, &pot, &state, &v, t)?;
+                    next_frame = t + frame_interval;
+                }
+                if t >= t_max {
+                    break Stop::Other(format!(
                     "no equilibrium after explicit.max_long_times = {} long times ({t:.6e} s); \
                      residual {:.3e}",
                     cf.max_long_times,
                     pot.residual(&g)
                 ));
+                }
             }
-        }
-        // The step.
-        if gd_left > 0 {
-            let cg = c.max(Real::MIN_POSITIVE);
-            let h = cg * dt * dt / 2.0;
-            for i in 0..n {
-                let f = Vec3::new(g[3 * i], g[3 * i + 1], g[3 * i + 2]);
-                v[i] = -f * (inv_m[i] / cg);
-                state.x[i] += v[i] * h;
-            }
-            gd_left -= 1;
-            if gd_left == 0 {
-                v.iter_mut().for_each(|v| *v = Vec3::zeros());
-            }
-        } else {
-            advance(&mut state.x, &mut v, &g, &inv_m, c, dt);
-        }
-        t += dt;
-        steps += 1;
-        s.summary.steps += 1;
-        if phase == Phase::Dial && dial < 1.0 {
-            dial = if dial_time > 0.0 {
-                (dial + dt / dial_time).min(1.0)
+            // The step.
+            if gd_left > 0 {
+                let cg = c.max(Real::MIN_POSITIVE);
+                let h = cg * dt * dt / 2.0;
+                for i in 0..n {
+                    let f = Vec3::new(g[3 * i], g[3 * i + 1], g[3 * i + 2]);
+                    v[i] = -f * (inv_m[i] / cg);
+                    state.x[i] += v[i] * h;
+                }
+                gd_left -= 1;
+                if gd_left == 0 {
+                    v.iter_mut().for_each(|v| *v = Vec3::zeros());
+                }
             } else {
-                1.0
-            };
-            if let Some(k) = next_hold {
-                if dial >= holds[k] {
-                    dial = holds[k];
-                    next_hold = (k + 1 < holds.len()).then_some(k + 1);
+                advance(&mut state.x, &mut v, &g, &inv_m, c, dt);
+            }
+            t += dt;
+            steps += 1;
+            s.summary.steps += 1;
+            if phase == Phase::Dial && dial < 1.0 {
+                dial = if dial_time > 0.0 {
+                    (dial + dt / dial_time).min(1.0)
+                } else {
+                    1.0
+                };
+                if let Some(k) = next_hold {
+                    if dial >= holds[k] {
+                        dial = holds[k];
+                        next_hold = (k + 1 < holds.len()).then_some(k + 1);
+                        phase = Phase::Wait;
+                    }
+                }
+                if dial >= 1.0 {
                     phase = Phase::Wait;
                 }
             }
-            if dial >= 1.0 {
-                phase = Phase::Wait;
-            }
-        }
-        if t >= next_frame {
-            let pot = s.potential(dial);
-            let healthy = state.x.iter().all(|p| p.iter().all(|c| c.is_finite()));
-            if !healthy {
-                break Stop::Unstable(format!(
-                    "the explicit dynamics went unstable at t = {t:.6e} s (a position is not \
+            if t >= next_frame {
+                let pot = s.potential(dial);
+                let healthy = state.x.iter().all(|p| p.iter().all(|c| c.is_finite()));
+                if !healthy {
+                    break Stop::Unstable(format!(
+                        "the explicit dynamics went unstable at t = {t:.6e} s (a position is not \
                      finite): lower explicit.time_step_prefactor (now {})",
-                    cf.time_step_prefactor
-                ));
-            }
-            s.summary.residual = Real::NAN;
-            s.frame(writer, &pot, &state, &v, t)?;
-            next_frame += frame_interval;
-            progress.update(
-                if phase == Phase::Dial {
-                    0.5 * dial
-                } else {
-                    0.5 + 0.5 * (t / t_max).min(1.0)
-                },
-                &format!(
-                    "explicit {}  t {t:.4e} s  dial {dial:.3}  E {energy:.4e} J",
+                        cf.time_step_prefactor
+                    ));
+                }
+                s.summary.residual = Real::NAN;
+                s.frame(writer, &pot, &state, &v, t)?;
+                next_frame += frame_interval;
+                progress.update(
                     if phase == Phase::Dial {
-                        "dialling"
+                        0.5 * dial
                     } else {
-                        "waiting"
-                    }
-                ),
-            );
-        }
-    };
+                        0.5 + 0.5 * (t / t_max).min(1.0)
+                    },
+                    &format!(
+                        "explicit {}  t {t:.4e} s  dial {dial:.3}  E {energy:.4e} J",
+                        if phase == Phase::Dial {
+                            "dialling"
+                        } else {
+                            "waiting"
+                        }
+                    ),
+                );
+            }
+        })
+    })?;
+    drop(team);
     let wall = clock.elapsed().as_secs_f64();
     report.microseconds_per_face_step =
         1e6 * wall / (steps.max(1) as Real * sc.num_faces() as Real);

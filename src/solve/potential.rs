@@ -180,7 +180,12 @@ impl<'a> Potential<'a> {
     ) -> Real {
         let sc = self.scene;
         if want != Want::Energy {
-            grad.par_chunks_mut(1 << 14).for_each(|c| c.fill(0.0));
+            // Within a team's hot loop, rayon's workers stay asleep: waking one would take a
+            // core from the team's spinning helpers.
+            crate::team::with_active(|team| match team {
+                Some(_) => grad.fill(0.0),
+                None => grad.par_chunks_mut(1 << 14).for_each(|c| c.fill(0.0)),
+            });
         }
         if want == Want::Hessian {
             values.par_chunks_mut(1 << 14).for_each(|c| c.fill(0.0));

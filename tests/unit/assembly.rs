@@ -155,6 +155,11 @@ fn gradient_is_bitwise_identical_for_any_partition() {
         for t in [2, 3, 4] {
             let pl = pool(t);
             assert!(pl.install(grad) == one, "{model}: {t} threads, even parts");
+            let team = shellsim::team::Team::new(t);
+            assert!(
+                pl.install(|| team.activate(grad)) == one,
+                "{model}: a team of {t} threads"
+            );
             let ne = p.maps.iter().map(|m| m.len()).max().unwrap();
             let skews: Vec<Vec<usize>> = vec![
                 (0..=t).map(|k| if k == t { ne } else { k }).collect(),
@@ -170,6 +175,10 @@ fn gradient_is_bitwise_identical_for_any_partition() {
                 assert!(
                     pl.install(grad) == one,
                     "{model}: {t} threads, parts {cuts:?}"
+                );
+                assert!(
+                    pl.install(|| team.activate(grad)) == one,
+                    "{model}: a team of {t} threads, parts {cuts:?}"
                 );
             }
         }
