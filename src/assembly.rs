@@ -12,7 +12,8 @@
 //! Hessian directly into entries no other block of that colour touches. Every entry therefore
 //! receives its contributions in a fixed order that does not depend on the threads: no
 //! floating-point atomics, no per-thread accumulators, results bitwise identical for any number
-//! of threads. Energies are stored per element and summed in element order.
+//! of threads. Energies are stored per element and summed in fixed blocks along the elements'
+//! Morton curve ([`ElementMap::sum_energies`]).
 
 use crate::energy::projection::{project, HessianProjection};
 use crate::energy::term::Stencil;
@@ -87,12 +88,28 @@ struct Parts {
     /// part's buffer, in element order.
     ptr: Vec<Vec<u32>>,
     offsets: Vec<Vec<u32>>,
-    /// Per part, the positions in `elements` of the elements it is home to, in element order:
-    /// their energies are copied into the compact tail of the part's buffer.
+    /// Per part, the positions in `elements` of the elements it is home to, by Morton rank:
+    /// the part sums their energies in blocks of [`EBLOCK`] into the tail of its buffer.
     home: Vec<Vec<u32>>,
-    /// Per element, its home part and its index in that part's compact energies.
-    energy_at: Vec<(u32, u32)>,
+    /// The home ranges: part p is home to Morton ranks `cuts[p]..cuts[p + 1]`.
+    cuts: Vec<usize>,
+    /// Per part, nanoseconds spent in it on a team since the last rebalancing, and the calls
+    /// counted.
+    busy: Vec<std::sync::atomic::AtomicU64>,
+    calls: u32,
+    /// Set by hand ([`ElementMap::set_gradient_partition`]): never rebalanced.
+    pinned: bool,
 }
+
+/// Elements per energy block. A term's energy is summed in blocks of this many consecutive
+/// elements along the Morton curve, each block in that order, then the blocks' sums in that
+/// order ([`ElementMap::sum_energies`]): the parts of the gradient's partition, whose home
+/// ranges start at multiples of it, sum their own blocks, and the caller adds one number per
+/// block instead of fetching one per element from the other cores' caches.
+pub const ENERGY_BLOCK: usize = 8;
+
+/// Team calls between two looks at the balance of the parts ([`Parts::rebalanced`]).
+const BALANCE_CALLS: u32 = 64;
 
 impl Clone for Scratch {
     fn clone(&self) -> Self {
@@ -513,7 +530,7 @@ impl Shared {
 }
 
 /// Accumulates one element term into `grad` (len n) and `values` (len nnz) as `want` says and
-/// returns its energy, summed in element order. `kernel(e, nodes, grad, hess)` evaluates
+/// returns its energy ([`ElementMap::sum_energies`]). `kernel(e, nodes, grad, hess)` evaluates
 /// element `e` with `N` local DOFs and `S` slots (slot `s` at `map.local[s]`); `fixed` is per
 /// node. `S` must equal `map.slots`.
 #[allow(clippy::too_many_arguments)]
@@ -537,7 +554,7 @@ where
             .into_par_iter()
             .map(|e| kernel(e, map.element(e), None, None))
             .collect();
-        return es.iter().sum();
+        return map.sum_energies(&es);
     }
     if want == Want::Gradient {
         return gather_gradient::<N, S, K>(map, &kernel, fixed, grad);
@@ -568,7 +585,7 @@ where
             }
         });
     }
-    energies.iter().sum()
+    map.sum_energies(&energies)
 }
 
 impl Parts {
@@ -578,6 +595,7 @@ impl Parts {
     /// evaluates the elements that hold one of its nodes, plus those it is home to (for the
     /// energy): elements across a part boundary are evaluated by each part that needs them.
     fn new(map: &ElementMap, cuts: Vec<usize>) -> Parts {
+        let cuts_kept = cuts.clone();
         let ne = map.len();
         let count = cuts.len() - 1;
         debug_assert!(cuts[0] == 0 && cuts[count] == ne && cuts.is_sorted());
@@ -616,17 +634,17 @@ impl Parts {
         let mut nodes: Vec<Vec<u32>> = vec![Vec::new(); count];
         let mut ptr: Vec<Vec<u32>> = vec![vec![0]; count];
         let mut offsets: Vec<Vec<u32>> = vec![Vec::new(); count];
-        let mut energy_at = vec![(0u32, 0u32); ne];
+        // Per part, its home elements by Morton rank, as positions in its elements.
         let mut homes: Vec<Vec<u32>> = vec![Vec::new(); count];
         let mut pos = vec![0u32; ne];
         for p in 0..count {
             for (k, &e) in elements[p].iter().enumerate() {
                 pos[e as usize] = k as u32;
-                if home[e as usize] as usize == p {
-                    energy_at[e as usize] = (p as u32, homes[p].len() as u32);
-                    homes[p].push(k as u32);
-                }
             }
+            homes[p] = map.morton[cuts[p]..cuts[p + 1]]
+                .iter()
+                .map(|&e| pos[e as usize])
+                .collect();
             for u in (0..num_nodes).filter(|&u| owner[u] as usize == p) {
                 nodes[p].push(u as u32);
                 for &off in &map.gather[map.gather_ptr[u]..map.gather_ptr[u + 1]] {
@@ -643,8 +661,50 @@ impl Parts {
             ptr,
             offsets,
             home: homes,
-            energy_at,
+            cuts: cuts_kept,
+            busy: (0..count).map(|_| Default::default()).collect(),
+            calls: 0,
+            pinned: false,
         }
+    }
+
+    /// New home ranges that even out the parts' measured times, or `None` while they are
+    /// even enough: each part's cost per home element is its time over its home count, the new
+    /// counts are in inverse proportion to it, and the cuts move half way there (the times
+    /// are noisy), in whole energy blocks. Any partition
+    /// gives the same bits ([`gather_gradient`]), so this only changes the speed.
+    fn rebalanced(&mut self) -> Option<Vec<usize>> {
+        use std::sync::atomic::Ordering::Relaxed;
+        let t: Vec<f64> = self
+            .busy
+            .iter()
+            .map(|b| b.swap(0, Relaxed) as f64)
+            .collect();
+        self.calls = 0;
+        let (count, ne) = (self.count, *self.cuts.last()?);
+        let n: Vec<f64> = self.cuts.windows(2).map(|w| (w[1] - w[0]) as f64).collect();
+        if self.pinned || t.iter().zip(&n).any(|(&t, &n)| t <= 0.0 || n <= 0.0) {
+            return None;
+        }
+        let speed: Vec<f64> = t.iter().zip(&n).map(|(t, n)| n / t).collect();
+        let total: f64 = speed.iter().sum();
+        let mut cuts = vec![0usize; count + 1];
+        let mut acc = 0.0;
+        for p in 0..count {
+            acc += speed[p] / total * ne as f64;
+            let target = if p + 1 == count { ne as f64 } else { acc };
+            let old = self.cuts[p + 1] as f64;
+            let cut = (old + 0.5 * (target - old)) / ENERGY_BLOCK as f64;
+            cuts[p + 1] = if p + 1 == count {
+                ne
+            } else {
+                (cut.round().max(0.0) as usize * ENERGY_BLOCK).min(ne)
+            };
+        }
+        for p in 1..count {
+            cuts[p] = cuts[p].max(cuts[p - 1]);
+        }
+        (cuts != self.cuts).then_some(cuts)
     }
 
     /// Per part, a zeroed buffer for its elements' outputs (`map.stride` each), its nodes'
@@ -656,20 +716,39 @@ impl Parts {
                     .iter()
                     .map(|&u| node_dofs(map.num_vertices, u as usize).1)
                     .sum();
-                vec![0.0; self.elements[p].len() * map.stride + sums + self.home[p].len()]
+                let blocks = self.home[p].len().div_ceil(ENERGY_BLOCK);
+                vec![0.0; self.elements[p].len() * map.stride + sums + blocks]
             })
             .collect()
     }
 
     /// Equal home ranges of `ne` elements for `count` parts.
     fn even_cuts(ne: usize, count: usize) -> Vec<usize> {
-        (0..=count).map(|p| p * ne / count).collect()
+        (0..=count)
+            .map(|p| {
+                if p == count {
+                    ne
+                } else {
+                    p * ne / count / ENERGY_BLOCK * ENERGY_BLOCK
+                }
+            })
+            .collect()
     }
 }
 
 impl ElementMap {
+    /// The term's energy from its elements' `energies` (J): summed in blocks of
+    /// [`ENERGY_BLOCK`] along the Morton curve, then the blocks in order. Every assembly path
+    /// sums this way, so energy, gradient and Hessian calls agree to the bit.
+    pub fn sum_energies(&self, energies: &[Real]) -> Real {
+        self.morton
+            .chunks(ENERGY_BLOCK)
+            .map(|b| b.iter().map(|&e| energies[e as usize]).sum::<Real>())
+            .sum()
+    }
+
     /// Installs the gradient partition with home ranges `cuts` (Morton ranks, `cuts[0] = 0`,
-    /// last = the element count, increasing): for tests that check that the gradient does not
+    /// last = the element count, increasing, the others multiples of [`ENERGY_BLOCK`]): for tests that check that the gradient does not
     /// depend on the partition. It stays until the part count changes.
     #[doc(hidden)]
     pub fn set_gradient_partition(&self, cuts: &[usize]) {
@@ -677,11 +756,15 @@ impl ElementMap {
             cuts.len() >= 2
                 && cuts[0] == 0
                 && *cuts.last().unwrap() == self.len()
-                && cuts.windows(2).all(|w| w[0] < w[1]),
+                && cuts.windows(2).all(|w| w[0] < w[1])
+                && cuts[1..cuts.len() - 1]
+                    .iter()
+                    .all(|c| c.is_multiple_of(ENERGY_BLOCK)),
             "bad cuts {cuts:?} for {} elements",
             self.len()
         );
-        let parts = Parts::new(self, cuts.to_vec());
+        let mut parts = Parts::new(self, cuts.to_vec());
+        parts.pinned = true;
         let bufs = parts.buffers(self);
         *self
             .scratch
@@ -700,7 +783,7 @@ impl ElementMap {
 /// The parts run on the calling thread's active [`crate::team::Team`] when there is one (one
 /// part per team thread), otherwise on rayon's pool.
 /// Every entry is the same sum in the same order whatever the partition, so results are
-/// bitwise identical for any number of threads. Returns the energy, summed in element order.
+/// bitwise identical for any number of threads. Returns the energy ([`ElementMap::sum_energies`]).
 fn gather_gradient<const N: usize, const S: usize, K>(
     map: &ElementMap,
     kernel: &K,
@@ -742,6 +825,15 @@ where
         .unwrap_or_else(|poisoned| poisoned.into_inner());
     let cuts =
         (guard.as_ref().map(|(p, _)| p.count) != Some(count)).then(|| Parts::even_cuts(ne, count));
+    let cuts = cuts.or_else(|| {
+        let parts = &mut guard.as_mut()?.0;
+        let look = team.is_some() && parts.calls >= BALANCE_CALLS;
+        if look {
+            parts.rebalanced()
+        } else {
+            None
+        }
+    });
     if let Some(cuts) = cuts {
         let parts = Parts::new(map, cuts);
         let bufs = parts.buffers(map);
@@ -763,12 +855,17 @@ where
         // into `grad`, whose lines the parts share, would make the cores fight over them.
         let (own, ptr, offsets) = (&parts.nodes[p], &parts.ptr[p], &parts.offsets[p]);
         let (buf, sums) = buf.split_at_mut(parts.elements[p].len() * (N + 1));
-        // The home elements' energies, packed at the end: the caller reads them, and reading
-        // them in place would share one line per element with the part's next writes.
+        // The home elements' energies, summed by block at the end: the caller reads the
+        // block sums (reading the energies in place would share one line per element with the
+        // part's next writes).
         let homes = &parts.home[p];
-        let (sums, energies) = sums.split_at_mut(sums.len() - homes.len());
-        for (en, &k) in energies.iter_mut().zip(homes) {
-            *en = buf[k as usize * (N + 1) + N];
+        let blocks = homes.len().div_ceil(ENERGY_BLOCK);
+        let (sums, energies) = sums.split_at_mut(sums.len() - blocks);
+        for (en, ks) in energies.iter_mut().zip(homes.chunks(ENERGY_BLOCK)) {
+            *en = ks
+                .iter()
+                .map(|&k| buf[k as usize * (N + 1) + N])
+                .sum::<Real>();
         }
         let mut at = 0;
         for (k, &u) in own.iter().enumerate() {
@@ -789,9 +886,13 @@ where
         let shared: Vec<Shared> = bufs.iter_mut().map(|b| Shared::new(b)).collect();
         team.run(&|p| {
             let Shared(ptr, len) = shared[p];
+            let start = std::time::Instant::now();
             // SAFETY: part p alone touches buffer p, and `run` returns after every part.
             work(p, unsafe { std::slice::from_raw_parts_mut(ptr, len) });
+            let ns = start.elapsed().as_nanos() as u64;
+            parts.busy[p].fetch_add(ns, std::sync::atomic::Ordering::Relaxed);
         });
+        parts.calls += 1;
     } else {
         bufs.par_iter_mut()
             .enumerate()
@@ -810,12 +911,10 @@ where
             at += dofs;
         }
     }
-    parts
-        .energy_at
-        .iter()
-        .map(|&(p, c)| {
-            let buf = &bufs[p as usize];
-            buf[buf.len() - parts.home[p as usize].len() + c as usize]
-        })
+    // The block sums, part after part: the blocks in Morton order, as `sum_energies` adds
+    // them.
+    bufs.iter()
+        .zip(&parts.home)
+        .flat_map(|(buf, h)| &buf[buf.len() - h.len().div_ceil(ENERGY_BLOCK)..])
         .sum()
 }

@@ -130,8 +130,9 @@ fn bitwise_identical(model: &str) {
 
 /// The gradient-only assembly (owner-computes, one part per thread) gives the same bits for
 /// any partition of the elements into parts: even ones for 1–4 threads, skewed ones installed
-/// by hand (a part of 1 element, a part of nearly all, quadratically growing parts). Patch fit
-/// (vertices only) and mid-edge (edge DOFs).
+/// by hand (a part of one energy block, a part of nearly all, quadratically growing parts), and
+/// run by a team of threads. Its energy is also the bits of the energy-only and the Hessian
+/// assembly's. Patch fit (vertices only) and mid-edge (edge DOFs).
 #[test]
 fn gradient_is_bitwise_identical_for_any_partition() {
     for model in [MODELS[1], MODELS[2]] {
@@ -152,6 +153,12 @@ fn gradient_is_bitwise_identical_for_any_partition() {
             )
         };
         let one = pool(1).install(grad);
+        let mut g = vec![0.0; p.n];
+        let e = pot.eval(&x, &phi, Want::Energy, &mut g, &mut []);
+        assert_eq!(e.to_bits(), one.0, "{model}: energy-only assembly");
+        let mut h = vec![0.0; p.nnz()];
+        let e = pot.eval(&x, &phi, Want::Hessian, &mut g, &mut h);
+        assert_eq!(e.to_bits(), one.0, "{model}: Hessian assembly");
         for t in [2, 3, 4] {
             let pl = pool(t);
             assert!(pl.install(grad) == one, "{model}: {t} threads, even parts");
@@ -161,12 +168,29 @@ fn gradient_is_bitwise_identical_for_any_partition() {
                 "{model}: a team of {t} threads"
             );
             let ne = p.maps.iter().map(|m| m.len()).max().unwrap();
+            // Home ranges start at multiples of the energy block.
+            let b = shellsim::assembly::ENERGY_BLOCK;
+            let last = ne.div_ceil(b) - 1;
             let skews: Vec<Vec<usize>> = vec![
-                (0..=t).map(|k| if k == t { ne } else { k }).collect(),
+                (0..=t).map(|k| if k == t { ne } else { k * b }).collect(),
                 (0..=t)
-                    .map(|k| if k == 0 { 0 } else { ne - (t - k) })
+                    .map(|k| {
+                        if k == 0 || k == t {
+                            k / t * ne
+                        } else {
+                            (last - (t - k)) * b
+                        }
+                    })
                     .collect(),
-                (0..=t).map(|k| k * k * ne / (t * t)).collect(),
+                (0..=t)
+                    .map(|k| {
+                        if k == t {
+                            ne
+                        } else {
+                            k * k * ne / (t * t) / b * b
+                        }
+                    })
+                    .collect(),
             ];
             for cuts in &skews {
                 for m in p.maps.iter().filter(|m| m.len() == ne) {
