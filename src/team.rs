@@ -49,8 +49,6 @@ struct Shared {
     panicked: AtomicBool,
     /// The team is being dropped.
     quit: AtomicBool,
-    /// Per part, nanoseconds spent in it over the regions since the last [`Team::take_busy`].
-    busy: Vec<AtomicU64>,
 }
 
 // SAFETY: `job` is written only by the caller while no region is running (every helper has
@@ -81,7 +79,6 @@ impl Team {
             wake: Condvar::new(),
             panicked: AtomicBool::new(false),
             quit: AtomicBool::new(false),
-            busy: (0..threads.max(1)).map(|_| AtomicU64::new(0)).collect(),
         });
         let handles = (1..threads.max(1))
             .map(|part| {
@@ -121,9 +118,7 @@ impl Team {
             let _g = s.lock.lock().unwrap_or_else(|p| p.into_inner());
             s.wake.notify_all();
         }
-        let start = Instant::now();
         let mine = catch_unwind(AssertUnwindSafe(|| job(0)));
-        s.busy[0].fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
         let mut spins = 0u32;
         while s.done.load(Ordering::Acquire) < helpers {
             spins = spins.wrapping_add(1);
@@ -140,16 +135,6 @@ impl Team {
         if s.panicked.swap(false, Ordering::Relaxed) {
             panic!("a part of a parallel region panicked on a helper thread");
         }
-    }
-
-    /// Per part, the seconds spent in it since the last call, and resets them: how evenly
-    /// the regions' work is split.
-    pub fn take_busy(&self) -> Vec<f64> {
-        self.shared
-            .busy
-            .iter()
-            .map(|b| b.swap(0, Ordering::Relaxed) as f64 * 1e-9)
-            .collect()
     }
 
     /// Runs `f` with this team active on the calling thread: [`with_active`] finds it there.
@@ -217,11 +202,9 @@ fn helper(s: &Shared, part: usize) {
         seen = s.epoch.load(Ordering::Acquire);
         // SAFETY: see `Shared`: published by the epoch increment just observed.
         let job = unsafe { &**s.job.get() };
-        let start = Instant::now();
         if catch_unwind(AssertUnwindSafe(|| job(part))).is_err() {
             s.panicked.store(true, Ordering::Relaxed);
         }
-        s.busy[part].fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
         s.done.fetch_add(1, Ordering::Release);
     }
 }
