@@ -49,6 +49,8 @@ struct Shared {
     panicked: AtomicBool,
     /// The team is being dropped.
     quit: AtomicBool,
+    /// A region is running: a second caller must not start one.
+    running: AtomicBool,
 }
 
 // SAFETY: `job` is written only by the caller while no region is running (every helper has
@@ -79,6 +81,7 @@ impl Team {
             wake: Condvar::new(),
             panicked: AtomicBool::new(false),
             quit: AtomicBool::new(false),
+            running: AtomicBool::new(false),
         });
         let handles = (1..threads.max(1))
             .map(|part| {
@@ -106,6 +109,11 @@ impl Team {
             return;
         }
         let s = &*self.shared;
+        // One region at a time: `job` and `done` belong to it.
+        assert!(
+            !s.running.swap(true, Ordering::Acquire),
+            "a team runs one parallel region at a time"
+        );
         // SAFETY: no region is running (the previous `run` waited for every helper), so no
         // helper reads `job`; the lifetime is erased because `run` does not return before
         // every helper is done with it.
@@ -129,6 +137,7 @@ impl Team {
                 std::hint::spin_loop();
             }
         }
+        s.running.store(false, Ordering::Release);
         if let Err(payload) = mine {
             std::panic::resume_unwind(payload);
         }
@@ -248,6 +257,15 @@ mod tests {
                     team.run(&|p| assert!(p != threads - 1, "boom"));
                 }));
                 assert!(r.is_err());
+                // A region started inside a region is refused, not a data race.
+                let nested = catch_unwind(AssertUnwindSafe(|| {
+                    team.run(&|p| {
+                        if p == 0 {
+                            team.run(&|_| {});
+                        }
+                    });
+                }));
+                assert!(nested.is_err());
                 // The team still works after a panic.
                 team.run(&|p| {
                     counts[p].fetch_add(1, Ordering::Relaxed);
