@@ -89,7 +89,7 @@ struct Parts {
     ptr: Vec<Vec<u32>>,
     offsets: Vec<Vec<u32>>,
     /// Per part, the positions in `elements` of the elements it is home to, by Morton rank:
-    /// the part sums their energies in blocks of [`EBLOCK`] into the tail of its buffer.
+    /// the part sums their energies in blocks of [`ENERGY_BLOCK`] into the tail of its buffer.
     home: Vec<Vec<u32>>,
     /// The home ranges: part p is home to Morton ranks `cuts[p]..cuts[p + 1]`.
     cuts: Vec<usize>,
@@ -595,7 +595,6 @@ impl Parts {
     /// evaluates the elements that hold one of its nodes, plus those it is home to (for the
     /// energy): elements across a part boundary are evaluated by each part that needs them.
     fn new(map: &ElementMap, cuts: Vec<usize>) -> Parts {
-        let cuts_kept = cuts.clone();
         let ne = map.len();
         let count = cuts.len() - 1;
         debug_assert!(cuts[0] == 0 && cuts[count] == ne && cuts.is_sorted());
@@ -661,7 +660,7 @@ impl Parts {
             ptr,
             offsets,
             home: homes,
-            cuts: cuts_kept,
+            cuts,
             busy: (0..count).map(|_| Default::default()).collect(),
             calls: 0,
             pinned: false,
@@ -671,8 +670,8 @@ impl Parts {
     /// New home ranges that even out the parts' measured times, or `None` while they are
     /// even enough: each part's cost per home element is its time over its home count, the new
     /// counts are in inverse proportion to it, and the cuts move half way there (the times
-    /// are noisy), in whole energy blocks. Any partition
-    /// gives the same bits ([`gather_gradient`]), so this only changes the speed.
+    /// are noisy), in whole energy blocks. Any partition gives the same bits
+    /// ([`gather_gradient`]), so this only changes the speed.
     fn rebalanced(&mut self) -> Option<Vec<usize>> {
         use std::sync::atomic::Ordering::Relaxed;
         let t: Vec<f64> = self
@@ -689,26 +688,21 @@ impl Parts {
         let speed: Vec<f64> = t.iter().zip(&n).map(|(t, n)| n / t).collect();
         let total: f64 = speed.iter().sum();
         let mut cuts = vec![0usize; count + 1];
-        let mut acc = 0.0;
-        for p in 0..count {
-            acc += speed[p] / total * ne as f64;
-            let target = if p + 1 == count { ne as f64 } else { acc };
-            let old = self.cuts[p + 1] as f64;
-            let cut = (old + 0.5 * (target - old)) / ENERGY_BLOCK as f64;
-            cuts[p + 1] = if p + 1 == count {
-                ne
-            } else {
-                (cut.round().max(0.0) as usize * ENERGY_BLOCK).min(ne)
-            };
-        }
+        cuts[count] = ne;
+        let mut target = 0.0;
         for p in 1..count {
-            cuts[p] = cuts[p].max(cuts[p - 1]);
+            target += speed[p - 1] / total * ne as f64;
+            let old = self.cuts[p] as f64;
+            let cut = (old + 0.5 * (target - old)) / ENERGY_BLOCK as f64;
+            cuts[p] = (cut.round().max(0.0) as usize * ENERGY_BLOCK)
+                .min(ne)
+                .max(cuts[p - 1]);
         }
         (cuts != self.cuts).then_some(cuts)
     }
 
     /// Per part, a zeroed buffer for its elements' outputs (`map.stride` each), its nodes'
-    /// sums and its home elements' energies.
+    /// sums and the sums of its home elements' energy blocks.
     fn buffers(&self, map: &ElementMap) -> Vec<Vec<Real>> {
         (0..self.count)
             .map(|p| {
@@ -748,8 +742,9 @@ impl ElementMap {
     }
 
     /// Installs the gradient partition with home ranges `cuts` (Morton ranks, `cuts[0] = 0`,
-    /// last = the element count, increasing, the others multiples of [`ENERGY_BLOCK`]): for tests that check that the gradient does not
-    /// depend on the partition. It stays until the part count changes.
+    /// last = the element count, increasing, the others multiples of [`ENERGY_BLOCK`]): for
+    /// tests that check that the gradient does not depend on the partition. It stays until the
+    /// part count changes and is never rebalanced.
     #[doc(hidden)]
     pub fn set_gradient_partition(&self, cuts: &[usize]) {
         assert!(
@@ -783,7 +778,8 @@ impl ElementMap {
 /// The parts run on the calling thread's active [`crate::team::Team`] when there is one (one
 /// part per team thread), otherwise on rayon's pool.
 /// Every entry is the same sum in the same order whatever the partition, so results are
-/// bitwise identical for any number of threads. Returns the energy ([`ElementMap::sum_energies`]).
+/// bitwise identical for any number of threads. Returns the energy
+/// ([`ElementMap::sum_energies`]).
 fn gather_gradient<const N: usize, const S: usize, K>(
     map: &ElementMap,
     kernel: &K,
@@ -823,17 +819,14 @@ where
         .0
         .lock()
         .unwrap_or_else(|poisoned| poisoned.into_inner());
-    let cuts =
-        (guard.as_ref().map(|(p, _)| p.count) != Some(count)).then(|| Parts::even_cuts(ne, count));
-    let cuts = cuts.or_else(|| {
-        let parts = &mut guard.as_mut()?.0;
-        let look = team.is_some() && parts.calls >= BALANCE_CALLS;
-        if look {
-            parts.rebalanced()
-        } else {
-            None
+    // A new partition for a new part count, or new home ranges from the measured times.
+    let cuts = match guard.as_mut() {
+        Some((parts, _)) if parts.count == count => {
+            let look = team.is_some() && parts.calls >= BALANCE_CALLS;
+            look.then(|| parts.rebalanced()).flatten()
         }
-    });
+        _ => Some(Parts::even_cuts(ne, count)),
+    };
     if let Some(cuts) = cuts {
         let parts = Parts::new(map, cuts);
         let bufs = parts.buffers(map);

@@ -69,6 +69,15 @@ thread_local! {
     static ACTIVE: std::cell::Cell<*const Team> = const { std::cell::Cell::new(std::ptr::null()) };
 }
 
+/// Puts back the thread's active team when dropped (also on a panic).
+struct Restore(*const Team);
+
+impl Drop for Restore {
+    fn drop(&mut self) {
+        ACTIVE.with(|a| a.set(self.0));
+    }
+}
+
 impl Team {
     /// A team of `threads` threads in all: the caller and `threads − 1` helpers.
     pub fn new(threads: usize) -> Team {
@@ -138,22 +147,18 @@ impl Team {
             }
         }
         s.running.store(false, Ordering::Release);
+        // Cleared whatever happens, so that the next region does not report this one's panic.
+        let helper_panicked = s.panicked.swap(false, Ordering::Relaxed);
         if let Err(payload) = mine {
             std::panic::resume_unwind(payload);
         }
-        if s.panicked.swap(false, Ordering::Relaxed) {
+        if helper_panicked {
             panic!("a part of a parallel region panicked on a helper thread");
         }
     }
 
     /// Runs `f` with this team active on the calling thread: [`with_active`] finds it there.
     pub fn activate<R>(&self, f: impl FnOnce() -> R) -> R {
-        struct Restore(*const Team);
-        impl Drop for Restore {
-            fn drop(&mut self) {
-                ACTIVE.with(|a| a.set(self.0));
-            }
-        }
         let _restore = Restore(ACTIVE.with(|a| a.replace(self as *const Team)));
         f()
     }
@@ -163,12 +168,6 @@ impl Team {
 /// running a region: a region's parts see none).
 pub fn with_active<R>(f: impl FnOnce(Option<&Team>) -> R) -> R {
     let p = ACTIVE.with(|a| a.replace(std::ptr::null()));
-    struct Restore(*const Team);
-    impl Drop for Restore {
-        fn drop(&mut self) {
-            ACTIVE.with(|a| a.set(self.0));
-        }
-    }
     let _restore = Restore(p);
     // SAFETY: a non-null pointer was set by `activate`, whose borrow of the team outlives the
     // call of `f` it wraps; it is cleared while `f` runs, so a nested call sees no team.
@@ -257,6 +256,10 @@ mod tests {
                     team.run(&|p| assert!(p != threads - 1, "boom"));
                 }));
                 assert!(r.is_err());
+                // Every part panics: the caller's panic is raised, and the helpers' is not
+                // left over for the next region.
+                let all = catch_unwind(AssertUnwindSafe(|| team.run(&|_| panic!("all"))));
+                assert!(all.is_err());
                 // A region started inside a region is refused, not a data race.
                 let nested = catch_unwind(AssertUnwindSafe(|| {
                     team.run(&|p| {
