@@ -535,13 +535,13 @@ fn bench_hessian_pot(
     }
 }
 
-/// One explicit step (gradient + symplectic Euler update) of MorphoShell's GCM cone with the
-/// patch fit, at the sizes MorphoShell was timed at (743–2060 triangles) and at ~8.6k, on 1 and
-/// 2 threads:
+/// One explicit step (gradient + symplectic Euler update, fused as the driver runs it) of
+/// MorphoShell's GCM cone with the patch fit, at the sizes MorphoShell was timed at (743–2060
+/// triangles) and at ~8.6k, on 1 and 2 threads:
 /// per step while the forms are dialled (densities recomputed) and while waiting (densities
 /// computed once). Report: time per step / faces = µs per triangle-step.
 fn explicit_step(c: &mut Criterion) {
-    use shellsim::integrate::explicit::{advance, gradient};
+    use shellsim::integrate::explicit::Step;
     for edge in [0.085, 0.05, 0.025] {
         let mut mesh = shellsim::mesh::generate::annulus(
             1.0,
@@ -590,10 +590,8 @@ fn explicit_step(c: &mut Criterion) {
                     pool.install(|| {
                         let team = shellsim::team::Team::new(threads);
                         team.activate(|| {
-                            b.iter(|| {
-                                gradient(&pot, &x, &mut gr);
-                                advance(&mut x, &mut v, &gr, &inv_m, 1e-3, 1e-9);
-                            })
+                            let mut step = Step::new(&pot, true);
+                            b.iter(|| step.take(&pot, &mut x, &mut v, &mut gr, &inv_m, 1e-3, 1e-9))
                         })
                     })
                 });

@@ -93,12 +93,49 @@ struct Parts {
     home: Vec<Vec<u32>>,
     /// The home ranges: part p is home to Morton ranks `cuts[p]..cuts[p + 1]`.
     cuts: Vec<usize>,
-    /// Per part, nanoseconds spent in it on a team since the last rebalancing, and the calls
-    /// counted.
-    busy: Vec<std::sync::atomic::AtomicU64>,
+    /// Per part and team call since the last rebalancing (`BALANCE_CALLS` slots), the
+    /// nanoseconds spent in it, and the calls counted.
+    busy: Vec<Vec<std::sync::atomic::AtomicU64>>,
     calls: u32,
     /// Set by hand ([`ElementMap::set_gradient_partition`]): never rebalanced.
     pinned: bool,
+}
+
+/// Work fused into the parts of an element term's gradient ([`with_owned_nodes`]): called once
+/// per part, on the thread that runs it, right after the part has summed the gradient of the
+/// nodes it owns, with those node ids and their sums (3 entries per vertex node, 1 per edge
+/// node, in the nodes' order; N for vertices, N·m for edge DOFs; fixed nodes included and not
+/// masked). Each node of the term's elements is owned by exactly one part.
+pub type OwnedNodes<'a> = dyn Fn(&[u32], &[Real]) + Sync + 'a;
+
+thread_local! {
+    /// The hook set by [`with_owned_nodes`] on this thread, until a gradient takes it.
+    static OWNED: std::cell::Cell<Option<*const OwnedNodes<'static>>> =
+        const { std::cell::Cell::new(None) };
+}
+
+/// Runs `f` with `hook` fused into the first element-term gradient that [`assemble_elements`]
+/// assembles on this thread inside it: that gradient's parts call `hook` with the nodes they
+/// own, and the pass that adds the parts' sums into the gradient is skipped (the term leaves
+/// `grad` untouched; the hook has the sums). Returns what `f` returns and whether a gradient
+/// took the hook. The explicit driver uses this to advance each node on the thread that summed
+/// its force, while that thread still has it in cache.
+pub fn with_owned_nodes<R>(hook: &OwnedNodes<'_>, f: impl FnOnce() -> R) -> (R, bool) {
+    struct Restore(Option<*const OwnedNodes<'static>>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            OWNED.with(|o| o.set(self.0));
+        }
+    }
+    // SAFETY: only the lifetime is erased. The pointer is dereferenced by a gradient called
+    // inside `f`, while `hook` is borrowed, and it is removed from the thread-local when `f`
+    // returns or unwinds.
+    let ptr =
+        unsafe { std::mem::transmute::<*const OwnedNodes<'_>, *const OwnedNodes<'static>>(hook) };
+    let _restore = Restore(OWNED.with(|o| o.replace(Some(ptr))));
+    let r = f();
+    let taken = OWNED.with(|o| o.get().is_none());
+    (r, taken)
 }
 
 /// Elements per energy block. A term's energy is summed in blocks of this many consecutive
@@ -661,23 +698,31 @@ impl Parts {
             offsets,
             home: homes,
             cuts,
-            busy: (0..count).map(|_| Default::default()).collect(),
+            busy: (0..count)
+                .map(|_| (0..BALANCE_CALLS).map(|_| Default::default()).collect())
+                .collect(),
             calls: 0,
             pinned: false,
         }
     }
 
     /// New home ranges that even out the parts' measured times, or `None` while they are
-    /// even enough: each part's cost per home element is its time over its home count, the new
-    /// counts are in inverse proportion to it, and the cuts move half way there (the times
-    /// are noisy), in whole energy blocks. Any partition gives the same bits
+    /// even enough: each part's cost per home element is its median time over the calls since
+    /// the last look (a median, because a shared host now and then stalls one thread for many
+    /// steps) over its home count, the new counts are in inverse proportion to it, and the cuts
+    /// move half way there, in whole energy blocks. Any partition gives the same bits
     /// ([`gather_gradient`]), so this only changes the speed.
     fn rebalanced(&mut self) -> Option<Vec<usize>> {
         use std::sync::atomic::Ordering::Relaxed;
+        let calls = (self.calls as usize).min(BALANCE_CALLS as usize);
         let t: Vec<f64> = self
             .busy
             .iter()
-            .map(|b| b.swap(0, Relaxed) as f64)
+            .map(|b| {
+                let mut ns: Vec<u64> = b[..calls].iter().map(|t| t.load(Relaxed)).collect();
+                ns.sort_unstable();
+                ns.get(calls / 2).map_or(0.0, |&t| t as f64)
+            })
             .collect();
         self.calls = 0;
         let (count, ne) = (self.count, *self.cuts.last()?);
@@ -776,7 +821,8 @@ impl ElementMap {
 /// `grad`. One synchronisation per call and no memory written by two threads; elements on a
 /// part boundary are evaluated more than once (2–3% of them on the explicit bench's meshes).
 /// The parts run on the calling thread's active [`crate::team::Team`] when there is one (one
-/// part per team thread), otherwise on rayon's pool.
+/// part per team thread), otherwise on rayon's pool. Inside [`with_owned_nodes`], each part
+/// hands its nodes' sums to the hook instead, and `grad` is left alone.
 /// Every entry is the same sum in the same order whatever the partition, so results are
 /// bitwise identical for any number of threads. Returns the energy
 /// ([`ElementMap::sum_energies`]).
@@ -794,13 +840,17 @@ where
         N + 1,
         "element map and kernel disagree on the DOFs"
     );
+    // SAFETY: a hook in the thread-local is borrowed by the `with_owned_nodes` call this one
+    // runs inside.
+    let hook = OWNED.with(|o| o.take()).map(|h| unsafe { &*h });
     crate::team::with_active(|team| {
         let threads = team.map_or_else(rayon::current_num_threads, |t| t.threads());
-        gather_gradient_on::<N, S, K>(map, kernel, fixed, grad, team, threads)
+        gather_gradient_on::<N, S, K>(map, kernel, fixed, grad, team, threads, hook)
     })
 }
 
-/// [`gather_gradient`] in `threads` parts, run by `team` when there is one, else by rayon.
+/// [`gather_gradient`] in `threads` parts, run by `team` when there is one, else by rayon;
+/// with `hook`, each part hands its nodes' sums to it instead of `grad`.
 fn gather_gradient_on<const N: usize, const S: usize, K>(
     map: &ElementMap,
     kernel: &K,
@@ -808,6 +858,7 @@ fn gather_gradient_on<const N: usize, const S: usize, K>(
     grad: &mut [Real],
     team: Option<&crate::team::Team>,
     threads: usize,
+    hook: Option<&OwnedNodes<'_>>,
 ) -> Real
 where
     K: Fn(usize, &[usize], Option<&mut SVec<N>>, Option<&mut SMat<N, N>>) -> Real + Sync,
@@ -872,18 +923,23 @@ where
             }
             at += dofs;
         }
+        if let Some(hook) = hook {
+            hook(own, sums);
+        }
     };
     if parts.count == 1 {
         work(0, &mut bufs[0]);
     } else if let Some(team) = team.filter(|t| t.threads() == parts.count) {
         let shared: Vec<Shared> = bufs.iter_mut().map(|b| Shared::new(b)).collect();
+        // Rebalancing looks after `BALANCE_CALLS` calls and restarts the count.
+        let call = parts.calls as usize % BALANCE_CALLS as usize;
         team.run(&|p| {
             let Shared(ptr, len) = shared[p];
             let start = std::time::Instant::now();
             // SAFETY: part p alone touches buffer p, and `run` returns after every part.
             work(p, unsafe { std::slice::from_raw_parts_mut(ptr, len) });
             let ns = start.elapsed().as_nanos() as u64;
-            parts.busy[p].fetch_add(ns, std::sync::atomic::Ordering::Relaxed);
+            parts.busy[p][call].store(ns, std::sync::atomic::Ordering::Relaxed);
         });
         parts.calls += 1;
     } else {
@@ -891,7 +947,7 @@ where
             .enumerate()
             .for_each(|(p, buf)| work(p, buf));
     }
-    for (p, buf) in bufs.iter().enumerate() {
+    for (p, buf) in bufs.iter().enumerate().filter(|_| hook.is_none()) {
         let mut at = parts.elements[p].len() * (N + 1);
         for &u in &parts.nodes[p] {
             let u = u as usize;

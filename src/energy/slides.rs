@@ -156,6 +156,10 @@ impl VertexKernel for Slides {
         ]
     }
 
+    fn acts_on_explicit_steps(&self) -> bool {
+        true
+    }
+
     fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
         if self.friction == 0.0 && self.contact_damping == 0.0 {
             return;

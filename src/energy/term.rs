@@ -271,6 +271,13 @@ pub trait Term: Send + Sync {
     ) {
     }
 
+    /// Whether the term overrides [`Term::explicit_step`] (default: no). A term that does must
+    /// say so here: the explicit driver fuses the update into the gradient's parallel parts
+    /// when no term acts on the step between the two.
+    fn acts_on_explicit_steps(&self) -> bool {
+        false
+    }
+
     /// Whether the term implements [`Term::predict`] (default: no).
     fn predicts(&self) -> bool {
         false
@@ -387,6 +394,10 @@ pub trait VertexKernel: Send + Sync {
         _dt: Real,
     ) {
     }
+    /// See [`Term::acts_on_explicit_steps`] (default: no).
+    fn acts_on_explicit_steps(&self) -> bool {
+        false
+    }
 }
 
 /// A [`VertexKernel`] as a [`Term`]. Fixed vertices contribute nothing to Φ (a constant);
@@ -410,6 +421,9 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
     }
     fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
         self.kernel.explicit_step(pot, x, v, g, dt);
+    }
+    fn acts_on_explicit_steps(&self) -> bool {
+        self.kernel.acts_on_explicit_steps()
     }
     fn observables(&self, pot: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
         self.kernel.observables(pot, x)

@@ -226,13 +226,168 @@ pub fn gradient(pot: &Potential, x: &[Vec3], g: &mut [Real]) -> Real {
 #[inline]
 pub fn advance(x: &mut [Vec3], v: &mut [Vec3], g: &[Real], inv_m: &[Real], c: Real, dt: Real) {
     for (i, (xi, vi)) in x.iter_mut().zip(v.iter_mut()).enumerate() {
-        if inv_m[i] == 0.0 {
-            *vi = Vec3::zeros();
-            continue;
-        }
         let f = Vec3::new(g[3 * i], g[3 * i + 1], g[3 * i + 2]);
-        *vi += (-f * inv_m[i] - *vi * c) * dt;
-        *xi += *vi * dt;
+        advance_node(xi, vi, f, inv_m[i], c, dt);
+    }
+}
+
+/// [`advance`] for one vertex with gradient `f` (N): the one place its arithmetic is written,
+/// so that the fused step ([`Step`]) gives the same bits.
+#[inline(always)]
+fn advance_node(x: &mut Vec3, v: &mut Vec3, f: Vec3, inv_m: Real, c: Real, dt: Real) {
+    if inv_m == 0.0 {
+        *v = Vec3::zeros();
+        return;
+    }
+    *v += (-f * inv_m - *v * c) * dt;
+    *x += *v * dt;
+}
+
+/// A pointer for writes by several threads to entries that each belongs to one of them.
+#[derive(Clone, Copy)]
+struct Disjoint(*mut Vec3);
+// SAFETY: shared only by `Step::take`, whose parts write disjoint entries.
+unsafe impl Send for Disjoint {}
+unsafe impl Sync for Disjoint {}
+
+impl Disjoint {
+    /// Entry `u`.
+    ///
+    /// # Safety
+    /// `u` is in bounds and no other thread touches it meanwhile.
+    #[inline(always)]
+    unsafe fn at<'a>(self, u: usize) -> &'a mut Vec3 {
+        unsafe { &mut *self.0.add(u) }
+    }
+}
+
+/// The explicit step, `g ← ∇Φ(x)` then [`advance`], fused when it can be.
+///
+/// When the scene's only term goes through [`crate::assembly::assemble_elements`] and does
+/// not act on the step ([`crate::energy::term::Term::acts_on_explicit_steps`]), each vertex is
+/// advanced inside the gradient's parallel parts, by the part that owns it, right after that
+/// part has summed its force ([`crate::assembly::with_owned_nodes`]). The new positions go
+/// into a second buffer, since other parts may still be reading the old ones, and the two are
+/// swapped when the parts are done. A step is then one parallel region with no serial pass over
+/// the nodes, and no core rereads the forces and positions another core has just written. The
+/// arithmetic is that of the unfused step, in the same order (the force of a node is
+/// `0 + Σ` of its element entries, zero where fixed or pinned, then [`advance`]), so both give
+/// the same bits, for any number of threads.
+pub struct Step {
+    /// Whether the scene allows fusing.
+    fusable: bool,
+    /// The other position buffer.
+    next: Vec<Vec3>,
+    /// Vertices in no element of the term: no part owns them, the caller advances them with
+    /// no force.
+    orphans: Vec<usize>,
+    /// Per DOF: whether it is pinned (its force is zero).
+    pinned: Vec<bool>,
+}
+
+impl Step {
+    /// The step for `pot`'s scene; `fuse = false` keeps it unfused (for comparisons).
+    pub fn new(pot: &Potential, fuse: bool) -> Step {
+        let sc = pot.scene;
+        let nv = sc.num_vertices();
+        let fusable = fuse
+            && sc.terms.len() == 1
+            && pot.pattern.maps.len() == 1
+            && !sc.terms[0].acts_on_explicit_steps();
+        let mut used = vec![false; nv];
+        if fusable {
+            let map = &pot.pattern.maps[0];
+            for e in 0..map.len() {
+                for &u in map.element(e) {
+                    if u < nv {
+                        used[u] = true;
+                    }
+                }
+            }
+        }
+        let mut pinned = vec![false; pot.pattern.n];
+        for &d in &sc.pinned_dofs {
+            pinned[d] = true;
+        }
+        Step {
+            fusable,
+            next: if fusable {
+                vec![Vec3::zeros(); nv]
+            } else {
+                Vec::new()
+            },
+            orphans: (0..nv).filter(|&u| !used[u]).collect(),
+            pinned,
+        }
+    }
+
+    /// Whether [`Step::take`] fuses the update into the gradient.
+    pub fn fused(&self) -> bool {
+        self.fusable
+    }
+
+    /// One step from positions `x` (m) with velocities `v` (m/s), drag rate `c` (1/s) and step
+    /// `dt` (s), `inv_m` the inverse lumped masses (1/kg, 0 where fixed); returns Φ(x) (J).
+    /// `g` is scratch: it holds ∇Φ(x) (N) after an unfused step, zeros after a fused one.
+    #[allow(clippy::too_many_arguments)]
+    pub fn take(
+        &mut self,
+        pot: &Potential,
+        x: &mut Vec<Vec3>,
+        v: &mut [Vec3],
+        g: &mut [Real],
+        inv_m: &[Real],
+        c: Real,
+        dt: Real,
+    ) -> Real {
+        if !self.fusable {
+            let energy = gradient(pot, x, g);
+            advance(x, v, g, inv_m, c, dt);
+            return energy;
+        }
+        let (n, fixed, pinned) = (x.len(), &pot.scene.node_fixed, &self.pinned);
+        let (vp, np) = (Disjoint(v.as_mut_ptr()), Disjoint(self.next.as_mut_ptr()));
+        let old: &[Vec3] = x;
+        let hook = move |nodes: &[u32], sums: &[Real]| {
+            let mut at = 0;
+            for &u in nodes {
+                let u = u as usize;
+                if u >= n {
+                    // An edge node: no position.
+                    at += 1;
+                    continue;
+                }
+                let force = |k: usize| {
+                    if fixed[u] || pinned[3 * u + k] {
+                        0.0
+                    } else {
+                        0.0 + sums[at + k]
+                    }
+                };
+                let f = Vec3::new(force(0), force(1), force(2));
+                at += 3;
+                let mut xu = old[u];
+                // SAFETY: each vertex is owned by one part, and only its part's hook writes
+                // its velocity and new position (`Disjoint`); `v` and `next` outlive the call.
+                unsafe {
+                    advance_node(&mut xu, vp.at(u), f, inv_m[u], c, dt);
+                    *np.at(u) = xu;
+                }
+            }
+        };
+        let (energy, taken) = crate::assembly::with_owned_nodes(&hook, || gradient(pot, old, g));
+        if !taken {
+            // The term did not assemble through the parts: `g` is its gradient.
+            advance(x, v, g, inv_m, c, dt);
+            return energy;
+        }
+        for &u in &self.orphans {
+            let mut xu = x[u];
+            advance_node(&mut xu, &mut v[u], Vec3::zeros(), inv_m[u], c, dt);
+            self.next[u] = xu;
+        }
+        std::mem::swap(x, &mut self.next);
+        energy
     }
 }
 
@@ -378,6 +533,7 @@ pub(super) fn run_explicit(
     // The steps' gradients run on a team of spinning threads: a step is too short for rayon's
     // sleeping workers to be woken twice per step (`crate::team`).
     let team = crate::team::Team::new(rayon::current_num_threads());
+    let mut step = Step::new(&s.potential(dial), true);
     let stop = team.activate(|| -> Result<Stop, RunError> {
         Ok(loop {
             if let Some(f) = super::interruption("t", t) {
@@ -399,22 +555,30 @@ pub(super) fn run_explicit(
             for term in sc.terms.iter() {
                 term.explicit_begin(&pot, &state.x, dt);
             }
-            let clock = std::time::Instant::now();
-            let energy = gradient(&pot, &state.x, &mut g);
-            s.summary.timing.newton.assembly += clock.elapsed().as_secs_f64();
-            // Terms that act on the step itself (slide friction), before the equilibrium test sees
-            // the forces.
-            for term in sc.terms.iter() {
-                term.explicit_step(&pot, &state.x, &mut v, &mut g, dt);
-            }
             let c = if phase == Phase::Dial {
                 rate_dial
             } else {
                 rate_wait
             };
+            let test = steps.is_multiple_of(window_steps) && steps > 0;
+            // Most steps are one fused gradient-and-update; the equilibrium test needs the force
+            // and the state it belongs to, the gradient-descent start its own update.
+            let fused = step.fused() && gd_left == 0 && !test;
+            let clock = std::time::Instant::now();
+            let energy = if fused {
+                step.take(&pot, &mut state.x, &mut v, &mut g, &inv_m, c, dt)
+            } else {
+                gradient(&pot, &state.x, &mut g)
+            };
+            s.summary.timing.newton.assembly += clock.elapsed().as_secs_f64();
+            // Terms that act on the step itself (slide friction), before the equilibrium test sees
+            // the forces.
+            for term in sc.terms.iter().filter(|_| !fused) {
+                term.explicit_step(&pot, &state.x, &mut v, &mut g, dt);
+            }
             // The equilibrium test, once per window (before the step, at the state the force
             // belongs to).
-            if steps.is_multiple_of(window_steps) && steps > 0 {
+            if test {
                 let healthy = energy.is_finite()
                     && state.x.iter().all(|p| p.iter().all(|c| c.is_finite()))
                     && v.iter().all(|p| p.iter().all(|c| c.is_finite()));
@@ -499,7 +663,7 @@ pub(super) fn run_explicit(
                 if gd_left == 0 {
                     v.iter_mut().for_each(|v| *v = Vec3::zeros());
                 }
-            } else {
+            } else if !fused {
                 advance(&mut state.x, &mut v, &g, &inv_m, c, dt);
             }
             t += dt;
