@@ -56,13 +56,10 @@ pub struct ElementMap {
     offsets: Vec<u32>,
     /// Blocks of elements grouped by colour; blocks of one colour share no stencil node.
     colours: Vec<Vec<Vec<usize>>>,
-    /// The gradient's gather: for node u, `gather[gather_ptr[u]..gather_ptr[u + 1]]` lists
-    /// where its entries sit in the per-element gradient buffer (element × `stride` + the slot's
-    /// local offset), in element order.
-    gather_ptr: Vec<usize>,
-    gather: Vec<u32>,
-    /// Per-element stride of that buffer: the element's DOFs plus its energy.
-    stride: usize,
+    /// Number of nodes (vertices, then edges when the stencil has edge DOFs).
+    num_nodes: usize,
+    /// The element's DOFs (`N` of its kernel).
+    dofs: usize,
     /// The elements along the Morton curve of their anchors.
     morton: Vec<u32>,
     /// The gradient's partition and buffers, reused.
@@ -84,10 +81,10 @@ struct Parts {
     elements: Vec<Vec<u32>>,
     /// Per part, the nodes it owns and writes.
     nodes: Vec<Vec<u32>>,
-    /// Per part and owned node, `offsets[ptr[k]..ptr[k + 1]]` locate the node's entries in the
-    /// part's buffer, in element order.
-    ptr: Vec<Vec<u32>>,
-    offsets: Vec<Vec<u32>>,
+    /// Per part, element (in `elements`) and slot: where the slot's node's sum starts in the
+    /// part's sums (its owned nodes in order, [`node_dofs`] entries each), or `u32::MAX` when
+    /// another part owns the node.
+    dst: Vec<Vec<u32>>,
     /// Per part, the positions in `elements` of the elements it is home to, by Morton rank:
     /// the part sums their energies in blocks of [`ENERGY_BLOCK`] into the tail of its buffer.
     home: Vec<Vec<u32>>,
@@ -262,26 +259,6 @@ impl Pattern {
                     })
                     .collect();
                 let colours = colour_blocks(nodes, st, &blocks);
-                let mut count = vec![0usize; nodes + 1];
-                for &u in &st.nodes {
-                    if u != NONE {
-                        count[u + 1] += 1;
-                    }
-                }
-                for u in 0..nodes {
-                    count[u + 1] += count[u];
-                }
-                let gather_ptr = count.clone();
-                let stride = st.slot_dofs.iter().sum::<usize>() + 1;
-                let mut gather = vec![0u32; st.nodes.len()];
-                for (k, &u) in st.nodes.iter().enumerate() {
-                    if u != NONE {
-                        let (e, slot) = (k / s.max(1), k % s.max(1));
-                        gather[count[u]] = (e * stride + local[slot]) as u32;
-                        count[u] += 1;
-                    }
-                }
-                gather.truncate(gather_ptr[nodes]);
                 ElementMap {
                     slots: s,
                     local,
@@ -289,9 +266,8 @@ impl Pattern {
                     num_vertices: nv,
                     offsets,
                     colours,
-                    gather_ptr,
-                    gather,
-                    stride,
+                    num_nodes: nodes,
+                    dofs: st.slot_dofs.iter().sum(),
                     morton,
                     scratch: Scratch::default(),
                 }
@@ -635,8 +611,7 @@ impl Parts {
         let ne = map.len();
         let count = cuts.len() - 1;
         debug_assert!(cuts[0] == 0 && cuts[count] == ne && cuts.is_sorted());
-        let num_nodes = map.gather_ptr.len() - 1;
-        let stride = map.stride;
+        let num_nodes = map.num_nodes;
         let mut home = vec![0u32; ne];
         for p in 0..count {
             for &e in &map.morton[cuts[p]..cuts[p + 1]] {
@@ -668,8 +643,9 @@ impl Parts {
             }
         }
         let mut nodes: Vec<Vec<u32>> = vec![Vec::new(); count];
-        let mut ptr: Vec<Vec<u32>> = vec![vec![0]; count];
-        let mut offsets: Vec<Vec<u32>> = vec![Vec::new(); count];
+        let mut dst: Vec<Vec<u32>> = vec![Vec::new(); count];
+        // Each node's first entry among its owner's sums.
+        let mut sum_at = vec![u32::MAX; num_nodes];
         // Per part, its home elements by Morton rank, as positions in its elements.
         let mut homes: Vec<Vec<u32>> = vec![Vec::new(); count];
         let mut pos = vec![0u32; ne];
@@ -681,21 +657,29 @@ impl Parts {
                 .iter()
                 .map(|&e| pos[e as usize])
                 .collect();
+            let mut at = 0;
             for u in (0..num_nodes).filter(|&u| owner[u] as usize == p) {
                 nodes[p].push(u as u32);
-                for &off in &map.gather[map.gather_ptr[u]..map.gather_ptr[u + 1]] {
-                    let (e, slot) = (off as usize / stride, off as usize % stride);
-                    offsets[p].push((pos[e] as usize * stride + slot) as u32);
-                }
-                ptr[p].push(offsets[p].len() as u32);
+                sum_at[u] = at as u32;
+                at += node_dofs(map.num_vertices, u).1;
             }
+            dst[p] = elements[p]
+                .iter()
+                .flat_map(|&e| map.element(e as usize))
+                .map(|&u| {
+                    if u != NONE && owner[u] as usize == p {
+                        sum_at[u]
+                    } else {
+                        u32::MAX
+                    }
+                })
+                .collect();
         }
         Parts {
             count,
             elements,
             nodes,
-            ptr,
-            offsets,
+            dst,
             home: homes,
             cuts,
             busy: (0..count)
@@ -746,8 +730,8 @@ impl Parts {
         (cuts != self.cuts).then_some(cuts)
     }
 
-    /// Per part, a zeroed buffer for its elements' outputs (`map.stride` each), its nodes'
-    /// sums and the sums of its home elements' energy blocks.
+    /// Per part, a zeroed buffer for its elements' energies, its nodes' sums and the sums of
+    /// its home elements' energy blocks.
     fn buffers(&self, map: &ElementMap) -> Vec<Vec<Real>> {
         (0..self.count)
             .map(|p| {
@@ -756,7 +740,7 @@ impl Parts {
                     .map(|&u| node_dofs(map.num_vertices, u as usize).1)
                     .sum();
                 let blocks = self.home[p].len().div_ceil(ENERGY_BLOCK);
-                vec![0.0; self.elements[p].len() * map.stride + sums + blocks]
+                vec![0.0; self.elements[p].len() + sums + blocks]
             })
             .collect()
     }
@@ -816,10 +800,11 @@ impl ElementMap {
 
 /// The gradient of one element term without colouring, owner-computes: the nodes are split
 /// into one part per thread along the Morton curve ([`Parts`]), and each part, in one parallel
-/// task, evaluates every element holding one of its nodes into its own buffer and sums its
-/// nodes' entries there, each in element order; then one sequential pass adds the sums into
-/// `grad`. One synchronisation per call and no memory written by two threads; elements on a
-/// part boundary are evaluated more than once (2–3% of them on the explicit bench's meshes).
+/// task, evaluates every element holding one of its nodes, in element order, adding the
+/// element's entries for the nodes it owns into its own sums as it goes; then one sequential
+/// pass adds the sums into `grad`. One synchronisation per call and no memory written by two
+/// threads; elements on a part boundary are evaluated more than once (1.0–2.6% of them on the
+/// explicit bench's meshes, 8632 to 793 faces, on two threads).
 /// The parts run on the calling thread's active [`crate::team::Team`] when there is one (one
 /// part per team thread), otherwise on rayon's pool. Inside [`with_owned_nodes`], each part
 /// hands its nodes' sums to the hook instead, and `grad` is left alone.
@@ -835,11 +820,7 @@ fn gather_gradient<const N: usize, const S: usize, K>(
 where
     K: Fn(usize, &[usize], Option<&mut SVec<N>>, Option<&mut SMat<N, N>>) -> Real + Sync,
 {
-    assert_eq!(
-        map.stride,
-        N + 1,
-        "element map and kernel disagree on the DOFs"
-    );
+    assert_eq!(map.dofs, N, "element map and kernel disagree on the DOFs");
     // SAFETY: a hook in the thread-local is borrowed by the `with_owned_nodes` call this one
     // runs inside.
     let hook = OWNED.with(|o| o.take()).map(|h| unsafe { &*h });
@@ -886,42 +867,40 @@ where
     let (parts, bufs) = guard.as_mut().expect("the partition was just built");
     let nv = map.num_vertices;
     let work = |p: usize, buf: &mut [Real]| {
+        let (own, dst) = (&parts.nodes[p], &parts.dst[p]);
+        let homes = &parts.home[p];
+        let blocks = homes.len().div_ceil(ENERGY_BLOCK);
+        let (energies, sums) = buf.split_at_mut(parts.elements[p].len());
+        let (sums, block_sums) = sums.split_at_mut(sums.len() - blocks);
+        // The owned nodes' sums, in the part's own buffer (writing them straight into `grad`,
+        // whose lines the parts share, would make the cores fight over them): each element's
+        // entries are added as it is evaluated, in element order, so every node's sum is
+        // `0 + Σ` over its elements in element order, whatever the partition.
+        sums.fill(0.0);
         let mut g = SVec::<N>::zeros();
-        for (out, &e) in buf.chunks_exact_mut(N + 1).zip(&parts.elements[p]) {
+        for ((en, &e), to) in energies
+            .iter_mut()
+            .zip(&parts.elements[p])
+            .zip(dst.chunks_exact(S))
+        {
             let e = e as usize;
             let mut st = [NONE; S];
             st.copy_from_slice(map.element(e));
-            let en = kernel(e, &st, Some(&mut g), None);
-            out[..N].copy_from_slice(g.as_slice());
-            out[N] = en;
-        }
-        // The owned nodes' sums, into the part's own tail of the buffer: writing them straight
-        // into `grad`, whose lines the parts share, would make the cores fight over them.
-        let (own, ptr, offsets) = (&parts.nodes[p], &parts.ptr[p], &parts.offsets[p]);
-        let (buf, sums) = buf.split_at_mut(parts.elements[p].len() * (N + 1));
-        // The home elements' energies, summed by block at the end: the caller reads the
-        // block sums (reading the energies in place would share one line per element with the
-        // part's next writes).
-        let homes = &parts.home[p];
-        let blocks = homes.len().div_ceil(ENERGY_BLOCK);
-        let (sums, energies) = sums.split_at_mut(sums.len() - blocks);
-        for (en, ks) in energies.iter_mut().zip(homes.chunks(ENERGY_BLOCK)) {
-            *en = ks
-                .iter()
-                .map(|&k| buf[k as usize * (N + 1) + N])
-                .sum::<Real>();
-        }
-        let mut at = 0;
-        for (k, &u) in own.iter().enumerate() {
-            let dofs = node_dofs(nv, u as usize).1;
-            let out = &mut sums[at..at + dofs];
-            out.fill(0.0);
-            for &off in &offsets[ptr[k] as usize..ptr[k + 1] as usize] {
-                for (c, o) in out.iter_mut().enumerate() {
-                    *o += buf[off as usize + c];
+            *en = kernel(e, &st, Some(&mut g), None);
+            for (s, &d) in to.iter().enumerate() {
+                if d != u32::MAX {
+                    let (l, d) = (map.local[s], d as usize);
+                    for c in 0..node_dofs(nv, st[s]).1 {
+                        sums[d + c] += g[l + c];
+                    }
                 }
             }
-            at += dofs;
+        }
+        // The home elements' energies, summed by block: the caller reads the block sums
+        // (reading the energies in place would share one line per element with the part's
+        // next writes).
+        for (b, ks) in block_sums.iter_mut().zip(homes.chunks(ENERGY_BLOCK)) {
+            *b = ks.iter().map(|&k| energies[k as usize]).sum::<Real>();
         }
         if let Some(hook) = hook {
             hook(own, sums);
@@ -948,7 +927,7 @@ where
             .for_each(|(p, buf)| work(p, buf));
     }
     for (p, buf) in bufs.iter().enumerate().filter(|_| hook.is_none()) {
-        let mut at = parts.elements[p].len() * (N + 1);
+        let mut at = parts.elements[p].len();
         for &u in &parts.nodes[p] {
             let u = u as usize;
             let (d0, dofs) = node_dofs(nv, u);
