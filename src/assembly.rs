@@ -100,10 +100,11 @@ struct Parts {
 
 /// Work fused into the parts of an element term's gradient ([`with_owned_nodes`]): called once
 /// per part, on the thread that runs it, right after the part has summed the gradient of the
-/// nodes it owns, with those node ids and their sums (3 entries per vertex node, 1 per edge
-/// node, in the nodes' order; N for vertices, N·m for edge DOFs; fixed nodes included and not
-/// masked). Each node of the term's elements is owned by exactly one part.
-pub type OwnedNodes<'a> = dyn Fn(&[u32], &[Real]) + Sync + 'a;
+/// nodes it owns, with those node ids, their sums (3 entries per vertex node, 1 per edge node,
+/// in the nodes' order; N for vertices, N·m for edge DOFs; fixed nodes included and not
+/// masked) and the term's mask of fixed nodes (by node id), whose entries the unfused gradient
+/// leaves at zero. Each node of the term's elements is owned by exactly one part.
+pub type OwnedNodes<'a> = dyn Fn(&[u32], &[Real], &[bool]) + Sync + 'a;
 
 thread_local! {
     /// The hook set by [`with_owned_nodes`] on this thread, until a gradient takes it.
@@ -903,7 +904,7 @@ where
             *b = ks.iter().map(|&k| energies[k as usize]).sum::<Real>();
         }
         if let Some(hook) = hook {
-            hook(own, sums);
+            hook(own, sums, fixed);
         }
     };
     if parts.count == 1 {

@@ -271,8 +271,8 @@ impl Disjoint {
 /// swapped when the parts are done. A step is then one parallel region with no serial pass over
 /// the nodes, and no core rereads the forces and positions another core has just written. The
 /// arithmetic is that of the unfused step, in the same order (the force of a node is
-/// `0 + Σ` of its element entries, zero where fixed or pinned, then [`advance`]), so both give
-/// the same bits, for any number of threads.
+/// `0 + Σ` of its element entries, zero where the term's mask fixes it or a DOF is pinned,
+/// then [`advance`]), so both give the same bits, for any number of threads.
 pub struct Step {
     /// Whether the scene allows fusing.
     fusable: bool,
@@ -294,7 +294,7 @@ impl Step {
             && sc.terms.len() == 1
             && pot.pattern.maps.len() == 1
             && !sc.terms[0].acts_on_explicit_steps();
-        let mut used = vec![false; nv];
+        let mut used = vec![!fusable; nv];
         if fusable {
             let map = &pot.pattern.maps[0];
             for e in 0..map.len() {
@@ -345,10 +345,15 @@ impl Step {
             advance(x, v, g, inv_m, c, dt);
             return energy;
         }
-        let (n, fixed, pinned) = (x.len(), &pot.scene.node_fixed, &self.pinned);
+        let (n, pinned) = (x.len(), &self.pinned);
+        // The writes through `Disjoint` below rely on these.
+        assert!(
+            v.len() == n && self.next.len() == n && inv_m.len() == n && pinned.len() >= 3 * n,
+            "a step built for another scene"
+        );
         let (vp, np) = (Disjoint(v.as_mut_ptr()), Disjoint(self.next.as_mut_ptr()));
         let old: &[Vec3] = x;
-        let hook = move |nodes: &[u32], sums: &[Real]| {
+        let hook = move |nodes: &[u32], sums: &[Real], fixed: &[bool]| {
             let mut at = 0;
             for &u in nodes {
                 let u = u as usize;

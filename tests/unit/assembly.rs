@@ -465,7 +465,7 @@ fn fused_explicit_step_gives_the_unfused_bits() {
     let x = bumpy(&free);
     let mut g = vec![0.0; p.n];
     let calls = std::sync::atomic::AtomicUsize::new(0);
-    let hook = |_: &[u32], _: &[f64]| {
+    let hook = |_: &[u32], _: &[f64], _: &[bool]| {
         calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     };
     let (_, taken) = shellsim::assembly::with_owned_nodes(&hook, || {
