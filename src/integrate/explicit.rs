@@ -577,9 +577,11 @@ pub(super) fn run_explicit(
             };
             s.summary.timing.newton.assembly += clock.elapsed().as_secs_f64();
             // Terms that act on the step itself (slide friction), before the equilibrium test sees
-            // the forces.
-            for term in sc.terms.iter().filter(|_| !fused) {
-                term.explicit_step(&pot, &state.x, &mut v, &mut g, dt);
+            // the forces (a fused step has none).
+            if !fused {
+                for term in sc.terms.iter() {
+                    term.explicit_step(&pot, &state.x, &mut v, &mut g, dt);
+                }
             }
             // The equilibrium test, once per window (before the step, at the state the force
             // belongs to).
