@@ -12,7 +12,7 @@ EXPECT.json (written by tests/vtk_python.rs):
                                                          "tol"}}}],
      "series": [{"pvd", "files": [...], "times": [...]}]}
 
-Needs VTK's Python package (`python3 -m pip install -r requirements.txt`). Exits 1 listing every
+Needs VTK's Python package (`scripts/test.sh` installs it into `.venv/`). Exits 1 listing every
 mismatch, 0 when all hold.
 """
 import json
@@ -22,7 +22,7 @@ import sys
 try:
     import vtk
 except ImportError:
-    sys.exit("VTK's Python package is missing: python3 -m pip install -r requirements.txt")
+    sys.exit("VTK's Python package is missing: scripts/test.sh installs it into .venv/")
 
 errors = []
 

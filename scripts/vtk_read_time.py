@@ -5,7 +5,7 @@ the median of 5 reads of each, in ms, with the file's size.
     cargo bench --bench kernels -- frame_write     # writes target/frame_write/*.vtu (~100k faces)
     python3 scripts/vtk_read_time.py target/frame_write/*.vtu
 
-Needs VTK's Python package (python3 -m pip install -r requirements.txt).
+Needs VTK's Python package (.venv/bin/python, which scripts/test.sh makes).
 """
 import os
 import statistics

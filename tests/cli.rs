@@ -1370,8 +1370,25 @@ fn huge_restart_velocities_are_bad_input() {
 /// frame, and its test command is the line `.ci/run` runs.
 #[test]
 fn readme_commands_work() {
+    // The README's two commands, in its order, in a fresh clone: the example scene (with the
+    // built binary for `cargo run --release --`), then its caption's `render`, then the test
+    // command must be the one `.ci/run` runs and must exist. Everything runs inside the clone,
+    // so an `out/` left in the working copy by the first command cannot change what is read.
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    assert!(
+        root.join(".git").exists(),
+        "this test clones the repository: run it in a git checkout"
+    );
+    let dir = tmp();
+    let clone = dir.path().join("shellsim");
+    let status = Command::new("git")
+        .args(["clone", "--quiet", "--no-hardlinks"])
+        .arg(&root)
+        .arg(&clone)
+        .status()
+        .expect("git runs");
+    assert!(status.success(), "git clone {}", root.display());
+    let readme = std::fs::read_to_string(clone.join("README.md")).unwrap();
     let block = readme
         .split("```sh\n")
         .nth(1)
@@ -1385,24 +1402,11 @@ fn readme_commands_work() {
     let example = lines[0]
         .strip_prefix("cargo run --release -- ")
         .expect("the example is `cargo run --release -- …`");
-    let dir = tmp();
-    // Repository paths resolve from the root; the output folder goes into the temporary one.
-    let args: Vec<String> = example
-        .split_whitespace()
-        .map(|a| {
-            let p = root.join(a);
-            if !a.starts_with('-') && p.exists() {
-                p.to_str().unwrap().to_string()
-            } else {
-                a.to_string()
-            }
-        })
-        .collect();
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let r = run(&args, dir.path());
+    let args: Vec<&str> = example.split_whitespace().collect();
+    let r = run(&args, &clone);
     assert_eq!(r.code, 0, "{example}: {}", r.stderr);
     let out = args[args.iter().position(|a| *a == "--out").unwrap() + 1];
-    assert!(dir.path().join(out).join("series.pvd").exists());
+    assert!(clone.join(out).join("series.pvd").exists());
 
     let caption = readme
         .split("`shellsim render ")
@@ -1412,15 +1416,30 @@ fn readme_commands_work() {
     let mut render = vec!["render"];
     render.extend(caption.split_whitespace());
     render.extend(["-o", "picture.png"]);
-    let r = run(&render, dir.path());
+    let r = run(&render, &clone);
     assert_eq!(r.code, 0, "render {caption}: {}", r.stderr);
-    let png = std::fs::read(dir.path().join("picture.png")).unwrap();
+    let png = std::fs::read(clone.join("picture.png")).unwrap();
     assert_eq!(&png[1..4], b"PNG");
 
-    let ci = std::fs::read_to_string(root.join(".ci/run")).unwrap();
+    // The run command's output is ignored by git, so the test command still sees a clean tree.
+    let status = Command::new("git")
+        .args(["status", "--porcelain", "--untracked-files=all"])
+        .current_dir(&clone)
+        .output()
+        .unwrap();
+    let dirty: Vec<&str> = std::str::from_utf8(&status.stdout)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.ends_with("picture.png"))
+        .collect();
+    assert!(dirty.is_empty(), "the README's run leaves {dirty:?}");
+
+    let test = lines[1];
+    let script = test.split_whitespace().next().unwrap();
+    assert!(clone.join(script).is_file(), "{script} is missing");
+    let ci = std::fs::read_to_string(clone.join(".ci/run")).unwrap();
     assert!(
-        ci.lines().any(|l| l.trim() == lines[1]),
-        ".ci/run does not run the README's test command `{}`",
-        lines[1]
+        ci.lines().any(|l| l.trim() == test),
+        ".ci/run does not run the README's test command `{test}`"
     );
 }

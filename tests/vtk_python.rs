@@ -6,7 +6,8 @@
 //! for single-precision fields in legacy ASCII, where the two readers round the text apart), and
 //! each `series.pvd` (parsed by VTK's XML parser) listing the frames in time order.
 //!
-//! Needs VTK's Python package: `python3 -m pip install -r requirements.txt` (`.ci/run` does).
+//! Needs VTK's Python package: `scripts/test.sh` makes the project's `.venv/` with it and names its
+//! interpreter in `SHELLSIM_PYTHON` (without that variable, `python3` is used).
 
 use serde_json::{json, Value};
 use std::path::Path;
@@ -141,15 +142,16 @@ fn vtk_reads_every_kind_of_frame_shellsim_writes() {
         json!({"frames": frames, "series": series}).to_string(),
     )
     .unwrap();
-    let r = Command::new("python3")
+    let python = std::env::var("SHELLSIM_PYTHON").unwrap_or_else(|_| "python3".into());
+    let r = Command::new(&python)
         .arg(root.join("scripts/vtk_check.py"))
         .arg(&spec)
         .output()
-        .expect("python3 runs");
+        .unwrap_or_else(|e| panic!("{python}: {e}"));
     assert!(
         r.status.success(),
-        "VTK disagrees with shellsim (or is missing: python3 -m pip install -r \
-         requirements.txt):\n{}{}",
+        "VTK disagrees with shellsim (or is missing from {python}: run the tests with \
+         scripts/test.sh):\n{}{}",
         String::from_utf8_lossy(&r.stdout),
         String::from_utf8_lossy(&r.stderr)
     );
