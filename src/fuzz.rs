@@ -347,7 +347,7 @@ pub fn harnesses(root: &std::path::Path) -> Result<Vec<Harness>, String> {
         crate::mesh::generate::Spacing::default(),
     );
     crate::cases::Case::SphericalCap.program(&mut sheet);
-    let own = |m: &Mesh, f: Format| mesh_to_bytes(m, f, "fuzz seed").map_err(|e| e.to_string());
+    let own = |m: &Mesh, f: Format| -> Result<Vec<u8>, String> { Ok(mesh_to_bytes(m, f, "fuzz seed")) };
     let mut legacy = read_dir("tests/data/vtk", &["vtk"])?;
     legacy.push(own(&sheet, Format::Vtk)?);
     legacy.push(own(&sheet, Format::VtkAscii)?);

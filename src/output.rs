@@ -801,15 +801,21 @@ impl Writer {
         let restart = &self.restart_fields;
         let single = self.selection.precision == crate::settings::Precision::Single;
         // The displacement gives the reference positions (positions − displacement), which
-        // `shellsim error` and scripts measure against: Float64 like the positions.
+        // `shellsim error` and scripts measure against: Float64 like the positions. A field
+        // with a value beyond Float32's range (3.4e38) stays Float64 rather than become inf.
+        let fits_f32 = |n: &str| {
+            [m.face_fields.get(n), m.vertex_fields.get(n)]
+                .into_iter()
+                .flatten()
+                .all(|f| f.data.iter().all(|&v| (v as f32).is_finite()))
+        };
         let bytes = crate::mesh::io::mesh_to_bytes_with(
             m,
             self.format,
             &format!("shellsim frame {index} t={}", row.time),
             &self.vtu,
-            &|n| single && n != "displacement" && !restart.contains(n),
-        )
-        .map_err(|e| ioerr(&path, e))?;
+            &|n| single && n != "displacement" && !restart.contains(n) && fits_f32(n),
+        );
         write_atomic(&path, &bytes).map_err(|e| ioerr(&path, e))?;
         self.built_is_written = true;
         if self.selection.snapshots == crate::settings::Snapshots::All {

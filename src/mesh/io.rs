@@ -7,16 +7,12 @@
 //! FIELD arrays or as SCALARS / VECTORS / NORMALS / TENSORS. MorphoShell input files work
 //! unchanged.
 //!
-//! Write: `.vtu` (XML, inline base64) or legacy `.vtk` (big-endian binary), always through a
-//! temporary file renamed into place, so a reader never sees half a file.
+//! Write: `.vtu` (`mesh/vtu.rs`) or legacy `.vtk` (ASCII or big-endian binary, written here),
+//! always through a temporary file renamed into place, so a reader never sees half a file.
 
 use super::{Field, Mesh, MeshError, RawMesh};
 use std::collections::BTreeMap;
 use std::path::Path;
-use vtkio::model::{
-    Attribute, Attributes, ByteOrder, CellType, Cells, DataSet, IOBuffer, UnstructuredGridPiece,
-    Version, VertexNumbers, Vtk,
-};
 
 /// Reads a triangle mesh and its fields. Validation of geometry happens in [`Mesh::validate`].
 ///
@@ -138,36 +134,9 @@ impl Format {
     }
 }
 
-/// Legacy FIELD arrays (any component count; what MorphoShell reads), Float32 where
-/// `single(name)`.
-fn fields_to_attributes(
-    fields: &BTreeMap<String, Field>,
-    single: &dyn Fn(&str) -> bool,
-) -> Vec<Attribute> {
-    if fields.is_empty() {
-        return Vec::new();
-    }
-    let arrays = fields
-        .iter()
-        .map(|(name, f)| vtkio::model::FieldArray {
-            name: name.clone(),
-            elem: f.components as u32,
-            data: if single(name) {
-                IOBuffer::F32(f.data.iter().map(|&x| x as f32).collect())
-            } else {
-                IOBuffer::F64(f.data.clone())
-            },
-        })
-        .collect();
-    vec![Attribute::Field {
-        name: "FieldData".into(),
-        data_array: arrays,
-    }]
-}
-
 /// Serialises a mesh with fields to bytes in the given format (`.vtu`: zlib-compressed raw
 /// appended data, every field Float64).
-pub fn mesh_to_bytes(mesh: &Mesh, format: Format, title: &str) -> Result<Vec<u8>, vtkio::Error> {
+pub fn mesh_to_bytes(mesh: &Mesh, format: Format, title: &str) -> Vec<u8> {
     mesh_to_bytes_with(mesh, format, title, &Default::default(), &|_| false)
 }
 
@@ -179,50 +148,112 @@ pub fn mesh_to_bytes_with(
     title: &str,
     vtu: &super::vtu::VtuOptions,
     single: &dyn Fn(&str) -> bool,
-) -> Result<Vec<u8>, vtkio::Error> {
-    if format == Format::Vtu {
-        return Ok(super::vtu::vtu_bytes(mesh, vtu, single));
+) -> Vec<u8> {
+    match format {
+        Format::Vtu => super::vtu::vtu_bytes(mesh, vtu, single),
+        Format::Vtk => legacy_bytes(mesh, title, true, single),
+        Format::VtkAscii => legacy_bytes(mesh, title, false, single),
     }
-    let points: Vec<f64> = mesh
-        .positions
-        .iter()
-        .flat_map(|p| [p.x, p.y, p.z])
+}
+
+/// A legacy VTK 4.2 `UNSTRUCTURED_GRID` of triangles: `POINTS n double`, `CELLS`,
+/// `CELL_TYPES` (5, VTK_TRIANGLE), then `CELL_DATA` and `POINT_DATA` as one `FIELD FieldData`
+/// block each, an array per field with any number of components (what MorphoShell reads),
+/// `float` where `single(name)`, else `double`. Binary data is big-endian, as the format
+/// requires; ASCII numbers are Rust's shortest round-trip representation. A name's spaces
+/// become `%20` (VTK's escape) and the title is kept to one line.
+fn legacy_bytes(mesh: &Mesh, title: &str, binary: bool, single: &dyn Fn(&str) -> bool) -> Vec<u8> {
+    use std::fmt::Write as _;
+    fn floats(out: &mut Vec<u8>, values: &[f64], per_line: usize, binary: bool, f32s: bool) {
+        if binary {
+            out.reserve(values.len() * if f32s { 4 } else { 8 });
+            for &v in values {
+                if f32s {
+                    out.extend_from_slice(&(v as f32).to_be_bytes());
+                } else {
+                    out.extend_from_slice(&v.to_be_bytes());
+                }
+            }
+            out.push(b'\n');
+            return;
+        }
+        let mut line = String::new();
+        for chunk in values.chunks(per_line.max(1)) {
+            line.clear();
+            for (i, &v) in chunk.iter().enumerate() {
+                if i > 0 {
+                    line.push(' ');
+                }
+                let _ = if f32s {
+                    write!(line, "{}", v as f32)
+                } else {
+                    write!(line, "{v}")
+                };
+            }
+            line.push('\n');
+            out.extend_from_slice(line.as_bytes());
+        }
+    }
+    fn ints(out: &mut Vec<u8>, values: &[u32], per_line: usize, binary: bool) {
+        if binary {
+            for &v in values {
+                out.extend_from_slice(&(v as i32).to_be_bytes());
+            }
+            out.push(b'\n');
+            return;
+        }
+        for chunk in values.chunks(per_line.max(1)) {
+            let line: Vec<String> = chunk.iter().map(u32::to_string).collect();
+            out.extend_from_slice(line.join(" ").as_bytes());
+            out.push(b'\n');
+        }
+    }
+    let fields = |out: &mut Vec<u8>, kind: &str, n: usize, fields: &BTreeMap<String, Field>| {
+        if fields.is_empty() {
+            return;
+        }
+        out.extend_from_slice(format!("{kind} {n}\nFIELD FieldData {}\n", fields.len()).as_bytes());
+        for (name, f) in fields {
+            let f32s = single(name);
+            let comps = f.components.max(1);
+            out.extend_from_slice(
+                format!(
+                    "{} {comps} {} {}\n",
+                    name.replace(' ', "%20"),
+                    f.data.len() / comps,
+                    if f32s { "float" } else { "double" }
+                )
+                .as_bytes(),
+            );
+            floats(out, &f.data, comps, binary, f32s);
+        }
+    };
+    let one_line: String = title
+        .chars()
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .take(255)
         .collect();
-    let cells = VertexNumbers::Legacy {
-        num_cells: mesh.faces.len() as u32,
-        vertices: mesh
-            .faces
-            .iter()
-            .flat_map(|f| [3u32, f[0] as u32, f[1] as u32, f[2] as u32])
-            .collect(),
-    };
-    let piece = UnstructuredGridPiece {
-        points: IOBuffer::F64(points),
-        cells: Cells {
-            cell_verts: cells,
-            types: vec![CellType::Triangle; mesh.faces.len()],
-        },
-        data: Attributes {
-            point: fields_to_attributes(&mesh.vertex_fields, single),
-            cell: fields_to_attributes(&mesh.face_fields, single),
-        },
-    };
-    let vtk = Vtk {
-        version: Version::new_legacy(4, 2),
-        title: title.to_string(),
-        byte_order: ByteOrder::BigEndian,
-        file_path: None,
-        data: DataSet::inline(piece),
-    };
-    let mut out = Vec::new();
-    if format == Format::VtkAscii {
-        let mut s = String::new();
-        vtk.write_legacy_ascii(&mut s)?;
-        out = s.into_bytes();
-    } else {
-        vtk.write_legacy(&mut out)?;
-    }
-    Ok(out)
+    let mut out = format!(
+        "# vtk DataFile Version 4.2\n{one_line}\n{}\nDATASET UNSTRUCTURED_GRID\nPOINTS {} double\n",
+        if binary { "BINARY" } else { "ASCII" },
+        mesh.positions.len()
+    )
+    .into_bytes();
+    let points: Vec<f64> = mesh.positions.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
+    floats(&mut out, &points, 3, binary, false);
+    let nf = mesh.faces.len();
+    out.extend_from_slice(format!("CELLS {nf} {}\n", 4 * nf).as_bytes());
+    let cells: Vec<u32> = mesh
+        .faces
+        .iter()
+        .flat_map(|f| [3, f[0] as u32, f[1] as u32, f[2] as u32])
+        .collect();
+    ints(&mut out, &cells, 4, binary);
+    out.extend_from_slice(format!("CELL_TYPES {nf}\n").as_bytes());
+    ints(&mut out, &vec![5; nf], 1, binary);
+    fields(&mut out, "CELL_DATA", nf, &mesh.face_fields);
+    fields(&mut out, "POINT_DATA", mesh.positions.len(), &mesh.vertex_fields);
+    out
 }
 
 /// Writes bytes atomically: a temporary file in the same folder, then a rename.
@@ -250,6 +281,6 @@ pub fn write_mesh(path: &Path, mesh: &Mesh, format: Format, title: &str) -> Resu
         path: path.display().to_string(),
         reason,
     };
-    let bytes = mesh_to_bytes(mesh, format, title).map_err(|e| werr(e.to_string()))?;
+    let bytes = mesh_to_bytes(mesh, format, title);
     write_atomic(path, &bytes).map_err(|e| werr(e.to_string()))
 }

@@ -2,9 +2,9 @@
 //! `DATASET POLYDATA` or `UNSTRUCTURED_GRID` of triangles, with CELL_DATA / POINT_DATA as FIELD
 //! arrays or as SCALARS / COLOR_SCALARS / VECTORS / NORMALS / TEXTURE_COORDINATES / TENSORS.
 //!
-//! Written here rather than taken from vtkio so that every error names the line and the section
-//! it is in, nothing is allocated from a count in a header before the data it announces is
-//! known to be there, and no input can panic.
+//! Written here rather than taken from a VTK crate so that every error names the line and the
+//! section it is in, nothing is allocated from a count in a header before the data it announces
+//! is known to be there, and no input can panic.
 //!
 //! Format: <https://docs.vtk.org/en/latest/design_documents/VTKFileFormats.html> (legacy part).
 //! Versions up to 4.2 store cells as `n i0 … i(n−1)` runs; 5.x as `OFFSETS` and `CONNECTIVITY`

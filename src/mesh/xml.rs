@@ -4,8 +4,8 @@
 //! any of VTK's compressors (zlib, LZ4, LZMA), `header_type` UInt32 or UInt64, either byte
 //! order.
 //!
-//! Written here rather than taken from vtkio so that every error names the byte offset and the
-//! element it is in, compressed-data headers are checked against the data before anything is
+//! Written here rather than taken from a VTK crate so that every error names the byte offset and
+//! the element it is in, compressed-data headers are checked against the data before anything is
 //! allocated or sliced, and no input can panic.
 //!
 //! Format: <https://docs.vtk.org/en/latest/design_documents/VTKFileFormats.html> (XML part).
@@ -355,10 +355,36 @@ fn inflate(c: Compressor, src: &[u8], want: usize, out: &mut Vec<u8>) -> Result<
                 .map_err(|e| e.to_string())?;
         }
         Compressor::Lzma => {
-            xz2::read::XzDecoder::new(src)
-                .take(limit)
-                .read_to_end(out)
-                .map_err(|e| e.to_string())?;
+            // The decoder writes into a sink that stops at `limit` bytes, so a block that
+            // claims little and inflates to much (a bomb) costs no more than its claim.
+            struct Capped<'a> {
+                out: &'a mut Vec<u8>,
+                left: usize,
+            }
+            impl std::io::Write for Capped<'_> {
+                fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+                    if self.left == 0 {
+                        return Err(std::io::Error::other("capped"));
+                    }
+                    let n = b.len().min(self.left);
+                    self.out.extend_from_slice(&b[..n]);
+                    self.left -= n;
+                    Ok(n)
+                }
+                fn flush(&mut self) -> std::io::Result<()> {
+                    Ok(())
+                }
+            }
+            let mut sink = Capped {
+                out,
+                left: limit as usize,
+            };
+            match lzma_rs::xz_decompress(&mut std::io::BufReader::new(src), &mut sink) {
+                Ok(()) => {}
+                // Past the claim: the caller reports the size mismatch.
+                Err(_) if sink.left == 0 => {}
+                Err(e) => return Err(e.to_string()),
+            }
         }
         Compressor::Lz4 => {
             // An LZ4 block expands at most 255×: a larger claim is refused before allocating.
