@@ -28,7 +28,9 @@ use std::process::ExitCode;
     about,
     args_conflicts_with_subcommands = true,
     subcommand_negates_reqs = true,
-    after_help = "Exit codes: 0 converged, 1 ran but did not converge, 2 bad input or I/O error."
+    after_help = "Exit codes: 0 converged, 1 ran but did not converge, 2 bad input or I/O \
+                  error, 130 / 143 interrupted by SIGINT / SIGTERM (the state reached is written \
+                  first)."
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -36,8 +38,8 @@ pub struct Cli {
     /// Settings file (TOML); see docs/settings.md.
     #[arg(required = true)]
     settings: Option<PathBuf>,
-    /// Triangle mesh: .vtk (legacy ASCII/binary), .vtu/.vtp (XML with inline data), or .off,
-    /// .obj, .ply, .stl.
+    /// Triangle mesh: .vtk (legacy ASCII/binary), .vtu/.vtp (XML, inline or appended data, any
+    /// of VTK's compressors), or .off, .obj, .ply, .stl.
     #[arg(required = true)]
     mesh: Option<PathBuf>,
     /// Output folder (created if needed). One holding an earlier run's output is refused
@@ -53,17 +55,23 @@ pub struct Cli {
     /// Override a settings key, e.g. --set material.thickness=0.002 (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
-    /// No progress bar even on a terminal.
+    /// No progress bar, and no start and end lines on stderr (errors are still printed).
     #[arg(long, short)]
     quiet: bool,
-    /// Print every Newton iteration (energy, residual, shift, step length) to stderr, in place
-    /// of the progress bar.
+    /// Print every step (time or dial, step size, energy, residual) and every Newton iteration
+    /// (energy, residual, shift, step length) to stderr, in place of the progress bar.
     #[arg(long, short)]
     verbose: bool,
-    /// Start from a frame of an earlier run on the same mesh (positions, velocities, edge DOFs;
-    /// time or dial from the series.pvd next to it).
+    /// Start from a frame of an earlier run on the same mesh (positions, velocities, edge DOFs,
+    /// and the integrator's state from the frame's `.state.json`; time or dial from the
+    /// series.pvd next to it).
     #[arg(long, value_name = "FRAME")]
     restart: Option<PathBuf>,
+    /// Continue the series in --out: restart from its last frame (or from --restart FRAME, a
+    /// frame of that folder, dropping the frames after it), number the new frames on, and
+    /// extend series.pvd, log.csv, run.json and the summary.
+    #[arg(long = "continue", conflicts_with = "overwrite")]
+    continue_series: bool,
 }
 
 #[derive(Subcommand, Debug)]
@@ -454,13 +462,63 @@ impl Progress for Bar {
     }
 }
 
+/// `-v`: every step's message as a line on stderr.
+struct Lines;
+impl Progress for Lines {
+    fn update(&mut self, _: Real, message: &str) {
+        eprintln!("{message}");
+    }
+}
+
+/// The frame a `--continue` run starts from: `--restart FRAME` (which must lie in `out`) or the
+/// last frame that `out/series.pvd` lists.
+fn continue_from(out: &std::path::Path, restart: Option<&PathBuf>) -> Result<PathBuf> {
+    let series = out.join("series.pvd");
+    let listed = crate::output::series_entries(&series).map_err(|e| anyhow!("--continue: {e}"))?;
+    match restart {
+        Some(p) => {
+            let same = p
+                .parent()
+                .map(|d| {
+                    if d.as_os_str().is_empty() {
+                        std::path::Path::new(".")
+                    } else {
+                        d
+                    }
+                })
+                .and_then(|d| d.canonicalize().ok())
+                == out.canonicalize().ok();
+            let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            if !same || !listed.iter().any(|(_, f)| f == name) {
+                bail!(
+                    "--continue --restart {}: the frame must be one that {} lists",
+                    p.display(),
+                    series.display()
+                );
+            }
+            Ok(p.clone())
+        }
+        None => match listed.last() {
+            Some((_, f)) => Ok(out.join(f)),
+            None => bail!("--continue: {} lists no frame", series.display()),
+        },
+    }
+}
+
 fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> {
+    let clock = std::time::Instant::now();
+    let started = crate::provenance::now();
     let settings = Settings::load(&settings_path, &cli.set)?;
     let mesh = read_mesh(&mesh_path)?;
     let mut scene = Scene::build(mesh, settings)?;
     crate::output::check_fields(&scene, &settings_path.display().to_string())?;
     crate::solve::newton::VERBOSE.store(cli.verbose, std::sync::atomic::Ordering::Relaxed);
-    let initial = match &cli.restart {
+    let restart = if cli.continue_series {
+        Some(continue_from(&cli.out, cli.restart.as_ref())?)
+    } else {
+        cli.restart.clone()
+    };
+    let initial = match &restart {
         Some(p) => {
             let (mut st, w) = crate::restart::read_restart(p, &scene)?;
             scene.warnings.extend(w);
@@ -470,6 +528,7 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
                 scene.dial_from_state(&st.state.x, &st.state.dofs);
                 st.time = 0.0;
                 st.dial = Some(0.0);
+                st.driver = None;
             }
             Some(st)
         }
@@ -497,9 +556,68 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
         .map_err(|e| anyhow!("cannot start {threads} threads: {e}"))?;
     crate::integrate::catch_signals()
         .map_err(|e| anyhow!("cannot install signal handlers: {e}"))?;
-    let mut writer = Writer::new(&cli.out, &scene, cli.overwrite)?;
-    let summary = pool.install(|| {
-        if !cli.quiet && !cli.verbose && std::io::stderr().is_terminal() {
+    let file = |p: &std::path::Path| {
+        crate::provenance::FileRecord::of(p).map_err(|e| anyhow!("{}: {e}", p.display()))
+    };
+    let mut record = crate::provenance::RunRecord {
+        shellsim_version: env!("CARGO_PKG_VERSION").into(),
+        commit: crate::provenance::commit().into(),
+        command_line: std::env::args_os()
+            .map(|a| a.to_string_lossy().into_owned())
+            .collect(),
+        working_folder: std::env::current_dir()
+            .map(|d| d.display().to_string())
+            .unwrap_or_default(),
+        settings: file(&settings_path)?,
+        overrides: cli.set.clone(),
+        resolved_settings: crate::output::RESOLVED_SETTINGS.into(),
+        mesh: file(&mesh_path)?,
+        vertices: scene.num_vertices(),
+        faces: scene.num_faces(),
+        restart: restart.as_deref().map(file).transpose()?,
+        threads,
+        host: crate::provenance::host(),
+        started,
+        ended: None,
+        status: "running".into(),
+        reason: String::new(),
+        exit_code: None,
+        frames: 0,
+        wall_seconds: 0.0,
+    };
+    let mut writer = match &restart {
+        Some(frame) if cli.continue_series => Writer::continuing(&cli.out, &scene, frame)?,
+        _ => Writer::new(&cli.out, &scene, cli.overwrite)?,
+    };
+    let frames_before = writer.num_frames();
+    let mut history = if cli.continue_series {
+        crate::provenance::read(&cli.out).map_err(|e| anyhow!("--continue: {e}"))?
+    } else {
+        None
+    }
+    .unwrap_or_default();
+    history.runs.push(record.clone());
+    writer.provenance(&history)?;
+    let mode = format!("{:?}", scene.settings.solver.mode).to_lowercase();
+    if !cli.quiet {
+        eprintln!(
+            "shellsim: {mode} run of {} on {} ({} vertices, {} faces, {threads} thread{}){} into {}",
+            settings_path.display(),
+            mesh_path.display(),
+            scene.num_vertices(),
+            scene.num_faces(),
+            if threads == 1 { "" } else { "s" },
+            match &restart {
+                Some(p) => format!(" from {}", p.display()),
+                None => String::new(),
+            },
+            cli.out.display()
+        );
+    }
+    let ran = pool.install(|| {
+        if cli.verbose {
+            run(&scene, &mut writer, &mut Lines, threads, initial)
+        } else if !cli.quiet && std::io::stderr().is_terminal() {
             let pb = indicatif::ProgressBar::new(1000);
             pb.set_style(
                 indicatif::ProgressStyle::with_template(
@@ -514,26 +632,65 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
         } else {
             run(&scene, &mut writer, &mut Quiet, threads, initial)
         }
-    })?;
-    if let Some(sig) = crate::integrate::interrupted() {
-        eprintln!(
-            "shellsim: {} (state so far in {})",
-            summary.reason,
-            cli.out.display()
-        );
+    });
+    let wall = clock.elapsed().as_secs_f64();
+    record.ended = Some(crate::provenance::now());
+    record.wall_seconds = wall;
+    record.frames = writer.num_frames() - frames_before;
+    let summary = match ran {
+        Ok(s) => s,
+        Err(e) => {
+            record.status = "failed".into();
+            record.reason = format!("{e:#}");
+            record.exit_code = Some(2);
+            *history.runs.last_mut().expect("pushed above") = record;
+            let _ = writer.provenance(&history);
+            return Err(e.into());
+        }
+    };
+    let where_ = format!(
+        "{} frame{} in {}",
+        record.frames,
+        if record.frames == 1 { "" } else { "s" },
+        cli.out.display()
+    );
+    let code = if let Some(sig) = crate::integrate::interrupted() {
+        record.status = "interrupted".into();
         // The shell convention: 128 + the signal (130 for SIGINT, 143 for SIGTERM).
-        return Ok((128 + sig) as u8);
-    }
-    if summary.converged {
-        Ok(0)
+        (128 + sig) as u8
+    } else if summary.converged {
+        record.status = "converged".into();
+        0
     } else {
-        eprintln!(
-            "shellsim: did not converge: {} (see {})",
+        record.status = "not converged".into();
+        1
+    };
+    record.reason = summary.reason.clone();
+    record.exit_code = Some(code);
+    *history.runs.last_mut().expect("pushed above") = record;
+    writer.provenance(&history)?;
+    let at = match summary.time {
+        Some(t) => format!("t = {} s", crate::math::human(t)),
+        None => format!("dial {}", crate::math::human(summary.dial)),
+    };
+    match code {
+        0 if !cli.quiet => eprintln!(
+            "shellsim: converged at {at} in {} s: {where_}",
+            crate::math::human(wall)
+        ),
+        0 => {}
+        1 => eprintln!(
+            "shellsim: did not converge ({at}, {} s): {} ({where_}; see {})",
+            crate::math::human(wall),
             summary.reason,
             cli.out.join("summary.json").display()
-        );
-        Ok(1)
+        ),
+        _ => eprintln!(
+            "shellsim: {} ({where_}; continue with --continue)",
+            summary.reason
+        ),
     }
+    Ok(code)
 }
 
 /// Prints a line on stdout; a closed pipe (`shellsim error … | head`) is not an error.

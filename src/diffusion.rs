@@ -176,7 +176,7 @@ pub enum DiffusionError {
     #[error(
         "the diffusion error control failed: sub-step {h:e} s still has an error estimate of {} \
          times the tolerance",
-        crate::math::sci(*.error)
+        crate::math::human(*.error)
     )]
     StepControl {
         /// The last sub-step tried (s).
@@ -280,6 +280,19 @@ pub enum SurfaceError {
 }
 
 impl Diffusion {
+    /// The sub-step size the error control proposes next (s; 0 before the first step): a
+    /// restart resumes it with [`Diffusion::resume_substep`].
+    pub fn next_substep(&self) -> Real {
+        self.h_next
+    }
+
+    /// Resumes the error control's next sub-step `h` (s) of an earlier run.
+    pub fn resume_substep(&mut self, h: Real) {
+        if h.is_finite() && h >= 0.0 {
+            self.h_next = h;
+        }
+    }
+
     /// Builds M and K on the reference mesh. `thickness` and `directions` (unit machine
     /// directions, any vector in or near the face plane; projected) are per face.
     pub fn new(

@@ -347,7 +347,8 @@ pub fn harnesses(root: &std::path::Path) -> Result<Vec<Harness>, String> {
         crate::mesh::generate::Spacing::default(),
     );
     crate::cases::Case::SphericalCap.program(&mut sheet);
-    let own = |m: &Mesh, f: Format| -> Result<Vec<u8>, String> { Ok(mesh_to_bytes(m, f, "fuzz seed")) };
+    let own =
+        |m: &Mesh, f: Format| -> Result<Vec<u8>, String> { Ok(mesh_to_bytes(m, f, "fuzz seed")) };
     let mut legacy = read_dir("tests/data/vtk", &["vtk"])?;
     legacy.push(own(&sheet, Format::Vtk)?);
     legacy.push(own(&sheet, Format::VtkAscii)?);

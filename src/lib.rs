@@ -45,6 +45,7 @@ pub mod math;
 pub mod mesh;
 pub mod morphoshell;
 pub mod output;
+pub mod provenance;
 pub mod render;
 pub mod rest;
 pub mod restart;

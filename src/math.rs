@@ -52,12 +52,34 @@ pub fn eig2(m: &Mat2) -> (Real, Real) {
     (0.5 * tr - disc, 0.5 * tr + disc)
 }
 
-/// A number for a message: `{:.3e}` when finite, else `"not finite"` (messages, logs and
-/// summaries never carry `NaN` or `inf`).
-pub fn sci(x: Real) -> String {
-    if x.is_finite() {
-        format!("{x:.3e}")
-    } else {
-        "not finite".into()
+/// A number for people (messages, labels, the terminal): four significant digits, plain
+/// between 1e-3 and 1e5 (`0.7`, `0.7284`, `12.5`, `31416`), otherwise scientific with the
+/// mantissa's trailing zeros dropped (`1.5e-7`, `2.346e12`); `"not finite"` for NaN and
+/// infinities (messages, logs and summaries never carry `NaN` or `inf`).
+pub fn human(x: Real) -> String {
+    if !x.is_finite() {
+        return "not finite".into();
     }
+    if x == 0.0 {
+        return "0".into();
+    }
+    let trim = |s: String| -> String {
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    };
+    let a = x.abs();
+    if (1e-3..1e5).contains(&a) {
+        let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+        let s = trim(format!("{x:.decimals$}"));
+        // Rounding can carry past the plain range (99999.5 → "100000"): that stays plain.
+        if s != "-0" {
+            return s;
+        }
+    }
+    let s = format!("{x:.3e}");
+    let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
+    format!("{}e{e}", trim(m.to_string()))
 }

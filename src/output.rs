@@ -126,7 +126,7 @@ impl Serialize for Energies {
 pub struct LogRow {
     /// Frame index.
     pub frame: usize,
-    /// Simulated time (s); in static mode, the dial factor.
+    /// Simulated time (s); in static mode the dial factor, and `log.csv` has no time column.
     pub time: Real,
     /// Dial factor of the rest forms.
     pub dial: Real,
@@ -193,8 +193,9 @@ pub struct Summary {
     pub faces: usize,
     /// Worker threads.
     pub threads: usize,
-    /// Final simulated time (s) (static: 0).
-    pub time: Real,
+    /// Final simulated time (s); absent in static runs, whose progress is the dial.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time: Option<Real>,
     /// Final dial factor.
     pub dial: Real,
     /// Hold points of `dial.holds` at which the run reached equilibrium.
@@ -290,9 +291,83 @@ pub struct Writer {
     built_is_written: bool,
     /// The fields a restart reads: always written, always Float64.
     restart_fields: std::collections::BTreeSet<String>,
+    /// Static runs: `log.csv` has no time column (the dial is the run's progress).
+    static_mode: bool,
+    /// The resolved settings, written into the folder with the provenance.
+    settings_snapshot: crate::settings::Settings,
+    /// `log.csv` rows of the frames a continued series keeps, verbatim, and its header.
+    kept_log: Option<(String, Vec<String>)>,
+    /// A continued series: the first frame (the restart state, already in the series) is not
+    /// written again.
+    skip_first: bool,
+    /// Space set aside so that a run stopped by a full disk can still write its summary.
+    reserve: Option<Reserve>,
     /// The folder's lock, released when the writer is dropped (`None`: a writer that only
     /// builds fields, [`check_fields`]).
     _lock: Option<Lock>,
+}
+
+/// `.shellsim.reserve`: space set aside while a run writes, removed on drop.
+struct Reserve(PathBuf);
+
+impl Drop for Reserve {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
+/// The resolved settings' file in a run folder ([`crate::provenance`]).
+pub const RESOLVED_SETTINGS: &str = "settings.resolved.toml";
+
+/// Bytes set aside in `.shellsim.reserve` while a run writes, released when the disk fills.
+const RESERVE_BYTES: usize = 1 << 20;
+
+/// The `(timestep, file)` entries of a `series.pvd`, in order.
+pub fn series_entries(path: &Path) -> Result<Vec<(Real, String)>, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let attr = |line: &str, key: &str| -> Option<String> {
+        let at = line.find(&format!("{key}=\""))? + key.len() + 2;
+        let rest = &line[at..];
+        Some(rest[..rest.find('"')?].to_string())
+    };
+    let mut out = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        if !line.contains("<DataSet") {
+            continue;
+        }
+        let (Some(t), Some(f)) = (attr(line, "timestep"), attr(line, "file")) else {
+            return Err(format!(
+                "{}: line {}: a DataSet without timestep or file",
+                path.display(),
+                i + 1
+            ));
+        };
+        let t: Real = t.parse().map_err(|_| {
+            format!(
+                "{}: line {}: timestep '{t}' is not a number",
+                path.display(),
+                i + 1
+            )
+        })?;
+        if f.contains('/') || f.contains('\\') || f.starts_with('.') {
+            return Err(format!(
+                "{}: line {}: '{f}' is not a file of this folder",
+                path.display(),
+                i + 1
+            ));
+        }
+        out.push((t, f));
+    }
+    Ok(out)
+}
+
+/// The state file written beside a frame (`frame_00003.vtu` → `frame_00003.state.json`).
+pub fn state_file(frame: &Path) -> PathBuf {
+    let stem = frame
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    frame.with_file_name(format!("{stem}.state.json"))
 }
 
 /// The fields a restart of `scene` reads from a frame: the velocity (dynamic modes), the edge
@@ -438,13 +513,28 @@ fn previous_outputs(dir: &Path, prefix: &str) -> std::io::Result<Vec<std::path::
             .is_some_and(|(n, ext)| {
                 !n.is_empty()
                     && n.bytes().all(|c| c.is_ascii_digit())
-                    && (ext == "vtu" || ext == "vtk" || ext == "png")
+                    && matches!(ext, "vtu" | "vtk" | "png" | "state.json")
             });
-        let ours = matches!(name, "summary.json" | "series.pvd" | "log.csv")
-            || frame
+        let ours = matches!(
+            name,
+            "summary.json" | "series.pvd" | "log.csv" | "run.json" | RESOLVED_SETTINGS
+        ) || frame
             || (name.starts_with('.') && name.ends_with(".tmp"));
         if ours && p.is_file() {
             out.push(p);
+        }
+    }
+    // Frames an earlier run wrote under another `output.prefix`: those its series lists, with
+    // their state files and pictures.
+    if let Ok(listed) = series_entries(&dir.join("series.pvd")) {
+        for (_, f) in listed {
+            let frame = dir.join(&f);
+            let png = frame.with_extension("png");
+            for p in [state_file(&frame), png, frame] {
+                if p.is_file() && !out.contains(&p) {
+                    out.push(p);
+                }
+            }
         }
     }
     out.sort();
@@ -510,14 +600,105 @@ impl Writer {
                 std::fs::remove_file(p).map_err(|e| ioerr(p, e))?;
             }
         }
-        let probe = dir.join(".shellsim-write-test");
-        std::fs::write(&probe, b"").map_err(|e| ioerr(dir, format!("not writable: {e}")))?;
-        let _ = std::fs::remove_file(&probe);
+        let reserve = Self::set_aside(dir)?;
         Ok(Writer {
             dir: dir.to_path_buf(),
+            reserve: Some(reserve),
             _lock: Some(lock),
             ..Writer::detached(scene)
         })
+    }
+
+    /// Checks that `dir` is writable by setting aside [`RESERVE_BYTES`] in
+    /// `.shellsim.reserve` (released by [`Writer::release_reserve`] when the disk fills, so the
+    /// summary still fits).
+    fn set_aside(dir: &Path) -> Result<Reserve, OutputError> {
+        let reserve = Reserve(dir.join(".shellsim.reserve"));
+        std::fs::write(&reserve.0, vec![0u8; RESERVE_BYTES])
+            .map_err(|e| ioerr(dir, format!("not writable: {e}")))?;
+        Ok(reserve)
+    }
+
+    /// Frees the space set aside at the start (a full disk: the summary is written next).
+    pub fn release_reserve(&mut self) {
+        self.reserve = None;
+    }
+
+    /// Continues the series in `dir` from its frame `from` (a frame it lists): the frames
+    /// after it go (with their state files, pictures and log rows), new frames are numbered on,
+    /// and the first frame the run writes (the restart state, which is `from` itself) is not
+    /// written again.
+    pub fn continuing(dir: &Path, scene: &Scene, from: &Path) -> Result<Self, OutputError> {
+        let lock = Lock::take(dir)?;
+        let mut w = Writer {
+            dir: dir.to_path_buf(),
+            ..Writer::detached(scene)
+        };
+        let series = dir.join("series.pvd");
+        let listed = series_entries(&series).map_err(|e| ioerr(&series, e))?;
+        let name = from
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let keep = listed
+            .iter()
+            .position(|(_, f)| *f == name)
+            .ok_or_else(|| ioerr(&series, format!("does not list {name}")))?;
+        let ext = format!(".{}", w.format.extension());
+        if !name.starts_with(&format!("{}_", w.prefix)) || !name.ends_with(&ext) {
+            return Err(ioerr(
+                from,
+                format!(
+                    "a continued series keeps its frames' names: this run writes {}_NNNNN{ext} \
+                     (output.prefix, output.format)",
+                    w.prefix
+                ),
+            ));
+        }
+        // log.csv: the header and the rows of the frames kept, verbatim.
+        let log_path = dir.join("log.csv");
+        let log = std::fs::read_to_string(&log_path).map_err(|e| ioerr(&log_path, e))?;
+        let mut lines = log.lines();
+        let header = lines.next().unwrap_or_default().to_string();
+        let rows: Vec<String> = lines.take(keep + 1).map(String::from).collect();
+        if rows.len() != keep + 1 {
+            return Err(ioerr(
+                &log_path,
+                format!(
+                    "has {} rows, the series {} frames",
+                    rows.len(),
+                    listed.len()
+                ),
+            ));
+        }
+        for (_, f) in &listed[keep + 1..] {
+            let frame = dir.join(f);
+            for p in [state_file(&frame), frame.with_extension("png"), frame] {
+                if p.is_file() {
+                    std::fs::remove_file(&p).map_err(|e| ioerr(&p, e))?;
+                }
+            }
+        }
+        w.frames = listed[..=keep].to_vec();
+        w.kept_log = Some((header, rows));
+        w.skip_first = true;
+        w.reserve = Some(Self::set_aside(dir)?);
+        w._lock = Some(lock);
+        w.write_series()?;
+        w.write_log()?;
+        Ok(w)
+    }
+
+    /// Writes `run.json` (and, the first time, the resolved settings) into the folder.
+    pub fn provenance(
+        &mut self,
+        record: &crate::provenance::Provenance,
+    ) -> Result<(), OutputError> {
+        let settings = self.dir.join(RESOLVED_SETTINGS);
+        let text = toml::to_string(&self.settings_snapshot).map_err(|e| ioerr(&settings, e))?;
+        write_atomic(&settings, text.as_bytes()).map_err(|e| ioerr(&settings, e))?;
+        crate::provenance::write(&self.dir, record)
+            .map_err(|e| ioerr(&crate::provenance::path(&self.dir), e))
     }
 
     /// Whether frames carry the field `name`: selected by `[output]`, or read by a restart.
@@ -565,6 +746,11 @@ impl Writer {
             selection: out.clone(),
             built_is_written: false,
             restart_fields,
+            static_mode: scene.settings.solver.mode == crate::settings::Mode::Static,
+            kept_log: None,
+            skip_first: false,
+            reserve: None,
+            settings_snapshot: scene.settings.clone(),
             _lock: None,
         }
     }
@@ -728,14 +914,21 @@ impl Writer {
         term_energies
     }
 
-    /// Writes one frame and appends its log row; rewrites the series and the log.
-    pub fn frame(
+    /// Writes one frame, the driver's state beside it (`PREFIX_NNNNN.state.json`) and its log
+    /// row; rewrites the series and the log. When a write fails (a full disk) the frame and
+    /// its state file go again, so frames, series and log stay in step.
+    pub fn frame<D: Serialize>(
         &mut self,
         pot: &Potential,
         state: &State,
         v: &[Vec3],
         mut row: LogRow,
+        driver: Option<&D>,
     ) -> Result<(), OutputError> {
+        if std::mem::take(&mut self.skip_first) {
+            // A continued series: this is the frame it continues from.
+            return Ok(());
+        }
         let (x, phi) = (&state.x[..], &state.dofs[..]);
         let sc = pot.scene;
         let index = self.frames.len();
@@ -777,7 +970,7 @@ impl Writer {
                     field: format!(
                         "{name}' at {what} {} (value {})",
                         i / fld.components.max(1),
-                        crate::math::sci(fld.data[i])
+                        crate::math::human(fld.data[i])
                     ),
                 });
             }
@@ -793,7 +986,7 @@ impl Writer {
             return Err(OutputError::NonFinite {
                 index,
                 time: row.time,
-                field: format!("{name}' of the log row (value {})", crate::math::sci(v)),
+                field: format!("{name}' of the log row (value {})", crate::math::human(v)),
             });
         }
         let name = format!("{}_{index:05}.{}", self.prefix, self.format.extension());
@@ -816,15 +1009,38 @@ impl Writer {
             &self.vtu,
             &|n| single && n != "displacement" && !restart.contains(n) && fits_f32(n),
         );
-        write_atomic(&path, &bytes).map_err(|e| ioerr(&path, e))?;
+        let state_path = state_file(&path);
+        let undo = |paths: &[&Path]| {
+            for p in paths {
+                let _ = std::fs::remove_file(p);
+            }
+        };
+        if let Some(d) = driver {
+            let text = serde_json::to_string(d).map_err(|e| ioerr(&state_path, e))?;
+            write_atomic(&state_path, text.as_bytes()).map_err(|e| ioerr(&state_path, e))?;
+        }
+        if let Err(e) = write_atomic(&path, &bytes) {
+            undo(&[&state_path]);
+            return Err(ioerr(&path, e));
+        }
         self.built_is_written = true;
+        self.frames.push((row.time, name));
+        self.log.push(row);
+        let written = self.write_log().and_then(|_| self.write_series());
+        if let Err(e) = written {
+            // Back to the folder as it was: the series and log rewritten without this frame
+            // (the frame's space is freed first).
+            undo(&[&path, &state_path]);
+            self.frames.pop();
+            self.log.pop();
+            self.built_is_written = false;
+            let _ = self.write_log().and_then(|_| self.write_series());
+            return Err(e);
+        }
         if self.selection.snapshots == crate::settings::Snapshots::All {
             self.snapshot(index)?;
         }
-        self.frames.push((row.time, name));
-        self.log.push(row);
-        self.write_series()?;
-        self.write_log()
+        Ok(())
     }
 
     /// `PREFIX_NNNNN.png` beside frame `index`, drawn from the frame last built
@@ -851,8 +1067,9 @@ impl Writer {
             "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n",
         );
         for (t, name) in &self.frames {
+            // Shortest round-trip digits: a restart reads the exact time back.
             s.push_str(&format!(
-                "    <DataSet timestep=\"{t:.12e}\" group=\"\" part=\"0\" file=\"{name}\"/>\n"
+                "    <DataSet timestep=\"{t}\" group=\"\" part=\"0\" file=\"{name}\"/>\n"
             ));
         }
         s.push_str("  </Collection>\n</VTKFile>\n");
@@ -860,22 +1077,62 @@ impl Writer {
         write_atomic(&path, s.as_bytes()).map_err(|e| ioerr(&path, e))
     }
 
-    fn write_log(&self) -> Result<(), OutputError> {
-        let mut s = String::from("frame,time,dial,");
-        if let Some(r) = self.log.first() {
-            for (name, _) in r.energy.columns() {
-                s.push_str(&format!("energy_{name},"));
-            }
-            for (name, _) in &r.observables {
-                s.push_str(&format!("{name},"));
-            }
+    /// `log.csv`'s header for this run's rows (`None` before the first row).
+    fn log_header(&self) -> Option<String> {
+        let r = self.log.first()?;
+        let mut s = String::from(if self.static_mode {
+            "frame,dial,"
+        } else {
+            "frame,time,dial,"
+        });
+        for (name, _) in r.energy.columns() {
+            s.push_str(&format!("energy_{name},"));
+        }
+        for (name, _) in &r.observables {
+            s.push_str(&format!("{name},"));
         }
         s.push_str(
             "residual,newton_iterations,steps,shifted_iterations,gauss_newton_iterations,\
-             rejected_steps,wall_seconds\n",
+             rejected_steps,wall_seconds",
         );
+        Some(s)
+    }
+
+    fn write_log(&self) -> Result<(), OutputError> {
+        let path = self.dir.join("log.csv");
+        let header = self.log_header();
+        let mut s = String::new();
+        match (&self.kept_log, &header) {
+            (Some((kept, _)), Some(h)) if kept != h => {
+                return Err(ioerr(
+                    &path,
+                    format!(
+                        "the continued run logs other columns than the series it continues \
+                         (it has `{kept}`, this run `{h}`): continue with the settings that \
+                         wrote it"
+                    ),
+                ))
+            }
+            (Some((kept, rows)), _) => {
+                s.push_str(kept);
+                s.push('\n');
+                for r in rows {
+                    s.push_str(r);
+                    s.push('\n');
+                }
+            }
+            (None, Some(h)) => {
+                s.push_str(h);
+                s.push('\n');
+            }
+            (None, None) => {}
+        }
         for r in &self.log {
-            s.push_str(&format!("{},{:.12e},{:.6},", r.frame, r.time, r.dial));
+            if self.static_mode {
+                s.push_str(&format!("{},{:.12e},", r.frame, r.dial));
+            } else {
+                s.push_str(&format!("{},{:.12e},{:.12e},", r.frame, r.time, r.dial));
+            }
             for (_, e) in r.energy.columns() {
                 s.push_str(&format!("{e:.12e},"));
             }
@@ -893,7 +1150,6 @@ impl Writer {
                 r.wall_seconds
             ));
         }
-        let path = self.dir.join("log.csv");
         write_atomic(&path, s.as_bytes()).map_err(|e| ioerr(&path, e))
     }
 

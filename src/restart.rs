@@ -35,6 +35,7 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
                 v,
                 time: 0.0,
                 dial: Some(dial),
+                driver: None,
             },
             warnings,
         ));
@@ -58,15 +59,49 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
             "{name}: not listed in a series.pvd next to it; the restart starts at time 0"
         ));
     }
+    let driver = read_driver_state(path)?;
+    if driver.is_none() {
+        warnings.push(format!(
+            "{name}: no {} beside it; the step control, holds and moisture start afresh, so \
+             the run does not follow the uninterrupted one exactly",
+            crate::output::state_file(path)
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        ));
+    }
     Ok((
         InitialState {
             state,
             v,
             time: time.unwrap_or(0.0),
             dial: None,
+            driver,
         },
         warnings,
     ))
+}
+
+/// The driver's state written beside the frame `path` (`None` when there is none); a file that
+/// is not one is an error naming it.
+fn read_driver_state(path: &Path) -> Result<Option<crate::integrate::DriverState>, MeshError> {
+    let p = crate::output::state_file(path);
+    let text = match std::fs::read_to_string(&p) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => {
+            return Err(MeshError::Read {
+                path: p.display().to_string(),
+                reason: e.to_string(),
+            })
+        }
+    };
+    serde_json::from_str(&text)
+        .map(Some)
+        .map_err(|e| MeshError::Invalid {
+            path: p.display().to_string(),
+            reason: format!("not a shellsim frame state: {e}"),
+        })
 }
 
 /// A restart's time must be finite and inside the run: the dial in [0, 1] in statics, the time

@@ -182,6 +182,23 @@ impl Term for Gas {
         "gas"
     }
 
+    /// Volume control: the multiplier λ (Pa), which warm-starts the next solve.
+    fn saved_state(&self) -> Vec<Real> {
+        vec![self.multiplier()]
+    }
+
+    fn load_state(&self, saved: &[Real]) -> Result<(), String> {
+        match saved {
+            [l] if l.is_finite() => {
+                *self.multiplier.lock().unwrap_or_else(|e| e.into_inner()) = *l;
+                Ok(())
+            }
+            _ => Err(format!(
+                "the gas's multiplier must be one finite number, got {saved:?}"
+            )),
+        }
+    }
+
     fn stencil(&self, scene: &Scene) -> Stencil {
         Stencil::faces(&scene.mesh, 0..scene.num_faces())
     }

@@ -237,6 +237,27 @@ impl VertexKernel for Slides {
             .store(((next - z) / dt).to_bits(), Ordering::Relaxed);
         self.set_upper(next);
     }
+
+    /// The upper slide's height (m) and velocity (m/s).
+    fn saved_state(&self) -> Vec<Real> {
+        vec![
+            self.upper(),
+            Real::from_bits(self.upper_velocity.load(Ordering::Relaxed)),
+        ]
+    }
+
+    fn load_state(&self, saved: &[Real]) -> Result<(), String> {
+        match saved {
+            [z, v] if z.is_finite() && v.is_finite() => {
+                self.set_upper(*z);
+                self.upper_velocity.store(v.to_bits(), Ordering::Relaxed);
+                Ok(())
+            }
+            _ => Err(format!(
+                "the slides' state must be a finite height and velocity, got {saved:?}"
+            )),
+        }
+    }
 }
 
 /// The slides' term when `[slides]` is enabled. A vertex starting beyond a slide is an error

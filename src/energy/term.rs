@@ -210,6 +210,18 @@ pub trait Term: Send + Sync {
         Vec::new()
     }
 
+    /// State the term carries across steps that no frame field holds (a gas's pressure
+    /// multiplier, a moving slide's height and speed), saved with every frame for an exact
+    /// restart (default: none).
+    fn saved_state(&self) -> Vec<Real> {
+        Vec::new()
+    }
+
+    /// Restores [`Term::saved_state`] on a restart; values of the wrong length are an error.
+    fn load_state(&self, _saved: &[Real]) -> Result<(), String> {
+        Ok(())
+    }
+
     /// Restores the tracked state at the restart state `(x, phi)` from the frame's field
     /// (`None` when the frame has none: the term then says in the returned warning what it
     /// assumed). An invalid field is an error naming the face.
@@ -398,6 +410,14 @@ pub trait VertexKernel: Send + Sync {
     fn acts_on_explicit_steps(&self) -> bool {
         false
     }
+    /// See [`Term::saved_state`] (default: none).
+    fn saved_state(&self) -> Vec<Real> {
+        Vec::new()
+    }
+    /// See [`Term::load_state`] (default: nothing to load).
+    fn load_state(&self, _saved: &[Real]) -> Result<(), String> {
+        Ok(())
+    }
 }
 
 /// A [`VertexKernel`] as a [`Term`]. Fixed vertices contribute nothing to Φ (a constant);
@@ -424,6 +444,12 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
     }
     fn acts_on_explicit_steps(&self) -> bool {
         self.kernel.acts_on_explicit_steps()
+    }
+    fn saved_state(&self) -> Vec<Real> {
+        self.kernel.saved_state()
+    }
+    fn load_state(&self, saved: &[Real]) -> Result<(), String> {
+        self.kernel.load_state(saved)
     }
     fn observables(&self, pot: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
         self.kernel.observables(pot, x)

@@ -20,8 +20,21 @@ pub(super) fn run_dynamic(
     v0: Option<Vec<Vec3>>,
     t0: Real,
     dial0: Option<Real>,
+    driver: Option<super::DriverState>,
 ) -> Result<(), RunError> {
     let sc = s.scene;
+    // A restart with the driver's state resumes at its exact time (series.pvd rounds it).
+    if let Some(d) = &driver {
+        if (d.time - t0).abs() > 1e-9 * t0.abs().max(s.config.dynamics.time.end) {
+            return Err(RunError::Restart(format!(
+                "the frame's state is at t = {} s, its series.pvd entry at {} s: they belong \
+                 to different frames",
+                crate::math::human(d.time),
+                crate::math::human(t0)
+            )));
+        }
+    }
+    let t0 = driver.as_ref().map_or(t0, |d| d.time);
     let cf = s.config.dynamics.clone();
     let tm = &cf.time;
     let opts = s.config.newton;
@@ -48,6 +61,12 @@ pub(super) fn run_dynamic(
         }
     }
     let mut holds_reached = 0usize;
+    if let Some(d) = &driver {
+        dial_now = d.dial;
+        holding = d.holding;
+        next_hold = d.next_hold.filter(|&k| k < holds.len());
+        holds_reached = d.holds_reached;
+    }
     let n = state.x.len();
     let mut v = v0.unwrap_or_else(|| vec![Vec3::zeros(); n]);
     let mut xhat = state.x.clone();
@@ -62,19 +81,53 @@ pub(super) fn run_dynamic(
     let mut moisture = Moisture::new(sc)?;
     let mut targets: Vec<(Sym2, Sym2)> = Vec::new();
     let mut trial_targets: Vec<(Sym2, Sym2)> = Vec::new();
+    if let (Some(m), Some(d)) = (&mut moisture, &driver) {
+        m.resume(sc, d).map_err(RunError::Restart)?;
+    }
     if let Some(m) = &moisture {
         targets = m.targets_of(sc, &m.u)?;
         m.publish(writer);
     }
+    // Halved on failure, ×1.5 after 3 easy steps (≤ 3 Newton iterations).
+    let mut steps = StepControl::new(tm.dt, tm.dt_min, tm.dt_max, 1.5, 3, 3);
+    if let Some(d) = &driver {
+        steps.resume(d.step, d.easy_steps);
+    }
+    // What a frame's state file records (see `DriverState`).
+    let record = |t: Real,
+                  dial: Real,
+                  steps: &StepControl,
+                  holding: bool,
+                  next_hold: Option<usize>,
+                  holds_reached: usize,
+                  moisture: &Option<Moisture>| super::DriverState {
+        time: t,
+        dial,
+        step: Some(steps.step),
+        easy_steps: steps.easy(),
+        holding,
+        next_hold,
+        holds_reached,
+        moisture: moisture.as_ref().map(|m| m.u.clone()),
+        diffusion_substep: moisture.as_ref().map(|m| m.diffusion.next_substep()),
+        ..Default::default()
+    };
     {
         let pot = accepted(s.potential(dial_now), moisture.as_ref(), &targets);
+        s.driver = record(
+            t0,
+            dial_now,
+            &steps,
+            holding,
+            next_hold,
+            holds_reached,
+            &moisture,
+        );
         s.frame(writer, &pot, &state, &v, t0)?;
     }
     // Friction: the lagged normal forces, carried from step to step.
     let mut lag = FrictionLag::new(sc, &state.x, cf.slip_speed);
     let mut t = t0;
-    // Halved on failure, ×1.5 after 3 easy steps (≤ 3 Newton iterations).
-    let mut steps = StepControl::new(tm.dt, tm.dt_min, tm.dt_max, 1.5, 3, 3);
     // The next output time after the start (a restart resumes the output grid).
     let mut clock = OutputClock::new(t0, tm.output_interval, tm.end);
     let mut failure: Option<RunFailure> = None;
@@ -274,6 +327,15 @@ pub(super) fn run_dynamic(
                 m.publish(writer);
             }
             let pot = accepted(s.potential(dial), moisture.as_ref(), &targets);
+            s.driver = record(
+                t,
+                dial_now,
+                &steps,
+                holding,
+                next_hold,
+                holds_reached,
+                &moisture,
+            );
             s.frame(writer, &pot, &state, &v, t)?;
             clock.passed(t, h, eps_t);
         }
@@ -281,9 +343,18 @@ pub(super) fn run_dynamic(
             break;
         }
     }
-    s.summary.time = t;
+    s.summary.time = Some(t);
     s.summary.dial = dial_now;
     s.summary.holds_reached = holds_reached;
+    s.driver = record(
+        t,
+        dial_now,
+        &steps,
+        holding,
+        next_hold,
+        holds_reached,
+        &moisture,
+    );
     s.summary.converged = failure.is_none();
     s.summary.reason = failure.map(|f| f.to_string()).unwrap_or_default();
     let pot = accepted(s.potential(dial_now), moisture.as_ref(), &targets);

@@ -429,6 +429,7 @@ pub(super) fn run_explicit(
     v0: Option<Vec<Vec3>>,
     t0: Real,
     dial0: Option<Real>,
+    _driver: Option<super::DriverState>,
 ) -> Result<(), RunError> {
     let sc = s.scene;
     let cf = sc.settings.explicit.clone();
@@ -732,7 +733,7 @@ pub(super) fn run_explicit(
     g.iter_mut().for_each(|x| *x = 0.0);
     pot.eval(&state.x, &[], Want::Gradient, &mut g, &mut []);
     s.summary.residual = pot.residual(&g);
-    s.summary.time = t;
+    s.summary.time = Some(t);
     s.summary.dial = dial;
     s.summary.explicit = Some(report);
     match stop {

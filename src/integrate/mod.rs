@@ -65,6 +65,9 @@ pub enum RunError {
     /// The moisture regions or fields are invalid.
     #[error("moisture: {0}")]
     Regions(#[from] crate::mesh::MeshError),
+    /// A restart's driver state does not fit the scene.
+    #[error("restart: {0}")]
+    Restart(String),
 }
 
 /// Why a run stopped before converging (exit 1); its text is `summary.json`'s `reason`.
@@ -85,8 +88,8 @@ pub enum RunFailure {
     /// point of the pressure–volume curve, or a snap).
     #[error(
         "no equilibrium found beyond a gauge pressure of {} Pa (dial {dial:.6}, enclosed volume {} m³): the balloon's pressure has a maximum there (its limit point: a rubber sphere's pressure peaks at a stretch of 7^(1/6) = 1.38) and a higher pressure has no equilibrium nearby. Prescribe the volume (gas.control = \"volume\") or the amount of gas (\"amount\") to follow the curve through it. Last solve: {cause}",
-        crate::math::sci(*.pressure),
-        crate::math::sci(*.volume)
+        crate::math::human(*.pressure),
+        crate::math::human(*.volume)
     )]
     PressureLimit {
         /// The last gauge pressure with an equilibrium (Pa).
@@ -289,6 +292,8 @@ struct Solver<'a> {
     /// The summary's counters when the previous frame was written; log rows report the
     /// differences.
     at_last_frame: Counters,
+    /// The driver's state as of the next frame (the drivers keep it current).
+    driver: DriverState,
 }
 
 /// Counters that log rows report per frame.
@@ -340,6 +345,7 @@ impl<'a> Solver<'a> {
             summary,
             start: Instant::now(),
             at_last_frame: Counters::default(),
+            driver: DriverState::default(),
         })
     }
 
@@ -423,7 +429,15 @@ impl<'a> Solver<'a> {
         };
         self.at_last_frame = now;
         let clock = Instant::now();
-        let r = writer.frame(pot, state, v, row);
+        let mut driver = self.driver.clone();
+        driver.mode = self.summary.mode.clone();
+        for t in self.scene.terms.iter() {
+            let saved = t.saved_state();
+            if !saved.is_empty() {
+                driver.terms.insert(t.name().to_string(), saved);
+            }
+        }
+        let r = writer.frame(pot, state, v, row, Some(&driver));
         self.summary.timing.output += clock.elapsed().as_secs_f64();
         r?;
         Ok(())
@@ -522,6 +536,20 @@ impl StepControl {
         }
     }
 
+    /// Resumes a restart's step control: its next step (when given) and its count of easy
+    /// steps.
+    pub fn resume(&mut self, step: Option<Real>, easy: usize) {
+        if let Some(h) = step.filter(|h| h.is_finite() && *h > 0.0) {
+            self.step = h.clamp(self.min, self.max);
+        }
+        self.easy = easy.min(self.easy_needed);
+    }
+
+    /// Easy steps counted towards the next growth.
+    pub fn easy(&self) -> usize {
+        self.easy
+    }
+
     /// After an accepted step that took `iterations` Newton iterations.
     pub fn accepted(&mut self, iterations: usize, calm: bool) {
         if iterations <= self.easy_iterations && calm {
@@ -545,10 +573,14 @@ impl StepControl {
 }
 
 /// Output times on a fixed grid of `interval` up to `end`, resumed on the grid after a restart.
+/// The k-th output time is `k × interval`, computed afresh (not summed), so a restarted run
+/// has the same output times, to the bit, as the uninterrupted one.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct OutputClock {
     /// The next output time.
     pub next: Real,
+    /// Its index on the grid.
+    k: Real,
     interval: Real,
     end: Real,
 }
@@ -556,9 +588,10 @@ pub(super) struct OutputClock {
 impl OutputClock {
     /// The clock of a run starting at `t0`.
     pub fn new(t0: Real, interval: Real, end: Real) -> Self {
-        let next = (((t0 / interval) + 1e-9).floor() + 1.0) * interval;
+        let k = ((t0 / interval) + 1e-9).floor() + 1.0;
         OutputClock {
-            next: next.min(end),
+            next: (k * interval).min(end),
+            k,
             interval,
             end,
         }
@@ -574,10 +607,10 @@ impl OutputClock {
     /// tolerance, so that an output time just ahead of `t` by round-off is passed too).
     pub fn passed(&mut self, t: Real, h: Real, eps: Real) {
         let tol = 1e-9 * h.max(eps);
-        while self.next <= t + tol {
-            self.next += self.interval;
+        while self.next <= t + tol && self.next < self.end {
+            self.k += 1.0;
+            self.next = (self.k * self.interval).min(self.end);
         }
-        self.next = self.next.min(self.end);
     }
 
     /// The step to take from `t` given the step control's `step`: `step`, shortened to land on
@@ -593,6 +626,41 @@ impl OutputClock {
     }
 }
 
+/// What a driver carries from step to step beyond the positions, velocities, edge DOFs and the
+/// terms' frame fields: written beside every frame as `PREFIX_NNNNN.state.json` (numbers
+/// round-trip exactly) and read back by a restart, so that a restarted run takes the same steps
+/// as the uninterrupted one.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DriverState {
+    /// `"static"`, `"dynamic"` or `"explicit"`: a restart in another mode ignores the rest.
+    pub mode: String,
+    /// Time (s); in statics the dial.
+    pub time: Real,
+    /// The dial factor.
+    pub dial: Real,
+    /// The step control: the next step (time step or dial increment) and the count of easy
+    /// steps towards growing it.
+    pub step: Option<Real>,
+    /// See `step`.
+    pub easy_steps: usize,
+    /// Hold points: waiting on one, the index of the next, and how many were reached.
+    pub holding: bool,
+    /// See `holding`.
+    pub next_hold: Option<usize>,
+    /// See `holding`.
+    pub holds_reached: usize,
+    /// Moisture: the diffusion's nodal values and its next sub-step (s).
+    pub moisture: Option<Vec<Real>>,
+    /// See `moisture`.
+    pub diffusion_substep: Option<Real>,
+    /// Terms' states that no frame field carries (a gas's pressure multiplier, a moving slide),
+    /// by term name.
+    pub terms: std::collections::BTreeMap<String, Vec<Real>>,
+    /// The explicit driver's own counters (its phase, equilibrium windows, next frame time).
+    pub explicit: std::collections::BTreeMap<String, Real>,
+}
+
 /// A state to start from instead of the reference mesh (a restart).
 #[derive(Clone, Debug)]
 pub struct InitialState {
@@ -605,6 +673,8 @@ pub struct InitialState {
     /// The dial factor to resume from when the file gives it (a MorphoShell ansatz); otherwise
     /// the dial follows from `time`.
     pub dial: Option<Real>,
+    /// The driver's state written with the frame, when there is one.
+    pub driver: Option<DriverState>,
 }
 
 /// Runs a scene to completion from the reference mesh, or from `initial` (a restart), writing
@@ -618,23 +688,34 @@ pub fn run(
 ) -> Result<Summary, RunError> {
     let pattern = Pattern::for_scene(scene);
     let mut s = Solver::new(scene, &pattern, threads)?;
-    let (mut state, v, start, dial) = match initial {
-        Some(st) => (st.state, st.v, Some(st.time), st.dial),
-        None => (State::reference(scene), None, None, None),
+    let (mut state, v, start, dial, driver) = match initial {
+        Some(st) => (st.state, st.v, Some(st.time), st.dial, st.driver),
+        None => (State::reference(scene), None, None, None, None),
     };
+    // A driver state of another mode (a static frame restarting a dynamic run) only gives
+    // what the frame gives.
+    let driver = driver.filter(|d| d.mode == s.summary.mode);
+    if let Some(d) = &driver {
+        for t in scene.terms.iter() {
+            if let Some(v) = d.terms.get(t.name()) {
+                t.load_state(v).map_err(RunError::Restart)?;
+            }
+        }
+    }
     let sb = s.config.symmetry_breaking;
-    if sb > 0.0 && is_planar(scene, &state.x) {
+    // A restart with its driver's state continues the state it is given, planar or not.
+    if sb > 0.0 && driver.is_none() && is_planar(scene, &state.x) {
         perturb(scene, &mut state.x, sb * scene.mean_edge, s.config.seed);
     }
     let ran = match s.config.mode {
         Mode::Static => statics::run_static(&mut s, writer, progress, state, dial.or(start)),
         Mode::Dynamic => {
             let t0 = start.unwrap_or(0.0);
-            dynamics::run_dynamic(&mut s, writer, progress, state, v, t0, dial)
+            dynamics::run_dynamic(&mut s, writer, progress, state, v, t0, dial, driver)
         }
         Mode::Explicit => {
             let t0 = start.unwrap_or(0.0);
-            explicit::run_explicit(&mut s, writer, progress, state, v, t0, dial)
+            explicit::run_explicit(&mut s, writer, progress, state, v, t0, dial, driver)
         }
     };
     match ran {
@@ -654,6 +735,7 @@ pub fn run(
         // An output failure mid-run (a full disk): the frames, series and log written so far
         // stay in step; a summary saying why is written if there is still room for it.
         Err(RunError::Output(e @ OutputError::Io { .. })) => {
+            writer.release_reserve();
             s.summary.converged = false;
             s.summary.reason = format!("output failed: {e}");
             s.summary.wall_seconds = s.start.elapsed().as_secs_f64();

@@ -188,6 +188,29 @@ impl Moisture {
         Ok(())
     }
 
+    /// Resumes the nodal moisture and the diffusion's next sub-step of a restart's driver
+    /// state (a state without moisture keeps the initial moisture).
+    pub(super) fn resume(&mut self, sc: &Scene, d: &super::DriverState) -> Result<(), String> {
+        let Some(u) = &d.moisture else {
+            return Ok(());
+        };
+        if u.len() != self.u.len() || u.iter().any(|v| !v.is_finite()) {
+            return Err(format!(
+                "the frame's moisture state has {} values, this scene's diffusion {} (or one is \
+                 not finite): it belongs to another scene",
+                u.len(),
+                self.u.len()
+            ));
+        }
+        self.u.copy_from_slice(u);
+        self.trial.copy_from_slice(u);
+        self.mass = self.masses_of(sc, &self.u);
+        if let Some(h) = d.diffusion_substep {
+            self.diffusion.resume_substep(h);
+        }
+        Ok(())
+    }
+
     /// Lumped vertex masses with face densities ρ_shell + (m⁺ + m⁻)/2 · ρ_water (seed 000 §3,
     /// "Mass Matrix"); empty when the water density is 0 (the scene's masses apply).
     pub(super) fn masses_of(&self, sc: &Scene, u: &[Real]) -> Vec<Real> {

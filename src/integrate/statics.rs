@@ -25,6 +25,11 @@ pub(super) fn run_static(
     let dial_start = restart.unwrap_or(0.0).clamp(0.0, 1.0);
     {
         let pot = s.potential(dial_start);
+        s.driver = super::DriverState {
+            time: dial_start,
+            dial: dial_start,
+            ..Default::default()
+        };
         s.frame(writer, &pot, &state, &zeros, dial_start)?;
     }
     let mut dial = dial_start;
@@ -115,6 +120,13 @@ pub(super) fn run_static(
             }
             if (cont_frames || at_hold) && dial < 1.0 {
                 let pot = s.potential(dial);
+                s.driver = super::DriverState {
+                    time: dial,
+                    dial,
+                    step: Some(steps.step),
+                    easy_steps: steps.easy(),
+                    ..Default::default()
+                };
                 s.frame(writer, &pot, &state, &zeros, dial)?;
             }
         } else if dial < 1.0 {
@@ -187,6 +199,14 @@ pub(super) fn run_static(
     s.summary.reason = failure.map(|f| f.to_string()).unwrap_or_default();
     let pot = s.potential(dial);
     s.summary.energy = Writer::energies(&pot, &state, &zeros);
-    s.frame(writer, &pot, &state, &zeros, 1.0_f64.max(dial))?;
+    s.driver = super::DriverState {
+        time: dial,
+        dial,
+        step: Some(steps.step),
+        easy_steps: steps.easy(),
+        ..Default::default()
+    };
+    // The series' time of a static frame is its dial (a failed run's last frame included).
+    s.frame(writer, &pot, &state, &zeros, dial)?;
     Ok(())
 }

@@ -62,7 +62,7 @@ pub fn check_closed_outward(mesh: &Mesh, topo: &Topology) -> Result<Real, MeshEr
             "the surface's normals point inward (enclosed volume {} m³ is not positive): \
              reverse the vertex order of every face (e.g. in ParaView: Filters > Reverse Sense, \
              or swap two indices of each triangle)",
-            crate::math::sci(v)
+            crate::math::human(v)
         )));
     }
     Ok(v)

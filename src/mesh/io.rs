@@ -239,7 +239,11 @@ fn legacy_bytes(mesh: &Mesh, title: &str, binary: bool, single: &dyn Fn(&str) ->
         mesh.positions.len()
     )
     .into_bytes();
-    let points: Vec<f64> = mesh.positions.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
+    let points: Vec<f64> = mesh
+        .positions
+        .iter()
+        .flat_map(|p| [p.x, p.y, p.z])
+        .collect();
     floats(&mut out, &points, 3, binary, false);
     let nf = mesh.faces.len();
     out.extend_from_slice(format!("CELLS {nf} {}\n", 4 * nf).as_bytes());
@@ -252,7 +256,12 @@ fn legacy_bytes(mesh: &Mesh, title: &str, binary: bool, single: &dyn Fn(&str) ->
     out.extend_from_slice(format!("CELL_TYPES {nf}\n").as_bytes());
     ints(&mut out, &vec![5; nf], 1, binary);
     fields(&mut out, "CELL_DATA", nf, &mesh.face_fields);
-    fields(&mut out, "POINT_DATA", mesh.positions.len(), &mesh.vertex_fields);
+    fields(
+        &mut out,
+        "POINT_DATA",
+        mesh.positions.len(),
+        &mesh.vertex_fields,
+    );
     out
 }
 

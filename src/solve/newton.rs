@@ -97,7 +97,7 @@ pub enum SolveError {
     /// The iteration limit was reached.
     #[error(
         "no convergence in {iterations} Newton iterations (residual {})",
-        crate::math::sci(*.residual)
+        crate::math::human(*.residual)
     )]
     NotConverged {
         /// Iterations done.
@@ -117,8 +117,8 @@ pub enum SolveError {
     /// No step length in 40 halvings decreased Φ enough.
     #[error(
         "line search stalled (residual {}, directional derivative {})",
-        crate::math::sci(*.residual),
-        crate::math::sci(*.slope)
+        crate::math::human(*.residual),
+        crate::math::human(*.slope)
     )]
     LineSearchStalled {
         /// ‖∇Φ‖∞/F.

@@ -334,8 +334,8 @@ impl Prism {
                 reason: format!(
                     "the position-based projection turned the prism inside out (thickness {}; \
                      rest thickness {})",
-                    crate::math::sci(h[f]),
-                    crate::math::sci(sc.thickness[f])
+                    crate::math::human(h[f]),
+                    crate::math::human(sc.thickness[f])
                 ),
             });
         }
@@ -353,7 +353,7 @@ impl Prism {
                     face: f,
                     reason: format!(
                         "thickness {} is not a positive finite number",
-                        crate::math::sci(v)
+                        crate::math::human(v)
                     ),
                 });
             }
