@@ -548,8 +548,11 @@ fn ioerr(path: &Path, e: impl ToString) -> OutputError {
     }
 }
 
-/// Per-face frames mapping barycentric to reference Cartesian coordinates (see module doc).
-fn output_frames(mesh: &Mesh) -> Vec<Mat2> {
+/// Per-face frames mapping the scene's barycentric coordinates to reference Cartesian
+/// coordinates (see module doc): on a curved reference, each face's frame starts at its first
+/// edge in the input's corner order.
+fn output_frames(scene: &Scene) -> Vec<Mat2> {
+    let mesh = &scene.mesh;
     let flat = mesh.is_flat_xy();
     (0..mesh.faces.len())
         .map(|f| {
@@ -558,7 +561,8 @@ fn output_frames(mesh: &Mesh) -> Vec<Mat2> {
             } else {
                 let [p0, p1, p2] = mesh.face_positions(f);
                 let (e1, e2) = (p1 - p0, p2 - p0);
-                let t1 = e1.normalize();
+                let [i0, i1, _] = scene.input_face(f);
+                let t1 = (mesh.positions[i1] - mesh.positions[i0]).normalize();
                 let n = e1.cross(&e2).normalize();
                 let t2 = n.cross(&t1);
                 Mat2::new(t1.dot(&e1), t1.dot(&e2), t2.dot(&e1), t2.dot(&e2))
@@ -713,9 +717,10 @@ impl Writer {
     /// A writer that builds frames' fields but writes nothing (no folder, no lock).
     fn detached(scene: &Scene) -> Self {
         let mesh = &scene.mesh;
+        // Frames keep the input's corner order.
         let mut frame_mesh = Mesh {
             positions: mesh.positions.clone(),
-            faces: mesh.faces.clone(),
+            faces: scene.input_faces(),
             ..Default::default()
         };
         if let Some(t) = mesh.face_fields.get("tri_tags") {
@@ -734,7 +739,7 @@ impl Writer {
             prefix: out.prefix.clone(),
             frames: Vec::new(),
             log: Vec::new(),
-            frames_t: output_frames(mesh),
+            frames_t: output_frames(scene),
             frame_mesh,
             extra: Default::default(),
             vtu: crate::mesh::vtu::VtuOptions {
@@ -885,6 +890,12 @@ impl Writer {
                         data,
                     },
                 );
+            }
+        }
+        // Slot fields in the input's corner order, like the faces.
+        for name in sc.slot_fields() {
+            if let Some(f) = ff.get_mut(name).filter(|f| f.components == 3) {
+                sc.reorder_slots(&mut f.data, true);
             }
         }
         if !sc.patches.is_empty() {

@@ -25,7 +25,7 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
     if let Some((dial, positions)) = read_ansatz(path, scene.num_vertices())? {
         let frame = crate::mesh::Mesh {
             positions,
-            faces: scene.mesh.faces.clone(),
+            faces: scene.input_faces(),
             ..Default::default()
         };
         let (state, v, warnings) = restart_from_frame(frame, &name, scene)?;
@@ -133,7 +133,9 @@ pub fn restart_from_frame(
         reason,
     };
     let mut warnings = Vec::new();
-    if frame.positions.len() != scene.num_vertices() || frame.faces != scene.mesh.faces {
+    let mut frame = frame;
+    // Frames keep the input's corner order; the scene may start slivers at another corner.
+    if frame.positions.len() != scene.num_vertices() || frame.faces != scene.input_faces() {
         return Err(bad(format!(
             "restart frame has {} vertices and {} faces, the mesh {} has {} and {} (or the faces \
              differ): a restart needs the frame of a run on the same mesh",
@@ -143,6 +145,14 @@ pub fn restart_from_frame(
             scene.num_vertices(),
             scene.num_faces()
         )));
+    }
+    frame.faces = scene.mesh.faces.clone();
+    for name in scene.slot_fields() {
+        if let Some(f) = frame.face_fields.get_mut(name) {
+            if f.components == 3 && f.data.len() == 3 * scene.num_faces() {
+                scene.reorder_slots(&mut f.data, false);
+            }
+        }
     }
     if let Some(v) = frame
         .positions

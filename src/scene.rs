@@ -36,6 +36,9 @@ pub struct Scene {
     pub mean_edge: Real,
     /// Warnings found while building (unused vertices, ill-conditioned patches, ...).
     pub warnings: Vec<String>,
+    /// Each face's corner shift from the input's order
+    /// ([`Mesh::anchor_faces_at_wide_angles`]): frames are written in the input's order.
+    pub corner_shift: Vec<u8>,
     /// Patch-fit bending data per face (`material.bending = "patch_fit"`), else empty.
     pub patches: Vec<crate::energy::patch::Patch>,
     /// Edge-DOF models: each face's orientation sign `σ` on its edges (+1 for the edge's first
@@ -75,7 +78,7 @@ impl Scene {
     /// Validates the mesh and builds the scene. Errors name the file, field and index.
     pub fn build(mut mesh: Mesh, settings: Settings) -> Result<Scene, MeshError> {
         let unused = mesh.validate()?;
-        mesh.anchor_faces_at_wide_angles();
+        let corner_shift = mesh.anchor_faces_at_wide_angles();
         let topo = Topology::build(&mesh)?;
         // A reference mesh folded flat onto itself across an edge has no mid-edge normal there.
         let normal = |f: usize| {
@@ -372,6 +375,7 @@ impl Scene {
             mass,
             fixed,
             warnings,
+            corner_shift,
             patches,
             edge_sign,
             node_fixed,
@@ -395,6 +399,53 @@ impl Scene {
     /// Number of faces.
     pub fn num_faces(&self) -> usize {
         self.mesh.faces.len()
+    }
+
+    /// Face `f`'s vertices in the input mesh's order (the scene may start a sliver at another
+    /// corner, [`Scene::corner_shift`]).
+    pub fn input_face(&self, f: usize) -> [usize; 3] {
+        let k = self.corner_shift.get(f).copied().unwrap_or(0) as usize;
+        let face = self.mesh.faces[f];
+        [0, 1, 2].map(|i| face[(i + 3 - k) % 3])
+    }
+
+    /// Every face in the input mesh's order.
+    pub fn input_faces(&self) -> Vec<[usize; 3]> {
+        (0..self.num_faces()).map(|f| self.input_face(f)).collect()
+    }
+
+    /// The per-face fields with one value per corner slot (the edge opposite each corner):
+    /// `edge_angles` and the terms' 3-component state fields. Frames write them in the input's
+    /// corner order.
+    pub fn slot_fields(&self) -> Vec<&'static str> {
+        let mut names = vec!["edge_angles"];
+        names.extend(
+            self.terms
+                .iter()
+                .filter(|t| t.state_components() == 3)
+                .filter_map(|t| t.state_field()),
+        );
+        names
+    }
+
+    /// Reorders per-face slot values (3 per face) between the scene's corner order and the
+    /// input's: `to_input` maps the scene's to the input's, otherwise back.
+    pub fn reorder_slots(&self, data: &mut [Real], to_input: bool) {
+        for (f, v) in data.chunks_exact_mut(3).enumerate() {
+            let k = self.corner_shift.get(f).copied().unwrap_or(0) as usize;
+            if k == 0 {
+                continue;
+            }
+            let old = [v[0], v[1], v[2]];
+            for j in 0..3 {
+                // The scene's slot j is the input's slot (k + j) mod 3.
+                if to_input {
+                    v[(k + j) % 3] = old[j];
+                } else {
+                    v[j] = old[(k + j) % 3];
+                }
+            }
+        }
     }
 
     /// The 3 extra vertices of each face's bending stencil: the neighbours' far vertices

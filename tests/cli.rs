@@ -1490,7 +1490,10 @@ fn restart_is_exact(scene: &str, mesh: &str, sets: &[&str], k: usize, stop: &str
     let end = format!("time.end={stop}");
     go("c", &["--set", &end]);
     let first = frames(&p.join("c"));
-    assert!(first > 1 && first < n, "{scene}: stopped with {first} frames");
+    assert!(
+        first > 1 && first < n,
+        "{scene}: stopped with {first} frames"
+    );
     go("c", &["--continue"]);
     assert_eq!(frames(&p.join("c")), n, "{scene}: the continued series");
     for j in 0..n {
@@ -1531,7 +1534,9 @@ fn restart_follows_the_uninterrupted_moisture_run_exactly() {
         "paper_strip.vtk",
         &["time.end=0.6"],
         2,
-        "0.3",
+        // The third output time, 3 × 0.1 in floating point: the stopped run's last step lands
+        // where the uninterrupted run's does.
+        "0.30000000000000004",
     );
 }
 
@@ -1624,7 +1629,9 @@ fn runs_talk_outside_a_terminal() {
     assert_eq!(r.code, 0, "{}", r.stderr);
     let lines: Vec<&str> = r.stderr.lines().collect();
     assert!(
-        lines.first().is_some_and(|l| l.starts_with("shellsim: static run of s.toml on m.vtk")),
+        lines
+            .first()
+            .is_some_and(|l| l.starts_with("shellsim: static run of s.toml on m.vtk")),
         "{}",
         r.stderr
     );
@@ -1641,7 +1648,9 @@ fn runs_talk_outside_a_terminal() {
     let r = run(&["s.toml", "m.vtk", "--out", "v", "-v"], p);
     assert_eq!(r.code, 0, "{}", r.stderr);
     assert!(
-        r.stderr.lines().any(|l| l.starts_with("continuation  dial ")),
+        r.stderr
+            .lines()
+            .any(|l| l.starts_with("continuation  dial ")),
         "{}",
         r.stderr
     );
@@ -1683,9 +1692,101 @@ fn static_runs_report_the_dial() {
         let dial = s["dial"].as_f64().unwrap();
         assert!(dial < 1.0, "{s}");
         let log = std::fs::read_to_string(p.join("f/log.csv")).unwrap();
-        let last: f64 = log.lines().last().unwrap().split(',').nth(1).unwrap().parse().unwrap();
+        let last: f64 = log
+            .lines()
+            .last()
+            .unwrap()
+            .split(',')
+            .nth(1)
+            .unwrap()
+            .parse()
+            .unwrap();
         assert_eq!(last, dial, "{log}");
         let series = shellsim::output::series_entries(&p.join("f/series.pvd")).unwrap();
         assert_eq!(series.last().unwrap().0, dial);
     }
+}
+
+/// Frames keep the input's corner order even where the scene starts a sliver at a wider
+/// corner, with the per-corner `edge_angles` in that order too, and a restart reads them back.
+#[test]
+fn frames_keep_the_input_corner_order() {
+    let d = tmp();
+    let p = d.path();
+    let r = run(
+        &[
+            "mesh",
+            "disk",
+            "--radius",
+            "1",
+            "--edge",
+            "0.15",
+            "--jitter",
+            "0.3",
+            "--seed",
+            "3",
+            "--program",
+            "spherical_cap",
+            "-o",
+            "disk.vtk",
+        ],
+        p,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let input = shellsim::mesh::io::read_mesh(&p.join("disk.vtk")).unwrap();
+    let mut anchored = input.clone();
+    let shifted = anchored
+        .anchor_faces_at_wide_angles()
+        .iter()
+        .filter(|&&k| k != 0)
+        .count();
+    assert!(
+        shifted > 0,
+        "the jittered disk needs some faces started elsewhere"
+    );
+    write(
+        p,
+        "s.toml",
+        "[material]\nthickness = 0.01\n[rest]\ntarget = \"mesh\"\n",
+    );
+    let r = run(&["s.toml", "disk.vtk", "--out", "o", "-q"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let last = final_frame(p, "o");
+    let frame = shellsim::mesh::io::read_mesh(&p.join(&last)).unwrap();
+    assert_eq!(
+        frame.faces, input.faces,
+        "{shifted} faces start at another corner"
+    );
+    // Each edge's angle appears in both its faces at the slots of the input's order.
+    let topo = shellsim::mesh::Topology::build(&input).unwrap();
+    let ea = &frame.face_fields["edge_angles"];
+    assert!(
+        ea.data.iter().any(|&v| v.abs() > 1e-6),
+        "a curved cap has edge angles to compare"
+    );
+    for (f, fe) in topo.face_edges.iter().enumerate() {
+        for (i, &e) in fe.iter().enumerate() {
+            let other = topo.edge_faces[e]
+                .iter()
+                .copied()
+                .find(|&g| g != f && g < input.faces.len());
+            if let Some(g) = other {
+                let j = topo.face_edges[g].iter().position(|&x| x == e).unwrap();
+                assert_eq!(ea.get(f)[i], ea.get(g)[j], "edge {e} at faces {f} and {g}");
+            }
+        }
+    }
+    let r = run(
+        &[
+            "s.toml",
+            "disk.vtk",
+            "--out",
+            "re",
+            "-q",
+            "--restart",
+            &last,
+        ],
+        p,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
 }

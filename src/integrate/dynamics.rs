@@ -161,7 +161,14 @@ pub(super) fn run_dynamic(
         trial.dofs.copy_from_slice(&state.dofs);
         let moisture_clock = Instant::now();
         if moisture.is_some() {
-            progress.update(t / tm.end, &format!("diffusion  t {t:.4e} s"));
+            progress.update(
+                t / tm.end,
+                &format!(
+                    "diffusion  t {} s  dt {} s",
+                    crate::math::human(t),
+                    crate::math::human(h)
+                ),
+            );
         }
         if let Some(m) = &mut moisture {
             // Diffuse over the step, then set the rest forms from the new surface moisture.
@@ -295,8 +302,11 @@ pub(super) fn run_dynamic(
         progress.update(
             t / tm.end,
             &format!(
-                "step  t {t:.4e} s  E {:.4e} J  r {:.1e}",
-                rep.energy, rep.residual
+                "step  t {} s  dt {} s  E {} J  r {}",
+                crate::math::human(t),
+                crate::math::human(h),
+                crate::math::human(rep.energy),
+                crate::math::human(rep.residual)
             ),
         );
         let at_output = clock.due(t, h, eps_t);

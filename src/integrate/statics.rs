@@ -94,6 +94,7 @@ pub(super) fn run_static(
             rep
         };
         if rep.converged {
+            let taken = target - dial;
             state.copy_from(&trial);
             s.scene.accept(&state.x, &state.dofs);
             let grow = rep.iterations <= 5;
@@ -111,8 +112,11 @@ pub(super) fn run_static(
             progress.update(
                 dial,
                 &format!(
-                    "continuation  dial {dial:.4}  E {:.4e} J  r {:.1e}",
-                    rep.energy, rep.residual
+                    "continuation  dial {}  step {}  E {} J  r {}",
+                    crate::math::human(dial),
+                    crate::math::human(taken),
+                    crate::math::human(rep.energy),
+                    crate::math::human(rep.residual)
                 ),
             );
             if at_hold {

@@ -205,10 +205,10 @@ impl Mesh {
     /// loses all its digits to cancellation (a needle of width 1e-8 gets a singular ā = I).
     /// A face is rotated only when the sine of its first angle is below half the largest of
     /// its three: regular meshes are left alone, and a second call changes nothing. A face
-    /// field `edge_angles` (3 values per face, in slot order) is rotated along. Returns the
-    /// number of faces rotated.
-    pub fn anchor_faces_at_wide_angles(&mut self) -> usize {
-        let mut rotated = 0;
+    /// field `edge_angles` (3 values per face, in slot order) is rotated along. Returns each
+    /// face's shift `k` (0: not rotated): its new corner `j` is its old corner `(k + j) mod 3`.
+    pub fn anchor_faces_at_wide_angles(&mut self) -> Vec<u8> {
+        let mut shift = vec![0u8; self.faces.len()];
         for f in 0..self.faces.len() {
             let [a, b, c] = self.faces[f];
             let p = [self.positions[a], self.positions[b], self.positions[c]];
@@ -233,10 +233,10 @@ impl Mesh {
                         }
                     }
                 }
-                rotated += 1;
+                shift[f] = best as u8;
             }
         }
-        rotated
+        shift
     }
 
     /// Checks coordinates, faces and fields; returns the unused vertices (a warning, not an
