@@ -300,6 +300,9 @@ pub struct Writer {
     /// A continued series: the first frame (the restart state, already in the series) is not
     /// written again.
     skip_first: bool,
+    /// A continued series: the summary of the run it continues, whose counts and times the new
+    /// summary adds to its own.
+    previous_summary: Option<serde_json::Value>,
     /// Space set aside so that a run stopped by a full disk can still write its summary.
     reserve: Option<Reserve>,
     /// The folder's lock, released when the writer is dropped (`None`: a writer that only
@@ -685,6 +688,9 @@ impl Writer {
         }
         w.frames = listed[..=keep].to_vec();
         w.kept_log = Some((header, rows));
+        w.previous_summary = std::fs::read_to_string(dir.join("summary.json"))
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok());
         w.skip_first = true;
         w.reserve = Some(Self::set_aside(dir)?);
         w._lock = Some(lock);
@@ -754,6 +760,7 @@ impl Writer {
             static_mode: scene.settings.solver.mode == crate::settings::Mode::Static,
             kept_log: None,
             skip_first: false,
+            previous_summary: None,
             reserve: None,
             settings_snapshot: scene.settings.clone(),
             _lock: None,
@@ -1164,10 +1171,40 @@ impl Writer {
         write_atomic(&path, s.as_bytes()).map_err(|e| ioerr(&path, e))
     }
 
-    /// Writes `summary.json`.
+    /// Writes `summary.json`; a continued series' summary counts the steps, iterations and
+    /// times of the runs before it too.
     pub fn summary(&self, summary: &Summary) -> Result<(), OutputError> {
         let path = self.dir.join("summary.json");
-        let text = serde_json::to_string_pretty(summary).map_err(|e| ioerr(&path, e))?;
+        let mut summary = summary.clone();
+        if let Some(prev) = &self.previous_summary {
+            let n = |k: &str| prev[k].as_u64().unwrap_or(0) as usize;
+            let x = |k: &str| prev[k].as_f64().unwrap_or(0.0);
+            let t = |k: &str| prev["timing"][k].as_f64().unwrap_or(0.0);
+            let s = &mut summary;
+            s.steps += n("steps");
+            s.rejected_steps += n("rejected_steps");
+            s.newton_iterations += n("newton_iterations");
+            s.shifted_iterations += n("shifted_iterations");
+            s.gauss_newton_iterations += n("gauss_newton_iterations");
+            s.indefinite_iterations += n("indefinite_iterations");
+            s.saddle_escapes += n("saddle_escapes");
+            s.diffusion_substeps += n("diffusion_substeps");
+            s.diffusion_rejected += n("diffusion_rejected");
+            s.diffusion_factorisations += n("diffusion_factorisations");
+            s.diffusion_cg_iterations += n("diffusion_cg_iterations");
+            s.diffusion_direct_solves += n("diffusion_direct_solves");
+            s.moisture_seconds += x("moisture_seconds");
+            s.wall_seconds += x("wall_seconds");
+            let tm = &mut s.timing;
+            tm.newton.assembly += t("assembly");
+            tm.newton.factorisation += t("factorisation");
+            tm.newton.solve += t("solve");
+            tm.newton.line_search += t("line_search");
+            tm.diffusion += t("diffusion");
+            tm.output += t("output");
+            tm.other += t("other");
+        }
+        let text = serde_json::to_string_pretty(&summary).map_err(|e| ioerr(&path, e))?;
         write_atomic(&path, text.as_bytes()).map_err(|e| ioerr(&path, e))?;
         // The last frame's picture, when the frame last built is the one last written (not a
         // refused non-finite state).

@@ -1509,6 +1509,10 @@ fn restart_is_exact(scene: &str, mesh: &str, sets: &[&str], k: usize, stop: &str
     };
     let log = |o: &str| strip(std::fs::read_to_string(p.join(o).join("log.csv")).unwrap());
     assert_eq!(log("full"), log("c"), "{scene}: log.csv without wall times");
+    let (sf, sc) = (summary_of(p, "full"), summary_of(p, "c"));
+    for key in ["steps", "newton_iterations", "rejected_steps", "frames", "final_frame"] {
+        assert_eq!(sf[key], sc[key], "{scene}: summary {key}");
+    }
     let runs: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(p.join("c/run.json")).unwrap()).unwrap();
     let runs = runs["runs"].as_array().unwrap();
