@@ -427,9 +427,9 @@ pub fn sweep(
         Settings::from_str_with(&text, &label, &arg_sets).map_err(|e| anyhow!("{e}"))?;
         Ok((p, sets, text))
     };
-    // The keys are checked on the first run (the grid's keys, or the first point's), then the size,
-    // then every run's settings before anything is written (not kept: a sweep of many runs is
-    // resolved again while it is written).
+    // The keys are checked on the first run (the grid's keys, or the first point's), then the
+    // size, then every run's settings before anything is written (not kept: a sweep of many
+    // runs is resolved again while it is written).
     resolve(0)?;
     let n = plan.count(&name)?;
     for i in 1..n {
@@ -611,7 +611,10 @@ fn clear(dir: &Path) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     let mut runs = Vec::new();
     for e in std::fs::read_dir(dir).with_context(|| ctx(dir))? {
-        let p = e.with_context(|| ctx(dir))?.path();
+        let e = e.with_context(|| ctx(dir))?;
+        // Not followed: a link named like a run folder is removed, never what it points to.
+        let kind = e.file_type().with_context(|| ctx(&e.path()))?;
+        let p = e.path();
         let Some(name) = p.file_name().and_then(|n| n.to_str()) else {
             continue;
         };
@@ -619,8 +622,9 @@ fn clear(dir: &Path) -> Result<Vec<PathBuf>> {
             || name == "joblog.tsv"
             || (name.starts_with("slurm-") && name.ends_with(".out"))
             || name.starts_with("mesh.")
+            || is_run_name(name)
             || (name.starts_with('.') && name.ends_with(".tmp"));
-        if p.is_dir() && is_run_name(name) {
+        if kind.is_dir() && is_run_name(name) {
             if let Some(pid) = crate::output::lock_owner(&p) {
                 bail!(
                     "{}: a run is under way in it (process {pid}); not replacing the sweep",
@@ -628,7 +632,7 @@ fn clear(dir: &Path) -> Result<Vec<PathBuf>> {
                 );
             }
             runs.push(p);
-        } else if ours && p.is_file() {
+        } else if ours && !kind.is_dir() {
             files.push(p);
         }
     }

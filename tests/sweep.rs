@@ -380,6 +380,12 @@ fn overwrite_replaces_the_earlier_sweep_only() {
     }
     std::fs::write(sw.join("joblog.tsv"), "").unwrap();
     std::fs::write(sw.join("run_0003/notes.txt"), "mine").unwrap();
+    // A link named like a run folder goes, not what it points to.
+    let elsewhere = p.join("elsewhere");
+    std::fs::create_dir(&elsewhere).unwrap();
+    std::fs::write(elsewhere.join("summary.json"), "{}").unwrap();
+    std::fs::remove_dir_all(sw.join("run_0001")).unwrap();
+    std::os::unix::fs::symlink(&elsewhere, sw.join("run_0001")).unwrap();
 
     // A run under way in the folder (a live lock: this process) stops the replacement.
     let lock = sw.join("run_0004/.shellsim.lock");
@@ -416,6 +422,7 @@ fn overwrite_replaces_the_earlier_sweep_only() {
         tree(&sw.join("run_0000")),
         ["settings.toml", "sweep_point.json"]
     );
+    assert_eq!(tree(&elsewhere), ["summary.json"]);
     let (c, table, e) = run(&["collect", "sw"], p);
     assert_eq!(c, 0, "{e}");
     assert_eq!(table.lines().count(), 3, "{table}");
