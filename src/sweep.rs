@@ -521,9 +521,10 @@ pub fn sweep(
          #SBATCH --mem={mem}\n\
          #SBATCH --output=slurm-%A_%a.out\n\
          # Written by shellsim sweep. Submit from this folder: sbatch slurm.sh (options given to\n\
-         # sbatch override these). {tasks} array tasks: task k runs lines {chunk}k + 1 to {chunk}k + {chunk}\n\
-         # of jobs.txt ({n} runs), one after another, each with --cpus-per-task threads; --time is\n\
-         # {time} per run. SHELLSIM names the binary (default: shellsim on the PATH).\n\
+         # sbatch override these). {tasks} array tasks of up to {chunk} runs (jobs.txt has {n}): task k\n\
+         # runs lines {chunk}·k + 1 to {chunk}·(k + 1), one after another, each with --cpus-per-task\n\
+         # threads; --time is {time} per run. SHELLSIM names the binary (default: shellsim on the\n\
+         # PATH).\n\
          : \"${{SLURM_ARRAY_TASK_ID:?submit this script with sbatch slurm.sh}}\"\n\
          cd \"${{SLURM_SUBMIT_DIR:-.}}\" || exit 2\n\
          export SHELLSIM=\"${{SHELLSIM:-shellsim}}\"\n\
