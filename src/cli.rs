@@ -403,25 +403,100 @@ fn render_cmd(a: RenderArgs) -> Result<()> {
     canvas.save_png(&out)
 }
 
-/// `shellsim sweep`: writes the sweep folder; with `--run`, runs its jobs and exits 1 unless
-/// every run converged.
+/// `shellsim sweep`: writes the sweep folder; with `--run`, runs its jobs (with this binary
+/// unless `$SHELLSIM` names another), prints a tally and exits 1 unless every run converged.
 fn sweep_cmd(a: SweepArgs) -> Result<u8> {
-    let (dir, n) = crate::sweep::sweep(&a.file, a.out.as_deref(), a.overwrite)?;
-    eprintln!(
-        "{n} runs in {}: run them with {}/run.sh (GNU parallel, else one by one) or sbatch \
-         slurm.sh there; then shellsim collect {}",
-        dir.display(),
-        dir.display(),
-        dir.display()
-    );
+    let w = crate::sweep::sweep(&a.file, a.out.as_deref(), a.overwrite, &sweep_run_overrides)?;
+    let (dir, n) = (w.dir.display(), w.runs);
+    for k in &w.kept {
+        eprintln!(
+            "warning: {} kept: it holds files that shellsim did not write",
+            k.display()
+        );
+    }
     if !a.run {
+        eprintln!(
+            "{n} runs in {dir}: run them with {dir}/run.sh (GNU parallel, else one by one) or \
+             sbatch slurm.sh there ({} array tasks of up to {} runs); then shellsim collect {dir}",
+            w.slurm_tasks, w.slurm_chunk
+        );
         return Ok(0);
     }
-    let status = std::process::Command::new("sh")
-        .arg(dir.join("run.sh"))
+    eprintln!("{n} runs in {dir}: running them with {dir}/run.sh");
+    let mut cmd = std::process::Command::new("sh");
+    cmd.arg(w.dir.join("run.sh"));
+    if std::env::var_os("SHELLSIM").is_none() {
+        if let Ok(exe) = std::env::current_exe() {
+            cmd.env("SHELLSIM", exe);
+        }
+    }
+    let status = cmd
         .status()
-        .map_err(|e| anyhow!("cannot start {}/run.sh: {e}", dir.display()))?;
-    Ok(if status.success() { 0 } else { 1 })
+        .map_err(|e| anyhow!("cannot start {dir}/run.sh: {e}"))?;
+    let failed: Vec<(usize, String)> = (0..n)
+        .filter_map(|i| crate::sweep::failure(&w.dir, i, n).map(|f| (i, f)))
+        .collect();
+    eprintln!(
+        "{n} runs: {} succeeded, {} failed{}",
+        n - failed.len(),
+        failed.len(),
+        if failed.is_empty() { "" } else { ":" }
+    );
+    const SHOWN: usize = 20;
+    for (i, why) in failed.iter().take(SHOWN) {
+        let run = crate::sweep::run_name(*i, n);
+        eprintln!("  {dir}/{run}: {why}");
+    }
+    if failed.len() > SHOWN {
+        eprintln!("  and {} more", failed.len() - SHOWN);
+    }
+    if !status.success() && failed.is_empty() {
+        eprintln!("{dir}/run.sh ended with {status}");
+    }
+    eprintln!("table: shellsim collect {dir}");
+    Ok(if failed.is_empty() && status.success() {
+        0
+    } else {
+        1
+    })
+}
+
+/// The `--set` overrides of a sweep's extra run arguments (its `args`), parsed by this
+/// binary's own parser after the arguments every job gives, as on a job's command line; an
+/// argument the parser refuses is an error naming it.
+fn sweep_run_overrides(args: &[String]) -> Result<Vec<String>> {
+    let job = [
+        "shellsim",
+        "settings.toml",
+        "mesh.vtk",
+        "--out",
+        "run",
+        "--overwrite",
+        "-q",
+        "--threads",
+        "1",
+    ];
+    let line = job
+        .iter()
+        .map(|s| s.to_string())
+        .chain(args.iter().cloned());
+    let cli = Cli::try_parse_from(line).map_err(|e| {
+        use clap::error::ErrorKind;
+        match e.kind() {
+            ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+                anyhow!("--help and --version are not a run's arguments")
+            }
+            _ => {
+                let text = e.to_string();
+                let first = text.lines().next().unwrap_or_default();
+                anyhow!("{}", first.trim_start_matches("error: "))
+            }
+        }
+    })?;
+    if cli.command.is_some() {
+        bail!("a subcommand is not a run's argument");
+    }
+    Ok(cli.set)
 }
 
 /// `shellsim import-morphoshell`: parse, translate, check that shellsim accepts the result, and

@@ -472,16 +472,10 @@ impl Lock {
                     return Ok(Lock(path));
                 }
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                    let pid = std::fs::read_to_string(&path)
-                        .ok()
-                        .and_then(|t| t.trim().parse::<u32>().ok());
-                    let alive = pid.is_some_and(|p| {
-                        p != std::process::id() && Path::new(&format!("/proc/{p}")).exists()
-                    });
-                    if alive {
+                    if let Some(pid) = lock_owner(dir) {
                         return Err(OutputError::Locked {
                             path: dir.display().to_string(),
-                            pid: pid.unwrap_or(0),
+                            pid,
                         });
                     }
                     // Stale: its run ended without removing it.
@@ -500,9 +494,21 @@ impl Drop for Lock {
     }
 }
 
+/// The process holding the run lock of `dir` (`.shellsim.lock`), when it is another process
+/// that is alive; `None` when there is no lock or it was left by a run that ended.
+pub(crate) fn lock_owner(dir: &Path) -> Option<u32> {
+    let pid = std::fs::read_to_string(dir.join(".shellsim.lock"))
+        .ok()
+        .and_then(|t| t.trim().parse::<u32>().ok())?;
+    (pid != std::process::id() && Path::new(&format!("/proc/{pid}")).exists()).then_some(pid)
+}
+
 /// Files of an earlier run in `dir`: its summary, series and log, frames `PREFIX_NNNNN.vtu|vtk`,
 /// their snapshots `PREFIX_NNNNN.png` and temporary files left by an interrupted write.
-fn previous_outputs(dir: &Path, prefix: &str) -> std::io::Result<Vec<std::path::PathBuf>> {
+pub(crate) fn previous_outputs(
+    dir: &Path,
+    prefix: &str,
+) -> std::io::Result<Vec<std::path::PathBuf>> {
     let mut out = Vec::new();
     for e in std::fs::read_dir(dir)? {
         let p = e?.path();
