@@ -800,7 +800,7 @@ pub fn plot(
         .iter()
         .map(|&t| {
             if log_y {
-                number(t, t / 10.0)
+                number(t, t)
             } else {
                 number(t, step(&ty))
             }
