@@ -110,6 +110,9 @@ struct PlotArgs {
     /// Picture size in pixels, WIDTHxHEIGHT.
     #[arg(long, default_value = "1024x768")]
     size: String,
+    /// A logarithmic vertical axis (every plotted value must be above 0).
+    #[arg(long)]
+    log_y: bool,
 }
 
 #[derive(clap::Args, Debug)]
@@ -128,9 +131,13 @@ struct RenderArgs {
     /// Picture size in pixels, WIDTHxHEIGHT.
     #[arg(long, default_value = "1024x768")]
     size: String,
-    /// Colour range LOW,HIGH (default: the field's minimum and maximum).
+    /// Colour range LOW,HIGH (default: the field's minimum and maximum; a field uniform to
+    /// round-off is drawn as one colour).
     #[arg(long, allow_hyphen_values = true)]
     range: Option<String>,
+    /// smooth (normals interpolated from the vertices) or flat (each face its own).
+    #[arg(long, default_value = "smooth")]
+    shading: crate::render::Shading,
 }
 
 #[derive(clap::Args, Debug)]
@@ -367,8 +374,8 @@ fn plot_cmd(a: PlotArgs) -> Result<()> {
             )
         })
         .collect();
-    let canvas =
-        crate::render::plot(a.x.trim(), &series, w, h).map_err(|e| anyhow!("{name}: {e}"))?;
+    let canvas = crate::render::plot(a.x.trim(), &series, w, h, a.log_y)
+        .map_err(|e| anyhow!("{name}: {e}"))?;
     let out = a.out.unwrap_or_else(|| {
         log.parent()
             .map(|d| d.join("plot.png"))
@@ -381,6 +388,9 @@ fn plot_cmd(a: PlotArgs) -> Result<()> {
 fn render_cmd(a: RenderArgs) -> Result<()> {
     let (w, h) = picture_size(&a.size)?;
     let mesh = read_mesh(&a.frame)?;
+    // The checks every reader of a mesh makes (face indices in range, finite coordinates,
+    // field lengths), before anything is drawn.
+    mesh.validate()?;
     let field = match a.field {
         Some(f) => Some(f),
         None => ["mean_curvature"]
@@ -397,7 +407,7 @@ fn render_cmd(a: RenderArgs) -> Result<()> {
         ),
     };
     let name = a.frame.display().to_string();
-    let canvas = crate::render::render(&mesh, field.as_deref(), &a.view, w, h, range)
+    let canvas = crate::render::render(&mesh, field.as_deref(), &a.view, w, h, range, a.shading)
         .map_err(|e| anyhow!("{name}: {e}"))?;
     let out = a.out.unwrap_or_else(|| a.frame.with_extension("png"));
     canvas.save_png(&out)

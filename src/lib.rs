@@ -54,3 +54,4 @@ pub mod settings;
 pub mod solve;
 pub mod sweep;
 pub mod team;
+pub mod units;

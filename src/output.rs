@@ -1081,9 +1081,17 @@ impl Writer {
                 .then_some("mean_curvature"),
         };
         let [w, h] = o.snapshot_size;
-        crate::render::render(m, field, &o.snapshot_view, w, h, None)
-            .and_then(|c| c.save_png(&path))
-            .map_err(|e| ioerr(&path, format!("{e:#}")))
+        crate::render::render(
+            m,
+            field,
+            &o.snapshot_view,
+            w,
+            h,
+            None,
+            crate::render::Shading::Smooth,
+        )
+        .and_then(|c| c.save_png(&path))
+        .map_err(|e| ioerr(&path, format!("{e:#}")))
     }
 
     fn write_series(&self) -> Result<(), OutputError> {

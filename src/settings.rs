@@ -2148,10 +2148,11 @@ impl Settings {
                 .map(|_| ())
                 .or_else(|e| ck.inv("output.snapshot_view", format!("{e:#}")))?;
             let [w, h] = o.snapshot_size;
-            if !(64..=16384).contains(&w) || !(64..=16384).contains(&h) {
+            let max = crate::render::MAX_SIDE;
+            if !(64..=max).contains(&w) || !(64..=max).contains(&h) {
                 return ck.inv(
                     "output.snapshot_size",
-                    format!("[{w}, {h}]: each side must lie in 64–16384 pixels"),
+                    format!("[{w}, {h}]: each side must lie in 64–{max} pixels"),
                 );
             }
         }

@@ -240,3 +240,238 @@ fn snapshots_are_written_beside_frames() {
     );
     assert!(!p.join("x").exists());
 }
+
+/// Smooth shading (the default) interpolates vertex normals, so a sphere's shading changes
+/// gradually from pixel to pixel; flat shading shows the facets as steps between neighbours.
+#[test]
+fn smooth_shading_hides_facets_and_flat_shows_them() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path();
+    let (c, e) = run(
+        &[
+            "mesh", "sphere", "--radius", "1", "--edge", "0.25", "-o", "s.vtk",
+        ],
+        p,
+    );
+    assert_eq!(c, 0, "{e}");
+    // Steps of more than 4 levels between horizontal neighbours, both on the surface.
+    let steps = |shading: &str| {
+        let out = format!("{shading}.png");
+        let (c, e) = run(
+            &[
+                "render",
+                "s.vtk",
+                "-o",
+                &out,
+                "--size",
+                "300x300",
+                "--shading",
+                shading,
+            ],
+            p,
+        );
+        assert_eq!(c, 0, "{e}");
+        let (w, h, px) = decode(&p.join(&out));
+        let surface = |q: [u8; 3]| q != [255, 255, 255];
+        let mut n = 0;
+        for y in 0..h {
+            for x in 1..w - 2 {
+                let (a, b) = (px[y * w + x], px[y * w + x + 1]);
+                // Interior pixels only (their neighbours on both sides on the surface).
+                if surface(px[y * w + x - 1])
+                    && surface(a)
+                    && surface(b)
+                    && surface(px[y * w + x + 2])
+                {
+                    n += (a[0] as i32 - b[0] as i32).abs().gt(&4) as usize;
+                }
+            }
+        }
+        n
+    };
+    let (smooth, flat) = (steps("smooth"), steps("flat"));
+    assert!(smooth * 10 < flat, "smooth {smooth} steps, flat {flat}");
+    let (c, e) = run(
+        &["render", "s.vtk", "-o", "x.png", "--shading", "gouraud"],
+        p,
+    );
+    assert_eq!(c, 2, "{e}");
+    assert!(e.contains("flat") && e.contains("smooth"), "{e}");
+}
+
+/// A field uniform but for round-off (2e-6 of its value) is drawn in the middle colour of the
+/// map, not stretched over all of it; the colour bar says so (its ends ±1% of the value).
+#[test]
+fn a_field_uniform_to_round_off_is_one_colour() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path();
+    std::fs::write(
+        p.join("u.vtk"),
+        "# vtk DataFile Version 3.0\nu\nASCII\nDATASET POLYDATA\nPOINTS 4 double\n0 0 0\n\
+         1 0 0\n1 1 0\n0 1 0\nPOLYGONS 2 8\n3 0 1 2\n3 0 2 3\nCELL_DATA 2\nSCALARS u double 1\n\
+         LOOKUP_TABLE default\n0.75 0.7500015\n",
+    )
+    .unwrap();
+    for shading in ["flat", "smooth"] {
+        let (c, e) = run(
+            &[
+                "render",
+                "u.vtk",
+                "--field",
+                "u",
+                "-o",
+                "u.png",
+                "--view",
+                "top",
+                "--size",
+                "300x200",
+                "--shading",
+                shading,
+            ],
+            p,
+        );
+        assert_eq!(c, 0, "{e}");
+        let (w, h, px) = decode(&p.join("u.png"));
+        let mut n = 0;
+        for y in 0..h {
+            for x in 0..w * 4 / 5 {
+                let q = px[y * w + x].map(|v| v as f64);
+                if q == [255.0; 3] {
+                    continue;
+                }
+                n += 1;
+                // Viridis' middle, [33, 145, 140], shaded: far from its purple and yellow ends.
+                assert!(
+                    q[0] < 0.4 * q[1] && (q[1] / q[2] - 145.0 / 140.0).abs() < 0.1,
+                    "{shading}: pixel ({x}, {y}) is {q:?}"
+                );
+            }
+        }
+        assert!(n > 10_000, "{n}");
+    }
+}
+
+/// The largest picture is one the renderer can allocate: a side beyond it is refused (exit 2,
+/// nothing written), on the command line and as `output.snapshot_size` before a run starts.
+#[test]
+fn picture_sizes_beyond_the_maximum_are_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path();
+    let (c, e) = run(
+        &[
+            "mesh", "square", "--size", "1", "--edge", "0.25", "-o", "sq.vtk",
+        ],
+        p,
+    );
+    assert_eq!(c, 0, "{e}");
+    for size in ["16384x16384", "8193x64", "64x8193"] {
+        for cmd in ["render", "plot"] {
+            let input = if cmd == "render" { "sq.vtk" } else { "log.csv" };
+            std::fs::write(p.join("log.csv"), "time,energy_total\n0,1\n1,2\n").unwrap();
+            let (c, e) = run(&[cmd, input, "-o", "big.png", "--size", size], p);
+            assert_eq!(c, 2, "{cmd} {size}: {e}");
+            assert!(e.contains("8192") && !e.contains("panicked"), "{e}");
+            assert!(!p.join("big.png").exists());
+        }
+    }
+    std::fs::write(
+        p.join("s.toml"),
+        "[material]\nyoung = 1.0e6\nthickness = 0.01\n[rest]\ntarget = \"uniform\"\n\
+         abar = [1.1, 0.0, 1.1]\n[output]\nsnapshots = \"all\"\nsnapshot_size = [16384, 16384]\n",
+    )
+    .unwrap();
+    let (c, e) = run(&["s.toml", "sq.vtk", "--out", "o", "-q"], p);
+    assert_eq!(c, 2, "{e}");
+    assert!(
+        e.contains("output.snapshot_size") && e.contains("8192"),
+        "{e}"
+    );
+    assert!(!p.join("o").exists());
+}
+
+/// `render` checks a frame as every other reader does: a face naming a vertex that does not
+/// exist is exit 2 naming the file and the face, not a panic, and nothing is drawn.
+#[test]
+fn render_refuses_a_frame_with_a_face_out_of_range() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path();
+    std::fs::write(
+        p.join("bad.vtk"),
+        "# vtk DataFile Version 3.0\nbad\nASCII\nDATASET POLYDATA\nPOINTS 3 double\n0 0 0\n\
+         1 0 0\n0 1 0\nPOLYGONS 1 4\n3 0 1 5\n",
+    )
+    .unwrap();
+    let (c, e) = run(&["render", "bad.vtk", "-o", "bad.png"], p);
+    assert_eq!(c, 2, "{e}");
+    assert!(
+        e.contains("bad.vtk") && e.contains("face 0") && e.contains("vertex 5"),
+        "{e}"
+    );
+    assert!(!p.join("bad.png").exists());
+}
+
+/// `plot --log-y`: a logarithmic axis over positive data; zero or negative data is refused
+/// (exit 2) naming the column and where, with no picture. The vertical axis is labelled.
+#[test]
+fn plot_log_axis_and_its_refusals() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path();
+    std::fs::write(
+        p.join("log.csv"),
+        "frame,time,energy_total,residual\n0,0.0,1.0,1e-1\n1,0.5,0.5,1e-4\n2,1.0,0.0,1e-9\n",
+    )
+    .unwrap();
+    let (c, e) = run(
+        &[
+            "plot", ".", "--y", "residual", "--log-y", "--size", "400x300", "-o", "r.png",
+        ],
+        p,
+    );
+    assert_eq!(c, 0, "{e}");
+    let (w, h, px) = decode(&p.join("r.png"));
+    // On a log axis the residual's three points fall in equal-ish steps: the middle one sits
+    // between the others, nearer the first (3 decades down of 8), unlike on a linear axis.
+    let blue: Vec<(usize, usize)> = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| px[y * w + x] == [0, 114, 178] && y > 40)
+        .collect();
+    let ys = |x0: usize, x1: usize| {
+        let v: Vec<usize> = blue
+            .iter()
+            .filter(|q| (x0..x1).contains(&q.0))
+            .map(|q| q.1)
+            .collect();
+        v.iter().sum::<usize>() as f64 / v.len().max(1) as f64
+    };
+    let xs: Vec<usize> = blue.iter().map(|q| q.0).collect();
+    let (xmin, xmax) = (*xs.iter().min().unwrap(), *xs.iter().max().unwrap());
+    let xmid = (xmin + xmax) / 2;
+    let (y0, ym, y1) = (
+        ys(xmin, xmin + 3),
+        ys(xmid - 1, xmid + 2),
+        ys(xmax - 2, xmax + 1),
+    );
+    let frac = (ym - y0) / (y1 - y0);
+    assert!((frac - 3.0 / 8.0).abs() < 0.08, "{y0} {ym} {y1}: {frac}");
+    // The vertical label: dark pixels in the leftmost column band, about the plot's middle.
+    let dark = (h / 3..2 * h / 3)
+        .flat_map(|y| (0..12).map(move |x| (x, y)))
+        .filter(|&(x, y)| px[y * w + x].iter().all(|&v| v < 128))
+        .count();
+    assert!(dark > 20, "{dark}");
+    let (c, e) = run(
+        &[
+            "plot",
+            ".",
+            "--y",
+            "residual,energy_total",
+            "--log-y",
+            "-o",
+            "bad.png",
+        ],
+        p,
+    );
+    assert_eq!(c, 2, "{e}");
+    assert!(e.contains("energy_total") && e.contains("--log-y"), "{e}");
+    assert!(!p.join("bad.png").exists());
+}
