@@ -104,9 +104,10 @@ struct PlotArgs {
     /// Columns to plot, comma-separated.
     #[arg(long, default_value = "energy_total")]
     y: String,
-    /// The column along the horizontal axis (time, dial, frame, …).
-    #[arg(long, default_value = "time")]
-    x: String,
+    /// The column along the horizontal axis (time, dial, frame, …; default: time, or the dial
+    /// for a static run, whose log has no time).
+    #[arg(long)]
+    x: Option<String>,
     /// Picture size in pixels, WIDTHxHEIGHT.
     #[arg(long, default_value = "1024x768")]
     size: String,
@@ -347,7 +348,12 @@ fn plot_cmd(a: PlotArgs) -> Result<()> {
             .position(|h| *h == c)
             .ok_or_else(|| anyhow!("{name}: no column '{c}'; it has: {}", head.join(", ")))
     };
-    let xi = col(a.x.trim())?;
+    let x = match &a.x {
+        Some(x) => x.trim().to_string(),
+        None if head.contains(&"time") => "time".into(),
+        None => "dial".into(),
+    };
+    let xi = col(&x)?;
     let ys: Vec<(String, usize)> =
         a.y.split(',')
             .map(str::trim)
@@ -374,8 +380,8 @@ fn plot_cmd(a: PlotArgs) -> Result<()> {
             )
         })
         .collect();
-    let canvas = crate::render::plot(a.x.trim(), &series, w, h, a.log_y)
-        .map_err(|e| anyhow!("{name}: {e}"))?;
+    let canvas =
+        crate::render::plot(&x, &series, w, h, a.log_y).map_err(|e| anyhow!("{name}: {e}"))?;
     let out = a.out.unwrap_or_else(|| {
         log.parent()
             .map(|d| d.join("plot.png"))

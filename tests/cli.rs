@@ -1510,7 +1510,13 @@ fn restart_is_exact(scene: &str, mesh: &str, sets: &[&str], k: usize, stop: &str
     let log = |o: &str| strip(std::fs::read_to_string(p.join(o).join("log.csv")).unwrap());
     assert_eq!(log("full"), log("c"), "{scene}: log.csv without wall times");
     let (sf, sc) = (summary_of(p, "full"), summary_of(p, "c"));
-    for key in ["steps", "newton_iterations", "rejected_steps", "frames", "final_frame"] {
+    for key in [
+        "steps",
+        "newton_iterations",
+        "rejected_steps",
+        "frames",
+        "final_frame",
+    ] {
         assert_eq!(sf[key], sc[key], "{scene}: summary {key}");
     }
     let runs: serde_json::Value =
@@ -1676,39 +1682,52 @@ fn static_runs_report_the_dial() {
     let s = summary_of(p, "o");
     assert!(s.get("time").is_none(), "{s}");
     assert_eq!(s["dial"], 1.0);
-    // A run that fails part-way: its last row, its last series entry and the summary agree.
+    // `plot` draws a static run against its dial.
+    let r = run(&["plot", "o", "-o", "p.png"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(p.join("p.png").exists());
+    // A run that fails part-way (two Newton iterations allowed per step, no membrane
+    // continuation: it stops at dial 1/64 on the GCM cone): its last row, its last series
+    // entry and the summary agree on the dial.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let settings = root.join("settings/gcm_cone.toml").display().to_string();
+    let mesh = root
+        .join("meshes/gcm_cone_jittered.vtk")
+        .display()
+        .to_string();
     let r = run(
         &[
-            "s.toml",
-            "m.vtk",
+            &settings,
+            &mesh,
             "--out",
             "f",
             "-q",
             "--set",
-            "solver.max_newton_iterations=1",
+            "solver.max_newton_iterations=2",
             "--set",
-            "solver.min_continuation_step=0.2",
+            "solver.membrane_continuation=1",
+            "--set",
+            "solver.min_continuation_step=0.01",
         ],
         p,
     );
-    if r.code == 1 {
-        let s = summary_of(p, "f");
-        let dial = s["dial"].as_f64().unwrap();
-        assert!(dial < 1.0, "{s}");
-        let log = std::fs::read_to_string(p.join("f/log.csv")).unwrap();
-        let last: f64 = log
-            .lines()
-            .last()
-            .unwrap()
-            .split(',')
-            .nth(1)
-            .unwrap()
-            .parse()
-            .unwrap();
-        assert_eq!(last, dial, "{log}");
-        let series = shellsim::output::series_entries(&p.join("f/series.pvd")).unwrap();
-        assert_eq!(series.last().unwrap().0, dial);
-    }
+    assert_eq!(r.code, 1, "{}", r.stderr);
+    let s = summary_of(p, "f");
+    let dial = s["dial"].as_f64().unwrap();
+    assert!(dial > 0.0 && dial < 1.0, "{s}");
+    let log = std::fs::read_to_string(p.join("f/log.csv")).unwrap();
+    let last: f64 = log
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .nth(1)
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(last, dial, "{log}");
+    let series = shellsim::output::series_entries(&p.join("f/series.pvd")).unwrap();
+    assert_eq!(series.last().unwrap().0, dial);
 }
 
 /// Frames keep the input's corner order even where the scene starts a sliver at a wider
