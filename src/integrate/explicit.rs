@@ -202,9 +202,10 @@ pub fn check(scene: &Scene) -> Result<(), String> {
         return Err(format!(
             "invalid 'explicit.max_long_times': {} long times of T = {} s at the time step Δt = \
              {} s (explicit.time_step_prefactor = {}) is {} steps, more than {max:e}. T/Δt is \
-             set by the mesh and the material (thinnest thickness {} m, from material.thickness or \
-             the mesh's ref_thicknesses; smallest altitude {} m; sample length {} m): lower explicit.max_long_times, raise \
-             explicit.time_step_prefactor up to the mesh's limit, or coarsen the mesh",
+             set by the mesh and the material (thinnest thickness {} m, from \
+             material.thickness or the mesh's ref_thicknesses; smallest altitude {} m; sample \
+             length {} m): lower explicit.max_long_times, raise explicit.time_step_prefactor \
+             up to the mesh's limit, or coarsen the mesh",
             cf.max_long_times,
             sci(sca.long_time),
             sci(dt),
