@@ -230,6 +230,89 @@ pub struct Summary {
     pub explicit: Option<ExplicitReport>,
 }
 
+impl Summary {
+    /// Refuses a summary that would hold a non-finite number (serialised as `null`): the run
+    /// is marked unconverged (exit 1) with an internal error naming the values, which
+    /// [`Writer::summary`] leaves out. Returns whether it did.
+    pub fn refuse_non_finite(&mut self) -> bool {
+        let (_, paths) = summary_json(self);
+        if paths.is_empty() {
+            return false;
+        }
+        self.converged = false;
+        let was = std::mem::take(&mut self.reason);
+        self.reason = format!(
+            "internal error: summary.json would hold a non-finite number at {} (left out){}",
+            paths.join(", "),
+            if was.is_empty() {
+                String::new()
+            } else {
+                format!("; the run stopped: {was}")
+            }
+        );
+        true
+    }
+}
+
+/// `summary` as JSON with every `null` (a non-finite number) left out, and the dotted paths
+/// of the values left out.
+pub fn summary_json(summary: &Summary) -> (String, Vec<String>) {
+    fn prune(v: &mut serde_json::Value, at: &str, out: &mut Vec<String>) {
+        let key = |k: &str| {
+            if at.is_empty() {
+                k.to_string()
+            } else {
+                format!("{at}.{k}")
+            }
+        };
+        match v {
+            serde_json::Value::Object(m) => {
+                m.retain(|k, x| {
+                    let null = x.is_null();
+                    if null {
+                        out.push(key(k));
+                    }
+                    !null
+                });
+                for (k, x) in m.iter_mut() {
+                    prune(x, &key(k), out);
+                }
+            }
+            serde_json::Value::Array(a) => {
+                a.retain(|x| {
+                    let null = x.is_null();
+                    if null {
+                        out.push(format!("{at}[]"));
+                    }
+                    !null
+                });
+                for (i, x) in a.iter_mut().enumerate() {
+                    prune(x, &format!("{at}[{i}]"), out);
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut paths = Vec::new();
+    let text = match serde_json::to_value(summary) {
+        Ok(mut v) => {
+            prune(&mut v, "", &mut paths);
+            match paths.is_empty() {
+                // The fields in their declared order.
+                true => serde_json::to_string_pretty(summary),
+                false => serde_json::to_string_pretty(&v),
+            }
+            .unwrap_or_default()
+        }
+        // Serialising plain data cannot fail; were it to, the file says so instead of a value.
+        Err(e) => {
+            paths.push(format!("(the whole summary: {e})"));
+            String::from("{}")
+        }
+    };
+    (text, paths)
+}
+
 /// Where a run's wall time went (s): Newton's parts (explicit mode: the force evaluations under
 /// `assembly`), the moisture diffusion, writing frames, and the rest (setup, predictors,
 /// bookkeeping).
@@ -251,8 +334,9 @@ pub struct Timing {
 pub struct ExplicitReport {
     /// The time step Δt (s).
     pub time_step: Real,
-    /// The mesh's measured stability limit of `explicit.time_step_prefactor` (none when the
-    /// stiffness at the start has no positive eigenvalue).
+    /// The mesh's measured stability limit of `explicit.time_step_prefactor` (left out when
+    /// the stiffness at the start has no positive eigenvalue).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub stable_prefactor: Option<Real>,
     /// The long time T (s).
     pub long_time: Real,
@@ -1218,7 +1302,8 @@ impl Writer {
             tm.output += t("output");
             tm.other += t("other");
         }
-        let text = serde_json::to_string_pretty(&summary).map_err(|e| ioerr(&path, e))?;
+        // Never a `null`: the caller refuses such a summary first (`Summary::refuse_non_finite`).
+        let (text, _) = summary_json(&summary);
         write_atomic(&path, text.as_bytes()).map_err(|e| ioerr(&path, e))?;
         // The last frame's picture, when the frame last built is the one last written (not a
         // refused non-finite state).

@@ -235,10 +235,28 @@ impl Scene {
             for (v, &t) in tags.data.iter().enumerate() {
                 fixed[v] |= c.fix_tags.contains(&(t.round() as i64));
             }
+            // A tag that fixes nothing is a mistake (a load selecting nothing is one too).
+            for (i, &tag) in c.fix_tags.iter().enumerate() {
+                if !tags.data.iter().any(|&t| t.round() as i64 == tag) {
+                    return Err(mesh.invalid(format!(
+                        "constraints.fix_tags[{i}] = {tag} selects no vertex: no value of \
+                         'node_tags' is {tag}"
+                    )));
+                }
+            }
         }
-        for b in &c.fix_boxes {
+        for (i, b) in c.fix_boxes.iter().enumerate() {
+            let mut any = false;
             for (v, p) in mesh.positions.iter().enumerate() {
-                fixed[v] |= (0..3).all(|k| p[k] >= b.min[k] && p[k] <= b.max[k]);
+                let inside = (0..3).all(|k| p[k] >= b.min[k] && p[k] <= b.max[k]);
+                fixed[v] |= inside;
+                any |= inside;
+            }
+            if !any {
+                return Err(mesh.invalid(format!(
+                    "constraints.fix_boxes[{i}] (min {:?}, max {:?}) selects no vertex",
+                    b.min, b.max
+                )));
             }
         }
         let mut clamped_edges = Vec::new();
@@ -388,6 +406,9 @@ impl Scene {
         scene.terms = crate::energy::term::Terms(std::sync::Arc::new(
             crate::energy::registry::terms(&scene)?,
         ));
+        if scene.settings.solver.mode == crate::settings::Mode::Explicit {
+            crate::integrate::explicit::check(&scene).map_err(|r| scene.mesh.invalid(r))?;
+        }
         Ok(scene)
     }
 

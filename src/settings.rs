@@ -1827,15 +1827,26 @@ impl Settings {
             ck.nonneg("slides.contact_damping", z)?;
         }
         ck.nonneg("slides.travel", sl.travel)?;
-        for (k, v) in [("slides.speed", sl.speed), ("slides.force", sl.force)] {
-            if !v.is_finite() {
-                return ck.inv(k, format!("must be finite, got {v:e}"));
+        let coordinate = crate::mesh::MAX_COORDINATE;
+        for (k, v, max, unit) in [
+            ("slides.speed", sl.speed, coordinate, "m/s"),
+            ("slides.force", sl.force, MAX_LOAD, "N"),
+            ("slides.travel", sl.travel, coordinate, "m"),
+        ] {
+            if !(v.is_finite() && v.abs() <= max) {
+                return ck.inv(
+                    k,
+                    format!("must be finite within ±{max:e} {unit}, got {v:e}"),
+                );
             }
         }
         for (k, v) in [("slides.lower", sl.lower), ("slides.upper", sl.upper)] {
             if let Some(v) = v {
-                if !v.is_finite() {
-                    return ck.inv(k, format!("must be finite, got {v:e}"));
+                if !(v.is_finite() && v.abs() <= coordinate) {
+                    return ck.inv(
+                        k,
+                        format!("must be a finite height within ±{coordinate:e} m, got {v:e}"),
+                    );
                 }
             }
         }
@@ -1903,6 +1914,25 @@ impl Settings {
             "explicit.morphoshell_speed_threshold",
             e.morphoshell_speed_threshold,
         )?;
+        if e.window_long_times > e.max_long_times {
+            return ck.inv(
+                "explicit.window_long_times",
+                format!(
+                    "a window of {:e} long times is longer than the run's limit, \
+                     explicit.max_long_times = {:e}: the equilibrium test could never run",
+                    e.window_long_times, e.max_long_times
+                ),
+            );
+        }
+        if e.gradient_descent_steps as Real > MAX_STEPS {
+            return ck.inv(
+                "explicit.gradient_descent_steps",
+                format!(
+                    "{} steps is more than {MAX_STEPS:e}",
+                    e.gradient_descent_steps
+                ),
+            );
+        }
         if e.max_long_times * e.frames_per_long_time > MAX_FRAMES {
             return ck.inv(
                 "explicit.frames_per_long_time",
@@ -2106,10 +2136,19 @@ impl Settings {
             ck.selection(&format!("constraints.clamp[{i}]"), sel)?;
         }
         for (i, d) in cs.displacement.iter().enumerate() {
-            if !d.displacement.iter().all(|c| c.is_finite()) {
+            // A displacement moves vertices: it is bounded like the coordinates themselves.
+            let max = crate::mesh::MAX_COORDINATE;
+            if !d
+                .displacement
+                .iter()
+                .all(|c| c.is_finite() && c.abs() <= max)
+            {
                 return ck.inv(
                     &format!("constraints.displacement[{i}].displacement"),
-                    format!("must be finite, got {}", vec_e(&d.displacement)),
+                    format!(
+                        "must be finite with components within ±{max:e} m, got {}",
+                        vec_e(&d.displacement)
+                    ),
                 );
             }
             ck.selection(&format!("constraints.displacement[{i}]"), &d.on)?;

@@ -1158,6 +1158,43 @@ fn unbounded_sizes_are_refused() {
     );
 }
 
+/// A constraint selection that selects nothing is bad input naming the key and the value, as
+/// a load's is: a tag no vertex carries, a box around no vertex. A prescribed displacement
+/// beyond the coordinates' range (±1e30 m) is refused like such a coordinate.
+#[test]
+fn constraints_that_select_nothing_or_move_too_far_are_refused() {
+    let d = tmp();
+    let p = d.path();
+    write(p, "m.vtk", TWO_TRIANGLES);
+    for (text, needles) in [
+        (
+            "[constraints]\nfix_tags = [1, 99]\n",
+            &["constraints.fix_tags[1] = 99", "selects no vertex"][..],
+        ),
+        (
+            "[constraints]\nfix_boxes = [{ min = [5, 5, 5], max = [6, 6, 6] }]\n",
+            &["constraints.fix_boxes[0]", "selects no vertex"],
+        ),
+        (
+            "[[constraints.displacement]]\ndisplacement = [1e31, 0, 0]\ntags = [1]\n",
+            &["constraints.displacement[0].displacement", "1e30"],
+        ),
+    ] {
+        write(p, "s.toml", &format!("{STATIC}{text}"));
+        for n in needles {
+            expect_bad(&["s.toml", "m.vtk", "-q"], p, n);
+        }
+    }
+    // A tag that does select vertices is fine.
+    write(
+        p,
+        "s.toml",
+        &format!("{STATIC}[constraints]\nfix_tags = [1]\n"),
+    );
+    let r = run(&["s.toml", "m.vtk", "--out", "ok", "-q"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+}
+
 /// A restart frame whose faces have collapsed (all vertices at one point) is bad input, named
 /// by face, before anything is written.
 #[test]

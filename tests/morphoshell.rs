@@ -349,6 +349,32 @@ fn morphoshell_mode_bad_input_is_named() {
             "λ = -",
         ),
         ("[dial]\nholds = [0.5, 0.2]\n", "dial.holds[1]"),
+        // Work bounds: ~1e13 steps to the time limit; a window the time limit never reaches.
+        (
+            "[explicit]\ntime_step_prefactor = 1e-6\n",
+            "explicit.time_step_prefactor = 0.000001) is",
+        ),
+        (
+            "[explicit]\nwindow_long_times = 10\nmax_long_times = 3\n",
+            "explicit.window_long_times",
+        ),
+        (
+            "[explicit]\nwindow_long_times = 1e308\n",
+            "explicit.window_long_times",
+        ),
+        // A drag that overflows, or that symplectic Euler cannot take (c Δt ≥ 2).
+        (
+            "[explicit]\ndamping_prefactor_wait = 1e308\n",
+            "explicit.damping_prefactor_wait",
+        ),
+        (
+            "[explicit]\ndamping_prefactor_dial = 1e6\n",
+            "explicit.damping_prefactor_dial",
+        ),
+        (
+            "[constraints]\nfix_boxes = [{ min = [-2, -2, -2], max = [2, 2, 2] }]\n",
+            "nothing to move",
+        ),
     ] {
         write(d, "bad.toml", &format!("{base}{extra}"));
         let (code, err) = run(&["bad.toml", "disk.vtk", "--out", "o", "-q"], d);
@@ -356,6 +382,17 @@ fn morphoshell_mode_bad_input_is_named() {
         assert!(err.contains(needle), "{extra}: {err}");
         assert!(!d.join("o").join("summary.json").exists());
     }
+    // A thickness of 1e-30 (an imported MorphoShell file can give one) makes the long time,
+    // the slowest bending mode's period, ~1e30 steps.
+    write(
+        d,
+        "bad.toml",
+        &base.replace("[material]\n", "[material]\nthickness = 1e-30\n"),
+    );
+    let (code, err) = run(&["bad.toml", "disk.vtk", "--out", "o", "-q"], d);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("thinnest thickness 1.000e-30 m"), "{err}");
+    assert!(err.contains("more than 1e9"), "{err}");
     write(
         d,
         "bad.toml",
@@ -364,6 +401,116 @@ fn morphoshell_mode_bad_input_is_named() {
     let (code, err) = run(&["bad.toml", "disk.vtk", "--out", "o", "-q"], d);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("material.bending"), "{err}");
+}
+
+/// A short explicit run that stops at its time limit writes a finite `log.csv` (the residual
+/// of every frame is the window test's force measure at that frame's state) and a
+/// `summary.json` without `null`; a window almost as long as the limit does not carry the run
+/// past it (the limit is checked every step).
+#[test]
+fn explicit_run_stops_at_its_limit_with_finite_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    shellsim(
+        &[
+            "mesh", "disk", "--radius", "1", "--edge", "0.3", "-o", "disk.vtk",
+        ],
+        d,
+    );
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = root.join("settings/cone_squeezed.toml");
+    let (code, err) = run(
+        &[
+            scene.to_str().unwrap(),
+            "disk.vtk",
+            "--out",
+            "o",
+            "-q",
+            "--set",
+            "explicit.max_long_times=0.2",
+            "--set",
+            "explicit.window_long_times=0.15",
+        ],
+        d,
+    );
+    assert_eq!(code, 1, "{err}");
+    let out = d.join("o");
+    let log = std::fs::read_to_string(out.join("log.csv")).unwrap();
+    let mut lines = log.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let mut rows = 0;
+    for line in lines {
+        for (name, cell) in head.iter().zip(line.split(',')) {
+            let v: Real = cell
+                .parse()
+                .unwrap_or_else(|_| panic!("{name}: '{cell}' in {line}"));
+            assert!(v.is_finite(), "{name}: {cell} in {line}");
+        }
+        rows += 1;
+    }
+    assert!(rows >= 3, "{log}");
+    let residuals = log_column(&out, "residual");
+    assert!(
+        residuals[1..].iter().all(|&r| r > 0.0),
+        "a moving sheet has a residual: {residuals:?}"
+    );
+    let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    assert!(!text.contains("null"), "{text}");
+    let s = summary(&out);
+    let reason = s["reason"].as_str().unwrap();
+    assert!(reason.contains("explicit.max_long_times"), "{reason}");
+    let (t, long) = (
+        s["time"].as_f64().unwrap(),
+        s["explicit"]["long_time"].as_f64().unwrap(),
+    );
+    let dt = s["explicit"]["time_step"].as_f64().unwrap();
+    assert!(
+        t >= 0.2 * long && t < 0.2 * long + 1.5 * dt,
+        "stopped at {} long times",
+        t / long
+    );
+}
+
+/// A flat sheet pressed by a force-controlled slide onto the lower slide carries the force:
+/// the contact is a penalty on the mid-surface, so the upper plane goes below the lower one by
+/// the penalty's give 2F/(n k) and every vertex is pushed from both sides. At the equilibrium
+/// test both slides carry the prescribed 2 mN: the test includes the slide's balance,
+/// |F − F_up| ≤ force_tolerance × E h ℓ (1e-7 × 3 × 0.02 × 0.25 = 1.5e-9 N, 1e-6 of the load),
+/// and the sheet's forces below the same tolerance per vertex bound the lower slide's to
+/// n × that (64 vertices: 5e-5 of the load).
+#[test]
+fn force_controlled_slide_on_a_flat_sheet_carries_the_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    shellsim(
+        &[
+            "mesh", "disk", "--radius", "1", "--edge", "0.25", "-o", "disk.vtk",
+        ],
+        d,
+    );
+    write(
+        d,
+        "flat.toml",
+        "[material]\nyoung = 3.0\npoisson = 0.5\ndensity = 1.0\nthickness = 0.02\n\
+         bending = \"patch_fit\"\n[solver]\nmode = \"explicit\"\n[explicit]\n\
+         time_step_prefactor = 0.6\ndial_long_times = 0.5\ndamping_prefactor_dial = 2\n\
+         damping_prefactor_wait = 2\n[slides]\nenabled = true\nlower = -0.03\nupper = 0.03\n\
+         control = \"force\"\nforce = 0.002\n",
+    );
+    let (code, err) = run(&["flat.toml", "disk.vtk", "--out", "o", "-q"], d);
+    let out = d.join("o");
+    let s = summary(&out);
+    assert_eq!(code, 0, "{err} {}", s["reason"]);
+    let col = |n: &str| *log_column(&out, n).last().unwrap();
+    let (up, down, gap) = (
+        col("slide_upper_force"),
+        col("slide_lower_force"),
+        col("slide_gap"),
+    );
+    eprintln!("flat sheet pressed: forces {up:e} / {down:e} N, gap {gap:e}");
+    assert!((up - 0.002).abs() < 1e-6 * 0.002, "upper force {up}");
+    assert!((down - 0.002).abs() < 5e-5 * 0.002, "lower force {down}");
+    assert!(gap < 0.0, "the planes overlap by the penalty's give: {gap}");
 }
 
 /// A liquid-crystal cone squashed between fixed glass slides with friction (explicit mode):

@@ -26,6 +26,14 @@
 //! sheet's push on it, F the prescribed downward force and ζ the drag (default: the sheet's mass
 //! times its waiting drag rate), integrated by backward Euler (unconditionally stable; the
 //! explicit update pumps energy into the sheet once the contact is stiff against ζ/Δt). The implicit modes hold both slides still (frictionless).
+//! A moved slide stops at the lower one. A pressed slide does not: the penalty acts on the
+//! mid-surface, so a sheet lying flat between the slides carries the force only with the upper
+//! plane below the lower one by the penalty's give, `2F/(n k)` for n vertices, each pushed from
+//! both sides (clamped at the lower slide, the upper one would sit in an empty gap with no
+//! contact and the force unbalanced). The explicit driver's equilibrium test requires the
+//! balance `F_up = F` ([`crate::energy::term::Term::explicit_unbalanced`]); a pressed slide
+//! that no free vertex touches while below the lower slide has passed the sheet, and the run
+//! stops with that reason.
 //!
 //! `log.csv` gets the slides' heights, the gap and the forces on each, computed from the state
 //! of the frame (never accumulated across steps).
@@ -160,6 +168,27 @@ impl VertexKernel for Slides {
         true
     }
 
+    /// A pressed slide is balanced when the sheet pushes back with the prescribed force. One
+    /// that no free vertex touches any more while below the lower slide has passed the sheet:
+    /// nothing can carry its force.
+    fn explicit_unbalanced(&self, pot: &Potential, x: &[Vec3]) -> Result<Real, String> {
+        if self.control != SlideControl::Force || (self.after_dial && pot.dial < 1.0) {
+            return Ok(0.0);
+        }
+        let (up, _) = self.forces(x, &pot.scene.fixed);
+        if up == 0.0 && self.force > 0.0 && self.upper() < self.lower {
+            return Err(format!(
+                "slides: the force-controlled upper slide (slides.force = {} N) has passed every \
+                 free vertex of the sheet and the lower slide (upper z = {} m, lower z = {} \
+                 m): nothing carries its force",
+                crate::math::human(self.force),
+                crate::math::human(self.upper()),
+                crate::math::human(self.lower)
+            ));
+        }
+        Ok((self.force - up).abs())
+    }
+
     fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
         if self.friction == 0.0 && self.contact_damping == 0.0 {
             return;
@@ -231,8 +260,14 @@ impl VertexKernel for Slides {
             }
             SlideControl::Force => self.pressed(x, fixed, z, dt),
         };
-        // The upper slide never passes the lower one.
-        let next = next.max(self.lower + 1e-12 * (1.0 + self.lower.abs()));
+        // A slide moved to a position stops at the lower one. A pressed slide does not: the
+        // contact is a penalty on the mid-surface, so a sheet lying flat between the slides
+        // carries the force only with the upper plane below the lower one, by the penalty's
+        // give (each vertex pushed from both sides, at the middle of the overlap).
+        let next = match self.control {
+            SlideControl::Speed => next.max(self.lower + 1e-12 * (1.0 + self.lower.abs())),
+            SlideControl::Force => next,
+        };
         self.upper_velocity
             .store(((next - z) / dt).to_bits(), Ordering::Relaxed);
         self.set_upper(next);

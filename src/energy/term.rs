@@ -283,6 +283,14 @@ pub trait Term: Send + Sync {
     ) {
     }
 
+    /// Explicit dynamics: the force (N) left unbalanced at positions `x` on a degree of
+    /// freedom the term moves itself (a force-controlled slide: the prescribed force minus the
+    /// sheet's push on it), which the equilibrium test requires to vanish like the sheet's own
+    /// forces; or why it never can (the slide has passed the sheet). Default: 0.
+    fn explicit_unbalanced(&self, _pot: &Potential, _x: &[Vec3]) -> Result<Real, String> {
+        Ok(0.0)
+    }
+
     /// Whether the term overrides [`Term::explicit_step`] (default: no). A term that does must
     /// say so here: the explicit driver fuses the update into the gradient's parallel parts
     /// when no term acts on the step between the two.
@@ -418,6 +426,10 @@ pub trait VertexKernel: Send + Sync {
     fn load_state(&self, _saved: &[Real]) -> Result<(), String> {
         Ok(())
     }
+    /// See [`Term::explicit_unbalanced`] (default: 0).
+    fn explicit_unbalanced(&self, _pot: &Potential, _x: &[Vec3]) -> Result<Real, String> {
+        Ok(0.0)
+    }
 }
 
 /// A [`VertexKernel`] as a [`Term`]. Fixed vertices contribute nothing to Φ (a constant);
@@ -450,6 +462,9 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
     }
     fn load_state(&self, saved: &[Real]) -> Result<(), String> {
         self.kernel.load_state(saved)
+    }
+    fn explicit_unbalanced(&self, pot: &Potential, x: &[Vec3]) -> Result<Real, String> {
+        self.kernel.explicit_unbalanced(pot, x)
     }
     fn observables(&self, pot: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
         self.kernel.observables(pot, x)

@@ -55,7 +55,17 @@
 //! that still creeps fails the displacement test, so the test cannot fire while the shape moves.
 //! `"morphoshell"` reproduces MorphoShell's test: the largest node force (drag included) below
 //! `morphoshell_force_threshold` × μ t a_min and the largest speed below
-//! `morphoshell_speed_threshold` × √(μ/ρ).
+//! `morphoshell_speed_threshold` × √(μ/ρ). Both include the force a term leaves unbalanced on
+//! a degree of freedom it moves itself (a pressed slide, [`Term::explicit_unbalanced`]), so a
+//! load the sheet does not carry is never reported as an equilibrium. Each frame's `residual`
+//! (`log.csv`) is the window test's force measure at the frame's state.
+//!
+//! ## Bounds
+//! Before anything is written ([`check`]): a vertex must be free; the drag must satisfy
+//! `c Δt < 2`; and `gradient_descent_steps + max_long_times · T/Δt` at most
+//! [`crate::settings::MAX_STEPS`]. The time limit is checked every step.
+//!
+//! [`Term::explicit_unbalanced`]: crate::energy::term::Term::explicit_unbalanced
 //!
 //! ## Failure
 //! A state that is not finite, or a kinetic energy above 100 × μ t A (strains of order ten
@@ -64,7 +74,7 @@
 
 use super::{Progress, RunError, Solver};
 use crate::assembly::Want;
-use crate::math::{Real, Vec3};
+use crate::math::{human, Real, Vec3};
 use crate::output::{ExplicitReport, Writer};
 use crate::scene::Scene;
 use crate::settings::EquilibriumTest;
@@ -149,6 +159,64 @@ impl Scales {
             long_time,
         }
     }
+}
+
+/// Checks, before anything is written, that an explicit run of `scene` makes sense and
+/// bounds its work; the error names the settings keys. A vertex must be free to move; the drag
+/// must keep symplectic Euler stable, `c Δt < 2` (beyond, the velocity grows by `|1 − c Δt|`
+/// per step); and the steps the time limit allows, `gradient_descent_steps + max_long_times ·
+/// T / Δt`, must not exceed [`crate::settings::MAX_STEPS`].
+pub fn check(scene: &Scene) -> Result<(), String> {
+    let cf = &scene.settings.explicit;
+    let nv = scene.num_vertices();
+    if !(0..nv).any(|v| !scene.node_fixed[v] && scene.mass[v] > 0.0) {
+        return Err(
+            "every vertex is fixed (constraint_indicators, constraints.fix_tags, \
+             fix_boxes, clamp or displacement): the explicit dynamics has nothing to move"
+                .into(),
+        );
+    }
+    let sca = Scales::of(scene);
+    let dt = cf.time_step_prefactor * sca.dt_unit;
+    for (key, p) in [
+        ("explicit.damping_prefactor_dial", cf.damping_prefactor_dial),
+        ("explicit.damping_prefactor_wait", cf.damping_prefactor_wait),
+    ] {
+        // The drag per step, c Δt = p · 2 ω_L Δt, against its limit 2.
+        let per_unit = 2.0 * sca.omega_long * dt;
+        if !(p * per_unit < 2.0) {
+            return Err(format!(
+                "invalid '{key}': {p:e} gives a drag of c Δt = {} per time step (c = {p:e} × 2 \
+                 ω_L, ω_L = {} rad/s, Δt = {} s); symplectic Euler's drag is unstable from c Δt \
+                 = 2, so this mesh and time step allow at most {}",
+                human(p * per_unit),
+                human(sca.omega_long),
+                human(dt),
+                human(2.0 / per_unit)
+            ));
+        }
+    }
+    let steps = cf.gradient_descent_steps as Real + cf.max_long_times * sca.long_time / dt;
+    let max = crate::settings::MAX_STEPS;
+    if !(steps <= max) {
+        return Err(format!(
+            "invalid 'explicit.max_long_times': {} long times of T = {} s at the time step Δt = \
+             {} s (explicit.time_step_prefactor = {}) is {} steps, more than {max:e}. T/Δt is \
+             set by the mesh and the material (thinnest thickness {} m, from \
+             material.thickness or the mesh's ref_thicknesses; smallest altitude {} m; sample \
+             length {} m): lower explicit.max_long_times, raise explicit.time_step_prefactor \
+             up to the mesh's limit, or coarsen the mesh",
+            cf.max_long_times,
+            human(sca.long_time),
+            human(dt),
+            cf.time_step_prefactor,
+            human(steps),
+            human(sca.t),
+            human(sca.a_min),
+            human(sca.length)
+        ));
+    }
+    Ok(())
 }
 
 /// The largest eigenvalue `ω_max²` of `M⁻¹H` at `x` (1/s²), by power iteration on the
@@ -411,8 +479,28 @@ enum Stop {
     Converged,
     /// The state blew up: it is not written.
     Unstable(String),
-    /// Interrupted or out of time: the state reached is written.
+    /// Interrupted, or a load that cannot balance: the state reached is written.
     Other(String),
+    /// The time limit `explicit.max_long_times` was reached: the state reached is written.
+    TimeLimit,
+}
+
+/// The largest force (N) a term leaves unbalanced on a degree of freedom of its own
+/// ([`crate::energy::term::Term::explicit_unbalanced`]), or why one never balances.
+fn unbalanced(pot: &Potential, x: &[Vec3]) -> Result<Real, String> {
+    let mut worst: Real = 0.0;
+    for term in pot.scene.terms.iter() {
+        worst = worst.max(term.explicit_unbalanced(pot, x)?);
+    }
+    Ok(worst)
+}
+
+/// The residual a frame reports: the window test's force measure `‖∇Φ‖∞ / F`, the terms'
+/// unbalanced forces included, at positions `x` (`g` is scratch).
+fn residual_at(pot: &Potential, x: &[Vec3], g: &mut [Real]) -> Real {
+    gradient(pot, x, g);
+    let f = pot.scene.force_scale.max(Real::MIN_POSITIVE);
+    pot.residual(g).max(unbalanced(pot, x).unwrap_or(0.0) / f)
 }
 
 /// A snapshot for the window test.
@@ -511,6 +599,8 @@ pub(super) fn run_explicit(
     }
     let mut v = v0.unwrap_or_else(|| vec![Vec3::zeros(); n]);
     let mut g = vec![0.0; s.pattern.n];
+    // The frames' residuals are taken here: `g` carries a test step's forces to its update.
+    let mut scratch = vec![0.0; s.pattern.n];
     let mut t = t0;
     let frame_interval = sca.long_time / cf.frames_per_long_time;
     let mut next_frame = t0 + frame_interval;
@@ -518,6 +608,7 @@ pub(super) fn run_explicit(
     let t_max = cf.max_long_times * sca.long_time;
     {
         let pot = s.potential(dial);
+        s.summary.residual = residual_at(&pot, &state.x, &mut scratch);
         s.frame(writer, &pot, &state, &v, t)?;
     }
     // The energy scale of the window test: the energy itself, but at least 1e-6 of the
@@ -604,10 +695,17 @@ pub(super) fn run_explicit(
                     stable_prefactor.map_or("unknown".into(), |p| format!("{p:.3}"))
                 ));
                 }
+                // A load the sheet can never balance (a pressed slide past the sheet) stops the
+                // run; one not balanced yet keeps it going.
+                let unbalanced = match unbalanced(&pot, &state.x) {
+                    Ok(f) => f,
+                    Err(why) => break Stop::Other(why),
+                };
                 let at_rest = phase == Phase::Wait
                     && match cf.equilibrium {
                         EquilibriumTest::Window => {
-                            let r = pot.residual(&g);
+                            let force_scale = sc.force_scale.max(Real::MIN_POSITIVE);
+                            let r = pot.residual(&g).max(unbalanced / force_scale);
                             let moved = state
                                 .x
                                 .iter()
@@ -631,6 +729,7 @@ pub(super) fn run_explicit(
                                 fmax = fmax.max(f.norm());
                                 vmax = vmax.max(v[i].norm());
                             }
+                            fmax = fmax.max(unbalanced);
                             fmax / (sca.mu * sca.t * sca.a_min) < cf.morphoshell_force_threshold
                                 && vmax / (sca.mu / sca.rho).sqrt() < cf.morphoshell_speed_threshold
                         }
@@ -645,17 +744,9 @@ pub(super) fn run_explicit(
                     s.summary.holds_reached += 1;
                     phase = Phase::Dial;
                     let pot = s.potential(dial);
-                    s.summary.residual = pot.residual(&g);
+                    s.summary.residual = residual_at(&pot, &state.x, &mut scratch);
                     s.frame(writer, &pot, &state, &v, t)?;
                     next_frame = t + frame_interval;
-                }
-                if t >= t_max {
-                    break Stop::Other(format!(
-                    "no equilibrium after explicit.max_long_times = {} long times ({t:.6e} s); \
-                     residual {:.3e}",
-                    cf.max_long_times,
-                    pot.residual(&g)
-                ));
                 }
             }
             // The step.
@@ -677,6 +768,11 @@ pub(super) fn run_explicit(
             t += dt;
             steps += 1;
             s.summary.steps += 1;
+            // The time limit, every step (a comparison): a window longer than the time left
+            // does not carry the run past it.
+            if t >= t_max {
+                break Stop::TimeLimit;
+            }
             if phase == Phase::Dial && dial < 1.0 {
                 dial = if dial_time > 0.0 {
                     (dial + dt / dial_time).min(1.0)
@@ -704,7 +800,7 @@ pub(super) fn run_explicit(
                         cf.time_step_prefactor
                     ));
                 }
-                s.summary.residual = Real::NAN;
+                s.summary.residual = residual_at(&pot, &state.x, &mut scratch);
                 s.frame(writer, &pot, &state, &v, t)?;
                 next_frame += frame_interval;
                 progress.update(
@@ -730,9 +826,7 @@ pub(super) fn run_explicit(
     report.microseconds_per_face_step =
         1e6 * wall / (steps.max(1) as Real * sc.num_faces() as Real);
     let pot = s.potential(dial);
-    g.iter_mut().for_each(|x| *x = 0.0);
-    pot.eval(&state.x, &[], Want::Gradient, &mut g, &mut []);
-    s.summary.residual = pot.residual(&g);
+    s.summary.residual = residual_at(&pot, &state.x, &mut scratch);
     s.summary.time = Some(t);
     s.summary.dial = dial;
     s.summary.explicit = Some(report);
@@ -750,9 +844,16 @@ pub(super) fn run_explicit(
                 writer.last_frame()
             );
         }
-        Stop::Other(reason) => {
+        Stop::Other(_) | Stop::TimeLimit => {
             s.summary.converged = false;
-            s.summary.reason = reason;
+            s.summary.reason = match stop {
+                Stop::Other(reason) => reason,
+                _ => format!(
+                    "no equilibrium after explicit.max_long_times = {} long times ({t:.6e} s); \
+                     residual {:.3e}",
+                    cf.max_long_times, s.summary.residual
+                ),
+            };
             s.summary.energy = Writer::energies(&pot, &state, &v);
             s.frame(writer, &pot, &state, &v, t)?;
         }

@@ -741,6 +741,7 @@ pub fn run(
             s.summary.wall_seconds = s.start.elapsed().as_secs_f64();
             s.summary.frames = writer.num_frames();
             s.summary.final_frame = writer.last_frame();
+            s.summary.refuse_non_finite();
             let _ = writer.summary(&s.summary);
             return Err(RunError::Output(e));
         }
@@ -755,6 +756,7 @@ pub fn run(
     t.other = (s.summary.wall_seconds
         - (n.assembly + n.factorisation + n.solve + n.line_search + t.diffusion + t.output))
         .max(0.0);
+    s.summary.refuse_non_finite();
     writer.summary(&s.summary)?;
     Ok(s.summary)
 }

@@ -392,3 +392,48 @@ fn malformed_files_are_named_errors_not_panics() {
     bad[off..off + 6].copy_from_slice(b"/wAAAA");
     check(&bad, "vtu", &["byte", "255 blocks"]);
 }
+
+/// `summary.json` never holds `null`: a summary with a non-finite number (a drag rate that
+/// overflowed) is refused, marked unconverged (exit 1) with an internal error naming the
+/// value, and written without it; a finite summary is left alone.
+#[test]
+fn a_summary_with_a_non_finite_number_is_refused() {
+    use shellsim::output::{summary_json, ExplicitReport, Summary};
+    let mut s = Summary {
+        converged: true,
+        explicit: Some(ExplicitReport {
+            damping_rate_dial: f64::INFINITY,
+            stable_prefactor: Some(f64::NAN),
+            ..Default::default()
+        }),
+        ..Default::default()
+    };
+    assert!(s.refuse_non_finite());
+    assert!(!s.converged);
+    assert!(s.reason.starts_with("internal error"), "{}", s.reason);
+    assert!(
+        s.reason.contains("explicit.damping_rate_dial"),
+        "{}",
+        s.reason
+    );
+    assert!(
+        s.reason.contains("explicit.stable_prefactor"),
+        "{}",
+        s.reason
+    );
+    let (text, left_out) = summary_json(&s);
+    assert_eq!(left_out.len(), 2, "{left_out:?}");
+    assert!(!text.contains("null"), "{text}");
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(v["converged"], false);
+    assert!(v["explicit"].get("damping_rate_dial").is_none());
+    let mut fine = Summary {
+        converged: true,
+        explicit: Some(ExplicitReport::default()),
+        ..Default::default()
+    };
+    assert!(!fine.refuse_non_finite());
+    assert!(fine.converged);
+    let (text, left_out) = summary_json(&fine);
+    assert!(left_out.is_empty() && !text.contains("null"), "{text}");
+}
