@@ -447,46 +447,52 @@ fn slides_squeeze_a_cone_and_bad_slides_are_named() {
     }
 }
 
-/// MorphoShell's GCM settings file (as in its repository, values by position) converts into a
-/// shellsim file that shellsim accepts, with the physics carried over; a file with too few
-/// entries, a non-numeric value or an entry out of order is exit 2 naming the line and entry.
+/// A settings file in MorphoShell's own format: its 23 entries in the order of its
+/// `read_settings.cpp`, with `//` comments on their own lines and after values, blank lines and
+/// uneven spacing.
+const MORPHOSHELL_SETTINGS: &str = "// Settings for a test run.
+
+// Frames per long time.
+outputs_per_char_long_time  = 400.0;
+
+// Negative: the mesh's ref_thicknesses.
+ref_thickness_if_uniform = 0.01;
+timestep_prefactor = 0.3;
+dialling_from_ansatz_rather_than_ref_state = true;
+dial_factors_to_hold_at_spacing = 0.5;
+dial_phase_time_prefactor = 0.25;
+
+time_between_equil_checks_prefactor = 0.01;
+damping_prefactor_1 = 4.0;
+damping_prefactor_2 = 6.0;
+num_steps_to_use_gradient_descent_dynamics_for_before_switching_to_newtonian_dynamics = 7;
+force_to_char_force_ratio_equil_threshold = 0.000001;
+speed_to_char_speed_ratio_equil_threshold = 0.00001;
+def_poisson_ratio = 0.5; // a decimal, not 1/2
+ref_shear_modulus_if_uniform = 1.0;
+ref_density = 1.0;
+bend_stiffening_scale_factor = 100000000000000000.0;
+patch_mat_dimless_conditioning_thresh = 10.0;
+slide_stiffness_prefactor = 0.0;
+slide_friction_coefficent = 0.0;
+slide_speed_prefactor = 0.0;
+using_initial_glass_slide_z_coords_from_settings_file = false;
+initial_upper_slide_z_coord = 12345.0;
+initial_lower_slide_z_coord = 12345.0;
+
+
+";
+
+/// A settings file in MorphoShell's order converts into a shellsim file that shellsim accepts,
+/// with the physics carried over (so does one in the gravity layout); a file with too few
+/// entries, a non-numeric value, a switch neither true nor false or an entry out of order is
+/// exit 2 naming the line and entry, with nothing written.
 #[test]
 fn import_morphoshell_settings() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let names = shellsim::morphoshell::ENTRIES;
-    let values = [
-        "400.0",
-        "true",
-        "10.0",
-        "0.01",
-        "0.5",
-        "1.0",
-        "1.0",
-        "0.25",
-        "0.01",
-        "4.0",
-        "6.0",
-        "0.3",
-        "0.5",
-        "0.000001",
-        "0.00001",
-        "100000000000000000.0",
-        "0.0",
-        "0.0",
-        "0.0",
-        "false",
-        "12345.0",
-        "12345.0",
-        "0.0",
-        "0",
-    ];
-    let text: String = names
-        .iter()
-        .zip(values)
-        .map(|(n, v)| format!("{n} = {v}; // comment\n"))
-        .collect();
-    write(d, "ms.txt", &format!("// MorphoShell settings\n\n{text}"));
+    let text = MORPHOSHELL_SETTINGS;
+    write(d, "ms.txt", text);
     shellsim(&["import-morphoshell", "ms.txt", "-o", "ms.toml"], d);
     let s = shellsim::settings::Settings::load(&d.join("ms.toml"), &[]).unwrap();
     assert_eq!(s.solver.mode, shellsim::settings::Mode::Explicit);
@@ -499,30 +505,87 @@ fn import_morphoshell_settings() {
         shellsim::settings::BendingModel::PatchFit
     );
     assert!((s.material.young - 3.0).abs() < 1e-15, "E = 2μ(1+ν)");
+    assert_eq!(s.material.thickness, 0.01);
+    assert!(!s.material.use_mesh_thickness && !s.material.use_mesh_shear_modulus);
     assert_eq!(s.explicit.time_step_prefactor, 0.3);
     assert_eq!(s.explicit.damping_prefactor_dial, 4.0);
     assert_eq!(s.explicit.damping_prefactor_wait, 6.0);
+    assert_eq!(s.explicit.gradient_descent_steps, 7);
     assert_eq!(s.explicit.dial_long_times, 0.5, "0.25 per phase, 2 phases");
     assert_eq!(s.dial.holds, vec![0.5]);
     assert_eq!(s.material.bend_stiffening, Some(1e17));
+    assert_eq!(s.dial.from, shellsim::settings::DialFrom::Start);
+    // A negative uniform value: per face from the mesh.
+    write(
+        d,
+        "mesh.txt",
+        &text.replace(
+            "ref_thickness_if_uniform = 0.01",
+            "ref_thickness_if_uniform = -1.0",
+        ),
+    );
+    shellsim(&["import-morphoshell", "mesh.txt", "-o", "mesh.toml"], d);
+    let s = shellsim::settings::Settings::load(&d.join("mesh.toml"), &[]).unwrap();
+    assert!(s.material.use_mesh_thickness && !s.material.use_mesh_shear_modulus);
+
+    // The gravity layout: 24 entries, its second entry the dialling switch.
+    let names = shellsim::morphoshell::GRAVITY_ENTRIES;
+    let value = |n: &str| match n {
+        "grav_field_strength" => "9.81".to_string(),
+        _ => text
+            .lines()
+            .find_map(|l| l.strip_prefix(n)?.trim().strip_prefix('='))
+            .map(|v| v.split(';').next().unwrap().trim().to_string())
+            .unwrap(),
+    };
+    let gravity: String = names
+        .iter()
+        .map(|n| format!("{n} = {};\n", value(n)))
+        .collect();
+    write(d, "grav.txt", &gravity);
+    shellsim(&["import-morphoshell", "grav.txt", "-o", "grav.toml"], d);
+    let s = shellsim::settings::Settings::load(&d.join("grav.toml"), &[]).unwrap();
+    assert_eq!(s.explicit.gradient_descent_steps, 7);
+    assert!((s.material.young - 3.0).abs() < 1e-15);
+    assert_eq!(
+        std::fs::read_to_string(d.join("grav.toml"))
+            .unwrap()
+            .matches("gravity = [0.0, 0.0, -9.81]")
+            .count(),
+        1
+    );
+
     // Bad files.
     let lines: Vec<&str> = text.lines().collect();
     for (bad, needle) in [
-        (
-            lines[..20].join("\n"),
-            "missing 'initial_upper_slide_z_coord'",
-        ),
+        (lines[..27].join("\n"), "missing 'initial_upper_slide_z_coord'"),
         (
             text.replace("ref_density = 1.0", "ref_density = one"),
-            ":9: ref_density = 'one' is not a number",
+            ":21: ref_density = 'one' is not a number",
+        ),
+        (
+            text.replace("= true;", "= 1;"),
+            ":9: dialling_from_ansatz_rather_than_ref_state = '1' is neither true nor false",
+        ),
+        (
+            text.replace("= 7;", "= 7.5;"),
+            ":16: num_steps_to_use_gradient_descent_dynamics_for_before_switching_to_newtonian_dynamics \
+             = '7.5' is not an integer",
         ),
         (
             text.replace("ref_density", "density"),
             "expects 'ref_density' here",
         ),
-        (format!("{text}extra = 1;\n"), "unknown entry 'extra'"),
+        (
+            format!("{text}grav_field_strength = 9.81;\n"),
+            "unknown entry 'grav_field_strength' after the 23",
+        ),
+        (
+            gravity.replace("grav_field_strength = 9.81;\n", ""),
+            "expects 'grav_field_strength' here",
+        ),
     ] {
-        write(d, "bad.txt", &format!("// MorphoShell settings\n\n{bad}"));
+        write(d, "bad.txt", &bad);
         let (code, err) = run(&["import-morphoshell", "bad.txt", "-o", "bad.toml"], d);
         assert_eq!(code, 2, "{err}");
         assert!(err.contains(needle), "{needle}: {err}");
