@@ -593,6 +593,127 @@ fn import_morphoshell_settings() {
     }
 }
 
+/// A flat 3 × 3-node square (8 triangles) written as MorphoShell's meshing scripts write a
+/// mesh: `%.15e` values, the per-face fields as one FIELD block, ā = I, b̄ = 0, and
+/// `ref_thicknesses` / `ref_shear_moduli` given per face.
+fn morphoshell_mesh(thickness: &[Real; 8], shear: &[Real; 8]) -> String {
+    let mut t = String::from(
+        "# vtk DataFile Version 2.0\nsquare\nASCII\nDATASET POLYDATA\nPOINTS 9 double\n",
+    );
+    for j in 0..3 {
+        for i in 0..3 {
+            t += &format!(
+                "{:.15e} {:.15e} {:.15e}\n",
+                i as Real * 0.5,
+                j as Real * 0.5,
+                0.0
+            );
+        }
+    }
+    t += "POLYGONS 8 32\n";
+    for j in 0..2 {
+        for i in 0..2 {
+            let v = 3 * j + i;
+            t += &format!("3 {} {} {}\n3 {} {} {}\n", v, v + 1, v + 4, v, v + 4, v + 3);
+        }
+    }
+    t += "CELL_DATA 8\nFIELD tri_quantities 5\nabar_info 3 8 double\n";
+    t += &"1.000000000000000e+00 0.000000000000000e+00 1.000000000000000e+00\n".repeat(8);
+    t += "bbar_info 3 8 double\n";
+    t += &"0.000000000000000e+00 0.000000000000000e+00 0.000000000000000e+00\n".repeat(8);
+    for (name, v) in [("ref_thicknesses", thickness), ("ref_shear_moduli", shear)] {
+        t += &format!("{name} 1 8 double\n");
+        for x in v {
+            t += &format!("{x:.15e}\n");
+        }
+    }
+    t += "tri_tags 1 8 int\n";
+    t += &"0\n".repeat(8);
+    t += "POINT_DATA 9\nFIELD node_quantities 2\nconstraint_indicators 1 9 int\n";
+    t += &"0\n".repeat(9);
+    t += "node_tags 1 9 int\n";
+    t += &"0\n".repeat(9);
+    t
+}
+
+/// MorphoShell's meshes carry −1234 in `ref_thicknesses` and `ref_shear_moduli` where its
+/// settings' uniform value is used: such a mesh runs with the uniform values (the settings
+/// `import-morphoshell` writes, or `use_mesh_* = false`), and a per-face value that would be
+/// used and is the placeholder, or not positive, is exit 2 naming the field and the face.
+#[test]
+fn morphoshell_mesh_placeholders() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let settings = MORPHOSHELL_SETTINGS.replace("= true;", "= false;");
+    write(d, "ms.txt", &settings);
+    shellsim(&["import-morphoshell", "ms.txt", "-o", "ms.toml"], d);
+    write(
+        d,
+        "placeholder.vtk",
+        &morphoshell_mesh(&[-1234.0; 8], &[-1234.0; 8]),
+    );
+    let static_run = |mesh: &str, out: &str, extra: &[&str]| {
+        let mut a = vec!["ms.toml", mesh, "--out", out, "-q"];
+        for s in ["solver.mode=\"static\"", "material.bending=\"midedge_sin\""] {
+            a.extend_from_slice(&["--set", s]);
+        }
+        a.extend_from_slice(extra);
+        run(&a, d)
+    };
+    let (code, err) = static_run("placeholder.vtk", "ok", &[]);
+    assert_eq!(code, 0, "{err}");
+    let thickness = |out: &str| {
+        final_frame(&d.join(out)).face_fields["thickness"]
+            .data
+            .clone()
+    };
+    // Frames write the thickness in Float32.
+    let near = |h: &[Real], want: Real| h.len() == 8 && h.iter().all(|x| (x - want).abs() < 1e-8);
+    assert!(near(&thickness("ok"), 0.01), "{:?}", thickness("ok"));
+
+    // The per-face values used: the placeholder, or a value that is not positive, is named.
+    let mut thick = [0.02; 8];
+    thick[5] = 0.0;
+    write(d, "mixed.vtk", &morphoshell_mesh(&thick, &[-1234.0; 8]));
+    for (mesh, key, needle) in [
+        (
+            "placeholder.vtk",
+            "material.use_mesh_thickness=true",
+            "'ref_thicknesses' must lie in (0, 1e30], but face 0 has -1.234e3 (MorphoShell's \
+             placeholder",
+        ),
+        (
+            "placeholder.vtk",
+            "material.use_mesh_shear_modulus=true",
+            "'ref_shear_moduli' must lie in (0, 1e15], but face 0 has -1.234e3 (MorphoShell's \
+             placeholder for the settings' uniform value; to use one, set \
+             material.use_mesh_shear_modulus = false)",
+        ),
+        (
+            "mixed.vtk",
+            "material.use_mesh_thickness=true",
+            "'ref_thicknesses' must lie in (0, 1e30], but face 5 has 0e0",
+        ),
+    ] {
+        let (code, err) = static_run(mesh, "bad", &["--set", key]);
+        assert_eq!(code, 2, "{key}: {err}");
+        assert!(
+            err.contains(mesh) && err.contains(needle),
+            "{needle}: {err}"
+        );
+        assert!(!d.join("bad").exists(), "nothing written");
+    }
+    // The per-face thicknesses are used where valid.
+    write(d, "thick.vtk", &morphoshell_mesh(&[0.02; 8], &[-1234.0; 8]));
+    let (code, err) = static_run(
+        "thick.vtk",
+        "thick",
+        &["--set", "material.use_mesh_thickness=true"],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(near(&thickness("thick"), 0.02), "{:?}", thickness("thick"));
+}
+
 /// The column `name` of a run's `log.csv` (one row per frame).
 fn log_column(out: &Path, name: &str) -> Vec<Real> {
     let text = std::fs::read_to_string(out.join("log.csv")).unwrap();
