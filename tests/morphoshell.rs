@@ -814,6 +814,13 @@ fn write_ansatz(path: &Path, dial: &str, x: &[Vec3], faces: &[[usize; 3]]) {
     for f in faces {
         t += &format!("3 {} {} {}\n", f[0], f[1], f[2]);
     }
+    // Then its face and vertex data (not read back).
+    t += &format!("CELL_DATA {}\n", faces.len());
+    t += &format!(
+        "POINT_DATA {}\nSCALARS angleDeficit double 1\nLOOKUP_TABLE default\n",
+        x.len()
+    );
+    t += &format!("{:.14e}\n", 0.0).repeat(x.len());
     std::fs::write(path, t).unwrap();
 }
 
@@ -918,6 +925,42 @@ fn morphoshell_ansatz_files() {
         "coord.vtk",
         &format!("{head}dial_factor = 0.5, stepcount = 1\nASCII\nDATASET POLYDATA\nPOINTS {n} double\n0 0 zero\n"),
         "coord.vtk:6",
+    );
+    // Files cut short: inside the last coordinate (no final newline), after the points, among
+    // the polygons; and a coordinate too many.
+    write_ansatz(&d.join("whole.vtk"), "0.5", &half.positions, &half.faces);
+    let whole = std::fs::read_to_string(d.join("whole.vtk")).unwrap();
+    let poly = whole.find("POLYGONS").unwrap();
+    // Up to the first digit of the last coordinate (5.0e-03 cut to 5).
+    let start = whole[..poly - 1].rfind(' ').unwrap() + 1;
+    let last_coordinate = start + whole[start..].find(|c: char| c.is_ascii_digit()).unwrap() + 1;
+    let point_lines = whole[..poly].lines().count();
+    bad(
+        "cut.vtk",
+        &whole[..last_coordinate],
+        &format!(
+            "cut.vtk:{point_lines}: the file ends inside the number '{}', without a final newline",
+            &whole[last_coordinate - 1..last_coordinate]
+        ),
+    );
+    bad(
+        "nopoly.vtk",
+        &whole[..poly],
+        &format!("the file ends after the {n} points, without the POLYGONS block"),
+    );
+    let third = poly + whole[poly..].match_indices('\n').nth(3).unwrap().0 + 1;
+    bad(
+        "halfpoly.vtk",
+        &whole[..third],
+        &format!("the file ends after 3 of the {} polygons", half.faces.len()),
+    );
+    bad(
+        "extra.vtk",
+        &whole.replacen("\nPOLYGONS", " 0\nPOLYGONS", 1),
+        &format!(
+            "extra.vtk:{point_lines}: '0' is more than the {} point coordinates",
+            3 * n
+        ),
     );
     bad(
         "short.vtk",
