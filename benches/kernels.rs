@@ -601,8 +601,7 @@ fn explicit_step(c: &mut Criterion) {
 }
 
 /// Writing one frame of a ~100k-face sheet (the benchmark square on the unit sphere, every
-/// field a run writes, in double): shellsim's writer in its variants against the writer it
-/// replaced (vtkio's XML writer: inline base64, uncompressed Float64). Prints bytes per face of
+/// field a run writes, in double): shellsim's writer in its variants. Prints bytes per face of
 /// each. Report: ms per frame and bytes per face.
 fn frame_write(c: &mut Criterion) {
     use shellsim::mesh::io::{mesh_to_bytes_with, Format};
@@ -623,7 +622,8 @@ fn frame_write(c: &mut Criterion) {
     let sc2 = Scene::build(sc.mesh.clone(), s2).unwrap();
     let mut w = shellsim::output::Writer::new(dir.path(), &sc2, true).unwrap();
     let pot2 = Potential::new(&sc2, &p);
-    w.frame(&pot2, &state, &v, Default::default()).unwrap();
+    w.frame(&pot2, &state, &v, Default::default(), None::<&()>)
+        .unwrap();
     let frame = shellsim::mesh::io::read_mesh(&dir.path().join("frame_00000.vtu")).unwrap();
     let nf = frame.faces.len();
     let restart = ["velocity", "edge_angles", "displacement"];
@@ -678,65 +678,7 @@ fn frame_write(c: &mut Criterion) {
             b.iter(|| black_box(mesh_to_bytes_with(&frame, Format::Vtu, "", &o, &f)))
         });
     }
-    let old = || vtkio_inline_base64(&frame);
-    eprintln!(
-        "vtkio_base64_double (before): {:.1} bytes/face",
-        old().len() as f64 / nf as f64
-    );
-    let _ = std::fs::write(out.join("vtkio_base64_double_before.vtu"), old());
-    g.bench_function("vtkio_base64_double_before", |b| {
-        b.iter(|| black_box(old()))
-    });
     let _ = pot;
-}
-
-/// The frame writer shellsim had before its own: vtkio's XML writer, inline base64, Float64.
-fn vtkio_inline_base64(mesh: &shellsim::mesh::Mesh) -> Vec<u8> {
-    use vtkio::model::*;
-    let attrs = |f: &std::collections::BTreeMap<String, shellsim::mesh::Field>| {
-        f.iter()
-            .map(|(name, fl)| {
-                Attribute::DataArray(DataArray {
-                    name: name.clone(),
-                    elem: ElementType::Generic(fl.components as u32),
-                    data: IOBuffer::F64(fl.data.clone()),
-                })
-            })
-            .collect()
-    };
-    let piece = UnstructuredGridPiece {
-        points: IOBuffer::F64(
-            mesh.positions
-                .iter()
-                .flat_map(|p| [p.x, p.y, p.z])
-                .collect(),
-        ),
-        cells: Cells {
-            cell_verts: VertexNumbers::XML {
-                connectivity: mesh
-                    .faces
-                    .iter()
-                    .flat_map(|f| f.map(|v| v as u64))
-                    .collect(),
-                offsets: (1..=mesh.faces.len() as u64).map(|i| 3 * i).collect(),
-            },
-            types: vec![CellType::Triangle; mesh.faces.len()],
-        },
-        data: Attributes {
-            point: attrs(&mesh.vertex_fields),
-            cell: attrs(&mesh.face_fields),
-        },
-    };
-    let vtk = Vtk {
-        version: Version::new_xml(1, 0),
-        title: String::new(),
-        byte_order: ByteOrder::BigEndian,
-        file_path: None,
-        data: DataSet::inline(piece),
-    };
-    let mut out = Vec::new();
-    vtk.write_xml(&mut out).unwrap();
-    out
 }
 
 criterion_group!(

@@ -8,7 +8,9 @@ use crate::cases::{curvature_error, shape_error, Case};
 use crate::integrate::{run, Progress, Quiet};
 use crate::math::{Real, Vec3};
 use crate::mesh::delaunay::{delaunay_annulus, delaunay_rectangle};
-use crate::mesh::generate::{annulus, rectangle, Spacing};
+use crate::mesh::generate::{
+    annulus, annulus_faces, check_planned, rectangle, rectangle_faces, Spacing,
+};
 use crate::mesh::io::{read_mesh, write_mesh, Format};
 use crate::mesh::Topology;
 use crate::output::Writer;
@@ -837,14 +839,26 @@ fn mesh_cmd(a: MeshArgs) -> Result<()> {
                     (a.lx, a.ly)
                 }
             };
+            let sides = match a.shape {
+                Shape::Square => "--edge and --size",
+                _ => "--edge, --lx and --ly",
+            };
             if a.delaunay {
+                let (faces, grid) =
+                    crate::mesh::delaunay::delaunay_planned(lx * ly, lx, ly, a.edge);
+                check_planned(faces, "faces", sides).map_err(|e| anyhow!(e))?;
+                check_planned(grid, "cells of the point grid", sides).map_err(|e| anyhow!(e))?;
                 delaunay_rectangle(-0.5 * lx, -0.5 * ly, lx, ly, a.edge, sp)
             } else {
+                check_planned(rectangle_faces(lx, ly, a.edge), "faces", sides)
+                    .map_err(|e| anyhow!(e))?;
                 rectangle(-0.5 * lx, -0.5 * ly, lx, ly, a.edge, sp)
             }
         }
         Shape::Disk => {
             pos("radius", a.radius)?;
+            let faces = annulus_faces(0.0, a.radius, 2.0 * std::f64::consts::PI, a.edge);
+            check_planned(faces, "faces", "--edge and --radius").map_err(|e| anyhow!(e))?;
             annulus(0.0, a.radius, 2.0 * std::f64::consts::PI, a.edge, sp)
         }
         Shape::Annulus => {
@@ -859,6 +873,18 @@ fn mesh_cmd(a: MeshArgs) -> Result<()> {
                 );
             }
             let sweep = a.sweep.min(360.0).to_radians();
+            let args = "--edge, --radius and --inner";
+            if a.delaunay {
+                let area = 0.5 * sweep * (a.radius * a.radius - a.inner * a.inner);
+                let box_side = 2.0 * a.radius;
+                let (faces, grid) =
+                    crate::mesh::delaunay::delaunay_planned(area, box_side, box_side, a.edge);
+                check_planned(faces, "faces", args).map_err(|e| anyhow!(e))?;
+                check_planned(grid, "cells of the point grid", args).map_err(|e| anyhow!(e))?;
+            } else {
+                let faces = annulus_faces(a.inner, a.radius, sweep, a.edge);
+                check_planned(faces, "faces", args).map_err(|e| anyhow!(e))?;
+            }
             if a.delaunay {
                 delaunay_annulus(a.inner, a.radius, sweep, a.edge, sp)
             } else {
@@ -891,6 +917,8 @@ fn mesh_cmd(a: MeshArgs) -> Result<()> {
             if a.edge > a.tube {
                 bail!("--edge ({}) must not exceed --tube ({})", a.edge, a.tube);
             }
+            let faces = crate::mesh::surfaces::torus_faces(a.radius, a.tube, a.edge);
+            check_planned(faces, "faces", "--edge, --radius and --tube").map_err(|e| anyhow!(e))?;
             crate::mesh::surfaces::torus(a.radius, a.tube, a.edge)
         }
     };

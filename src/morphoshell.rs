@@ -1,24 +1,29 @@
 //! MorphoShell's settings files (`name = value;` statements, `//` comments), converted into a
 //! shellsim settings file with the same physics.
 //!
-//! MorphoShell reads its settings by position: the n-th statement must carry the n-th name of
-//! [`ENTRIES`], and every one must be there. The importer keeps that rule and names the line and
-//! the entry expected when it is broken, when a value is not a number (or `true`/`false`), or
-//! when there are too few or too many entries.
+//! MorphoShell reads its settings by position (its `read_settings.cpp`): after the comments
+//! (`//` to the end of the line) and all white space are removed, the n-th statement must carry
+//! the n-th name of [`ENTRIES`], and all 23 must be there. The two switches are `true` or
+//! `false`, the gradient-descent step count an integer, the rest numbers. The importer keeps
+//! those rules and names the line and the entry expected when one is broken, and refuses
+//! entries after the last (MorphoShell would ignore them). It also reads the gravity layout
+//! ([`GRAVITY_ENTRIES`], 24 entries with `grav_field_strength`), which its second entry tells
+//! apart.
 //!
 //! The translation (MorphoShell's meaning → shellsim's key):
 //! * its stretching convention (strain `a − ā`, 4× the Koiter energy) and its patch fit:
 //!   `material.stretch_convention = "morphoshell"`, `material.bending = "patch_fit"`;
-//! * μ per face (`ref_shear_modulus_if_uniform`, or the mesh's `ref_shear_moduli` when it is
-//!   negative): `material.young = 2μ(1+ν)`, `use_mesh_shear_modulus`; the same for the
-//!   thickness;
+//! * μ per face (`ref_shear_modulus_if_uniform` when positive; zero or negative means the
+//!   mesh's `ref_shear_moduli`, as in MorphoShell): `material.young = 2μ(1+ν)`,
+//!   `use_mesh_shear_modulus`; the same for the thickness. With the uniform value, the mesh's
+//!   per-face field is ignored (MorphoShell's meshes carry the placeholder −1234 there);
 //! * its dynamics and their prefactors: `solver.mode = "explicit"`, `[explicit]`; each dial
 //!   phase between holds lasts `dial_phase_time_prefactor` long times, so
 //!   `dial_long_times = prefactor / spacing`, and the holds are the multiples of the spacing
 //!   below 1;
 //! * its equilibrium thresholds (kept in `[explicit]`; the test used stays shellsim's, which
 //!   cannot fire early; `explicit.equilibrium = "morphoshell"` reproduces MorphoShell's stop);
-//! * bend stiffening γ, gravity, the glass slides (`slide_speed_prefactor` × L / T_bend, with L
+//! * bend stiffening γ, gravity (gravity layout), the glass slides (`slide_speed_prefactor` × L / T_bend, with L
 //!   the reference perimeter and T_bend the bending long time, needs the mesh: given, the speed
 //!   is computed; without it, a nonzero prefactor is an error that says so);
 //! * `dialling_from_ansatz_rather_than_ref_state`: `dial.from = "start"`, with the ansatz given
@@ -28,8 +33,37 @@
 use crate::math::Real;
 use anyhow::{bail, Result};
 
-/// MorphoShell's entries in the order its reader expects them.
-pub const ENTRIES: [&str; 24] = [
+/// MorphoShell's 23 entries, in the order its `read_settings.cpp` reads them.
+pub const ENTRIES: [&str; 23] = [
+    "outputs_per_char_long_time",
+    "ref_thickness_if_uniform",
+    "timestep_prefactor",
+    "dialling_from_ansatz_rather_than_ref_state",
+    "dial_factors_to_hold_at_spacing",
+    "dial_phase_time_prefactor",
+    "time_between_equil_checks_prefactor",
+    "damping_prefactor_1",
+    "damping_prefactor_2",
+    "num_steps_to_use_gradient_descent_dynamics_for_before_switching_to_newtonian_dynamics",
+    "force_to_char_force_ratio_equil_threshold",
+    "speed_to_char_speed_ratio_equil_threshold",
+    "def_poisson_ratio",
+    "ref_shear_modulus_if_uniform",
+    "ref_density",
+    "bend_stiffening_scale_factor",
+    "patch_mat_dimless_conditioning_thresh",
+    "slide_stiffness_prefactor",
+    "slide_friction_coefficent",
+    "slide_speed_prefactor",
+    "using_initial_glass_slide_z_coords_from_settings_file",
+    "initial_upper_slide_z_coord",
+    "initial_lower_slide_z_coord",
+];
+
+/// The gravity layout: MorphoShell's entries and `grav_field_strength`, 24 in this order. Its
+/// second entry differs from MorphoShell's, so a file is read in this layout exactly when its
+/// second entry is `dialling_from_ansatz_rather_than_ref_state`.
+pub const GRAVITY_ENTRIES: [&str; 24] = [
     "outputs_per_char_long_time",
     "dialling_from_ansatz_rather_than_ref_state",
     "patch_mat_dimless_conditioning_thresh",
@@ -56,8 +90,15 @@ pub const ENTRIES: [&str; 24] = [
     "num_steps_to_use_gradient_descent_dynamics_for_before_switching_to_newtonian_dynamics",
 ];
 
-/// The number of entries MorphoShell's reader requires.
-pub const REQUIRED: usize = 24;
+/// The entries MorphoShell reads as `true` or `false` (any other value is its error too).
+const BOOLEANS: [&str; 2] = [
+    "dialling_from_ansatz_rather_than_ref_state",
+    "using_initial_glass_slide_z_coords_from_settings_file",
+];
+
+/// The entry MorphoShell reads as an integer.
+const INTEGER: &str =
+    "num_steps_to_use_gradient_descent_dynamics_for_before_switching_to_newtonian_dynamics";
 
 /// One statement: its line (1-based), name and value.
 #[derive(Clone, Debug)]
@@ -117,14 +158,45 @@ impl MorphoSettings {
     }
 }
 
-/// Parses a MorphoShell settings file's text (`file` names it in messages).
+/// The value of entry `name` written as `value`, typed as MorphoShell reads it.
+fn value(name: &str, value: &str, at: &str) -> Result<Real> {
+    let v = if BOOLEANS.contains(&name) {
+        match value {
+            "true" => 1.0,
+            "false" => 0.0,
+            other => bail!("{at}: {name} = '{other}' is neither true nor false"),
+        }
+    } else if name == INTEGER {
+        value
+            .parse::<i64>()
+            .map_err(|_| anyhow::anyhow!("{at}: {name} = '{value}' is not an integer"))?
+            as Real
+    } else {
+        value
+            .parse::<Real>()
+            .map_err(|_| anyhow::anyhow!("{at}: {name} = '{value}' is not a number"))?
+    };
+    if !v.is_finite() {
+        bail!("{at}: {name} = {value} is not finite");
+    }
+    Ok(v)
+}
+
+/// Parses a MorphoShell settings file's text (`file` names it in messages): MorphoShell's 23
+/// entries ([`ENTRIES`]), or the 24 of the gravity layout ([`GRAVITY_ENTRIES`]) when the second
+/// entry is that layout's.
 pub fn parse(text: &str, file: &str) -> Result<MorphoSettings> {
     let st = statements(text, file)?;
+    let layout: &[&str] = match st.get(1) {
+        Some(s) if s.name == GRAVITY_ENTRIES[1] => &GRAVITY_ENTRIES,
+        _ => &ENTRIES,
+    };
+    let required = layout.len();
     let mut values = Vec::new();
     for (k, s) in st.iter().enumerate() {
-        let Some(&expected) = ENTRIES.get(k) else {
+        let Some(&expected) = layout.get(k) else {
             bail!(
-                "{file}:{}: unknown entry '{}' after the {REQUIRED} that MorphoShell reads",
+                "{file}:{}: unknown entry '{}' after the {required} that MorphoShell reads",
                 s.line,
                 s.name
             );
@@ -138,24 +210,15 @@ pub fn parse(text: &str, file: &str) -> Result<MorphoSettings> {
                 s.name
             );
         }
-        let v = match s.value.as_str() {
-            "true" => 1.0,
-            "false" => 0.0,
-            other => other.parse::<Real>().map_err(|_| {
-                anyhow::anyhow!("{file}:{}: {expected} = '{other}' is not a number", s.line)
-            })?,
-        };
-        if !v.is_finite() {
-            bail!("{file}:{}: {expected} = {v} is not finite", s.line);
-        }
+        let v = value(expected, &s.value, &format!("{file}:{}", s.line))?;
         values.push((expected.to_string(), v));
     }
-    if st.len() < REQUIRED {
+    if st.len() < required {
         let last = st.last().map_or(0, |s| s.line);
         bail!(
-            "{file}: {} entries, but MorphoShell needs {REQUIRED}: missing '{}' (after line {last})",
+            "{file}: {} entries, but MorphoShell needs {required}: missing '{}' (after line {last})",
             st.len(),
-            ENTRIES[st.len()]
+            layout[st.len()]
         );
     }
     Ok(MorphoSettings { values })

@@ -270,9 +270,12 @@ fn series_time(path: &Path) -> Option<Result<Real, String>> {
 
 /// A MorphoShell ansatz file: legacy ASCII VTK whose title line reads
 /// `dial_factor = <s>[, stepcount = <n>]`, as MorphoShell writes its frames and reads its
-/// ansatz files (only that title and the `POINTS` block are read; what follows is ignored, as in
-/// MorphoShell). Returns `None` when `path` is not one (any other frame), else the dial factor
-/// and the positions; errors name the file and line.
+/// ansatz files. The title and the `POINTS` block are read (exactly 3 × the count of
+/// coordinates); the `POLYGONS` block MorphoShell writes next must be there and complete, and
+/// the file must end with a newline, as MorphoShell's writer ends it: a file cut short is an
+/// error, not a shape with a cut coordinate. The face and vertex data after the polygons are
+/// ignored, as in MorphoShell. Returns `None` when `path` is not one (any other frame), else the
+/// dial factor and the positions; errors name the file and line.
 pub fn read_ansatz(path: &Path, vertices: usize) -> Result<Option<(Real, Vec<Vec3>)>, MeshError> {
     let name = path.display().to_string();
     let bad = |line: usize, reason: String| MeshError::Invalid {
@@ -359,6 +362,15 @@ pub fn read_ansatz(path: &Path, vertices: usize) -> Result<Option<(Real, Vec<Vec
             format!("{n} points; the mesh has {vertices} vertices (the ansatz must be of the same mesh)"),
         ));
     }
+    // MorphoShell writes every line with its newline: a file ending inside a number was cut.
+    crate::mesh::ends_mid_number(&bytes).map_err(|e| {
+        let (l, reason) = e
+            .strip_prefix("line ")
+            .and_then(|r| r.split_once(": "))
+            .and_then(|(l, r)| Some((l.parse().ok()?, r.to_string())))
+            .unwrap_or((0, e.clone()));
+        bad(l, reason)
+    })?;
     let mut coords = Vec::with_capacity(3 * n);
     let mut line = at + 1;
     while coords.len() < 3 * n {
@@ -374,7 +386,10 @@ pub fn read_ansatz(path: &Path, vertices: usize) -> Result<Option<(Real, Vec<Vec
         };
         for tok in l.split_whitespace() {
             if coords.len() == 3 * n {
-                break;
+                return Err(bad(
+                    line + 1,
+                    format!("'{tok}' is more than the {} point coordinates", 3 * n),
+                ));
             }
             let v: Real = tok
                 .parse()
@@ -392,6 +407,7 @@ pub fn read_ansatz(path: &Path, vertices: usize) -> Result<Option<(Real, Vec<Vec
         }
         line += 1;
     }
+    ansatz_polygons(&all, line, n).map_err(|(l, reason)| bad(l, reason))?;
     Ok(Some((
         dial,
         coords
@@ -399,4 +415,64 @@ pub fn read_ansatz(path: &Path, vertices: usize) -> Result<Option<(Real, Vec<Vec
             .map(|c| Vec3::new(c[0], c[1], c[2]))
             .collect(),
     )))
+}
+
+/// Checks what follows an ansatz file's points, from line index `from` of `lines`: MorphoShell
+/// writes `POLYGONS <faces> <4 × faces>` and one `3 i j k` line per face (indices below
+/// `points`) next, then the face and vertex data, which are not read. A file that ends before
+/// the polygons are complete was cut short. Errors carry the line (1-based).
+fn ansatz_polygons(lines: &[&str], from: usize, points: usize) -> Result<(), (usize, String)> {
+    let cut = |l: usize, what: String| {
+        (
+            l,
+            format!("the file ends {what}, where MorphoShell writes more: it is cut short"),
+        )
+    };
+    let Some(at) = (from..lines.len()).find(|&i| !lines[i].trim().is_empty()) else {
+        return Err(cut(
+            lines.len(),
+            format!("after the {points} points, without the POLYGONS block"),
+        ));
+    };
+    let head: Vec<&str> = lines[at].split_whitespace().collect();
+    let counts = match head[..] {
+        ["POLYGONS", f, size] => f
+            .parse::<usize>()
+            .ok()
+            .zip(size.parse::<usize>().ok())
+            .filter(|&(f, size)| f.checked_mul(4) == Some(size)),
+        _ => None,
+    };
+    let Some((faces, _)) = counts else {
+        return Err((
+            at + 1,
+            format!(
+                "after the {points} points, expected 'POLYGONS <faces> <4 × faces>' (triangles), \
+                 found '{}'",
+                lines[at].trim()
+            ),
+        ));
+    };
+    for k in 0..faces {
+        let l = at + 1 + k;
+        let Some(text) = lines.get(l) else {
+            return Err(cut(l, format!("after {k} of the {faces} polygons")));
+        };
+        let ok = match text.split_whitespace().collect::<Vec<_>>()[..] {
+            ["3", a, b, c] => [a, b, c]
+                .iter()
+                .all(|i| i.parse::<usize>().is_ok_and(|i| i < points)),
+            _ => false,
+        };
+        if !ok {
+            return Err((
+                l + 1,
+                format!(
+                    "polygon {k} is '{}', not '3 i j k' with indices below {points}",
+                    text.trim()
+                ),
+            ));
+        }
+    }
+    Ok(())
 }

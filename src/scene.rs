@@ -61,13 +61,32 @@ pub struct Scene {
     pub prescribed: Vec<(usize, Vec3)>,
 }
 
-fn positive_face_field(mesh: &Mesh, name: &str, max: Real) -> Result<Option<Vec<Real>>, MeshError> {
+/// The per-face field `name`, checked to lie in (0, `max`] (an error naming the face), when
+/// `used` (the settings `key` says so); `None` when not used or absent. An unused field is not read, so MorphoShell's
+/// placeholder −1234 (written when its settings' uniform value is used) does no harm there.
+fn positive_face_field(
+    mesh: &Mesh,
+    name: &str,
+    max: Real,
+    (key, used): (&str, bool),
+) -> Result<Option<Vec<Real>>, MeshError> {
+    if !used {
+        return Ok(None);
+    }
     let Some(f) = mesh.face_field(name, 1)? else {
         return Ok(None);
     };
     if let Some(i) = f.data.iter().position(|&v| !(v > 0.0 && v <= max)) {
+        let placeholder = if f.data[i] == -1234.0 {
+            format!(
+                " (MorphoShell's placeholder for the settings' uniform value; to use one, set \
+                 material.{key} = false)"
+            )
+        } else {
+            String::new()
+        };
         return Err(mesh.invalid(format!(
-            "face field '{name}' must lie in (0, {max:e}], but face {i} has {:e}",
+            "face field '{name}' must lie in (0, {max:e}], but face {i} has {:e}{placeholder}",
             f.data[i]
         )));
     }
@@ -105,16 +124,17 @@ impl Scene {
                 unused[0]
             ));
         }
+        warnings.extend(mesh.unknown_field_warnings());
         let nf = mesh.faces.len();
         let nv = mesh.positions.len();
         let m = &settings.material;
-        let thickness = match (
-            m.use_mesh_thickness,
-            positive_face_field(&mesh, "ref_thicknesses", crate::mesh::MAX_COORDINATE)?,
-        ) {
-            (true, Some(t)) => t,
-            _ => vec![m.thickness; nf],
-        };
+        let thickness = positive_face_field(
+            &mesh,
+            "ref_thicknesses",
+            crate::mesh::MAX_COORDINATE,
+            ("use_mesh_thickness", m.use_mesh_thickness),
+        )?
+        .unwrap_or_else(|| vec![m.thickness; nf]);
         // A shell is thin: a thickness beyond 10× the sheet's size is no shell (and overflows).
         let size = mesh.bbox_diagonal();
         if let Some(f) = thickness.iter().position(|&h| h > 10.0 * size) {
@@ -124,12 +144,14 @@ impl Scene {
                 thickness[f]
             )));
         }
-        let young = match (
-            m.use_mesh_shear_modulus,
-            positive_face_field(&mesh, "ref_shear_moduli", crate::settings::MAX_MODULUS)?,
-        ) {
-            (true, Some(mu)) => mu.iter().map(|mu| 2.0 * mu * (1.0 + m.poisson)).collect(),
-            _ => vec![m.young; nf],
+        let young = match positive_face_field(
+            &mesh,
+            "ref_shear_moduli",
+            crate::settings::MAX_MODULUS,
+            ("use_mesh_shear_modulus", m.use_mesh_shear_modulus),
+        )? {
+            Some(mu) => mu.iter().map(|mu| 2.0 * mu * (1.0 + m.poisson)).collect(),
+            None => vec![m.young; nf],
         };
         let lame = young
             .iter()

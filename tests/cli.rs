@@ -1850,3 +1850,138 @@ fn frames_keep_the_input_corner_order() {
     );
     assert_eq!(r.code, 0, "{}", r.stderr);
 }
+
+/// `shellsim mesh` with arguments that would make an impossible mesh (a tiny, zero, negative,
+/// NaN or infinite edge, a huge shape, a count beyond the 10⁷-face bound) is exit 2 naming the
+/// argument, for every shape, planar and Delaunay: never a panic or an abort on allocation, and
+/// nothing written.
+#[test]
+fn mesh_arguments_beyond_the_bound_are_refused() {
+    let d = tmp();
+    let p = d.path();
+    let shapes: &[(&str, &[&str], &str)] = &[
+        ("square", &[], "--size"),
+        ("square", &["--delaunay"], "--size"),
+        ("rectangle", &[], "--lx"),
+        ("rectangle", &["--delaunay"], "--lx"),
+        ("disk", &[], "--radius"),
+        ("annulus", &[], "--radius"),
+        ("annulus", &["--delaunay"], "--radius"),
+        ("annulus", &["--delaunay", "--sweep", "90"], "--radius"),
+        ("sphere", &[], "--radius"),
+        ("capsule", &[], "--radius"),
+        ("peanut", &[], "--radius"),
+        ("teddy", &[], "--radius"),
+        ("torus", &[], "--radius"),
+    ];
+    for &(shape, extra, size) in shapes {
+        let cases: Vec<(Vec<&str>, &str)> = vec![
+            (vec!["--edge", "1e-300"], "--edge"),
+            (vec!["--edge", "1e-5"], "more than the 1e7"),
+            (vec!["--edge", "0"], "--edge"),
+            (vec!["--edge", "-1"], "--edge"),
+            (vec!["--edge", "NaN"], "--edge"),
+            (vec!["--edge", "inf"], "--edge"),
+            (vec!["--edge", "0.1", size, "1e300"], size),
+            (vec!["--edge", "0.1", size, "1e12"], size),
+            (vec!["--edge", "0.1", size, "inf"], size),
+        ];
+        for (args, needle) in cases {
+            let mut a = vec!["mesh", shape, "-o", "m.vtk"];
+            a.extend_from_slice(extra);
+            a.extend_from_slice(&args);
+            let r = run(&a, p);
+            let what = format!("{}: {}", a.join(" "), r.stderr);
+            assert_eq!(r.code, 2, "{what}");
+            assert!(r.stderr.contains(needle), "{needle} not named: {what}");
+            assert!(!r.stderr.contains("panicked"), "{what}");
+            assert!(!p.join("m.vtk").exists(), "written: {what}");
+        }
+    }
+    // The bound's message gives the count.
+    let r = run(&["mesh", "square", "--edge", "1e-300", "-o", "m.vtk"], p);
+    assert!(
+        r.stderr.contains(
+            "--edge and --size would make uncountably many (beyond floating point) faces"
+        ),
+        "{}",
+        r.stderr
+    );
+    let r = run(&["mesh", "square", "--edge", "1e-5", "-o", "m.vtk"], p);
+    assert!(
+        r.stderr
+            .contains("--edge and --size would make about 2.000e10 faces, more than the 1e7"),
+        "{}",
+        r.stderr
+    );
+}
+
+/// A mesh field shellsim does not read (a misspelt name) is warned about, one line per field,
+/// naming it and the fields that are read; the run goes on. The fields of shellsim's own frames
+/// are not warned about, whether a frame is the mesh or the restart.
+#[test]
+fn unknown_mesh_fields_warn() {
+    let d = tmp();
+    let p = d.path();
+    let text = TWO_TRIANGLES
+        .replace("FIELD FieldData 5", "FIELD FieldData 6")
+        .replace(
+            "tri_tags 1 2 int\n0 1\n",
+            "tri_tags 1 2 int\n0 1\nref_thicknes 1 2 double\n0.1 0.1\n",
+        )
+        .replace("FIELD FieldData 2\n", "FIELD FieldData 3\n")
+        .replace(
+            "node_tags 1 4 int\n0 0 1 1\n",
+            "node_tags 1 4 int\n0 0 1 1\nconstraint_indicator 1 4 int\n1 1 0 0\n",
+        );
+    write(p, "m.vtk", &text);
+    write(
+        p,
+        "s.toml",
+        &format!("{STATIC}[output]\nmorphoshell_fields = true\n"),
+    );
+    let r = run(&["s.toml", "m.vtk", "--out", "o", "-q"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let lines: Vec<&str> = r
+        .stderr
+        .lines()
+        .filter(|l| l.contains("is not one shellsim reads"))
+        .collect();
+    assert_eq!(lines.len(), 2, "{}", r.stderr);
+    assert!(
+        lines[0].starts_with("warning: m.vtk: face field 'ref_thicknes'")
+            && lines[0].contains("ref_thicknesses, ref_shear_moduli"),
+        "{}",
+        lines[0]
+    );
+    assert!(
+        lines[1].starts_with("warning: m.vtk: vertex field 'constraint_indicator'")
+            && lines[1].contains("constraint_indicators, node_tags"),
+        "{}",
+        lines[1]
+    );
+    // A frame as the mesh, and as the restart (static and dynamic frames).
+    let frame = final_frame(p, "o");
+    write(p, "plain.toml", "[solver]\nmode = \"static\"\n");
+    let r = run(&["plain.toml", &frame, "--out", "f", "-q"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(!r.stderr.contains("warning"), "{}", r.stderr);
+    write(p, "dyn.toml", "[solver]\nmode = \"dynamic\"\n[time]\nend = 0.001\ndt = 0.001\n[output]\nmorphoshell_fields = true\n");
+    let r = run(&["dyn.toml", "m.vtk", "--out", "g", "-q"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let frame = final_frame(p, "g");
+    for args in [
+        vec!["dyn.toml", &frame, "--out", "h", "-q"],
+        vec!["dyn.toml", "m.vtk", "--out", "i", "-q", "--restart", &frame],
+    ] {
+        let r = run(&args, p);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        let unknown = r
+            .stderr
+            .lines()
+            .filter(|l| l.contains("is not one shellsim reads"));
+        // The restart's mesh is m.vtk, whose two fields warn as before; the frame adds none.
+        let expected = if args.contains(&"--restart") { 2 } else { 0 };
+        assert_eq!(unknown.count(), expected, "{}", r.stderr);
+    }
+}

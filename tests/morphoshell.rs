@@ -594,46 +594,52 @@ fn slides_squeeze_a_cone_and_bad_slides_are_named() {
     }
 }
 
-/// MorphoShell's GCM settings file (as in its repository, values by position) converts into a
-/// shellsim file that shellsim accepts, with the physics carried over; a file with too few
-/// entries, a non-numeric value or an entry out of order is exit 2 naming the line and entry.
+/// A settings file in MorphoShell's own format: its 23 entries in the order of its
+/// `read_settings.cpp`, with `//` comments on their own lines and after values, blank lines and
+/// uneven spacing.
+const MORPHOSHELL_SETTINGS: &str = "// Settings for a test run.
+
+// Frames per long time.
+outputs_per_char_long_time  = 400.0;
+
+// Negative: the mesh's ref_thicknesses.
+ref_thickness_if_uniform = 0.01;
+timestep_prefactor = 0.3;
+dialling_from_ansatz_rather_than_ref_state = true;
+dial_factors_to_hold_at_spacing = 0.5;
+dial_phase_time_prefactor = 0.25;
+
+time_between_equil_checks_prefactor = 0.01;
+damping_prefactor_1 = 4.0;
+damping_prefactor_2 = 6.0;
+num_steps_to_use_gradient_descent_dynamics_for_before_switching_to_newtonian_dynamics = 7;
+force_to_char_force_ratio_equil_threshold = 0.000001;
+speed_to_char_speed_ratio_equil_threshold = 0.00001;
+def_poisson_ratio = 0.5; // a decimal, not 1/2
+ref_shear_modulus_if_uniform = 1.0;
+ref_density = 1.0;
+bend_stiffening_scale_factor = 100000000000000000.0;
+patch_mat_dimless_conditioning_thresh = 10.0;
+slide_stiffness_prefactor = 0.0;
+slide_friction_coefficent = 0.0;
+slide_speed_prefactor = 0.0;
+using_initial_glass_slide_z_coords_from_settings_file = false;
+initial_upper_slide_z_coord = 12345.0;
+initial_lower_slide_z_coord = 12345.0;
+
+
+";
+
+/// A settings file in MorphoShell's order converts into a shellsim file that shellsim accepts,
+/// with the physics carried over (so does one in the gravity layout); a file with too few
+/// entries, a non-numeric value, a switch neither true nor false or an entry out of order is
+/// exit 2 naming the line and entry, with nothing written.
 #[test]
 fn import_morphoshell_settings() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let names = shellsim::morphoshell::ENTRIES;
-    let values = [
-        "400.0",
-        "true",
-        "10.0",
-        "0.01",
-        "0.5",
-        "1.0",
-        "1.0",
-        "0.25",
-        "0.01",
-        "4.0",
-        "6.0",
-        "0.3",
-        "0.5",
-        "0.000001",
-        "0.00001",
-        "100000000000000000.0",
-        "0.0",
-        "0.0",
-        "0.0",
-        "false",
-        "12345.0",
-        "12345.0",
-        "0.0",
-        "0",
-    ];
-    let text: String = names
-        .iter()
-        .zip(values)
-        .map(|(n, v)| format!("{n} = {v}; // comment\n"))
-        .collect();
-    write(d, "ms.txt", &format!("// MorphoShell settings\n\n{text}"));
+    let text = MORPHOSHELL_SETTINGS;
+    write(d, "ms.txt", text);
     shellsim(&["import-morphoshell", "ms.txt", "-o", "ms.toml"], d);
     let s = shellsim::settings::Settings::load(&d.join("ms.toml"), &[]).unwrap();
     assert_eq!(s.solver.mode, shellsim::settings::Mode::Explicit);
@@ -646,35 +652,213 @@ fn import_morphoshell_settings() {
         shellsim::settings::BendingModel::PatchFit
     );
     assert!((s.material.young - 3.0).abs() < 1e-15, "E = 2μ(1+ν)");
+    assert_eq!(s.material.thickness, 0.01);
+    assert!(!s.material.use_mesh_thickness && !s.material.use_mesh_shear_modulus);
     assert_eq!(s.explicit.time_step_prefactor, 0.3);
     assert_eq!(s.explicit.damping_prefactor_dial, 4.0);
     assert_eq!(s.explicit.damping_prefactor_wait, 6.0);
+    assert_eq!(s.explicit.gradient_descent_steps, 7);
     assert_eq!(s.explicit.dial_long_times, 0.5, "0.25 per phase, 2 phases");
     assert_eq!(s.dial.holds, vec![0.5]);
     assert_eq!(s.material.bend_stiffening, Some(1e17));
+    assert_eq!(s.dial.from, shellsim::settings::DialFrom::Start);
+    // A negative uniform value: per face from the mesh.
+    write(
+        d,
+        "mesh.txt",
+        &text.replace(
+            "ref_thickness_if_uniform = 0.01",
+            "ref_thickness_if_uniform = -1.0",
+        ),
+    );
+    shellsim(&["import-morphoshell", "mesh.txt", "-o", "mesh.toml"], d);
+    let s = shellsim::settings::Settings::load(&d.join("mesh.toml"), &[]).unwrap();
+    assert!(s.material.use_mesh_thickness && !s.material.use_mesh_shear_modulus);
+
+    // The gravity layout: 24 entries, its second entry the dialling switch.
+    let names = shellsim::morphoshell::GRAVITY_ENTRIES;
+    let value = |n: &str| match n {
+        "grav_field_strength" => "9.81".to_string(),
+        _ => text
+            .lines()
+            .find_map(|l| l.strip_prefix(n)?.trim().strip_prefix('='))
+            .map(|v| v.split(';').next().unwrap().trim().to_string())
+            .unwrap(),
+    };
+    let gravity: String = names
+        .iter()
+        .map(|n| format!("{n} = {};\n", value(n)))
+        .collect();
+    write(d, "grav.txt", &gravity);
+    shellsim(&["import-morphoshell", "grav.txt", "-o", "grav.toml"], d);
+    let s = shellsim::settings::Settings::load(&d.join("grav.toml"), &[]).unwrap();
+    assert_eq!(s.explicit.gradient_descent_steps, 7);
+    assert!((s.material.young - 3.0).abs() < 1e-15);
+    assert_eq!(
+        std::fs::read_to_string(d.join("grav.toml"))
+            .unwrap()
+            .matches("gravity = [0.0, 0.0, -9.81]")
+            .count(),
+        1
+    );
+
     // Bad files.
     let lines: Vec<&str> = text.lines().collect();
     for (bad, needle) in [
-        (
-            lines[..20].join("\n"),
-            "missing 'initial_upper_slide_z_coord'",
-        ),
+        (lines[..27].join("\n"), "missing 'initial_upper_slide_z_coord'"),
         (
             text.replace("ref_density = 1.0", "ref_density = one"),
-            ":9: ref_density = 'one' is not a number",
+            ":21: ref_density = 'one' is not a number",
+        ),
+        (
+            text.replace("= true;", "= 1;"),
+            ":9: dialling_from_ansatz_rather_than_ref_state = '1' is neither true nor false",
+        ),
+        (
+            text.replace("= 7;", "= 7.5;"),
+            ":16: num_steps_to_use_gradient_descent_dynamics_for_before_switching_to_newtonian_dynamics \
+             = '7.5' is not an integer",
         ),
         (
             text.replace("ref_density", "density"),
             "expects 'ref_density' here",
         ),
-        (format!("{text}extra = 1;\n"), "unknown entry 'extra'"),
+        (
+            format!("{text}grav_field_strength = 9.81;\n"),
+            "unknown entry 'grav_field_strength' after the 23",
+        ),
+        (
+            gravity.replace("grav_field_strength = 9.81;\n", ""),
+            "expects 'grav_field_strength' here",
+        ),
     ] {
-        write(d, "bad.txt", &format!("// MorphoShell settings\n\n{bad}"));
+        write(d, "bad.txt", &bad);
         let (code, err) = run(&["import-morphoshell", "bad.txt", "-o", "bad.toml"], d);
         assert_eq!(code, 2, "{err}");
         assert!(err.contains(needle), "{needle}: {err}");
         assert!(!d.join("bad.toml").exists());
     }
+}
+
+/// A flat 3 × 3-node square (8 triangles) written as MorphoShell's meshing scripts write a
+/// mesh: `%.15e` values, the per-face fields as one FIELD block, ā = I, b̄ = 0, and
+/// `ref_thicknesses` / `ref_shear_moduli` given per face.
+fn morphoshell_mesh(thickness: &[Real; 8], shear: &[Real; 8]) -> String {
+    let mut t = String::from(
+        "# vtk DataFile Version 2.0\nsquare\nASCII\nDATASET POLYDATA\nPOINTS 9 double\n",
+    );
+    for j in 0..3 {
+        for i in 0..3 {
+            t += &format!(
+                "{:.15e} {:.15e} {:.15e}\n",
+                i as Real * 0.5,
+                j as Real * 0.5,
+                0.0
+            );
+        }
+    }
+    t += "POLYGONS 8 32\n";
+    for j in 0..2 {
+        for i in 0..2 {
+            let v = 3 * j + i;
+            t += &format!("3 {} {} {}\n3 {} {} {}\n", v, v + 1, v + 4, v, v + 4, v + 3);
+        }
+    }
+    t += "CELL_DATA 8\nFIELD tri_quantities 5\nabar_info 3 8 double\n";
+    t += &"1.000000000000000e+00 0.000000000000000e+00 1.000000000000000e+00\n".repeat(8);
+    t += "bbar_info 3 8 double\n";
+    t += &"0.000000000000000e+00 0.000000000000000e+00 0.000000000000000e+00\n".repeat(8);
+    for (name, v) in [("ref_thicknesses", thickness), ("ref_shear_moduli", shear)] {
+        t += &format!("{name} 1 8 double\n");
+        for x in v {
+            t += &format!("{x:.15e}\n");
+        }
+    }
+    t += "tri_tags 1 8 int\n";
+    t += &"0\n".repeat(8);
+    t += "POINT_DATA 9\nFIELD node_quantities 2\nconstraint_indicators 1 9 int\n";
+    t += &"0\n".repeat(9);
+    t += "node_tags 1 9 int\n";
+    t += &"0\n".repeat(9);
+    t
+}
+
+/// MorphoShell's meshes carry −1234 in `ref_thicknesses` and `ref_shear_moduli` where its
+/// settings' uniform value is used: such a mesh runs with the uniform values (the settings
+/// `import-morphoshell` writes, or `use_mesh_* = false`), and a per-face value that would be
+/// used and is the placeholder, or not positive, is exit 2 naming the field and the face.
+#[test]
+fn morphoshell_mesh_placeholders() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let settings = MORPHOSHELL_SETTINGS.replace("= true;", "= false;");
+    write(d, "ms.txt", &settings);
+    shellsim(&["import-morphoshell", "ms.txt", "-o", "ms.toml"], d);
+    write(
+        d,
+        "placeholder.vtk",
+        &morphoshell_mesh(&[-1234.0; 8], &[-1234.0; 8]),
+    );
+    let static_run = |mesh: &str, out: &str, extra: &[&str]| {
+        let mut a = vec!["ms.toml", mesh, "--out", out, "-q"];
+        for s in ["solver.mode=\"static\"", "material.bending=\"midedge_sin\""] {
+            a.extend_from_slice(&["--set", s]);
+        }
+        a.extend_from_slice(extra);
+        run(&a, d)
+    };
+    let (code, err) = static_run("placeholder.vtk", "ok", &[]);
+    assert_eq!(code, 0, "{err}");
+    let thickness = |out: &str| {
+        final_frame(&d.join(out)).face_fields["thickness"]
+            .data
+            .clone()
+    };
+    // Frames write the thickness in Float32.
+    let near = |h: &[Real], want: Real| h.len() == 8 && h.iter().all(|x| (x - want).abs() < 1e-8);
+    assert!(near(&thickness("ok"), 0.01), "{:?}", thickness("ok"));
+
+    // The per-face values used: the placeholder, or a value that is not positive, is named.
+    let mut thick = [0.02; 8];
+    thick[5] = 0.0;
+    write(d, "mixed.vtk", &morphoshell_mesh(&thick, &[-1234.0; 8]));
+    for (mesh, key, needle) in [
+        (
+            "placeholder.vtk",
+            "material.use_mesh_thickness=true",
+            "'ref_thicknesses' must lie in (0, 1e30], but face 0 has -1.234e3 (MorphoShell's \
+             placeholder",
+        ),
+        (
+            "placeholder.vtk",
+            "material.use_mesh_shear_modulus=true",
+            "'ref_shear_moduli' must lie in (0, 1e15], but face 0 has -1.234e3 (MorphoShell's \
+             placeholder for the settings' uniform value; to use one, set \
+             material.use_mesh_shear_modulus = false)",
+        ),
+        (
+            "mixed.vtk",
+            "material.use_mesh_thickness=true",
+            "'ref_thicknesses' must lie in (0, 1e30], but face 5 has 0e0",
+        ),
+    ] {
+        let (code, err) = static_run(mesh, "bad", &["--set", key]);
+        assert_eq!(code, 2, "{key}: {err}");
+        assert!(
+            err.contains(mesh) && err.contains(needle),
+            "{needle}: {err}"
+        );
+        assert!(!d.join("bad").exists(), "nothing written");
+    }
+    // The per-face thicknesses are used where valid.
+    write(d, "thick.vtk", &morphoshell_mesh(&[0.02; 8], &[-1234.0; 8]));
+    let (code, err) = static_run(
+        "thick.vtk",
+        "thick",
+        &["--set", "material.use_mesh_thickness=true"],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(near(&thickness("thick"), 0.02), "{:?}", thickness("thick"));
 }
 
 /// The column `name` of a run's `log.csv` (one row per frame).
@@ -777,6 +961,13 @@ fn write_ansatz(path: &Path, dial: &str, x: &[Vec3], faces: &[[usize; 3]]) {
     for f in faces {
         t += &format!("3 {} {} {}\n", f[0], f[1], f[2]);
     }
+    // Then its face and vertex data (not read back).
+    t += &format!("CELL_DATA {}\n", faces.len());
+    t += &format!(
+        "POINT_DATA {}\nSCALARS angleDeficit double 1\nLOOKUP_TABLE default\n",
+        x.len()
+    );
+    t += &format!("{:.14e}\n", 0.0).repeat(x.len());
     std::fs::write(path, t).unwrap();
 }
 
@@ -881,6 +1072,42 @@ fn morphoshell_ansatz_files() {
         "coord.vtk",
         &format!("{head}dial_factor = 0.5, stepcount = 1\nASCII\nDATASET POLYDATA\nPOINTS {n} double\n0 0 zero\n"),
         "coord.vtk:6",
+    );
+    // Files cut short: inside the last coordinate (no final newline), after the points, among
+    // the polygons; and a coordinate too many.
+    write_ansatz(&d.join("whole.vtk"), "0.5", &half.positions, &half.faces);
+    let whole = std::fs::read_to_string(d.join("whole.vtk")).unwrap();
+    let poly = whole.find("POLYGONS").unwrap();
+    // Up to the first digit of the last coordinate (5.0e-03 cut to 5).
+    let start = whole[..poly - 1].rfind(' ').unwrap() + 1;
+    let last_coordinate = start + whole[start..].find(|c: char| c.is_ascii_digit()).unwrap() + 1;
+    let point_lines = whole[..poly].lines().count();
+    bad(
+        "cut.vtk",
+        &whole[..last_coordinate],
+        &format!(
+            "cut.vtk:{point_lines}: the file ends inside the number '{}', without a final newline",
+            &whole[last_coordinate - 1..last_coordinate]
+        ),
+    );
+    bad(
+        "nopoly.vtk",
+        &whole[..poly],
+        &format!("the file ends after the {n} points, without the POLYGONS block"),
+    );
+    let third = poly + whole[poly..].match_indices('\n').nth(3).unwrap().0 + 1;
+    bad(
+        "halfpoly.vtk",
+        &whole[..third],
+        &format!("the file ends after 3 of the {} polygons", half.faces.len()),
+    );
+    bad(
+        "extra.vtk",
+        &whole.replacen("\nPOLYGONS", " 0\nPOLYGONS", 1),
+        &format!(
+            "extra.vtk:{point_lines}: '0' is more than the {} point coordinates",
+            3 * n
+        ),
     );
     bad(
         "short.vtk",

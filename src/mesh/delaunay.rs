@@ -155,6 +155,15 @@ pub fn triangulate(points: &[Vec2]) -> Vec<[usize; 3]> {
         .collect()
 }
 
+/// What a Delaunay mesh of a domain of area `area` in a box `lx × ly` at spacing `edge`
+/// allocates, in floating point: about twice its interior points in faces, and the cells of the
+/// dart-throwing grid (both are checked with [`super::generate::check_planned`]).
+pub fn delaunay_planned(area: Real, lx: Real, ly: Real, edge: Real) -> (Real, Real) {
+    let points = 1.15 * area / (edge * edge * 3f64.sqrt() / 2.0) + 2.0 * (lx + ly) / edge;
+    let cell = 0.7 * edge / std::f64::consts::SQRT_2;
+    (2.0 * points, (lx / cell + 2.0) * (ly / cell + 2.0))
+}
+
 /// A rectangle `[x0, x0+lx] × [y0, y0+ly]` meshed by the Delaunay triangulation of points about
 /// `edge` apart: equally spaced points on the boundary, and interior points thrown at random
 /// (seeded) and kept when no earlier point is closer than `0.7 × edge` (dart throwing), so the

@@ -52,6 +52,47 @@ pub struct Spacing {
     pub checkerboard: bool,
 }
 
+/// The most faces `shellsim mesh` generates (10⁷): a mesh beyond it takes gigabytes and hours
+/// to simulate. The generators' sizes are planned in floating point from their arguments and
+/// checked against it before anything is allocated ([`check_planned`]).
+pub const MAX_FACES: Real = 1e7;
+
+/// Checks a planned count of faces (or of another item a generator allocates per face, named by
+/// `what`), computed in floating point so that no size overflows, against [`MAX_FACES`]. `args`
+/// names the arguments that set it, for the message.
+pub fn check_planned(count: Real, what: &str, args: &str) -> Result<(), String> {
+    if count.is_finite() && count <= MAX_FACES {
+        return Ok(());
+    }
+    let count = if count.is_finite() {
+        format!("about {}", crate::math::human(count))
+    } else {
+        "uncountably many (beyond floating point)".into()
+    };
+    Err(format!(
+        "{args} would make {count} {what}, more than the {MAX_FACES:e} shellsim allows: make \
+         --edge larger or the shape smaller"
+    ))
+}
+
+/// The number of cells along a side of length `l` at spacing `edge`, as the generators round
+/// it (at least 1), in floating point.
+fn cells(l: Real, edge: Real) -> Real {
+    (l / edge).round().max(1.0)
+}
+
+/// The faces [`rectangle`] makes for sides `lx`, `ly` at spacing `edge`: 2 per grid cell.
+pub fn rectangle_faces(lx: Real, ly: Real, edge: Real) -> Real {
+    2.0 * cells(lx, edge) * cells(ly, edge)
+}
+
+/// An upper bound of the faces [`annulus`] makes: each band between two rings has as many
+/// faces as its two rings have vertices, and the outer ring has the most.
+pub fn annulus_faces(r_in: Real, r_out: Real, sweep: Real, edge: Real) -> Real {
+    let ring = (sweep.min(2.0 * PI) * r_out / edge).round().max(6.0) + 1.0;
+    2.0 * cells(r_out - r_in, edge) * ring
+}
+
 fn graded(n: usize, grading: Real) -> Vec<Real> {
     // Nodes in [0, 1] whose consecutive spacings form a geometric series with ratio r such that
     // last/first = grading.

@@ -487,6 +487,9 @@ pub fn parse(bytes: &[u8]) -> Result<RawMesh, Fail> {
             ))
         }
     };
+    if !binary {
+        super::ends_mid_number(bytes)?;
+    }
     let mut r = Reader { lx, binary };
     let mut points: Option<Vec<Real>> = None;
     let mut cells: Option<Vec<Vec<usize>>> = None;

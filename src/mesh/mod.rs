@@ -82,6 +82,45 @@ fn triangles(cells: &[Vec<usize>], types: Option<&[usize]>) -> Result<Vec<[usize
         .collect()
 }
 
+/// For a text file: an error when it ends inside a number, i.e. its last line has no newline
+/// and ends in a digit or a point. Such a file was most likely cut short (the number, and what
+/// should follow it, lost), and reading the cut number would silently change a value: every
+/// writer shellsim knows of ends its last line with a newline.
+pub(crate) fn ends_mid_number(b: &[u8]) -> Result<(), String> {
+    let Some(&last) = b.last() else {
+        return Ok(());
+    };
+    if !(last.is_ascii_digit() || last == b'.') {
+        return Ok(());
+    }
+    let start = b
+        .iter()
+        .rposition(|c| c.is_ascii_whitespace())
+        .map_or(0, |p| p + 1);
+    let line = b.iter().filter(|&&c| c == b'\n').count() + 1;
+    Err(format!(
+        "line {line}: the file ends inside the number '{}', without a final newline: it looks \
+         cut short (a complete file ends its last line with a newline)",
+        String::from_utf8_lossy(&b[start..])
+    ))
+}
+
+/// For a text file without counts (OBJ): an error when its last line has content but no
+/// newline, a sign that it was cut short (a line cut anywhere, even after a space, could lose a
+/// polygon's vertex without a trace).
+pub(crate) fn ends_inside_line(b: &[u8]) -> Result<(), String> {
+    let start = b.iter().rposition(|&c| c == b'\n').map_or(0, |p| p + 1);
+    if b[start..].trim_ascii().is_empty() {
+        return Ok(());
+    }
+    let line = b.iter().filter(|&&c| c == b'\n').count() + 1;
+    Err(format!(
+        "line {line}: the file ends inside the line '{}', without a final newline: it looks cut \
+         short (a complete file ends its last line with a newline)",
+        String::from_utf8_lossy(&b[start..]).trim()
+    ))
+}
+
 /// Twice the area of triangle `(a, b, c)` over its longest edge squared: scale-free, 0 for a
 /// degenerate triangle (and for one whose edges overflow).
 pub fn area_ratio(a: &Vec3, b: &Vec3, c: &Vec3) -> Real {
@@ -138,6 +177,60 @@ pub struct Mesh {
 /// where squared lengths and energies overflow.
 pub const MAX_COORDINATE: Real = 1e30;
 
+/// The per-face fields shellsim reads from a mesh (docs/files.md describes each).
+pub const INPUT_FACE_FIELDS: [&str; 10] = [
+    "abar_info",
+    "bbar_info",
+    "ref_thicknesses",
+    "ref_shear_moduli",
+    "tri_tags",
+    "warp_direction",
+    "growth_factor",
+    "machine_direction",
+    "moisture_top",
+    "moisture_bottom",
+];
+
+/// The per-vertex fields shellsim reads from a mesh.
+pub const INPUT_VERTEX_FIELDS: [&str; 2] = ["constraint_indicators", "node_tags"];
+
+/// The fields of shellsim's own frames that are not input fields, per face and per vertex: a
+/// frame read as a mesh carries them, and they are ignored without a word.
+pub const FRAME_FIELDS: [&[&str]; 2] = [
+    &[
+        "a",
+        "b",
+        "abar",
+        "bbar",
+        "mean_curvature",
+        "gauss_curvature",
+        "k1",
+        "k2",
+        "max_stretch",
+        "thickness",
+        "stretching_energy_density",
+        "bending_energy_density",
+        "pressure",
+        "skin_volume_ratio",
+        "edge_angles",
+        "moment_turn",
+        "patch_condition",
+        "strain_measure",
+        "cauchy_stress_eigval_1",
+        "cauchy_stress_eigval_2",
+        "dimless_cauchy_stress_eigval_1",
+        "dimless_cauchy_stress_eigval_2",
+        "cauchy_stress_eigvec_1",
+        "cauchy_stress_eigvec_2",
+    ],
+    &[
+        "displacement",
+        "velocity",
+        "angle_deficit",
+        "angle_deficit_gauss_curvature",
+    ],
+];
+
 /// Errors in reading or validating a mesh. Each names the file and the offending index.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -182,6 +275,39 @@ impl Mesh {
             path: self.name(),
             reason: reason.into(),
         }
+    }
+
+    /// One warning per field that shellsim neither reads nor writes into its frames (a
+    /// misspelt name would otherwise change nothing without a word), naming it and the fields
+    /// that are read.
+    pub fn unknown_field_warnings(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for (fields, known, frame, what) in [
+            (
+                &self.face_fields,
+                &INPUT_FACE_FIELDS[..],
+                FRAME_FIELDS[0],
+                "face",
+            ),
+            (
+                &self.vertex_fields,
+                &INPUT_VERTEX_FIELDS[..],
+                FRAME_FIELDS[1],
+                "vertex",
+            ),
+        ] {
+            for name in fields.keys() {
+                if !known.contains(&name.as_str()) && !frame.contains(&name.as_str()) {
+                    out.push(format!(
+                        "{}: {what} field '{name}' is not one shellsim reads; it is ignored \
+                         (the {what} fields read: {})",
+                        self.name(),
+                        known.join(", ")
+                    ));
+                }
+            }
+        }
+        out
     }
 
     /// Vertices of face `f`.

@@ -147,6 +147,7 @@ fn index(v: i64, nv: usize, line: usize) -> Result<usize, String> {
 /// numbers; colours or normals after them ignored), one polygon per line (`k i₀ … i_{k−1}`,
 /// anything after the indices ignored).
 pub(super) fn parse_off(b: &[u8]) -> Result<RawMesh, String> {
+    super::ends_mid_number(b)?;
     let mut it = lines(b).filter(|(_, l)| !l.is_empty());
     let (hl, header) = it
         .next()
@@ -218,6 +219,7 @@ pub(super) fn parse_off(b: &[u8]) -> Result<RawMesh, String> {
 
 /// OBJ: `v x y z [w]` and `f` statements (module doc); everything else is ignored.
 pub(super) fn parse_obj(b: &[u8]) -> Result<RawMesh, String> {
+    super::ends_inside_line(b)?;
     let mut points: Vec<Real> = Vec::new();
     let mut faces = Vec::new();
     let mut poly = Vec::new();
@@ -473,6 +475,9 @@ pub(super) fn parse_ply(b: &[u8]) -> Result<RawMesh, String> {
         }
     };
     let format = format.ok_or("the header has no 'format' line")?;
+    if format == PlyFormat::Ascii {
+        super::ends_mid_number(b)?;
+    }
     let mut r = PlyReader {
         lex: super::legacy::Lexer {
             b,
@@ -505,7 +510,9 @@ pub(super) fn parse_ply(b: &[u8]) -> Result<RawMesh, String> {
         {
             return Err("the face element has no list property 'vertex_indices'".into());
         }
-        for k in 0..el.count {
+        // An element without properties has no data: its count costs nothing to skip.
+        let count = if el.props.is_empty() { 0 } else { el.count };
+        for k in 0..count {
             let mut xyz = [0.0; 3];
             let mut fields: Vec<(&str, Real)> = Vec::new();
             poly.clear();
@@ -573,69 +580,146 @@ pub(super) fn parse_ply(b: &[u8]) -> Result<RawMesh, String> {
     })
 }
 
-/// STL, binary (80-byte header, triangle count, 50 bytes per triangle) when the size says so,
-/// else ASCII (`solid … facet normal … outer loop vertex ×3 endloop endfacet … endsolid`).
-pub(super) fn parse_stl(b: &[u8]) -> Result<RawMesh, String> {
-    let mut corners: Vec<[Real; 3]> = Vec::new();
-    let binary = b.len() >= 84 && {
-        let n = u32::from_le_bytes([b[80], b[81], b[82], b[83]]) as u64;
-        84 + 50 * n == b.len() as u64
-    };
-    if binary {
-        let n = (b.len() - 84) / 50;
-        for t in 0..n {
-            let base = 84 + 50 * t + 12;
-            for c in 0..3 {
-                let mut p = [0.0; 3];
-                for (k, pk) in p.iter_mut().enumerate() {
-                    let o = base + 12 * c + 4 * k;
-                    *pk = f32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]) as Real;
-                }
-                corners.push(p);
+/// The corners of a binary STL whose size matches its triangle count.
+fn stl_binary(b: &[u8]) -> Vec<[Real; 3]> {
+    let n = (b.len() - 84) / 50;
+    let mut corners = Vec::with_capacity(3 * n);
+    for t in 0..n {
+        let base = 84 + 50 * t + 12;
+        for c in 0..3 {
+            let mut p = [0.0; 3];
+            for (k, pk) in p.iter_mut().enumerate() {
+                let o = base + 12 * c + 4 * k;
+                *pk = f32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]) as Real;
             }
-        }
-    } else {
-        if !b.trim_ascii_start().starts_with(b"solid") {
-            return Err(
-                "neither a binary STL (its size is not 84 + 50 × its triangle count) nor an \
-                 ASCII one (it does not start with 'solid')"
-                    .into(),
-            );
-        }
-        let mut in_loop = 0usize;
-        let mut facets = 0usize;
-        for (l, s) in lines(b) {
-            let mut t = s.split_whitespace();
-            match t.next() {
-                Some("vertex") => {
-                    let mut p = [0.0; 3];
-                    for (k, c) in ["x", "y", "z"].iter().enumerate() {
-                        let v = t.next().ok_or(format!("line {l}: the vertex has no {c}"))?;
-                        p[k] = number(v, l, &format!("the vertex's {c}"))?;
-                    }
-                    corners.push(p);
-                    in_loop += 1;
-                }
-                Some("outer") => in_loop = 0,
-                Some("endloop") => {
-                    if in_loop != 3 {
-                        return Err(format!(
-                            "line {l}: facet {facets} has {in_loop} vertices; STL facets are \
-                             triangles"
-                        ));
-                    }
-                    facets += 1;
-                }
-                _ => {}
-            }
-        }
-        if !corners.len().is_multiple_of(3) {
-            return Err(format!(
-                "the file ends inside a facet ({} corners read)",
-                corners.len()
-            ));
+            corners.push(p);
         }
     }
+    corners
+}
+
+/// The corners of an ASCII STL: one or more `solid [name]` … `endsolid [name]` blocks of
+/// `facet normal nx ny nz` / `outer loop` / 3 × `vertex x y z` / `endloop` / `endfacet`, one
+/// statement a line. Anything out of place, a number that is not one, a statement with too few
+/// or too many numbers, or an end of file before `endsolid` (a file cut short) is an error
+/// naming the line.
+fn stl_ascii(b: &[u8]) -> Result<Vec<[Real; 3]>, String> {
+    /// Where the reader is: what it expects next.
+    #[derive(Clone, Copy, PartialEq)]
+    enum At {
+        Solid,
+        Facet,
+        Loop,
+        Vertex(usize),
+        EndFacet,
+        Done,
+    }
+    let expected = |at: At| match at {
+        At::Solid => "'solid'",
+        At::Facet => "'facet normal' or 'endsolid'",
+        At::Loop => "'outer loop'",
+        At::Vertex(k) if k < 3 => "'vertex'",
+        At::Vertex(_) => "'endloop'",
+        At::EndFacet => "'endfacet'",
+        At::Done => "'solid' or the end of the file",
+    };
+    let numbers = |t: &mut std::str::SplitWhitespace, l: usize, what: &str| {
+        let mut p = [0.0; 3];
+        for (k, c) in ["x", "y", "z"].iter().enumerate() {
+            let v = t.next().ok_or(format!("line {l}: the {what} has no {c}"))?;
+            p[k] = number(v, l, &format!("the {what}'s {c}"))?;
+        }
+        if let Some(extra) = t.next() {
+            return Err(format!(
+                "line {l}: the {what} has more than 3 numbers ('{extra}')"
+            ));
+        }
+        Ok::<_, String>(p)
+    };
+    let mut corners = Vec::new();
+    let mut at = At::Solid;
+    let mut facets = 0usize;
+    let mut last = 0usize;
+    for (i, raw) in b.split(|&c| c == b'\n').enumerate() {
+        let l = i + 1;
+        let s = std::str::from_utf8(raw).unwrap_or("\u{fffd}");
+        let mut t = s.split_whitespace();
+        let Some(kw) = t.next() else { continue };
+        last = l;
+        let unexpected = || {
+            format!(
+                "line {l}: expected {} (facet {facets}), found '{}'",
+                expected(at),
+                s.trim()
+            )
+        };
+        at = match (at, kw) {
+            (At::Solid | At::Done, "solid") => At::Facet,
+            (At::Facet, "facet") => {
+                if t.next() != Some("normal") {
+                    return Err(unexpected());
+                }
+                numbers(&mut t, l, "facet normal")?;
+                At::Loop
+            }
+            (At::Facet, "endsolid") => At::Done,
+            (At::Loop, "outer") if t.next() == Some("loop") && t.next().is_none() => At::Vertex(0),
+            (At::Vertex(k), "vertex") => {
+                corners.push(numbers(&mut t, l, "vertex")?);
+                At::Vertex(k + 1)
+            }
+            (At::Vertex(3), "endloop") if t.next().is_none() => At::EndFacet,
+            (At::Vertex(k), "endloop") if k != 3 => {
+                return Err(format!(
+                    "line {l}: facet {facets} has {k} vertices; STL facets are triangles"
+                ))
+            }
+            (At::EndFacet, "endfacet") if t.next().is_none() => {
+                facets += 1;
+                At::Facet
+            }
+            _ => return Err(unexpected()),
+        };
+    }
+    if at != At::Done {
+        return Err(format!(
+            "line {last}: the file ends inside {}, where {} was expected: it is cut short",
+            if at == At::Facet || at == At::Solid {
+                "the solid".to_string()
+            } else {
+                format!("facet {facets}")
+            },
+            expected(at)
+        ));
+    }
+    Ok(corners)
+}
+
+/// STL, binary (80-byte header, triangle count, 50 bytes per triangle) when the size says so,
+/// else ASCII (`solid … facet normal … outer loop vertex ×3 endloop endfacet … endsolid`, read
+/// strictly: every keyword in its place, to the `endsolid`).
+pub(super) fn parse_stl(b: &[u8]) -> Result<RawMesh, String> {
+    let count = (b.len() >= 84).then(|| u32::from_le_bytes([b[80], b[81], b[82], b[83]]) as u64);
+    let binary = count.is_some_and(|n| 84 + 50 * n == b.len() as u64);
+    let corners = if binary {
+        stl_binary(b)
+    } else if b.trim_ascii_start().starts_with(b"solid") && !b.contains(&0) {
+        stl_ascii(b)?
+    } else if let Some(n) = count {
+        return Err(format!(
+            "a binary STL announcing {n} triangles (bytes 80–83) has 84 + 50 × {n} = {} bytes, \
+             this file {} (and it is not an ASCII STL: that starts with 'solid' and holds no zero \
+             bytes)",
+            84 + 50 * n,
+            b.len()
+        ));
+    } else {
+        return Err(
+            "neither a binary STL (shorter than its 84-byte header) nor an ASCII one (it does \
+             not start with 'solid')"
+                .into(),
+        );
+    };
     if corners.is_empty() {
         return Err("no triangles".into());
     }

@@ -239,9 +239,16 @@ fn area(m: &Mesh) -> Real {
 /// A named closed shape (`sphere`, `capsule`, `peanut`, `teddy`) of size `r` (m) with edges
 /// about `edge` long.
 pub fn closed_shape(name: &str, r: Real, edge: Real) -> Result<Mesh, String> {
+    // A geodesic sphere of frequency k has 20 k² faces: planned from the area in floating point.
+    let planned = |area: Real| {
+        let tri = 3.0_f64.sqrt() / 4.0 * edge * edge;
+        super::generate::check_planned(area / tri, "faces", "--edge and --radius")
+    };
+    // Every shape holds the sphere of radius r: its area is a lower bound, checked first.
+    let sphere = 4.0 * std::f64::consts::PI * r * r;
+    planned(sphere)?;
     if name == "sphere" {
-        let k = frequency_for(4.0 * std::f64::consts::PI * r * r, edge);
-        return Ok(geodesic_sphere(r, k));
+        return Ok(geodesic_sphere(r, frequency_for(sphere, edge)));
     }
     let f = implicit_shape(name, r).ok_or_else(|| format!("unknown closed shape '{name}'"))?;
     let shape = Implicit {
@@ -250,8 +257,15 @@ pub fn closed_shape(name: &str, r: Real, edge: Real) -> Result<Mesh, String> {
         reach: 4.0 * r,
     };
     let coarse = shape.mesh(8, 0)?;
+    planned(area(&coarse))?;
     let k = frequency_for(area(&coarse), edge);
     shape.mesh(k, 40)
+}
+
+/// The faces [`torus`] makes: 2 per cell of its `u`, `v` grid, in floating point.
+pub fn torus_faces(major: Real, minor: Real, edge: Real) -> Real {
+    use std::f64::consts::TAU;
+    2.0 * (TAU * major / edge).round().max(6.0) * (TAU * minor / edge).round().max(6.0)
 }
 
 /// A torus about the z axis: major radius `major` (centre to tube centre), tube radius

@@ -437,3 +437,98 @@ fn a_summary_with_a_non_finite_number_is_refused() {
     let (text, left_out) = summary_json(&fine);
     assert!(left_out.is_empty() && !text.contains("null"), "{text}");
 }
+
+/// A file cut short never loads as another mesh: every prefix of each text and binary fixture
+/// (STL ASCII and binary, OFF, OBJ, PLY ASCII and both binaries, legacy VTK ASCII and binary)
+/// is refused, or reads as the whole file does (a cut that loses nothing, such as the name
+/// after `endsolid`). A number cut at the end of the file (`1.61803399` read as `1.6`), a missing
+/// `endloop`/`endfacet`/`endsolid`, or a count larger than the data is an error naming the line
+/// or byte offset. OBJ has no counts: a cut at a line's end loses its last lines unseen, so only
+/// cuts inside a line are checked there.
+#[test]
+fn truncated_files_are_refused() {
+    use shellsim::mesh::io::mesh_from_bytes;
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    for name in [
+        "shapes/ico_ascii.stl",
+        "shapes/ico_binary.stl",
+        "shapes/cube.off",
+        "shapes/cube.obj",
+        "shapes/cube_ascii.ply",
+        "shapes/cube_le.ply",
+        "shapes/cube_be.ply",
+        "vtk/ascii_42.vtk",
+        "vtk/poly_ascii_51.vtk",
+        "vtk/binary_42.vtk",
+    ] {
+        let bytes = std::fs::read(root.join(name)).unwrap();
+        let ext = name.rsplit('.').next().unwrap();
+        let whole = mesh_from_bytes(&bytes, ext).unwrap();
+        for cut in 0..bytes.len() {
+            let part = &bytes[..cut];
+            if ext == "obj" && part.last() == Some(&b'\n') {
+                continue;
+            }
+            if let Ok(m) = mesh_from_bytes(part, ext) {
+                assert!(
+                    m.positions == whole.positions && m.faces == whole.faces,
+                    "{name} cut at byte {cut} of {} reads as another mesh",
+                    bytes.len()
+                );
+            }
+        }
+    }
+    // The messages name the place.
+    let ico = std::fs::read_to_string(root.join("shapes/ico_ascii.stl")).unwrap();
+    // Cut inside facet 0's last coordinate, 1.61803399 read as 1.6 were the file accepted.
+    let at = ico.find("vertex 0 1 1.61803399").unwrap() + "vertex 0 1 1.6".len();
+    let cases: Vec<(String, &str, &str)> = vec![
+        (
+            ico[..at].to_string(),
+            "stl",
+            "line 6: the file ends inside facet 0, where 'endloop' was expected: it is cut short",
+        ),
+        (
+            ico.replacen("    endloop\n", "", 1),
+            "stl",
+            "line 7: expected 'endloop' (facet 0), found 'endfacet'",
+        ),
+        (
+            ico.replacen("  endfacet\n", "", 1),
+            "stl",
+            "line 8: expected 'endfacet' (facet 0), found 'facet normal 0 0 0'",
+        ),
+        (
+            ico.replace("endsolid ico\n", ""),
+            "stl",
+            "the file ends inside the solid, where 'facet normal' or 'endsolid' was expected",
+        ),
+        (
+            "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2".into(),
+            "off",
+            "line 6: the file ends inside the number '2', without a final newline",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3 ".into(),
+            "obj",
+            "line 5: the file ends inside the line 'f 1 2 4 3'",
+        ),
+        (
+            "# vtk DataFile Version 3.0\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 double\n0 0 0 1 0 0 0 1 0\nPOLYGONS 1 4\n3 0 1 2\nPOINT_DATA 3\nSCALARS s double 1\nLOOKUP_TABLE default\n1 2 0.8".into(),
+            "vtk",
+            "line 12: the file ends inside the number '0.8'",
+        ),
+    ];
+    for (text, ext, want) in cases {
+        let err = mesh_from_bytes(text.as_bytes(), ext).unwrap_err();
+        assert!(err.contains(want), "'{err}' should say '{want}'");
+    }
+    // A binary STL whose count is larger than its data.
+    let mut bin = std::fs::read(root.join("shapes/ico_binary.stl")).unwrap();
+    bin.truncate(bin.len() - 7);
+    let err = mesh_from_bytes(&bin, "stl").unwrap_err();
+    assert!(
+        err.contains("announcing 20 triangles") && err.contains("1084 bytes, this file 1077"),
+        "{err}"
+    );
+}
