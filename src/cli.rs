@@ -795,14 +795,20 @@ fn print_out(text: &str) {
 fn mesh_cmd(a: MeshArgs) -> Result<()> {
     let pos = |name: &str, v: Real| -> Result<()> {
         if !(v.is_finite() && v > 0.0) {
-            bail!("--{name} must be positive, got {v:e}");
+            bail!(
+                "--{name} must be positive, got {v_h}",
+                v_h = crate::math::human(v)
+            );
         }
         Ok(())
     };
     pos("edge", a.edge)?;
     pos("grading", a.grading)?;
     if !(0.0..0.5).contains(&a.jitter) {
-        bail!("--jitter must lie in [0, 0.5), got {:e}", a.jitter);
+        bail!(
+            "--jitter must lie in [0, 0.5), got {}",
+            crate::math::human(a.jitter)
+        );
     }
     let sp = Spacing {
         grading: a.grading,

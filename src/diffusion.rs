@@ -174,10 +174,8 @@ pub enum DiffusionError {
     /// The error control could not meet the tolerance with sub-steps down to `2^-40` of the
     /// step: the state or the conditions are not finite or not resolvable.
     #[error(
-        "the diffusion error control failed: sub-step {h:e} s still has an error estimate of {} \
-         times the tolerance",
-        crate::math::human(*.error)
-    )]
+        "the diffusion error control failed: sub-step {h_h} s still has an error estimate of {} \
+         times the tolerance", crate::math::human(*.error), h_h = crate::math::human(*.h))]
     StepControl {
         /// The last sub-step tried (s).
         h: Real,

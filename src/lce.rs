@@ -130,8 +130,10 @@ pub fn build(mesh: &Mesh, settings: &Settings) -> Result<Vec<LceFace>, MeshError
         let (lo, hi) = (lambda.min(lambda.powf(-nu)), lambda.max(lambda.powf(-nu)));
         if !(lo >= 1e-6 && hi <= 1e6) {
             return Err(mesh.invalid(format!(
-                "{source}: face {f} asks for stretches {lo:e} to {hi:e} (λ = {lambda}, ν = {nu}), \
-                 outside 1e-6..1e6"
+                "{source}: face {f} asks for stretches {lo_h} to {hi_h} (λ = {lambda}, ν = {nu}), \
+                 outside 1e-6..1e6",
+                lo_h = crate::math::human(lo),
+                hi_h = crate::math::human(hi)
             )));
         }
         out.push(LceFace::new(&reference_frame(mesh, f), theta, lambda, nu));

@@ -56,7 +56,8 @@ pub fn eig2(m: &Mat2) -> (Real, Real) {
 /// between 1e-3 and 1e5 (`0.7`, `0.7284`, `12.5`, `31416`), otherwise scientific with the
 /// mantissa's trailing zeros dropped (`1.5e-7`, `2.346e12`); `"not finite"` for NaN and
 /// infinities (messages, logs and summaries never carry `NaN` or `inf`).
-pub fn human(x: Real) -> String {
+pub fn human(x: impl std::borrow::Borrow<Real>) -> String {
+    let x = *x.borrow();
     if !x.is_finite() {
         return "not finite".into();
     }

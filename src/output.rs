@@ -60,7 +60,8 @@ pub enum OutputError {
     },
     /// A frame contained NaN or infinity; it was not written.
     #[error(
-        "frame {index} at t = {time:e} would hold a non-finite value in '{field}; not written"
+        "frame {index} at t = {} would hold a non-finite value in '{field}; not written",
+        crate::math::human(*.time)
     )]
     NonFinite {
         /// Frame index.

@@ -161,21 +161,23 @@ pub fn pulled_back_targets(
         let axy = abar_xy(f);
         if !(axy[0] > 0.0 && crate::math::sym_det(&axy) > 0.0) {
             return Err(mesh.invalid(format!(
-                "{what}: abar at face {f} is not positive definite: [{:e}, {:e}, {:e}]",
-                axy[0], axy[1], axy[2]
+                "{what}: abar at face {f} is not positive definite: [{}, {}, {}]",
+                crate::math::human(axy[0]),
+                crate::math::human(axy[1]),
+                crate::math::human(axy[2])
             )));
         }
         // Stretches beyond 1e±6 are no material's, and their squares overflow in the energy.
         let (lo, hi) = crate::math::eig2(&crate::math::sym_to_mat(&axy));
         if lo < MIN_METRIC || hi > 1.0 / MIN_METRIC {
             return Err(mesh.invalid(format!(
-                "{what}: abar at face {f}, [{:e}, {:e}, {:e}], asks for stretches {:e} to {:e}, \
+                "{what}: abar at face {f}, [{}, {}, {}], asks for stretches {} to {}, \
                  outside 1e-6..1e6",
-                axy[0],
-                axy[1],
-                axy[2],
-                lo.sqrt(),
-                hi.sqrt()
+                crate::math::human(axy[0]),
+                crate::math::human(axy[1]),
+                crate::math::human(axy[2]),
+                crate::math::human(lo.sqrt()),
+                crate::math::human(hi.sqrt())
             )));
         }
         let bxy = bbar_xy(f);
@@ -185,8 +187,10 @@ pub fn pulled_back_targets(
             .find(|c| !c.is_finite() || c.abs() * size > MAX_CURVATURE_TIMES_SIZE)
         {
             return Err(mesh.invalid(format!(
-                "{what}: bbar at face {f} has an entry {c:e} 1/m: a curvature radius below \
-                 1e-9 of the sheet's size ({size:e} m)"
+                "{what}: bbar at face {f} has an entry {c_h} 1/m: a curvature radius below \
+                 1e-9 of the sheet's size ({size_h} m)",
+                c_h = crate::math::human(c),
+                size_h = crate::math::human(size)
             )));
         }
         let t = reference_frame(mesh, f);

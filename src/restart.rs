@@ -114,7 +114,9 @@ fn check_time(scene: &Scene, t: Real) -> Result<(), String> {
     };
     if !(t.is_finite() && (0.0..=hi).contains(&t)) {
         return Err(format!(
-            "series.pvd gives the frame the {what} {t:e}, outside this run's [0, {hi:e}]"
+            "series.pvd gives the frame the {what} {t_h}, outside this run's [0, {hi_h}]",
+            t_h = crate::math::human(t),
+            hi_h = crate::math::human(hi)
         ));
     }
     Ok(())
@@ -180,10 +182,10 @@ pub fn restart_from_frame(
                 .position(|c| !c.is_finite() || c.abs() > crate::mesh::MAX_COORDINATE)
             {
                 return Err(bad(format!(
-                    "field 'velocity' at vertex {} is {:e} m/s, beyond ±{:e} m/s",
+                    "field 'velocity' at vertex {} is {} m/s, beyond ±{} m/s",
                     i / 3,
-                    f.data[i],
-                    crate::mesh::MAX_COORDINATE
+                    crate::math::human(f.data[i]),
+                    crate::math::human(crate::mesh::MAX_COORDINATE)
                 )));
             }
             Some(
@@ -212,9 +214,11 @@ pub fn restart_from_frame(
                             seen[e] = true;
                         } else if (phi[e] - val).abs() > EDGE_ANGLE_TOLERANCE {
                             return Err(bad(format!(
-                                "field 'edge_angles': the two faces of edge {:?} disagree ({:e} \
-                                 at face {fi} vs {:e})",
-                                scene.topo.edges[e], val, phi[e]
+                                "field 'edge_angles': the two faces of edge {:?} disagree ({} \
+                                 at face {fi} vs {})",
+                                scene.topo.edges[e],
+                                crate::math::human(val),
+                                crate::math::human(phi[e])
                             )));
                         }
                     }
@@ -398,8 +402,8 @@ pub fn read_ansatz(path: &Path, vertices: usize) -> Result<Option<(Real, Vec<Vec
                 return Err(bad(
                     line + 1,
                     format!(
-                        "coordinate {tok} is not finite or beyond ±{:e}",
-                        crate::mesh::MAX_COORDINATE
+                        "coordinate {tok} is not finite or beyond ±{}",
+                        crate::math::human(crate::mesh::MAX_COORDINATE)
                     ),
                 ));
             }

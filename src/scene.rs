@@ -86,8 +86,9 @@ fn positive_face_field(
             String::new()
         };
         return Err(mesh.invalid(format!(
-            "face field '{name}' must lie in (0, {max:e}], but face {i} has {:e}{placeholder}",
-            f.data[i]
+            "face field '{name}' must lie in (0, {}], but face {i} has {}{placeholder}",
+            crate::math::human(max),
+            crate::math::human(f.data[i])
         )));
     }
     Ok(Some(f.data.clone()))
@@ -139,9 +140,10 @@ impl Scene {
         let size = mesh.bbox_diagonal();
         if let Some(f) = thickness.iter().position(|&h| h > 10.0 * size) {
             return Err(mesh.invalid(format!(
-                "thickness {:e} m at face {f} is more than 10× the sheet's size ({size:e} m): \
+                "thickness {} m at face {f} is more than 10× the sheet's size ({size_h} m): \
                  not a thin shell",
-                thickness[f]
+                crate::math::human(thickness[f]),
+                size_h = crate::math::human(size)
             )));
         }
         let young = match positive_face_field(
@@ -361,9 +363,10 @@ impl Scene {
                 let p = g.penetration(v, x);
                 if g.area[v] > 0.0 && p > g.smoothing {
                     return Err(mesh.invalid(format!(
-                        "vertex {v} starts {p:.3e} m inside the ground (its surface, mid-surface \
+                        "vertex {v} starts {p_h} m inside the ground (its surface, mid-surface \
                          − h/2, is below the plane through contact.point with contact.normal); \
-                         move the plane or the mesh"
+                         move the plane or the mesh",
+                        p_h = crate::math::human(p)
                     )));
                 }
             }
@@ -829,9 +832,9 @@ impl GrowthInputs {
 pub enum GrowthError {
     /// A swelling stretch `1 + μ m` that is not positive.
     #[error(
-        "growth at face {face}: the stretch 1 + mu m = 1 + {worst:e} is not positive (mu {mu:e}, \
-         moisture top {top:e}, bottom {bottom:e}): a length cannot become ≤ 0"
-    )]
+        "growth at face {face}: the stretch 1 + mu m = 1 + {worst_h} is not positive (mu {mu_h}, \
+         moisture top {top_h}, bottom {bottom_h}): a length cannot become ≤ 0"
+    , worst_h = crate::math::human(*.worst), mu_h = crate::math::human(*.mu), top_h = crate::math::human(*.top), bottom_h = crate::math::human(*.bottom))]
     Stretch {
         /// The face.
         face: usize,
@@ -847,7 +850,9 @@ pub enum GrowthError {
     /// The law's `ā` is not positive definite (or `b̄` is not finite).
     #[error(
         "growth at face {face}: growth.law {law:?} makes abar non-positive-definite (moisture \
-         top {top:e}, bottom {bottom:e})"
+         top {}, bottom {})",
+        crate::math::human(*.top),
+        crate::math::human(*.bottom)
     )]
     NotPositiveDefinite {
         /// The face.

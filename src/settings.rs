@@ -1386,13 +1386,16 @@ impl Settings {
                 return inv(
                     "material.c1",
                     format!(
-                        "model = \"mooney_rivlin\" needs c1 > 0 (Pa), got {:e}",
-                        m.c1
+                        "model = \"mooney_rivlin\" needs c1 > 0 (Pa), got {}",
+                        crate::math::human(m.c1)
                     ),
                 );
             }
             if !(m.c2.is_finite() && m.c2 >= 0.0) {
-                return inv("material.c2", format!("must be ≥ 0 (Pa), got {:e}", m.c2));
+                return inv(
+                    "material.c2",
+                    format!("must be ≥ 0 (Pa), got {}", crate::math::human(m.c2)),
+                );
             }
         }
         if m.model == MaterialModel::Prism {
@@ -1429,8 +1432,8 @@ impl Settings {
             return inv(
                 "material.baraff_witkin.r",
                 format!(
-                    "must be ≥ 0 (a negative cubic term softens the strain limit), got {:e}",
-                    bw.r
+                    "must be ≥ 0 (a negative cubic term softens the strain limit), got {}",
+                    crate::math::human(bw.r)
                 ),
             );
         }
@@ -1439,7 +1442,10 @@ impl Settings {
                 if !(v.is_finite() && v > 0.0) {
                     return inv(
                         &format!("material.baraff_witkin.{key}"),
-                        format!("must be a positive number (Pa), got {v:e}"),
+                        format!(
+                            "must be a positive number (Pa), got {v_h}",
+                            v_h = crate::math::human(v)
+                        ),
                     );
                 }
             }
@@ -1484,9 +1490,10 @@ impl Settings {
             return ck.inv(
                 "material.young",
                 format!(
-                    "{:e} Pa is beyond {MAX_MODULUS:e} Pa (diamond is 1.2e12): energies of such a \
+                    "{} Pa is beyond {MAX_MODULUS_h} Pa (diamond is 1.2e12): energies of such a \
                      sheet overflow",
-                    m.young
+                    crate::math::human(m.young),
+                    MAX_MODULUS_h = crate::math::human(MAX_MODULUS)
                 ),
             );
         }
@@ -1505,7 +1512,9 @@ impl Settings {
                 return ck.inv(
                     key,
                     format!(
-                        "{v:e} {unit} is beyond {max:e} {unit}: energies of such a sheet overflow"
+                        "{v_h} {unit} is beyond {max_h} {unit}: energies of such a sheet overflow",
+                        v_h = crate::math::human(v),
+                        max_h = crate::math::human(max)
                     ),
                 );
             }
@@ -1513,7 +1522,10 @@ impl Settings {
         if !(m.poisson > -1.0 && m.poisson <= 0.5) {
             return ck.inv(
                 "material.poisson",
-                format!("must lie in (-1, 0.5], got {:e}", m.poisson),
+                format!(
+                    "must lie in (-1, 0.5], got {}",
+                    crate::math::human(m.poisson)
+                ),
             );
         }
         self.validate_material_model(name)?;
@@ -1529,7 +1541,10 @@ impl Settings {
                 let key = format!("rest.{name}[{i}]");
                 match v {
                     Field::Value(v) if !v.is_finite() => {
-                        return ck.inv(&key, format!("must be finite, got {v:e}"))
+                        return ck.inv(
+                            &key,
+                            format!("must be finite, got {v_h}", v_h = crate::math::human(v)),
+                        )
                     }
                     Field::Expr(_) => {
                         if let Err(e) = v.compile() {
@@ -1557,7 +1572,10 @@ impl Settings {
                 }
                 if let Some(v) = f.constant() {
                     if !v.is_finite() {
-                        return ck.inv(&key, format!("must be finite, got {v:e}"));
+                        return ck.inv(
+                            &key,
+                            format!("must be finite, got {v_h}", v_h = crate::math::human(v)),
+                        );
                     }
                 }
             }
@@ -1584,21 +1602,30 @@ impl Settings {
         if !(s.continuation_step > 0.0 && s.continuation_step <= 1.0) {
             return ck.inv(
                 "solver.continuation_step",
-                format!("must lie in (0, 1], got {:e}", s.continuation_step),
+                format!(
+                    "must lie in (0, 1], got {}",
+                    crate::math::human(s.continuation_step)
+                ),
             );
         }
         ck.pos("solver.min_continuation_step", s.min_continuation_step)?;
         if !(s.max_continuation_step > 0.0 && s.max_continuation_step <= 1.0) {
             return ck.inv(
                 "solver.max_continuation_step",
-                format!("must lie in (0, 1], got {:e}", s.max_continuation_step),
+                format!(
+                    "must lie in (0, 1], got {}",
+                    crate::math::human(s.max_continuation_step)
+                ),
             );
         }
         if let Softening::Factor(c) = s.membrane_continuation {
             if !(c >= 1.0 && c.is_finite()) {
                 return ck.inv(
                     "solver.membrane_continuation",
-                    format!("must be \"auto\" or a finite number ≥ 1, got {c:e}"),
+                    format!(
+                        "must be \"auto\" or a finite number ≥ 1, got {c_h}",
+                        c_h = crate::math::human(c)
+                    ),
                 );
             }
         }
@@ -1619,12 +1646,22 @@ impl Settings {
             ("growth.moisture_bottom", g.moisture_bottom),
         ] {
             if !v.is_finite() || v.abs() > MAX_MOISTURE {
-                return ck.inv(k, format!("must lie in ±{MAX_MOISTURE:e}, got {v:e}"));
+                return ck.inv(
+                    k,
+                    format!(
+                        "must lie in ±{MAX_MOISTURE_h}, got {v_h}",
+                        MAX_MOISTURE_h = crate::math::human(MAX_MOISTURE),
+                        v_h = crate::math::human(v)
+                    ),
+                );
             }
         }
         match &g.s {
             Field::Value(v) if !v.is_finite() => {
-                return ck.inv("growth.s", format!("must be finite, got {v:e}"))
+                return ck.inv(
+                    "growth.s",
+                    format!("must be finite, got {v_h}", v_h = crate::math::human(v)),
+                )
             }
             Field::Expr(_) => {
                 if let Err(e) = g.s.compile() {
@@ -1666,7 +1703,7 @@ impl Settings {
                 if !g.value.is_finite() {
                     return ck.inv(
                         "moisture.ground.value",
-                        format!("must be finite, got {:e}", g.value),
+                        format!("must be finite, got {}", crate::math::human(g.value)),
                     );
                 }
                 if let AutoOr::Value(d) = g.distance {
@@ -1691,21 +1728,29 @@ impl Settings {
                     "moisture.grading",
                     format!(
                         "must lie in 1..=10 with grading^(layers/2) ≤ 1e6 (thickest to thinnest \
-                         layer), got {:e} with {} layers",
-                        mo.grading, mo.layers
+                         layer), got {} with {} layers",
+                        crate::math::human(mo.grading),
+                        mo.layers
                     ),
                 );
             }
             if !(mo.tolerance >= 1e-10 && mo.tolerance <= 0.1) {
                 return ck.inv(
                     "moisture.tolerance",
-                    format!("must lie in 1e-10..=0.1, got {:e}", mo.tolerance),
+                    format!(
+                        "must lie in 1e-10..=0.1, got {}",
+                        crate::math::human(mo.tolerance)
+                    ),
                 );
             }
             if !mo.initial.is_finite() || mo.initial.abs() > MAX_MOISTURE {
                 return ck.inv(
                     "moisture.initial",
-                    format!("must lie in ±{MAX_MOISTURE:e}, got {:e}", mo.initial),
+                    format!(
+                        "must lie in ±{MAX_MOISTURE_h}, got {}",
+                        crate::math::human(mo.initial),
+                        MAX_MOISTURE_h = crate::math::human(MAX_MOISTURE)
+                    ),
                 );
             }
             if self.solver.mode != Mode::Dynamic {
@@ -1732,7 +1777,7 @@ impl Settings {
                     if !v.is_finite() {
                         return ck.inv(
                             &format!("moisture.boundary[{i}]"),
-                            format!("non-finite value {v:e}"),
+                            format!("non-finite value {v_h}", v_h = crate::math::human(v)),
                         );
                     }
                 }
@@ -1740,7 +1785,11 @@ impl Settings {
                     if v.abs() > MAX_MOISTURE {
                         return ck.inv(
                             &format!("moisture.boundary[{i}].{what}"),
-                            format!("must lie in ±{MAX_MOISTURE:e}, got {v:e}"),
+                            format!(
+                                "must lie in ±{MAX_MOISTURE_h}, got {v_h}",
+                                MAX_MOISTURE_h = crate::math::human(MAX_MOISTURE),
+                                v_h = crate::math::human(v)
+                            ),
                         );
                     }
                 }
@@ -1753,7 +1802,7 @@ impl Settings {
                 if b.kind == SurfaceKind::Robin && b.k < 0.0 {
                     return ck.inv(
                         &format!("moisture.boundary[{i}].k"),
-                        format!("must be ≥ 0, got {:e}", b.k),
+                        format!("must be ≥ 0, got {}", crate::math::human(b.k)),
                     );
                 }
             }
@@ -1776,8 +1825,10 @@ impl Settings {
             return ck.inv(
                 "time.dt",
                 format!(
-                    "need dt_min ≤ dt ≤ dt_max, got {:e} ≤ {:e} ≤ {:e}",
-                    t.dt_min, t.dt, t.dt_max
+                    "need dt_min ≤ dt ≤ dt_max, got {} ≤ {} ≤ {}",
+                    crate::math::human(t.dt_min),
+                    crate::math::human(t.dt),
+                    crate::math::human(t.dt_max)
                 ),
             );
         }
@@ -1787,9 +1838,12 @@ impl Settings {
             return ck.inv(
                 "time.end",
                 format!(
-                    "{:e} s at steps of at most time.dt_max = {:e} s is {steps:e} steps, more \
-                     than {MAX_STEPS:e}; raise time.dt_max or lower time.end",
-                    t.end, t.dt_max
+                    "{} s at steps of at most time.dt_max = {} s is {steps_h} steps, more \
+                     than {MAX_STEPS_h}; raise time.dt_max or lower time.end",
+                    crate::math::human(t.end),
+                    crate::math::human(t.dt_max),
+                    steps_h = crate::math::human(steps),
+                    MAX_STEPS_h = crate::math::human(MAX_STEPS)
                 ),
             );
         }
@@ -1798,9 +1852,12 @@ impl Settings {
             return ck.inv(
                 "time.output_interval",
                 format!(
-                    "{:e} s between frames over {:e} s is {frames:e} frames, more than \
-                     {MAX_FRAMES:e}",
-                    t.output_interval, t.end
+                    "{} s between frames over {} s is {frames_h} frames, more than \
+                     {MAX_FRAMES_h}",
+                    crate::math::human(t.output_interval),
+                    crate::math::human(t.end),
+                    frames_h = crate::math::human(frames),
+                    MAX_FRAMES_h = crate::math::human(MAX_FRAMES)
                 ),
             );
         }
@@ -1808,9 +1865,10 @@ impl Settings {
             return ck.inv(
                 "time.output_interval",
                 format!(
-                    "{:e} s is below time.dt_min = {:e} s: frames cannot be closer than the \
+                    "{} s is below time.dt_min = {} s: frames cannot be closer than the \
                      smallest step",
-                    t.output_interval, t.dt_min
+                    crate::math::human(t.output_interval),
+                    crate::math::human(t.dt_min)
                 ),
             );
         }
@@ -1836,7 +1894,11 @@ impl Settings {
             if !(v.is_finite() && v.abs() <= max) {
                 return ck.inv(
                     k,
-                    format!("must be finite within ±{max:e} {unit}, got {v:e}"),
+                    format!(
+                        "must be finite within ±{max_h} {unit}, got {v_h}",
+                        max_h = crate::math::human(max),
+                        v_h = crate::math::human(v)
+                    ),
                 );
             }
         }
@@ -1845,7 +1907,11 @@ impl Settings {
                 if !(v.is_finite() && v.abs() <= coordinate) {
                     return ck.inv(
                         k,
-                        format!("must be a finite height within ±{coordinate:e} m, got {v:e}"),
+                        format!(
+                            "must be a finite height within ±{coordinate_h} m, got {v_h}",
+                            coordinate_h = crate::math::human(coordinate),
+                            v_h = crate::math::human(v)
+                        ),
                     );
                 }
             }
@@ -1918,9 +1984,10 @@ impl Settings {
             return ck.inv(
                 "explicit.window_long_times",
                 format!(
-                    "a window of {:e} long times is longer than the run's limit, \
-                     explicit.max_long_times = {:e}: the equilibrium test could never run",
-                    e.window_long_times, e.max_long_times
+                    "a window of {} long times is longer than the run's limit, \
+                     explicit.max_long_times = {}: the equilibrium test could never run",
+                    crate::math::human(e.window_long_times),
+                    crate::math::human(e.max_long_times)
                 ),
             );
         }
@@ -1928,8 +1995,9 @@ impl Settings {
             return ck.inv(
                 "explicit.gradient_descent_steps",
                 format!(
-                    "{} steps is more than {MAX_STEPS:e}",
-                    e.gradient_descent_steps
+                    "{} steps is more than {MAX_STEPS_h}",
+                    e.gradient_descent_steps,
+                    MAX_STEPS_h = crate::math::human(MAX_STEPS)
                 ),
             );
         }
@@ -1937,8 +2005,10 @@ impl Settings {
             return ck.inv(
                 "explicit.frames_per_long_time",
                 format!(
-                    "{} frames per long time over {} long times is more than {MAX_FRAMES:e} frames",
-                    e.frames_per_long_time, e.max_long_times
+                    "{} frames per long time over {} long times is more than {MAX_FRAMES_h} frames",
+                    e.frames_per_long_time,
+                    e.max_long_times,
+                    MAX_FRAMES_h = crate::math::human(MAX_FRAMES)
                 ),
             );
         }
@@ -1982,8 +2052,9 @@ impl Settings {
             return ck.inv(
                 "loads.gravity",
                 format!(
-                    "must be finite with components within ±{MAX_GRAVITY:e} m/s², got {}",
-                    vec_e(g)
+                    "must be finite with components within ±{MAX_GRAVITY_h} m/s², got {}",
+                    vec_e(g),
+                    MAX_GRAVITY_h = crate::math::human(MAX_GRAVITY)
                 ),
             );
         }
@@ -1994,7 +2065,11 @@ impl Settings {
             } else {
                 ck.inv(
                     &key,
-                    format!("must be finite within ±{MAX_LOAD:e}, got {}", vec_e(v)),
+                    format!(
+                        "must be finite within ±{MAX_LOAD_h}, got {}",
+                        vec_e(v),
+                        MAX_LOAD_h = crate::math::human(MAX_LOAD)
+                    ),
                 )
             }
         };
@@ -2011,8 +2086,9 @@ impl Settings {
                 return ck.inv(
                     &format!("loads.pressure[{i}].pressure"),
                     format!(
-                        "must be finite within ±{MAX_LOAD:e} Pa, got {:e}",
-                        p.pressure
+                        "must be finite within ±{MAX_LOAD_h} Pa, got {}",
+                        crate::math::human(p.pressure),
+                        MAX_LOAD_h = crate::math::human(MAX_LOAD)
                     ),
                 );
             }
@@ -2023,8 +2099,9 @@ impl Settings {
                 return ck.inv(
                     &format!("loads.moment[{i}].moment"),
                     format!(
-                        "must be finite within ±{MAX_LOAD:e} N·m/m, got {:e}",
-                        m.moment
+                        "must be finite within ±{MAX_LOAD_h} N·m/m, got {}",
+                        crate::math::human(m.moment),
+                        MAX_LOAD_h = crate::math::human(MAX_LOAD)
                     ),
                 );
             }
@@ -2047,7 +2124,11 @@ impl Settings {
             } else {
                 ck.inv(
                     key,
-                    format!("must be finite within ±{MAX_LOAD:e} {unit}, got {v:e}"),
+                    format!(
+                        "must be finite within ±{MAX_LOAD_h} {unit}, got {v_h}",
+                        MAX_LOAD_h = crate::math::human(MAX_LOAD),
+                        v_h = crate::math::human(v)
+                    ),
                 )
             }
         };
@@ -2058,8 +2139,8 @@ impl Settings {
                         "gas.amount",
                         format!(
                             "amount control needs a positive amount of gas (p V at the reference \
-                             volume, J), got {:e}",
-                            g.amount
+                             volume, J), got {}",
+                            crate::math::human(g.amount)
                         ),
                     );
                 }
@@ -2071,8 +2152,8 @@ impl Settings {
                     return ck.inv(
                         "gas.volume",
                         format!(
-                            "volume control needs a positive enclosed volume (m³), got {:e}",
-                            g.volume
+                            "volume control needs a positive enclosed volume (m³), got {}",
+                            crate::math::human(g.volume)
                         ),
                     );
                 }
@@ -2085,7 +2166,10 @@ impl Settings {
         if !(g.gamma > 1.0 && g.gamma <= 10.0) {
             return ck.inv(
                 "gas.gamma",
-                format!("must lie in (1, 10] (1.4 for air), got {:e}", g.gamma),
+                format!(
+                    "must lie in (1, 10] (1.4 for air), got {}",
+                    crate::math::human(g.gamma)
+                ),
             );
         }
         Ok(())
@@ -2146,8 +2230,9 @@ impl Settings {
                 return ck.inv(
                     &format!("constraints.displacement[{i}].displacement"),
                     format!(
-                        "must be finite with components within ±{max:e} m, got {}",
-                        vec_e(&d.displacement)
+                        "must be finite with components within ±{max_h} m, got {}",
+                        vec_e(&d.displacement),
+                        max_h = crate::math::human(max)
                     ),
                 );
             }
@@ -2225,13 +2310,25 @@ impl Check<'_> {
     }
     fn pos(&self, key: &str, v: Real) -> Result<(), SettingsError> {
         if !(v.is_finite() && v > 0.0) {
-            return self.inv(key, format!("must be a positive number, got {v:e}"));
+            return self.inv(
+                key,
+                format!(
+                    "must be a positive number, got {v_h}",
+                    v_h = crate::math::human(v)
+                ),
+            );
         }
         Ok(())
     }
     fn nonneg(&self, key: &str, v: Real) -> Result<(), SettingsError> {
         if !(v.is_finite() && v >= 0.0) {
-            return self.inv(key, format!("must be a non-negative number, got {v:e}"));
+            return self.inv(
+                key,
+                format!(
+                    "must be a non-negative number, got {v_h}",
+                    v_h = crate::math::human(v)
+                ),
+            );
         }
         Ok(())
     }
@@ -2316,8 +2413,8 @@ impl<'de> Deserialize<'de> for Field {
     }
 }
 
-/// `[a, b, c]` with every number in `{:e}` form, for messages.
+/// `[a, b, c]` with every number as [`crate::math::human`] writes it, for messages.
 fn vec_e(v: &[Real]) -> String {
-    let parts: Vec<String> = v.iter().map(|x| format!("{x:e}")).collect();
+    let parts: Vec<String> = v.iter().map(crate::math::human).collect();
     format!("[{}]", parts.join(", "))
 }

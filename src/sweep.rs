@@ -31,7 +31,7 @@
 //! ```
 //!
 //! A folder is taken for a sweep folder when it holds `jobs.txt`, `run.sh` and `slurm.sh`;
-//! `--overwrite` replaces one (see [`clear`]) and nothing else: a sweep is written only into a
+//! `--overwrite` replaces one (see `clear`) and nothing else: a sweep is written only into a
 //! new or empty folder or over a sweep.
 
 use crate::settings::{apply_overrides, Settings};
@@ -246,11 +246,13 @@ impl Plan {
         let count = match total {
             Some(n) => n.to_string(),
             None => format!(
-                "about {:.4e}",
-                self.axes
-                    .iter()
-                    .map(|(_, a)| a.len() as f64)
-                    .product::<f64>()
+                "about {}",
+                crate::math::human(
+                    self.axes
+                        .iter()
+                        .map(|(_, a)| a.len() as f64)
+                        .product::<f64>()
+                )
             ),
         };
         let mut sizes: Vec<String> = self.axes.iter().map(|(_, a)| a.len().to_string()).collect();
@@ -818,7 +820,7 @@ mod tests {
         let e = plan(&grid(64, "1, 2")).count("f").unwrap_err().to_string();
         assert!(e.contains("18446744073709551616 runs"), "{e}");
         let e = plan(&grid(130, "1, 2")).count("f").unwrap_err().to_string();
-        assert!(e.contains("about 1.3611e39 runs"), "{e}");
+        assert!(e.contains("about 1.361e39 runs"), "{e}");
         // Run i is the grid's combination i, the last key fastest.
         let p = plan(&grid(64, "1, 2"));
         let last = p.point(1);

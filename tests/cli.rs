@@ -1910,7 +1910,7 @@ fn mesh_arguments_beyond_the_bound_are_refused() {
     let r = run(&["mesh", "square", "--edge", "1e-5", "-o", "m.vtk"], p);
     assert!(
         r.stderr
-            .contains("--edge and --size would make about 2.000e10 faces, more than the 1e7"),
+            .contains("--edge and --size would make about 2e10 faces, more than the 1e7"),
         "{}",
         r.stderr
     );
@@ -1984,4 +1984,50 @@ fn unknown_mesh_fields_warn() {
         let expected = if args.contains(&"--restart") { 2 } else { 0 };
         assert_eq!(unknown.count(), expected, "{}", r.stderr);
     }
+}
+
+/// An explicit run with a pressed glass slide, restarted from one of its frames, takes the
+/// uninterrupted run's steps: its time, dial, equilibrium windows, frame times and the slide's
+/// height and speed come back from the frame's state, and every later frame is the same to the
+/// bit.
+#[test]
+fn restart_follows_the_uninterrupted_explicit_run_exactly() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let d = tmp();
+    let p = d.path();
+    let settings = root
+        .join("settings/cone_squeezed.toml")
+        .display()
+        .to_string();
+    let mesh = root.join("meshes/squeeze_disk.vtk").display().to_string();
+    let r = run(&[&settings, &mesh, "--out", "full", "-q"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let n = frames(&p.join("full"));
+    assert!(n > 6, "{n} frames");
+    let k = n / 2;
+    let from = format!("full/frame_{k:05}.vtu");
+    let r = run(
+        &[&settings, &mesh, "--out", "re", "-q", "--restart", &from],
+        p,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_eq!(frames(&p.join("re")), n - k);
+    for j in 1..n - k {
+        assert!(
+            frame_state(&p.join("full"), k + j) == frame_state(&p.join("re"), j),
+            "frame {j} of the restart differs from frame {} of the whole run",
+            k + j
+        );
+    }
+    let log = |o: &str| std::fs::read_to_string(p.join(o).join("log.csv")).unwrap();
+    let slide = |o: &str| -> Vec<String> {
+        let text = log(o);
+        let mut lines = text.lines();
+        let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let c = head.iter().position(|h| *h == "slide_upper_z").unwrap();
+        lines
+            .map(|l| l.split(',').nth(c).unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(slide("full")[k..], slide("re")[..], "the slide's height");
 }

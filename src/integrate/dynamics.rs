@@ -17,11 +17,14 @@ pub(super) fn run_dynamic(
     writer: &mut Writer,
     progress: &mut dyn Progress,
     mut state: State,
-    v0: Option<Vec<Vec3>>,
-    t0: Real,
-    dial0: Option<Real>,
-    driver: Option<super::DriverState>,
+    from: super::Resume,
 ) -> Result<(), RunError> {
+    let super::Resume {
+        v: v0,
+        t0,
+        dial: dial0,
+        driver,
+    } = from;
     let sc = s.scene;
     // A restart with the driver's state resumes at its exact time (series.pvd rounds it).
     if let Some(d) = &driver {
@@ -93,36 +96,26 @@ pub(super) fn run_dynamic(
     if let Some(d) = &driver {
         steps.resume(d.step, d.easy_steps);
     }
-    // What a frame's state file records (see `DriverState`).
-    let record = |t: Real,
-                  dial: Real,
-                  steps: &StepControl,
-                  holding: bool,
-                  next_hold: Option<usize>,
-                  holds_reached: usize,
-                  moisture: &Option<Moisture>| super::DriverState {
-        time: t,
-        dial,
-        step: Some(steps.step),
-        easy_steps: steps.easy(),
-        holding,
-        next_hold,
-        holds_reached,
-        moisture: moisture.as_ref().map(|m| m.u.clone()),
-        diffusion_substep: moisture.as_ref().map(|m| m.diffusion.next_substep()),
-        ..Default::default()
-    };
+    // What a frame's state file records at time `t` (see `DriverState`).
+    macro_rules! record {
+        ($t:expr) => {
+            super::DriverState {
+                time: $t,
+                dial: dial_now,
+                step: Some(steps.step),
+                easy_steps: steps.easy(),
+                holding,
+                next_hold,
+                holds_reached,
+                moisture: moisture.as_ref().map(|m| m.u.clone()),
+                diffusion_substep: moisture.as_ref().map(|m| m.diffusion.next_substep()),
+                ..Default::default()
+            }
+        };
+    }
     {
         let pot = accepted(s.potential(dial_now), moisture.as_ref(), &targets);
-        s.driver = record(
-            t0,
-            dial_now,
-            &steps,
-            holding,
-            next_hold,
-            holds_reached,
-            &moisture,
-        );
+        s.driver = record!(t0);
         s.frame(writer, &pot, &state, &v, t0)?;
     }
     // Friction: the lagged normal forces, carried from step to step.
@@ -337,15 +330,7 @@ pub(super) fn run_dynamic(
                 m.publish(writer);
             }
             let pot = accepted(s.potential(dial), moisture.as_ref(), &targets);
-            s.driver = record(
-                t,
-                dial_now,
-                &steps,
-                holding,
-                next_hold,
-                holds_reached,
-                &moisture,
-            );
+            s.driver = record!(t);
             s.frame(writer, &pot, &state, &v, t)?;
             clock.passed(t, h, eps_t);
         }
@@ -356,15 +341,7 @@ pub(super) fn run_dynamic(
     s.summary.time = Some(t);
     s.summary.dial = dial_now;
     s.summary.holds_reached = holds_reached;
-    s.driver = record(
-        t,
-        dial_now,
-        &steps,
-        holding,
-        next_hold,
-        holds_reached,
-        &moisture,
-    );
+    s.driver = record!(t);
     s.summary.converged = failure.is_none();
     s.summary.reason = failure.map(|f| f.to_string()).unwrap_or_default();
     let pot = accepted(s.potential(dial_now), moisture.as_ref(), &targets);

@@ -184,24 +184,26 @@ pub fn check(scene: &Scene) -> Result<(), String> {
     ] {
         // The drag per step, c Δt = p · 2 ω_L Δt, against its limit 2.
         let per_unit = 2.0 * sca.omega_long * dt;
-        if !(p * per_unit < 2.0) {
+        // NaN fails too.
+        if (p * per_unit).is_nan() || p * per_unit >= 2.0 {
             return Err(format!(
-                "invalid '{key}': {p:e} gives a drag of c Δt = {} per time step (c = {p:e} × 2 \
+                "invalid '{key}': {p_h} gives a drag of c Δt = {} per time step (c = {p_h} × 2 \
                  ω_L, ω_L = {} rad/s, Δt = {} s); symplectic Euler's drag is unstable from c Δt \
                  = 2, so this mesh and time step allow at most {}",
                 human(p * per_unit),
                 human(sca.omega_long),
                 human(dt),
-                human(2.0 / per_unit)
+                human(2.0 / per_unit),
+                p_h = crate::math::human(p)
             ));
         }
     }
     let steps = cf.gradient_descent_steps as Real + cf.max_long_times * sca.long_time / dt;
     let max = crate::settings::MAX_STEPS;
-    if !(steps <= max) {
+    if steps.is_nan() || steps > max {
         return Err(format!(
             "invalid 'explicit.max_long_times': {} long times of T = {} s at the time step Δt = \
-             {} s (explicit.time_step_prefactor = {}) is {} steps, more than {max:e}. T/Δt is \
+             {} s (explicit.time_step_prefactor = {}) is {} steps, more than {max_h}. T/Δt is \
              set by the mesh and the material (thinnest thickness {} m, from \
              material.thickness or the mesh's ref_thicknesses; smallest altitude {} m; sample \
              length {} m): lower explicit.max_long_times, raise explicit.time_step_prefactor \
@@ -213,7 +215,8 @@ pub fn check(scene: &Scene) -> Result<(), String> {
             human(steps),
             human(sca.t),
             human(sca.a_min),
-            human(sca.length)
+            human(sca.length),
+            max_h = crate::math::human(max)
         ));
     }
     Ok(())
@@ -509,16 +512,53 @@ struct Window {
     energy: Real,
 }
 
+/// What an explicit run's frame records for an exact restart (see `DriverState`).
+#[allow(clippy::too_many_arguments)]
+fn saved(
+    t: Real,
+    dial: Real,
+    phase: Phase,
+    next_hold: Option<usize>,
+    holds_reached: usize,
+    next_frame: Real,
+    steps: usize,
+    gd_left: usize,
+    energy_floor: Real,
+    window: &Window,
+) -> super::DriverState {
+    let mut e = std::collections::BTreeMap::new();
+    e.insert("phase".into(), if phase == Phase::Dial { 0.0 } else { 1.0 });
+    e.insert("next_frame".into(), next_frame);
+    e.insert("steps".into(), steps as Real);
+    e.insert("gradient_descent_left".into(), gd_left as Real);
+    e.insert("energy_floor".into(), energy_floor);
+    if window.energy.is_finite() {
+        e.insert("window_energy".into(), window.energy);
+    }
+    super::DriverState {
+        time: t,
+        dial,
+        next_hold,
+        holds_reached,
+        explicit: e,
+        window_positions: Some(window.x.iter().flat_map(|p| [p.x, p.y, p.z]).collect()),
+        ..Default::default()
+    }
+}
+
 pub(super) fn run_explicit(
     s: &mut Solver,
     writer: &mut Writer,
     progress: &mut dyn Progress,
     mut state: State,
-    v0: Option<Vec<Vec3>>,
-    t0: Real,
-    dial0: Option<Real>,
-    _driver: Option<super::DriverState>,
+    from: super::Resume,
 ) -> Result<(), RunError> {
+    let super::Resume {
+        v: v0,
+        t0,
+        dial: dial0,
+        driver,
+    } = from;
     let sc = s.scene;
     let cf = sc.settings.explicit.clone();
     let holds = sc.settings.dial.holds.clone();
@@ -597,6 +637,7 @@ pub(super) fn run_explicit(
         dial = holds[next_hold.unwrap_or(0)];
         phase = Phase::Wait;
     }
+    let mut holds_reached = 0;
     let mut v = v0.unwrap_or_else(|| vec![Vec3::zeros(); n]);
     let mut g = vec![0.0; s.pattern.n];
     // The frames' residuals are taken here: `g` carries a test step's forces to its update.
@@ -606,15 +647,10 @@ pub(super) fn run_explicit(
     let mut next_frame = t0 + frame_interval;
     let window_steps = ((cf.window_long_times * sca.long_time / dt).round() as usize).max(1);
     let t_max = cf.max_long_times * sca.long_time;
-    {
-        let pot = s.potential(dial);
-        s.summary.residual = residual_at(&pot, &state.x, &mut scratch);
-        s.frame(writer, &pot, &state, &v, t)?;
-    }
     // The energy scale of the window test: the energy itself, but at least 1e-6 of the
     // target's energy in the starting shape (a compatible target relaxes to Φ ≈ 0, where a
     // test relative to Φ alone would ask for round-off).
-    let energy_floor = {
+    let mut energy_floor = {
         let pot = s.potential(1.0);
         1e-6 * gradient(&pot, &state.x, &mut g).abs()
     };
@@ -623,8 +659,70 @@ pub(super) fn run_explicit(
         energy: Real::NAN,
     };
     let mut gd_left = cf.gradient_descent_steps;
-    let clock = std::time::Instant::now();
     let mut steps: usize = 0;
+    // A restart with the driver's state resumes its exact time, phase, windows and frames.
+    if let Some(d) = &driver {
+        let get = |k: &str| d.explicit.get(k).copied();
+        let bad = |what: &str| {
+            RunError::Restart(format!("the frame's explicit state has no valid '{what}'"))
+        };
+        t = d.time;
+        dial = d.dial.clamp(0.0, 1.0);
+        next_hold = d.next_hold.filter(|&k| k < holds.len());
+        holds_reached = d.holds_reached;
+        phase = match get("phase") {
+            Some(0.0) => Phase::Dial,
+            Some(1.0) => Phase::Wait,
+            _ => return Err(bad("phase")),
+        };
+        let count = |k: &str| match get(k) {
+            Some(c) if c >= 0.0 && c.fract() == 0.0 && c < 1e15 => Ok(c as usize),
+            _ => Err(bad(k)),
+        };
+        steps = count("steps")?;
+        gd_left = count("gradient_descent_left")?;
+        next_frame = get("next_frame")
+            .filter(|f| f.is_finite())
+            .ok_or_else(|| bad("next_frame"))?;
+        energy_floor = get("energy_floor")
+            .filter(|f| f.is_finite())
+            .ok_or_else(|| bad("energy_floor"))?;
+        window.energy = get("window_energy").unwrap_or(Real::NAN);
+        match &d.window_positions {
+            Some(w) if w.len() == 3 * n && w.iter().all(|c| c.is_finite()) => {
+                for (i, p) in window.x.iter_mut().enumerate() {
+                    *p = Vec3::new(w[3 * i], w[3 * i + 1], w[3 * i + 2]);
+                }
+            }
+            _ => return Err(bad("window_positions")),
+        }
+    }
+    s.summary.holds_reached = holds_reached;
+    report.holds_reached = holds_reached;
+    // The driver's state as a frame records it.
+    macro_rules! state_now {
+        () => {
+            saved(
+                t,
+                dial,
+                phase,
+                next_hold,
+                holds_reached,
+                next_frame,
+                steps,
+                gd_left,
+                energy_floor,
+                &window,
+            )
+        };
+    }
+    {
+        let pot = s.potential(dial);
+        s.summary.residual = residual_at(&pot, &state.x, &mut scratch);
+        s.driver = state_now!();
+        s.frame(writer, &pot, &state, &v, t)?;
+    }
+    let clock = std::time::Instant::now();
     // The densities at a dial that stays put (holds, waiting), computed once.
     let mut frozen: Option<(Real, Vec<crate::energy::material::KoiterDensity>)> = None;
     // The steps' gradients run on a team of spinning threads: a step is too short for rayon's
@@ -688,12 +786,15 @@ pub(super) fn run_explicit(
                     .sum();
                 if !healthy || kinetic > blow_up {
                     break Stop::Unstable(format!(
-                    "the explicit dynamics went unstable at t = {t:.6e} s (energy {energy:e} J, \
-                     kinetic {kinetic:e} J): lower explicit.time_step_prefactor (now {}, this \
+                        "the explicit dynamics went unstable at t = {t_h} s (energy {energy_h} J, \
+                     kinetic {kinetic_h} J): lower explicit.time_step_prefactor (now {}, this \
                      mesh's measured limit {})",
-                    cf.time_step_prefactor,
-                    stable_prefactor.map_or("unknown".into(), |p| format!("{p:.3}"))
-                ));
+                        cf.time_step_prefactor,
+                        stable_prefactor.map_or("unknown".into(), |p| format!("{p:.3}")),
+                        t_h = crate::math::human(t),
+                        energy_h = crate::math::human(energy),
+                        kinetic_h = crate::math::human(kinetic)
+                    ));
                 }
                 // A load the sheet can never balance (a pressed slide past the sheet) stops the
                 // run; one not balanced yet keeps it going.
@@ -740,13 +841,15 @@ pub(super) fn run_explicit(
                     if dial >= 1.0 {
                         break Stop::Converged;
                     }
-                    report.holds_reached += 1;
-                    s.summary.holds_reached += 1;
+                    holds_reached += 1;
+                    report.holds_reached = holds_reached;
+                    s.summary.holds_reached = holds_reached;
                     phase = Phase::Dial;
                     let pot = s.potential(dial);
                     s.summary.residual = residual_at(&pot, &state.x, &mut scratch);
-                    s.frame(writer, &pot, &state, &v, t)?;
                     next_frame = t + frame_interval;
+                    s.driver = state_now!();
+                    s.frame(writer, &pot, &state, &v, t)?;
                 }
             }
             // The step.
@@ -795,14 +898,16 @@ pub(super) fn run_explicit(
                 let healthy = state.x.iter().all(|p| p.iter().all(|c| c.is_finite()));
                 if !healthy {
                     break Stop::Unstable(format!(
-                        "the explicit dynamics went unstable at t = {t:.6e} s (a position is not \
+                        "the explicit dynamics went unstable at t = {t_h} s (a position is not \
                      finite): lower explicit.time_step_prefactor (now {})",
-                        cf.time_step_prefactor
+                        cf.time_step_prefactor,
+                        t_h = crate::math::human(t)
                     ));
                 }
                 s.summary.residual = residual_at(&pot, &state.x, &mut scratch);
-                s.frame(writer, &pot, &state, &v, t)?;
                 next_frame += frame_interval;
+                s.driver = state_now!();
+                s.frame(writer, &pot, &state, &v, t)?;
                 progress.update(
                     if phase == Phase::Dial {
                         0.5 * dial
@@ -810,12 +915,16 @@ pub(super) fn run_explicit(
                         0.5 + 0.5 * (t / t_max).min(1.0)
                     },
                     &format!(
-                        "explicit {}  t {t:.4e} s  dial {dial:.3}  E {energy:.4e} J",
+                        "explicit {}  t {} s  dt {} s  dial {}  E {} J",
                         if phase == Phase::Dial {
                             "dialling"
                         } else {
                             "waiting"
-                        }
+                        },
+                        human(t),
+                        human(dt),
+                        human(dial),
+                        human(energy)
                     ),
                 );
             }
@@ -830,6 +939,7 @@ pub(super) fn run_explicit(
     s.summary.time = Some(t);
     s.summary.dial = dial;
     s.summary.explicit = Some(report);
+    s.driver = state_now!();
     match stop {
         Stop::Converged => {
             s.summary.converged = true;
@@ -849,9 +959,11 @@ pub(super) fn run_explicit(
             s.summary.reason = match stop {
                 Stop::Other(reason) => reason,
                 _ => format!(
-                    "no equilibrium after explicit.max_long_times = {} long times ({t:.6e} s); \
-                     residual {:.3e}",
-                    cf.max_long_times, s.summary.residual
+                    "no equilibrium after explicit.max_long_times = {} long times ({t_h} s); \
+                     residual {}",
+                    cf.max_long_times,
+                    crate::math::human(s.summary.residual),
+                    t_h = crate::math::human(t)
                 ),
             };
             s.summary.energy = Writer::energies(&pot, &state, &v);

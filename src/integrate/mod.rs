@@ -75,7 +75,7 @@ pub enum RunError {
 #[non_exhaustive]
 pub enum RunFailure {
     /// Statics: the dial increment was halved below `solver.min_continuation_step`.
-    #[error("continuation step fell below {min:e} at dial {dial:.6}: {cause}")]
+    #[error("continuation step fell below {min_h} at dial {dial:.6}: {cause}", min_h = crate::math::human(*.min))]
     ContinuationStep {
         /// The minimum increment.
         min: Real,
@@ -102,7 +102,7 @@ pub enum RunFailure {
         cause: SolveError,
     },
     /// Statics: raising the stretching weight back to 1 failed.
-    #[error("membrane continuation stalled at stretching weight {scale:.3e}: {cause}")]
+    #[error("membrane continuation stalled at stretching weight {scale_h}: {cause}", scale_h = crate::math::human(*.scale))]
     MembraneContinuation {
         /// The stretching weight reached.
         scale: Real,
@@ -119,7 +119,7 @@ pub enum RunFailure {
     #[error("after escaping a saddle: {0}")]
     AfterSaddle(SolveError),
     /// Dynamics: the time step was halved below `time.dt_min`.
-    #[error("time step fell below dt_min = {dt_min:e} at t = {t:.6e}: {cause}")]
+    #[error("time step fell below dt_min = {dt_min_h} at t = {t_h}: {cause}", dt_min_h = crate::math::human(*.dt_min), t_h = crate::math::human(*.t))]
     TimeStep {
         /// The minimum time step (s).
         dt_min: Real,
@@ -129,7 +129,7 @@ pub enum RunFailure {
         cause: SolveError,
     },
     /// A signal (SIGINT, SIGTERM) asked the run to stop; the state reached is the last frame.
-    #[error("interrupted by {signal} at {what} {at:e}")]
+    #[error("interrupted by {signal} at {what} {at_h}", at_h = crate::math::human(*.at))]
     Interrupted {
         /// The signal's name.
         signal: &'static str,
@@ -139,7 +139,7 @@ pub enum RunFailure {
         at: Real,
     },
     /// Dynamics: the moisture boundary conditions could not be switched.
-    #[error("moisture at t = {t:.6e}: {source}")]
+    #[error("moisture at t = {t_h}: {source}", t_h = crate::math::human(*.t))]
     MoistureSurface {
         /// The time reached (s).
         t: Real,
@@ -147,7 +147,7 @@ pub enum RunFailure {
         source: crate::diffusion::SurfaceError,
     },
     /// Dynamics: the moisture diffusion solve failed.
-    #[error("moisture diffusion at t = {t:.6e}: {source}")]
+    #[error("moisture diffusion at t = {t_h}: {source}", t_h = crate::math::human(*.t))]
     Diffusion {
         /// The time reached (s).
         t: Real,
@@ -155,7 +155,7 @@ pub enum RunFailure {
         source: crate::diffusion::DiffusionError,
     },
     /// Dynamics: the moisture made a rest form invalid.
-    #[error("at t = {t:.6e}: {source}")]
+    #[error("at t = {t_h}: {source}", t_h = crate::math::human(*.t))]
     Growth {
         /// The time reached (s).
         t: Real,
@@ -657,8 +657,21 @@ pub struct DriverState {
     /// Terms' states that no frame field carries (a gas's pressure multiplier, a moving slide),
     /// by term name.
     pub terms: std::collections::BTreeMap<String, Vec<Real>>,
-    /// The explicit driver's own counters (its phase, equilibrium windows, next frame time).
+    /// The explicit driver's own numbers: `phase` (0 dialling, 1 waiting), `next_frame` (s),
+    /// `steps` (since its start, which align the equilibrium windows), `gradient_descent_left`,
+    /// `energy_floor` (J) and `window_energy` (J, absent before the first window).
     pub explicit: std::collections::BTreeMap<String, Real>,
+    /// The explicit driver's positions at its last equilibrium window (x, y, z per vertex).
+    pub window_positions: Option<Vec<Real>>,
+}
+
+/// Where a dynamic or explicit driver starts: the velocities (at rest when `None`), the time,
+/// the dial when the restart file gives it, and the driver's saved state.
+pub(super) struct Resume {
+    v: Option<Vec<Vec3>>,
+    t0: Real,
+    dial: Option<Real>,
+    driver: Option<DriverState>,
 }
 
 /// A state to start from instead of the reference mesh (a restart).
@@ -709,13 +722,18 @@ pub fn run(
     }
     let ran = match s.config.mode {
         Mode::Static => statics::run_static(&mut s, writer, progress, state, dial.or(start)),
-        Mode::Dynamic => {
-            let t0 = start.unwrap_or(0.0);
-            dynamics::run_dynamic(&mut s, writer, progress, state, v, t0, dial, driver)
-        }
-        Mode::Explicit => {
-            let t0 = start.unwrap_or(0.0);
-            explicit::run_explicit(&mut s, writer, progress, state, v, t0, dial, driver)
+        Mode::Dynamic | Mode::Explicit => {
+            let from = Resume {
+                v,
+                t0: start.unwrap_or(0.0),
+                dial,
+                driver,
+            };
+            if s.config.mode == Mode::Dynamic {
+                dynamics::run_dynamic(&mut s, writer, progress, state, from)
+            } else {
+                explicit::run_explicit(&mut s, writer, progress, state, from)
+            }
         }
     };
     match ran {

@@ -187,7 +187,8 @@ impl<'a> Reader<'a> {
                     Ok(x as usize)
                 } else {
                     Err(format!(
-                        "line {line}, {section}: value {i} is {x:e}, not an index or count"
+                        "line {line}, {section}: value {i} is {x_h}, not an index or count",
+                        x_h = crate::math::human(x)
                     ))
                 }
             })

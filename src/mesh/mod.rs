@@ -335,7 +335,7 @@ impl Mesh {
     /// face's shift `k` (0: not rotated): its new corner `j` is its old corner `(k + j) mod 3`.
     pub fn anchor_faces_at_wide_angles(&mut self) -> Vec<u8> {
         let mut shift = vec![0u8; self.faces.len()];
-        for f in 0..self.faces.len() {
+        for (f, shift) in shift.iter_mut().enumerate() {
             let [a, b, c] = self.faces[f];
             let p = [self.positions[a], self.positions[b], self.positions[c]];
             let sine = |k: usize| {
@@ -359,7 +359,7 @@ impl Mesh {
                         }
                     }
                 }
-                shift[f] = best as u8;
+                *shift = best as u8;
             }
         }
         shift
@@ -379,16 +379,20 @@ impl Mesh {
         for (i, p) in self.positions.iter().enumerate() {
             if !p.iter().all(|c| c.is_finite()) {
                 return Err(self.invalid(format!(
-                    "vertex {i} has a non-finite coordinate ({:e}, {:e}, {:e})",
-                    p.x, p.y, p.z
+                    "vertex {i} has a non-finite coordinate ({}, {}, {})",
+                    crate::math::human(p.x),
+                    crate::math::human(p.y),
+                    crate::math::human(p.z)
                 )));
             }
         }
         for (i, p) in self.positions.iter().enumerate() {
             if let Some(c) = p.iter().find(|c| c.abs() > MAX_COORDINATE) {
                 return Err(self.invalid(format!(
-                    "vertex {i} has a coordinate {c:e} m, beyond ±{MAX_COORDINATE:e} m: rescale \
-                     the mesh (energies of such a sheet overflow)"
+                    "vertex {i} has a coordinate {c_h} m, beyond ±{MAX_COORDINATE_h} m: rescale \
+                     the mesh (energies of such a sheet overflow)",
+                    c_h = crate::math::human(c),
+                    MAX_COORDINATE_h = crate::math::human(MAX_COORDINATE)
                 )));
             }
         }
@@ -411,7 +415,8 @@ impl Mesh {
             if cr <= 1e-12 {
                 return Err(self.invalid(format!(
                     "face {fi} {f:?} has zero area (degenerate triangle: twice its area is \
-                     {cr:e} of its longest edge squared)"
+                     {} of its longest edge squared)",
+                    crate::math::human(cr)
                 )));
             }
         }

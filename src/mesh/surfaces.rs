@@ -195,7 +195,8 @@ impl Implicit<'_> {
             let dot = n.dot(&g);
             if dot.is_nan() || dot <= 0.0 {
                 return Err(format!(
-                    "face {i} turned over while meshing (try a finer --edge than {mean_edge:e})"
+                    "face {i} turned over while meshing (try a finer --edge than {})",
+                    crate::math::human(mean_edge)
                 ));
             }
         }

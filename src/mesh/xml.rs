@@ -551,7 +551,10 @@ fn as_indices(v: &[Real], node: &Node, what: &str) -> Result<Vec<usize>, Fail> {
             if x >= 0.0 && x.fract() == 0.0 && x < 1e15 {
                 Ok(x as usize)
             } else {
-                Err(node.at(format!("{what} entry {i} is {x:e}, not an index")))
+                Err(node.at(format!(
+                    "{what} entry {i} is {x_h}, not an index",
+                    x_h = crate::math::human(x)
+                )))
             }
         })
         .collect()

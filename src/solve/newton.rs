@@ -376,8 +376,9 @@ pub fn newton(
             rep.converged = true;
             if VERBOSE.load(std::sync::atomic::Ordering::Relaxed) {
                 eprintln!(
-                    "newton {:>3}: energy {e:+.9e} J  residual {:.3e}  converged",
-                    rep.iterations, rep.residual
+                    "newton {:>3}: energy {e:+.9e} J  residual {}  converged",
+                    rep.iterations,
+                    crate::math::human(rep.residual)
                 );
             }
             return rep;
@@ -513,11 +514,11 @@ pub fn newton(
         rep.timing.line_search += clock.elapsed().as_secs_f64();
         if VERBOSE.load(std::sync::atomic::Ordering::Relaxed) {
             eprintln!(
-                "newton {:>3}: energy {:+.9e} J  residual {:.3e}  shift {:.1e}  step {:.4}{}{}",
+                "newton {:>3}: energy {:+.9e} J  residual {}  shift {}  step {:.4}{}{}",
                 rep.iterations,
                 e,
-                rep.residual,
-                tau,
+                crate::math::human(rep.residual),
+                crate::math::human(tau),
                 alpha,
                 if projected { "  gauss-newton" } else { "" },
                 if accepted {

@@ -323,8 +323,8 @@ pub fn build_patches(
         };
         if cond > MAX_CONDITION {
             warnings.push(format!(
-                "patch_fit: face {f}: best patch {nodes:?} has condition number {cond:.3e} > {MAX_CONDITION:.0e}; used anyway"
-            ));
+                "patch_fit: face {f}: best patch {nodes:?} has condition number {cond_h} > {MAX_CONDITION_h}; used anyway"
+            , cond_h = crate::math::human(cond), MAX_CONDITION_h = crate::math::human(MAX_CONDITION)));
         }
         // Cartesian weights: ∂xx R = 2 c3/ℓ², ∂xy R = c4/ℓ², ∂yy R = 2 c5/ℓ², c = M⁻¹ R.
         let l2 = ell * ell;
