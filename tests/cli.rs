@@ -1655,6 +1655,16 @@ fn run_folders_record_what_made_them() {
         std::fs::read(p.join("again/frame_00001.vtu")).unwrap(),
         "the resolved settings give the same frame"
     );
+    // ParaView names the tensor components.
+    let raw = std::fs::read(p.join("o/frame_00001.vtu")).unwrap();
+    let raw = String::from_utf8_lossy(&raw);
+    assert!(
+        raw.contains(
+            "Name=\"abar\" NumberOfComponents=\"3\" ComponentName0=\"xx\" \
+             ComponentName1=\"xy\" ComponentName2=\"yy\""
+        ),
+        "component names"
+    );
     // --overwrite removes the provenance with the rest of the earlier run.
     let r = run(&["s.toml", "m.vtk", "--out", "o", "--overwrite", "-q"], p);
     assert_eq!(r.code, 0, "{}", r.stderr);
@@ -2030,4 +2040,54 @@ fn restart_follows_the_uninterrupted_explicit_run_exactly() {
             .collect()
     };
     assert_eq!(slide("full")[k..], slide("re")[..], "the slide's height");
+}
+
+/// A frame that cannot be written (here its temporary file's name is taken by a folder, as a
+/// full disk would refuse it) stops the run with the frames, the series and the log in step
+/// and a summary saying why; `--overwrite` then removes every file of that run, frames it wrote
+/// under another `output.prefix` included.
+#[test]
+fn a_failed_write_leaves_the_folder_in_step() {
+    let d = tmp();
+    let p = d.path();
+    write(p, "m.vtk", TWO_TRIANGLES);
+    let dynamic = "[material]\nthickness = 0.05\n[solver]\nmode = \"dynamic\"\n[time]\nend = 0.1\ndt = 0.01\ndt_max = 0.01\noutput_interval = 0.01\n[output]\nprefix = \"step\"\n";
+    write(p, "dyn.toml", dynamic);
+    std::fs::create_dir_all(p.join("o/.step_00003.vtu.tmp")).unwrap();
+    let r = run(&["dyn.toml", "m.vtk", "--out", "o", "-q"], p);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("step_00003.vtu"), "{}", r.stderr);
+    let o = p.join("o");
+    let listed = shellsim::output::series_entries(&o.join("series.pvd")).unwrap();
+    assert_eq!(listed.len(), 3, "{listed:?}");
+    for (k, (_, f)) in listed.iter().enumerate() {
+        assert_eq!(f, &format!("step_{k:05}.vtu"));
+        assert!(o.join(f).exists());
+    }
+    assert!(!o.join("step_00003.vtu").exists());
+    assert!(!o.join("step_00003.state.json").exists());
+    let log = std::fs::read_to_string(o.join("log.csv")).unwrap();
+    assert_eq!(log.lines().count(), 4, "{log}");
+    let s = summary_of(p, "o");
+    assert_eq!(s["converged"], false);
+    assert!(
+        s["reason"].as_str().unwrap().starts_with("output failed"),
+        "{s}"
+    );
+    assert!(!o.join(".shellsim.reserve").exists());
+    // The default prefix now: --overwrite removes the `step_*` frames too.
+    std::fs::remove_dir(o.join(".step_00003.vtu.tmp")).unwrap();
+    let plain = dynamic.replace("[output]\nprefix = \"step\"\n", "");
+    write(p, "plain.toml", &plain);
+    let r = run(
+        &["plain.toml", "m.vtk", "--out", "o", "-q", "--overwrite"],
+        p,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let left: Vec<String> = std::fs::read_dir(&o)
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().to_str().map(String::from))
+        .filter(|n| n.starts_with("step_"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
 }

@@ -144,6 +144,18 @@ fn escape(s: &str) -> String {
     o
 }
 
+/// The names ParaView shows for the components of a frame's multi-component fields: the
+/// symmetric tensors `a`, `b`, `abar`, `bbar` as `[xx, xy, yy]` (reference Cartesian
+/// coordinates), and the per-corner slot fields as the edges opposite `v0`, `v1`, `v2`.
+/// Vectors (positions, `displacement`, `velocity`, stress directions) keep VTK's X, Y, Z.
+fn component_names(name: &str, comps: usize) -> Option<[&'static str; 3]> {
+    match (name, comps) {
+        ("a" | "b" | "abar" | "bbar", 3) => Some(["xx", "xy", "yy"]),
+        ("edge_angles" | "moment_turn", 3) => Some(["opposite_v0", "opposite_v1", "opposite_v2"]),
+        _ => None,
+    }
+}
+
 /// Serialises a triangle mesh with its fields; the field named `n` is written as Float32 when
 /// `single(n)`.
 pub fn vtu_bytes(mesh: &Mesh, opts: &VtuOptions, single: &dyn Fn(&str) -> bool) -> Vec<u8> {
@@ -227,6 +239,11 @@ pub fn vtu_bytes(mesh: &Mesh, opts: &VtuOptions, single: &dyn Fn(&str) -> bool) 
             "        <DataArray type=\"{}\"{named} NumberOfComponents=\"{comps}\"",
             v.type_name()
         );
+        if let Some(names) = component_names(name, *comps).filter(|_| *sec != "Points") {
+            for (i, c) in names.iter().enumerate() {
+                let _ = write!(x, " ComponentName{i}=\"{c}\"");
+            }
+        }
         match opts.encoding {
             Encoding::Appended => {
                 let _ = writeln!(x, " format=\"appended\" offset=\"{offset}\"/>");
