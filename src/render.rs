@@ -633,6 +633,11 @@ pub fn ticks(lo: Real, hi: Real, n: usize) -> Vec<Real> {
 /// Ticks of a logarithmic axis over [lo, hi] (both > 0): powers of ten (every k-th when there
 /// are many), else 1, 2 and 5 times them, else linear ticks.
 pub fn log_ticks(lo: Real, hi: Real) -> Vec<Real> {
+    // Decades exist only for a positive, finite span (a zero or infinite end would make the
+    // exponents overflow and the list unbounded).
+    if !(lo > 0.0 && hi.is_finite() && lo <= hi) {
+        return Vec::new();
+    }
     let (a, b) = (lo.log10().ceil() as i32, hi.log10().floor() as i32);
     if b - a >= 1 {
         let every = ((b - a) / 8 + 1).max(1);
@@ -950,5 +955,6 @@ mod tests {
     fn log_ticks_are_decades_or_their_multiples() {
         assert_eq!(log_ticks(0.5e-3, 2.0), vec![1e-3, 1e-2, 1e-1, 1.0]);
         assert_eq!(log_ticks(1.5, 9.0), vec![2.0, 5.0]);
+        assert!(log_ticks(0.0, 1.0).is_empty() && log_ticks(1.0, Real::INFINITY).is_empty());
     }
 }

@@ -310,10 +310,17 @@ fn prescribed_displacement_follows_the_dial() {
     let frames = s["frames"].as_u64().unwrap();
     assert!(frames >= 3, "{frames} frames");
     let log = std::fs::read_to_string(dir.join("od/log.csv")).unwrap();
+    let dial_col = log
+        .lines()
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|h| h == "dial")
+        .unwrap();
     let dials: Vec<f64> = log
         .lines()
         .skip(1)
-        .map(|l| l.split(',').nth(2).unwrap().parse().unwrap())
+        .map(|l| l.split(',').nth(dial_col).unwrap().parse().unwrap())
         .collect();
     let mesh = shellsim::mesh::io::read_mesh(&dir.join("r.vtk")).unwrap();
     for (k, dial) in dials.iter().enumerate() {
@@ -378,10 +385,11 @@ fn end_moment_rolls_a_strip_along_the_elastica() {
         let log = std::fs::read_to_string(dir.join(&out).join("log.csv")).unwrap();
         let header: Vec<&str> = log.lines().next().unwrap().split(',').collect();
         assert!(header.contains(&"moment_rotation"), "{header:?}");
+        let dial_col = header.iter().position(|h| *h == "dial").unwrap();
         let dials: Vec<f64> = log
             .lines()
             .skip(1)
-            .map(|l| l.split(',').nth(2).unwrap().parse().unwrap())
+            .map(|l| l.split(',').nth(dial_col).unwrap().parse().unwrap())
             .collect();
         assert_eq!(*dials.last().unwrap(), 1.0);
         // The tip has turned through the full circle (and not by its value modulo 2π).
