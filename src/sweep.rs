@@ -760,6 +760,23 @@ pub fn collect(dirs: &[PathBuf]) -> Result<String> {
         if let Some(p) = read("sweep_point.json")? {
             cells("", &p, &mut row);
         }
+        // What made the run (its latest invocation in run.json).
+        if let Some(prov) = read("run.json")? {
+            if let Some(last) = prov["runs"].as_array().and_then(|r| r.last()) {
+                let overrides: Vec<&str> = last["overrides"]
+                    .as_array()
+                    .map(|o| o.iter().filter_map(|v| v.as_str()).collect())
+                    .unwrap_or_default();
+                let made = serde_json::json!({
+                    "shellsim_version": last["shellsim_version"],
+                    "commit": last["commit"],
+                    "overrides": overrides.join(" "),
+                    "mesh_sha256": last["mesh"]["sha256"],
+                    "started": last["started"],
+                });
+                cells("run", &made, &mut row);
+            }
+        }
         match read("summary.json")? {
             Some(s) => {
                 row[1].1 = "done".into();

@@ -66,9 +66,13 @@ fn a_two_by_two_sweep_runs_and_collects() {
         col("status"),
         col("energy.total"),
     );
+    // What made each run, from its run.json.
+    let (cv, cm) = (col("run.shellsim_version"), col("run.mesh_sha256"));
     let mut energies = Vec::new();
     for (i, r) in rows.iter().enumerate() {
         assert_eq!(r[cs], "done", "{table}");
+        assert_eq!(r[cv], env!("CARGO_PKG_VERSION"), "{table}");
+        assert_eq!(r[cm].len(), 64, "{table}");
         let t: f64 = r[ct].parse().unwrap();
         let y: f64 = r[cy].parse().unwrap();
         assert_eq!(
