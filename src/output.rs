@@ -378,8 +378,6 @@ pub struct Writer {
     restart_fields: std::collections::BTreeSet<String>,
     /// Static runs: `log.csv` has no time column (the dial is the run's progress).
     static_mode: bool,
-    /// The resolved settings, written into the folder with the provenance.
-    settings_snapshot: crate::settings::Settings,
     /// `log.csv` rows of the frames a continued series keeps, verbatim, and its header.
     kept_log: Option<(String, Vec<String>)>,
     /// A continued series: the first frame (the restart state, already in the series) is not
@@ -406,6 +404,13 @@ impl Drop for Reserve {
 
 /// The resolved settings' file in a run folder ([`crate::provenance`]).
 pub const RESOLVED_SETTINGS: &str = "settings.resolved.toml";
+
+/// Writes the run's resolved settings ([`RESOLVED_SETTINGS`]) into `dir`, once per run.
+fn write_resolved_settings(dir: &Path, scene: &Scene) -> Result<(), OutputError> {
+    let path = dir.join(RESOLVED_SETTINGS);
+    let text = toml::to_string(&scene.settings).map_err(|e| ioerr(&path, e))?;
+    write_atomic(&path, text.as_bytes()).map_err(|e| ioerr(&path, e))
+}
 
 /// Bytes set aside in `.shellsim.reserve` while a run writes, released when the disk fills.
 const RESERVE_BYTES: usize = 1 << 20;
@@ -699,6 +704,7 @@ impl Writer {
             }
         }
         let reserve = Self::set_aside(dir)?;
+        write_resolved_settings(dir, scene)?;
         Ok(Writer {
             dir: dir.to_path_buf(),
             reserve: Some(reserve),
@@ -784,20 +790,15 @@ impl Writer {
             .and_then(|t| serde_json::from_str(&t).ok());
         w.skip_first = true;
         w.reserve = Some(Self::set_aside(dir)?);
+        write_resolved_settings(dir, scene)?;
         w._lock = Some(lock);
         w.write_series()?;
         w.write_log()?;
         Ok(w)
     }
 
-    /// Writes `run.json` (and, the first time, the resolved settings) into the folder.
-    pub fn provenance(
-        &mut self,
-        record: &crate::provenance::Provenance,
-    ) -> Result<(), OutputError> {
-        let settings = self.dir.join(RESOLVED_SETTINGS);
-        let text = toml::to_string(&self.settings_snapshot).map_err(|e| ioerr(&settings, e))?;
-        write_atomic(&settings, text.as_bytes()).map_err(|e| ioerr(&settings, e))?;
+    /// Writes `run.json` into the folder.
+    pub fn provenance(&self, record: &crate::provenance::Provenance) -> Result<(), OutputError> {
         crate::provenance::write(&self.dir, record)
             .map_err(|e| ioerr(&crate::provenance::path(&self.dir), e))
     }
@@ -853,7 +854,6 @@ impl Writer {
             skip_first: false,
             previous_summary: None,
             reserve: None,
-            settings_snapshot: scene.settings.clone(),
             _lock: None,
         }
     }

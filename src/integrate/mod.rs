@@ -665,6 +665,19 @@ pub struct DriverState {
     pub window_positions: Option<Vec<Real>>,
 }
 
+impl DriverState {
+    /// A static run's state: the dial (its time too) and the step control.
+    fn at_dial(dial: Real, steps: &StepControl) -> Self {
+        DriverState {
+            time: dial,
+            dial,
+            step: Some(steps.step),
+            easy_steps: steps.easy(),
+            ..Default::default()
+        }
+    }
+}
+
 /// Where a dynamic or explicit driver starts: the velocities (at rest when `None`), the time,
 /// the dial when the restart file gives it, and the driver's saved state.
 pub(super) struct Resume {

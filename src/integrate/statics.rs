@@ -124,13 +124,7 @@ pub(super) fn run_static(
             }
             if (cont_frames || at_hold) && dial < 1.0 {
                 let pot = s.potential(dial);
-                s.driver = super::DriverState {
-                    time: dial,
-                    dial,
-                    step: Some(steps.step),
-                    easy_steps: steps.easy(),
-                    ..Default::default()
-                };
+                s.driver = super::DriverState::at_dial(dial, &steps);
                 s.frame(writer, &pot, &state, &zeros, dial)?;
             }
         } else if dial < 1.0 {
@@ -203,13 +197,7 @@ pub(super) fn run_static(
     s.summary.reason = failure.map(|f| f.to_string()).unwrap_or_default();
     let pot = s.potential(dial);
     s.summary.energy = Writer::energies(&pot, &state, &zeros);
-    s.driver = super::DriverState {
-        time: dial,
-        dial,
-        step: Some(steps.step),
-        easy_steps: steps.easy(),
-        ..Default::default()
-    };
+    s.driver = super::DriverState::at_dial(dial, &steps);
     // The series' time of a static frame is its dial (a failed run's last frame included).
     s.frame(writer, &pot, &state, &zeros, dial)?;
     Ok(())
