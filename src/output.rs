@@ -454,14 +454,7 @@ pub fn series_entries(path: &Path) -> Result<Vec<(Real, String)>, String> {
     Ok(out)
 }
 
-/// The state file written beside a frame (`frame_00003.vtu` → `frame_00003.state.json`).
-pub fn state_file(frame: &Path) -> PathBuf {
-    let stem = frame
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    frame.with_file_name(format!("{stem}.state.json"))
-}
+pub use crate::restart::state_file;
 
 /// The fields a restart of `scene` reads from a frame: the velocity (dynamic modes), the edge
 /// angles (edge-DOF bending) and the terms' states.

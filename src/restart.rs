@@ -64,7 +64,7 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
         warnings.push(format!(
             "{name}: no {} beside it; the step control, holds and moisture start afresh, so \
              the run does not follow the uninterrupted one exactly",
-            crate::output::state_file(path)
+            state_file(path)
                 .file_name()
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default()
@@ -82,10 +82,20 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
     ))
 }
 
+/// The state file written beside a frame (`frame_00003.vtu` → `frame_00003.state.json`): the
+/// driver's state that a restart reads ([`crate::integrate::DriverState`]).
+pub fn state_file(frame: &Path) -> std::path::PathBuf {
+    let stem = frame
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    frame.with_file_name(format!("{stem}.state.json"))
+}
+
 /// The driver's state written beside the frame `path` (`None` when there is none); a file that
 /// is not one is an error naming it.
 fn read_driver_state(path: &Path) -> Result<Option<crate::integrate::DriverState>, MeshError> {
-    let p = crate::output::state_file(path);
+    let p = state_file(path);
     let text = match std::fs::read_to_string(&p) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
