@@ -9,7 +9,7 @@ use crate::integrate::{run, Progress, Quiet};
 use crate::math::{Real, Vec3};
 use crate::mesh::delaunay::{delaunay_annulus, delaunay_rectangle};
 use crate::mesh::generate::{
-    annulus, annulus_faces, check_planned, rectangle, rectangle_faces, Spacing,
+    annulus, annulus_faces, check_planned_within, rectangle, rectangle_faces, Spacing, MAX_FACES,
 };
 use crate::mesh::io::{read_mesh, write_mesh, Format};
 use crate::mesh::Topology;
@@ -36,7 +36,7 @@ use std::process::ExitCode;
 )]
 pub struct Cli {
     #[command(subcommand)]
-    command: Option<Command>,
+    pub(crate) command: Option<Command>,
     /// Settings file (TOML); see docs/settings.md.
     #[arg(required = true)]
     settings: Option<PathBuf>,
@@ -77,7 +77,7 @@ pub struct Cli {
 }
 
 #[derive(Subcommand, Debug)]
-enum Command {
+pub(crate) enum Command {
     /// Write a generated triangle mesh.
     Mesh(MeshArgs),
     /// Error of a frame written by shellsim against an analytic case (prints JSON).
@@ -97,7 +97,7 @@ enum Command {
 }
 
 #[derive(clap::Args, Debug)]
-struct PlotArgs {
+pub(crate) struct PlotArgs {
     /// A run folder (its log.csv is read) or a log.csv.
     run: PathBuf,
     /// Output PNG (default: plot.png in the run folder).
@@ -119,7 +119,7 @@ struct PlotArgs {
 }
 
 #[derive(clap::Args, Debug)]
-struct RenderArgs {
+pub(crate) struct RenderArgs {
     /// A frame (or any mesh file shellsim reads).
     frame: PathBuf,
     /// Output PNG (default: the frame's name with .png).
@@ -144,7 +144,7 @@ struct RenderArgs {
 }
 
 #[derive(clap::Args, Debug)]
-struct SweepArgs {
+pub(crate) struct SweepArgs {
     /// Sweep file (TOML: settings, mesh, [grid], [[points]], out, args).
     file: PathBuf,
     /// Sweep folder (default: the file's `out`, else its name without .toml).
@@ -159,7 +159,7 @@ struct SweepArgs {
 }
 
 #[derive(clap::Args, Debug)]
-struct CollectArgs {
+pub(crate) struct CollectArgs {
     /// Run folders, or folders of runs (a sweep folder).
     #[arg(required = true)]
     dirs: Vec<PathBuf>,
@@ -169,7 +169,7 @@ struct CollectArgs {
 }
 
 #[derive(clap::Args, Debug)]
-struct ImportArgs {
+pub(crate) struct ImportArgs {
     /// MorphoShell settings file (`name = value;` lines in its reader's order).
     settings: PathBuf,
     /// The mesh the settings go with (needed only to convert a moving slide's speed).
@@ -211,7 +211,7 @@ enum MeshFormat {
 }
 
 #[derive(clap::Args, Debug)]
-struct MeshArgs {
+pub(crate) struct MeshArgs {
     /// Shape to mesh.
     shape: Shape,
     /// Output file.
@@ -270,7 +270,7 @@ struct MeshArgs {
 }
 
 #[derive(clap::Args, Debug)]
-struct ErrorArgs {
+pub(crate) struct ErrorArgs {
     /// Analytic case (enlarged_square, spherical_cap, hyperboloid, rhombus, cylinder).
     case: String,
     /// A frame written by shellsim (its reference positions are positions − displacement).
@@ -338,6 +338,25 @@ fn plot_cmd(a: PlotArgs) -> Result<()> {
     };
     let name = log.display().to_string();
     let text = std::fs::read_to_string(&log).map_err(|e| anyhow!("{name}: {e}"))?;
+    let canvas = plot_log(&text, &name, a.x.as_deref(), &a.y, (w, h), a.log_y)?;
+    let out = a.out.unwrap_or_else(|| {
+        log.parent()
+            .map(|d| d.join("plot.png"))
+            .unwrap_or_else(|| PathBuf::from("plot.png"))
+    });
+    canvas.save_png(&out)
+}
+
+/// The plot of the text of a log.csv (named `name` in messages): the columns `y`
+/// (comma-separated) over `x` (default: time, else the dial), into a `size` picture.
+pub(crate) fn plot_log(
+    text: &str,
+    name: &str,
+    x: Option<&str>,
+    y: &str,
+    (w, h): (usize, usize),
+    log_y: bool,
+) -> Result<crate::render::Canvas> {
     let mut lines = text.lines();
     let head: Vec<&str> = lines
         .next()
@@ -350,18 +369,18 @@ fn plot_cmd(a: PlotArgs) -> Result<()> {
             .position(|h| *h == c)
             .ok_or_else(|| anyhow!("{name}: no column '{c}'; it has: {}", head.join(", ")))
     };
-    let x = match &a.x {
+    let x = match x {
         Some(x) => x.trim().to_string(),
         None if head.contains(&"time") => "time".into(),
         None => "dial".into(),
     };
     let xi = col(&x)?;
-    let ys: Vec<(String, usize)> =
-        a.y.split(',')
-            .map(str::trim)
-            .filter(|c| !c.is_empty())
-            .map(|c| col(c).map(|i| (c.to_string(), i)))
-            .collect::<Result<_>>()?;
+    let ys: Vec<(String, usize)> = y
+        .split(',')
+        .map(str::trim)
+        .filter(|c| !c.is_empty())
+        .map(|c| col(c).map(|i| (c.to_string(), i)))
+        .collect::<Result<_>>()?;
     if ys.is_empty() {
         bail!("--y names no column");
     }
@@ -382,31 +401,50 @@ fn plot_cmd(a: PlotArgs) -> Result<()> {
             )
         })
         .collect();
-    let canvas =
-        crate::render::plot(&x, &series, w, h, a.log_y).map_err(|e| anyhow!("{name}: {e}"))?;
-    let out = a.out.unwrap_or_else(|| {
-        log.parent()
-            .map(|d| d.join("plot.png"))
-            .unwrap_or_else(|| PathBuf::from("plot.png"))
-    });
-    canvas.save_png(&out)
+    crate::render::plot(&x, &series, w, h, log_y).map_err(|e| anyhow!("{name}: {e}"))
 }
 
 /// `shellsim render`: reads the frame, draws it, writes the PNG (nothing on an error).
 fn render_cmd(a: RenderArgs) -> Result<()> {
     let (w, h) = picture_size(&a.size)?;
     let mesh = read_mesh(&a.frame)?;
+    let name = a.frame.display().to_string();
+    let canvas = render_frame(
+        &mesh,
+        &name,
+        a.field,
+        &a.view,
+        (w, h),
+        a.range.as_deref(),
+        a.shading,
+    )?;
+    let out = a.out.unwrap_or_else(|| a.frame.with_extension("png"));
+    canvas.save_png(&out)
+}
+
+/// The picture of a frame read from `name`: checked as every reader checks a mesh, coloured by
+/// `field` (default: mean_curvature if there is one) over `range` (`LOW,HIGH`; default: the
+/// field's own).
+pub(crate) fn render_frame(
+    mesh: &crate::mesh::Mesh,
+    name: &str,
+    field: Option<String>,
+    view: &str,
+    (w, h): (usize, usize),
+    range: Option<&str>,
+    shading: crate::render::Shading,
+) -> Result<crate::render::Canvas> {
     // The checks every reader of a mesh makes (face indices in range, finite coordinates,
     // field lengths), before anything is drawn.
     mesh.validate()?;
-    let field = match a.field {
+    let field = match field {
         Some(f) => Some(f),
         None => ["mean_curvature"]
             .into_iter()
             .map(String::from)
             .find(|f| mesh.face_fields.contains_key(f)),
     };
-    let range = match &a.range {
+    let range = match range {
         None => None,
         Some(r) => Some(
             number_pair::<Real>(r, &[','])
@@ -414,11 +452,8 @@ fn render_cmd(a: RenderArgs) -> Result<()> {
                 .ok_or_else(|| anyhow!("--range '{r}': expected LOW,HIGH with LOW < HIGH"))?,
         ),
     };
-    let name = a.frame.display().to_string();
-    let canvas = crate::render::render(&mesh, field.as_deref(), &a.view, w, h, range, a.shading)
-        .map_err(|e| anyhow!("{name}: {e}"))?;
-    let out = a.out.unwrap_or_else(|| a.frame.with_extension("png"));
-    canvas.save_png(&out)
+    crate::render::render(mesh, field.as_deref(), view, w, h, range, shading)
+        .map_err(|e| anyhow!("{name}: {e}"))
 }
 
 /// `shellsim sweep`: writes the sweep folder; with `--run`, runs its jobs (with this binary
@@ -482,7 +517,7 @@ fn sweep_cmd(a: SweepArgs) -> Result<u8> {
 /// The `--set` overrides of a sweep's extra run arguments (its `args`), parsed by this
 /// binary's own parser after the arguments every job gives, as on a job's command line; an
 /// argument the parser refuses is an error naming it.
-fn sweep_run_overrides(args: &[String]) -> Result<Vec<String>> {
+pub(crate) fn sweep_run_overrides(args: &[String]) -> Result<Vec<String>> {
     let job = [
         "shellsim",
         "settings.toml",
@@ -523,12 +558,27 @@ fn import_cmd(a: ImportArgs) -> Result<()> {
     let name = a.settings.display().to_string();
     let text =
         std::fs::read_to_string(&a.settings).map_err(|e| anyhow!("{name}: cannot read: {e}"))?;
-    let m = crate::morphoshell::parse(&text, &name)?;
+    let toml = import_text(&text, &name, a.mesh.as_deref())?;
+    match a.out {
+        Some(p) => std::fs::write(&p, toml).map_err(|e| anyhow!("{}: {e}", p.display()))?,
+        None => print!("{toml}"),
+    }
+    Ok(())
+}
+
+/// The shellsim settings file of the text of a MorphoShell settings file read from `name`,
+/// checked to be one shellsim accepts. `mesh` is read only to convert a moving slide's speed.
+pub(crate) fn import_text(
+    text: &str,
+    name: &str,
+    mesh: Option<&std::path::Path>,
+) -> Result<String> {
+    let m = crate::morphoshell::parse(text, name)?;
     // A moving slide's speed is p × L / T_bend: from the mesh, with the translated material.
-    let speed = match &a.mesh {
+    let speed = match mesh {
         Some(mp) if m.get("slide_speed_prefactor") != 0.0 => {
-            let draft = crate::morphoshell::to_toml(&m, &name, Some(0.0))?;
-            let settings = Settings::from_str_with(&draft, &name, &[])?;
+            let draft = crate::morphoshell::to_toml(&m, name, Some(0.0))?;
+            let settings = Settings::from_str_with(&draft, name, &[])?;
             let scene = Scene::build(read_mesh(mp)?, settings)?;
             let sc = crate::integrate::explicit::Scales::of(&scene);
             let t_bend = 2.0 * std::f64::consts::PI / sc.omega_long;
@@ -536,14 +586,10 @@ fn import_cmd(a: ImportArgs) -> Result<()> {
         }
         _ => None,
     };
-    let toml = crate::morphoshell::to_toml(&m, &name, speed)?;
+    let toml = crate::morphoshell::to_toml(&m, name, speed)?;
     // The result must be a valid shellsim settings file.
     Settings::from_str_with(&toml, &format!("{name} (converted)"), &[])?;
-    match a.out {
-        Some(p) => std::fs::write(&p, toml).map_err(|e| anyhow!("{}: {e}", p.display()))?,
-        None => print!("{toml}"),
-    }
-    Ok(())
+    Ok(toml)
 }
 
 struct Bar(indicatif::ProgressBar);
@@ -793,6 +839,34 @@ fn print_out(text: &str) {
 }
 
 fn mesh_cmd(a: MeshArgs) -> Result<()> {
+    let mesh = build_mesh(&a, MAX_FACES)?;
+    let ext = a.out.extension().and_then(|s| s.to_str()).unwrap_or("");
+    let format = match (a.format, ext) {
+        (Some(MeshFormat::Vtk), _) => Format::Vtk,
+        (Some(MeshFormat::VtkAscii), _) => Format::VtkAscii,
+        (Some(MeshFormat::Vtu), _) => Format::Vtu,
+        (None, "vtu") => Format::Vtu,
+        (None, "vtk") => Format::Vtk,
+        (None, other) => bail!(
+            "{}: unknown extension '.{other}' (use .vtk or .vtu)",
+            a.out.display()
+        ),
+    };
+    write_mesh(&a.out, &mesh, format, "shellsim generated mesh")?;
+    print_out(&format!(
+        "{}: {} vertices, {} faces",
+        a.out.display(),
+        mesh.positions.len(),
+        mesh.faces.len()
+    ));
+    Ok(())
+}
+
+/// The mesh `shellsim mesh` writes for its arguments, checked (validation and topology), and
+/// refused before anything is allocated when it would have more than `max_faces` faces.
+pub(crate) fn build_mesh(a: &MeshArgs, max_faces: Real) -> Result<crate::mesh::Mesh> {
+    let check_planned =
+        |count: Real, what: &str, args: &str| check_planned_within(count, max_faces, what, args);
     let pos = |name: &str, v: Real| -> Result<()> {
         if !(v.is_finite() && v > 0.0) {
             bail!(
@@ -907,7 +981,7 @@ fn mesh_cmd(a: MeshArgs) -> Result<()> {
                 );
             }
             let name = format!("{:?}", a.shape).to_lowercase();
-            crate::mesh::surfaces::closed_shape(&name, a.radius, a.edge)
+            crate::mesh::surfaces::closed_shape_within(&name, a.radius, a.edge, max_faces)
                 .map_err(|e| anyhow!("cannot mesh the {name}: {e}"))?
         }
         Shape::Torus => {
@@ -946,26 +1020,7 @@ fn mesh_cmd(a: MeshArgs) -> Result<()> {
     }
     mesh.validate()?;
     Topology::build(&mesh)?;
-    let ext = a.out.extension().and_then(|s| s.to_str()).unwrap_or("");
-    let format = match (a.format, ext) {
-        (Some(MeshFormat::Vtk), _) => Format::Vtk,
-        (Some(MeshFormat::VtkAscii), _) => Format::VtkAscii,
-        (Some(MeshFormat::Vtu), _) => Format::Vtu,
-        (None, "vtu") => Format::Vtu,
-        (None, "vtk") => Format::Vtk,
-        (None, other) => bail!(
-            "{}: unknown extension '.{other}' (use .vtk or .vtu)",
-            a.out.display()
-        ),
-    };
-    write_mesh(&a.out, &mesh, format, "shellsim generated mesh")?;
-    print_out(&format!(
-        "{}: {} vertices, {} faces",
-        a.out.display(),
-        mesh.positions.len(),
-        mesh.faces.len()
-    ));
-    Ok(())
+    Ok(mesh)
 }
 
 fn error_cmd(a: ErrorArgs) -> Result<()> {

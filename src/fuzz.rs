@@ -1,6 +1,7 @@
 //! An in-process fuzzer on stable Rust for shellsim's input paths: legacy VTK, XML VTK, the
-//! shape-collection formats (OFF, OBJ, PLY, STL), the settings (through [`Scene::build`]) and
-//! restart frames.
+//! shape-collection formats (OFF, OBJ, PLY, STL), the settings (through [`Scene::build`]),
+//! restart frames, and the commands' own inputs: frames drawn by `render`, logs drawn by
+//! `plot`, `mesh`'s arguments, sweep files and MorphoShell settings files.
 //!
 //! Each execution takes a seed input, applies one to four structured mutations (truncation,
 //! bit flips, a number replaced by an extreme one, a count edited, a span deleted, duplicated or
@@ -35,11 +36,33 @@ pub enum Target {
     Ply,
     /// `.stl` bytes (ASCII and binary) → mesh → validation → topology.
     Stl,
+    /// `.vtu`/`.vtk` frame bytes → mesh → `render`'s checks and picture (small), coloured by
+    /// the default field, by one of the mesh's fields and by a field it lacks.
+    Render,
+    /// `log.csv` bytes → `plot`'s columns and picture (small).
+    Plot,
+    /// `shellsim mesh` arguments, one a line → the real parser → the mesh (at most
+    /// [`MESH_FACES`] faces), checked, not written.
+    Mesh,
+    /// Sweep file text → the sweep's checks and run count, nothing read or written.
+    Sweep,
+    /// MorphoShell settings text → `import-morphoshell`'s translation → settings.
+    ImportMorphoshell,
 }
+
+/// The most faces a mesh of the `mesh` target may have (larger ones are refused before they
+/// are generated, as `shellsim mesh` refuses more than [`crate::mesh::generate::MAX_FACES`]).
+pub const MESH_FACES: crate::math::Real = 2000.0;
+
+/// The picture size of the `render` target (the smallest `render` draws).
+const RENDER_SIZE: (usize, usize) = (64, 64);
+
+/// The picture size of the `plot` target (the smallest `plot` draws).
+const PLOT_SIZE: (usize, usize) = (200, 150);
 
 impl Target {
     /// All targets, in order.
-    pub const ALL: [Target; 8] = [
+    pub const ALL: [Target; 13] = [
         Target::Legacy,
         Target::Xml,
         Target::Settings,
@@ -48,6 +71,11 @@ impl Target {
         Target::Obj,
         Target::Ply,
         Target::Stl,
+        Target::Render,
+        Target::Plot,
+        Target::Mesh,
+        Target::Sweep,
+        Target::ImportMorphoshell,
     ];
     /// Its name in reports and crash files.
     pub fn name(self) -> &'static str {
@@ -60,6 +88,11 @@ impl Target {
             Target::Obj => "obj",
             Target::Ply => "ply",
             Target::Stl => "stl",
+            Target::Render => "render",
+            Target::Plot => "plot",
+            Target::Mesh => "mesh",
+            Target::Sweep => "sweep",
+            Target::ImportMorphoshell => "import-morphoshell",
         }
     }
 
@@ -67,8 +100,11 @@ impl Target {
     pub fn ext(self) -> &'static str {
         match self {
             Target::Legacy => "vtk",
-            Target::Xml | Target::Restart => "vtu",
-            Target::Settings => "toml",
+            Target::Xml | Target::Restart | Target::Render => "vtu",
+            Target::Settings | Target::Sweep => "toml",
+            Target::Plot => "csv",
+            Target::Mesh => "args",
+            Target::ImportMorphoshell => "txt",
             Target::Off => "off",
             Target::Obj => "obj",
             Target::Ply => "ply",
@@ -76,11 +112,21 @@ impl Target {
         }
     }
 
-    /// The target of an extension or name (`vtk` and `legacy` alike).
+    /// The target of an extension or name (`vtk` and `legacy` alike; an extension names the
+    /// first target reading it).
     pub fn from_name(name: &str) -> Option<Target> {
         Target::ALL
             .into_iter()
-            .find(|t| t.name() == name || (t.ext() == name && *t != Target::Restart))
+            .find(|t| t.name() == name)
+            .or_else(|| Target::ALL.into_iter().find(|t| t.ext() == name))
+    }
+
+    /// The target of a crash file's name, `TARGET-…` (the longest target name it starts with).
+    pub fn of_file(file: &str) -> Option<Target> {
+        Target::ALL
+            .into_iter()
+            .filter(|t| file.starts_with(&format!("{}-", t.name())))
+            .max_by_key(|t| t.name().len())
     }
 }
 
@@ -94,6 +140,8 @@ pub struct Harness {
     pub mesh: Option<Mesh>,
     /// The scene frames are restarted into (restart target).
     pub scene: Option<Scene>,
+    /// The settings every run of a sweep starts from (sweep target).
+    pub base_settings: Option<String>,
 }
 
 /// Counts of one fuzzing run.
@@ -282,6 +330,18 @@ impl Harness {
                         Ok(m) => crate::restart::restart_from_frame(m, "fuzz", scene).is_ok(),
                     }
                 }
+                Target::Render => render(input)?,
+                Target::Plot => plot(input),
+                Target::Mesh => mesh(input),
+                Target::Sweep => {
+                    let text = String::from_utf8_lossy(input);
+                    let base = self.base_settings.as_deref().unwrap_or_default();
+                    crate::sweep::check_text(&text, "fuzz", base, &crate::cli::sweep_run_overrides)
+                        .is_ok()
+                }
+                Target::ImportMorphoshell => {
+                    crate::cli::import_text(&String::from_utf8_lossy(input), "fuzz", None).is_ok()
+                }
             })
         };
         crate::mesh::io::catch_quietly(run).and_then(|r| r)
@@ -292,10 +352,16 @@ impl Harness {
         let rng = &mut Rng::new(seed ^ (self.target as u64).wrapping_mul(0x51_7CC1_B727_220A));
         let mut rep = Report::default();
         let start = std::time::Instant::now();
+        // An abort (an allocation beyond memory) cannot be caught: with this variable set, each
+        // input is written to the file it names before it runs, so the last one survives.
+        let last = std::env::var_os("SHELLSIM_FUZZ_LAST");
         for _ in 0..execs {
             let mut input = self.seeds[below(rng, self.seeds.len())].clone();
             for _ in 0..1 + below(rng, 4) {
                 mutate(&mut input, rng);
+            }
+            if let Some(p) = &last {
+                let _ = std::fs::write(p, &input);
             }
             rep.execs += 1;
             match self.exec(&input) {
@@ -314,10 +380,74 @@ impl Harness {
     }
 }
 
+/// The `render` target: the frame read (`.vtu`, else `.vtk`), then drawn as `render` draws it,
+/// with the default field, the input's choice of its fields (with a view and a range) and a
+/// field it lacks. Accepted when the first picture is drawn.
+fn render(input: &[u8]) -> Result<bool, String> {
+    use crate::render::Shading;
+    let ext = if input.starts_with(b"<") {
+        "vtu"
+    } else {
+        "vtk"
+    };
+    let m = match mesh_from_bytes(input, ext) {
+        Err(e) if e.contains("please report") => return Err(e),
+        Err(_) => return Ok(false),
+        Ok(m) => m,
+    };
+    let draw = |field: Option<String>, view: &str, range: Option<&str>, shading| {
+        crate::cli::render_frame(&m, "fuzz", field, view, RENDER_SIZE, range, shading).is_ok()
+    };
+    let accepted = draw(None, "iso", None, Shading::Smooth);
+    // A choice from the input's bytes, so that a saved input replays the same calls.
+    let pick = input
+        .iter()
+        .fold(0usize, |h, &c| h.wrapping_mul(31) ^ c as usize);
+    let fields: Vec<&String> = m.face_fields.keys().chain(m.vertex_fields.keys()).collect();
+    if !fields.is_empty() {
+        let f = fields[pick % fields.len()].clone();
+        let view = ["top", "side", "30,-95", "nan,1e308", "back"][pick / 7 % 5];
+        let range = [None, Some("-1,1"), Some("0,1e-300"), Some("1,0")][pick / 3 % 4];
+        let shading = [Shading::Smooth, Shading::Flat][pick / 11 % 2];
+        draw(Some(f), view, range, shading);
+    }
+    draw(Some("no_such_field".into()), "iso", None, Shading::Flat);
+    Ok(accepted)
+}
+
+/// The `plot` target: the log drawn as `plot` draws it by default, then with every column on a
+/// logarithmic axis over the frame number. Accepted when the first picture is drawn.
+fn plot(input: &[u8]) -> bool {
+    let Ok(text) = std::str::from_utf8(input) else {
+        return false;
+    };
+    let plot = |x, y: &str, log_y| crate::cli::plot_log(text, "fuzz", x, y, PLOT_SIZE, log_y);
+    let accepted = plot(None, "energy_total", false).is_ok();
+    let all = text.lines().next().unwrap_or_default();
+    let _ = plot(Some("frame"), all, true);
+    accepted
+}
+
+/// The `mesh` target: the input's lines are the arguments after `shellsim`, parsed by the
+/// command line's parser; a `mesh` command is generated (not written).
+fn mesh(input: &[u8]) -> bool {
+    use clap::Parser;
+    let text = String::from_utf8_lossy(input);
+    let args = std::iter::once("shellsim").chain(text.lines());
+    match crate::cli::Cli::try_parse_from(args) {
+        Ok(crate::cli::Cli {
+            command: Some(crate::cli::Command::Mesh(a)),
+            ..
+        }) => crate::cli::build_mesh(&a, MESH_FACES).is_ok(),
+        _ => false,
+    }
+}
+
 /// The harnesses of all targets, with seeds from a source tree at `root`: the VTK files under
-/// `tests/data/vtk` and `tests/data/shapes`, the scenes under `settings/`, and files shellsim
-/// writes itself (a small
-/// programmed sheet in every output format, a restart frame with velocities and edge angles).
+/// `tests/data/vtk` and `tests/data/shapes`, the scenes under `settings/` and the sweeps under
+/// `settings/sweeps/`, logs, `mesh` arguments, a sweep file and a MorphoShell settings file
+/// under `tests/data/fuzz_seeds/`, and files shellsim writes itself (a small programmed sheet in
+/// every output format, a restart frame with velocities and edge angles).
 pub fn harnesses(root: &std::path::Path) -> Result<Vec<Harness>, String> {
     use crate::mesh::io::{mesh_to_bytes, Format};
     use crate::mesh::Field;
@@ -380,12 +510,35 @@ pub fn harnesses(root: &std::path::Path) -> Result<Vec<Harness>, String> {
         },
     );
     let restart = vec![own(&frame, Format::Vtu)?];
+    // Frames to draw: the XML files and shellsim's own frames (legacy and XML, with fields).
+    let mut render = read_dir("tests/data/vtk", &["vtu"])?;
+    render.push(own(&frame, Format::Vtu)?);
+    render.push(own(&frame, Format::Vtk)?);
+    render.push(own(&sheet, Format::VtkAscii)?);
+    let lce_cone = std::fs::read_to_string(root.join("settings/lce_cone.toml"))
+        .map_err(|e| format!("settings/lce_cone.toml: {e}"))?;
+    let mut sweeps = read_dir("settings/sweeps", &["toml"])?;
+    sweeps.extend(read_dir("tests/data/fuzz_seeds", &["toml"])?);
+    let seeded = |t: Target, base: Option<String>| -> Result<Harness, String> {
+        let seeds = match t {
+            Target::Sweep => sweeps.clone(),
+            _ => read_dir("tests/data/fuzz_seeds", &[t.ext()])?,
+        };
+        Ok(Harness {
+            target: t,
+            seeds,
+            mesh: None,
+            scene: None,
+            base_settings: base,
+        })
+    };
     let shapes = |t: Target| -> Result<Harness, String> {
         Ok(Harness {
             target: t,
             seeds: read_dir("tests/data/shapes", &[t.ext()])?,
             mesh: None,
             scene: None,
+            base_settings: None,
         })
     };
     Ok(vec![
@@ -394,28 +547,43 @@ pub fn harnesses(root: &std::path::Path) -> Result<Vec<Harness>, String> {
             seeds: legacy,
             mesh: None,
             scene: None,
+            base_settings: None,
         },
         Harness {
             target: Target::Xml,
             seeds: xml,
             mesh: None,
             scene: None,
+            base_settings: None,
         },
         Harness {
             target: Target::Settings,
             seeds: settings,
             mesh: Some(sheet),
             scene: None,
+            base_settings: None,
         },
         Harness {
             target: Target::Restart,
             seeds: restart,
             mesh: None,
             scene: Some(scene),
+            base_settings: None,
         },
         shapes(Target::Off)?,
         shapes(Target::Obj)?,
         shapes(Target::Ply)?,
         shapes(Target::Stl)?,
+        Harness {
+            target: Target::Render,
+            seeds: render,
+            mesh: None,
+            scene: None,
+            base_settings: None,
+        },
+        seeded(Target::Plot, None)?,
+        seeded(Target::Mesh, None)?,
+        seeded(Target::Sweep, Some(lce_cone))?,
+        seeded(Target::ImportMorphoshell, None)?,
     ])
 }

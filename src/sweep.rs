@@ -383,6 +383,93 @@ pub struct Written {
     pub kept: Vec<PathBuf>,
 }
 
+/// A sweep file parsed and its `[slurm]` and `args` checked, with the args' `--set` overrides.
+fn parse(
+    text: &str,
+    name: &str,
+    check_args: &dyn Fn(&[String]) -> Result<Vec<String>>,
+) -> Result<(SweepFile, Vec<String>)> {
+    let file: SweepFile = toml::from_str(text).map_err(|e| anyhow!("{name}: {e}"))?;
+    file.slurm.check(name)?;
+    for a in &file.args {
+        if a.chars().any(char::is_control) {
+            bail!("{name}: args: {a:?} holds a control character (a newline?)");
+        }
+    }
+    let arg_sets = check_args(&file.args).map_err(|e| anyhow!("{name}: args: {e:#}"))?;
+    Ok((file, arg_sets))
+}
+
+/// The runs of a sweep: its plan, on the settings every run starts from.
+struct Runs<'a> {
+    /// The sweep file's name, for messages.
+    name: &'a str,
+    /// The grid and the points.
+    plan: Plan,
+    /// The settings every run starts from.
+    table: toml::Table,
+    /// The `--set` overrides of the sweep's `args`, on top of every run's.
+    arg_sets: Vec<String>,
+    /// The number of runs.
+    n: usize,
+}
+
+impl<'a> Runs<'a> {
+    /// Reads the plan, then checks the keys on the first run (the grid's keys, or the first
+    /// point's), then the size, then every run's settings.
+    fn check(
+        file: &SweepFile,
+        name: &'a str,
+        table: toml::Table,
+        arg_sets: Vec<String>,
+    ) -> Result<Runs<'a>> {
+        let plan = Plan::new(file, name)?;
+        let mut runs = Runs {
+            name,
+            plan,
+            table,
+            arg_sets,
+            n: 0,
+        };
+        runs.resolve(0)?;
+        runs.n = runs.plan.count(name)?;
+        for i in 1..runs.n {
+            runs.resolve(i)?;
+        }
+        Ok(runs)
+    }
+
+    /// Run i's overrides and resolved settings, checked with the args' overrides on top.
+    fn resolve(&self, i: usize) -> Result<(Point, Vec<String>, String)> {
+        let name = self.name;
+        let p = self.plan.point(i);
+        let sets: Vec<String> = p.iter().map(|(k, v)| override_arg(k, v)).collect();
+        let mut t = self.table.clone();
+        apply_overrides(&mut t, &sets).map_err(|e| anyhow!("{name}: run {i}: {e}"))?;
+        let text = toml::to_string(&t).map_err(|e| anyhow!("{name}: run {i}: {e}"))?;
+        let mut label = format!("{name}, run {i} ({})", sets.join(" "));
+        if !self.arg_sets.is_empty() {
+            label += &format!(" with args --set {}", self.arg_sets.join(" --set "));
+        }
+        Settings::from_str_with(&text, &label, &self.arg_sets).map_err(|e| anyhow!("{e}"))?;
+        Ok((p, sets, text))
+    }
+}
+
+/// The checks `shellsim sweep` makes of the text of a sweep file named `name`, on
+/// `settings_text` in place of the settings file it names, without reading or writing any file
+/// (the mesh is not read): the number of runs, or the first error.
+pub fn check_text(
+    text: &str,
+    name: &str,
+    settings_text: &str,
+    check_args: &dyn Fn(&[String]) -> Result<Vec<String>>,
+) -> Result<usize> {
+    let (file, arg_sets) = parse(text, name, check_args)?;
+    let table: toml::Table = settings_text.parse().map_err(|e| anyhow!("{name}: {e}"))?;
+    Ok(Runs::check(&file, name, table, arg_sets)?.n)
+}
+
 /// `shellsim sweep`: checks every run's settings, then writes the sweep folder.
 /// `check_args(args)` parses the sweep's `args` as a run's command line does and returns their
 /// `--set` overrides (which every run's settings are checked with).
@@ -394,14 +481,7 @@ pub fn sweep(
 ) -> Result<Written> {
     let name = path.display().to_string();
     let text = std::fs::read_to_string(path).with_context(|| name.clone())?;
-    let file: SweepFile = toml::from_str(&text).map_err(|e| anyhow!("{name}: {e}"))?;
-    file.slurm.check(&name)?;
-    for a in &file.args {
-        if a.chars().any(char::is_control) {
-            bail!("{name}: args: {a:?} holds a control character (a newline?)");
-        }
-    }
-    let arg_sets = check_args(&file.args).map_err(|e| anyhow!("{name}: args: {e:#}"))?;
+    let (file, arg_sets) = parse(&text, &name, check_args)?;
     let base = path.parent().unwrap_or(Path::new(""));
     let settings_path = base.join(&file.settings);
     let mesh_path = base.join(&file.mesh);
@@ -414,29 +494,10 @@ pub fn sweep(
     if !mesh_path.is_file() {
         bail!("{name}: mesh '{}' is not a file", mesh_path.display());
     }
-    let plan = Plan::new(&file, &name)?;
-    // Run i's overrides and resolved settings, checked with the args' overrides on top.
-    let resolve = |i: usize| -> Result<(Point, Vec<String>, String)> {
-        let p = plan.point(i);
-        let sets: Vec<String> = p.iter().map(|(k, v)| override_arg(k, v)).collect();
-        let mut t = table.clone();
-        apply_overrides(&mut t, &sets).map_err(|e| anyhow!("{name}: run {i}: {e}"))?;
-        let text = toml::to_string(&t).map_err(|e| anyhow!("{name}: run {i}: {e}"))?;
-        let mut label = format!("{name}, run {i} ({})", sets.join(" "));
-        if !arg_sets.is_empty() {
-            label += &format!(" with args --set {}", arg_sets.join(" --set "));
-        }
-        Settings::from_str_with(&text, &label, &arg_sets).map_err(|e| anyhow!("{e}"))?;
-        Ok((p, sets, text))
-    };
-    // The keys are checked on the first run (the grid's keys, or the first point's), then the
-    // size, then every run's settings before anything is written (not kept: a sweep of many
+    // Every run's settings are checked before anything is written (not kept: a sweep of many
     // runs is resolved again while it is written).
-    resolve(0)?;
-    let n = plan.count(&name)?;
-    for i in 1..n {
-        resolve(i)?;
-    }
+    let runs = Runs::check(&file, &name, table, arg_sets)?;
+    let n = runs.n;
     // The mesh is read (the format from its extension, which names the copy).
     crate::mesh::io::read_mesh(&mesh_path).map_err(|e| anyhow!("{name}: mesh: {e}"))?;
     let ext = mesh_path
@@ -460,7 +521,7 @@ pub fn sweep(
     let extra: String = file.args.iter().map(|a| format!(" {}", quote(a))).collect();
     let mut jobs = String::new();
     for i in 0..n {
-        let (point, sets, text) = resolve(i)?;
+        let (point, sets, text) = runs.resolve(i)?;
         let run = run_name(i, n);
         let rd = dir.join(&run);
         std::fs::create_dir_all(&rd).with_context(|| rd.display().to_string())?;

@@ -61,7 +61,13 @@ pub const MAX_FACES: Real = 1e7;
 /// `what`), computed in floating point so that no size overflows, against [`MAX_FACES`]. `args`
 /// names the arguments that set it, for the message.
 pub fn check_planned(count: Real, what: &str, args: &str) -> Result<(), String> {
-    if count.is_finite() && count <= MAX_FACES {
+    check_planned_within(count, MAX_FACES, what, args)
+}
+
+/// [`check_planned`] against the bound `max` in place of [`MAX_FACES`] (the fuzzer keeps its
+/// meshes small with it).
+pub fn check_planned_within(count: Real, max: Real, what: &str, args: &str) -> Result<(), String> {
+    if count.is_finite() && count <= max {
         return Ok(());
     }
     let count = if count.is_finite() {
@@ -70,7 +76,7 @@ pub fn check_planned(count: Real, what: &str, args: &str) -> Result<(), String> 
         "uncountably many (beyond floating point)".into()
     };
     Err(format!(
-        "{args} would make {count} {what}, more than the {MAX_FACES:e} shellsim allows: make \
+        "{args} would make {count} {what}, more than the {max:e} shellsim allows: make \
          --edge larger or the shape smaller"
     ))
 }

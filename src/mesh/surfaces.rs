@@ -240,10 +240,20 @@ fn area(m: &Mesh) -> Real {
 /// A named closed shape (`sphere`, `capsule`, `peanut`, `teddy`) of size `r` (m) with edges
 /// about `edge` long.
 pub fn closed_shape(name: &str, r: Real, edge: Real) -> Result<Mesh, String> {
+    closed_shape_within(name, r, edge, super::generate::MAX_FACES)
+}
+
+/// [`closed_shape`], refused when it would have more than `max_faces` faces.
+pub fn closed_shape_within(
+    name: &str,
+    r: Real,
+    edge: Real,
+    max_faces: Real,
+) -> Result<Mesh, String> {
     // A geodesic sphere of frequency k has 20 k² faces: planned from the area in floating point.
     let planned = |area: Real| {
         let tri = 3.0_f64.sqrt() / 4.0 * edge * edge;
-        super::generate::check_planned(area / tri, "faces", "--edge and --radius")
+        super::generate::check_planned_within(area / tri, max_faces, "faces", "--edge and --radius")
     };
     // Every shape holds the sphere of radius r: its area is a lower bound, checked first.
     let sphere = 4.0 * std::f64::consts::PI * r * r;
