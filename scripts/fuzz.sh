@@ -4,7 +4,8 @@
 # restart frames, OFF, OBJ, PLY, STL) and the commands' own inputs (frames drawn by render, logs
 # drawn by plot, mesh's arguments through the real parser, sweep files checked and counted,
 # MorphoShell settings through import-morphoshell). 80000 per path: 1 040 000 executions in
-# about 37 s on one core, 6 600–340 000 per second by path, no panic.
+# 29 s on one core, 5 800–410 000 per second by path (mesh slowest, PLY fastest), no panic, no
+# abort, at most 8 MB resident (seeds 1 and 2).
 #
 #     scripts/fuzz.sh [EXECS_PER_TARGET] [SEED]
 #

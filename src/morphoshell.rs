@@ -240,8 +240,13 @@ pub fn to_toml(m: &MorphoSettings, file: &str, slide_speed: Option<Real>) -> Res
         );
     }
     let spacing = g("dial_factors_to_hold_at_spacing");
-    if !(spacing > 0.0 && spacing <= 1.0) {
-        bail!("{file}: dial_factors_to_hold_at_spacing = {spacing} must lie in (0, 1]");
+    let min_spacing = 1.0 / crate::settings::MAX_HOLDS as Real;
+    if !(spacing >= min_spacing && spacing <= 1.0) {
+        bail!(
+            "{file}: dial_factors_to_hold_at_spacing = {spacing} must lie in [{min_spacing}, 1] \
+             (at most {} holds)",
+            crate::settings::MAX_HOLDS
+        );
     }
     let mut t = String::new();
     let mut line = |s: String| {

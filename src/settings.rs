@@ -25,6 +25,8 @@ pub const MAX_GRAVITY: Real = 1e15;
 pub const MAX_LOAD: Real = 1e30;
 /// Most element layers through the thickness in `[moisture]`.
 pub const MAX_LAYERS: usize = 256;
+/// Most holds on the dial (`dial.holds`): each is a solve to equilibrium and a frame.
+pub const MAX_HOLDS: usize = 10_000;
 
 /// Errors in the settings file or its overrides.
 #[derive(Debug, thiserror::Error)]
@@ -2009,6 +2011,16 @@ impl Settings {
                     e.frames_per_long_time,
                     e.max_long_times,
                     MAX_FRAMES_h = crate::math::human(MAX_FRAMES)
+                ),
+            );
+        }
+        if self.dial.holds.len() > MAX_HOLDS {
+            return ck.inv(
+                "dial.holds",
+                format!(
+                    "{} holds is more than {MAX_HOLDS}: each hold is a solve to equilibrium \
+                     and a frame",
+                    self.dial.holds.len()
                 ),
             );
         }
