@@ -332,7 +332,7 @@ fn moisture_step(c: &mut Criterion) {
             (0..nf)
                 .map(|f| {
                     let (mt, mb) = diff.surface_moisture(&u, f);
-                    let r = shellsim::growth::linear_swelling(
+                    let r = shellsim::rest::laws::linear_swelling::linear_swelling(
                         &sc.rest.abar0[f],
                         &sc.rest.bbar0[f],
                         sc.thickness[f],

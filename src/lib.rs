@@ -32,13 +32,13 @@
 pub mod assembly;
 pub mod cases;
 pub mod cli;
+pub mod config;
 pub mod diffusion;
 pub mod energy;
 pub mod expr;
 pub mod fields;
 pub mod fuzz;
 pub mod geometry;
-pub mod growth;
 pub mod integrate;
 pub mod lce;
 pub mod math;

@@ -959,8 +959,11 @@ impl Writer {
         ff.insert("k1".into(), Field::scalar(k1s));
         ff.insert("k2".into(), Field::scalar(k2s));
         ff.insert("max_stretch".into(), Field::scalar(stretch));
-        // The rest thickness, unless a term gives the current one.
-        ff.insert("thickness".into(), Field::scalar(sc.thickness.clone()));
+        // The rest thickness at this dial, unless a term gives the current one.
+        ff.insert(
+            "thickness".into(),
+            Field::scalar((0..nf).map(|f| pot.thickness(f)).collect()),
+        );
         for (name, data) in term_fields {
             ff.insert(name, Field::scalar(data));
         }
@@ -1342,7 +1345,7 @@ fn morphoshell_fields(m: &mut Mesh, pot: &Potential, x: &[Vec3], phi: &[Real], a
     for (f, face) in sc.mesh.faces.iter().enumerate() {
         let (e1, e2) = (x[face[1]] - x[face[0]], x[face[2]] - x[face[0]]);
         let (l, u) = crate::fields::cauchy_principal(&e1, &e2, &a[f], &ga[f]);
-        let mu_t = sc.lame[f].beta * sc.thickness[f];
+        let mu_t = sc.lame[f].beta * pot.thickness(f);
         l1.push(l[0]);
         l2.push(l[1]);
         d1.push(l[0] / mu_t);

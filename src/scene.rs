@@ -53,6 +53,10 @@ pub struct Scene {
     pub pinned_dofs: Vec<usize>,
     /// Per-face inputs of the growth law.
     pub growth: GrowthInputs,
+    /// Per face, the rest thickness at dial 1 over the reference thickness, when a growth law
+    /// scales it (uniform volumetric growth); empty otherwise (see
+    /// [`crate::solve::Potential::thickness`]).
+    pub grown_thickness: Vec<Real>,
     /// The ground plane (`contact.enabled`), else `None`.
     pub ground: Option<crate::solve::contact::Ground>,
     /// The energy terms the settings enable, in assembly order ([`crate::energy::registry`]).
@@ -215,6 +219,7 @@ impl Scene {
         rest.order = settings.dial.order;
 
         let growth = GrowthInputs::read(&mesh, &settings)?;
+        let mut grown_thickness = Vec::new();
         if settings.growth.law != crate::settings::GrowthLaw::None {
             for (f, &h) in thickness.iter().enumerate() {
                 let m = if settings.moisture.enabled {
@@ -223,10 +228,14 @@ impl Scene {
                     (growth.moisture_top[f], growth.moisture_bottom[f])
                 };
                 let reference = (rest.abar0[f], rest.bbar0[f]);
-                let (a, b) = growth_face(&settings, &growth, f, reference, h, m)
+                let g = growth_face(&settings, &growth, f, reference, h, m)
                     .map_err(|e| mesh.invalid(e.to_string()))?;
-                rest.abar1[f] = a;
-                rest.bbar1[f] = b;
+                rest.abar1[f] = g.abar;
+                rest.bbar1[f] = g.bbar;
+                if g.thickness_ratio != 1.0 {
+                    grown_thickness.resize(nf, 1.0);
+                    grown_thickness[f] = g.thickness_ratio;
+                }
             }
         }
         if settings.moisture.enabled {
@@ -424,6 +433,7 @@ impl Scene {
             node_fixed,
             pinned_dofs,
             growth,
+            grown_thickness,
             ground,
             terms: Default::default(),
             prescribed,
@@ -789,18 +799,26 @@ pub struct GrowthInputs {
 
 impl GrowthInputs {
     fn read(mesh: &Mesh, settings: &Settings) -> Result<Self, MeshError> {
-        use crate::settings::GrowthLaw;
         let g = &settings.growth;
+        let law = crate::rest::laws::law(g.law);
         let mut out = GrowthInputs {
             moisture_top: face_values(mesh, "moisture_top", g.moisture_top)?,
             moisture_bottom: face_values(mesh, "moisture_bottom", g.moisture_bottom)?,
-            s: match mesh.face_field("growth_factor", 1)? {
-                Some(_) => face_values(mesh, "growth_factor", 0.0)?,
-                None => settings_field(mesh, &g.s, "growth.s")?,
+            s: match (mesh.face_field("growth_factor", 1)?, &g.s) {
+                (Some(_), _) => face_values(mesh, "growth_factor", 0.0)?,
+                (None, Some(s)) => settings_field(mesh, s, "growth.s")?,
+                (None, None) if law.is_some_and(|l| l.needs_s()) => {
+                    return Err(mesh.invalid(format!(
+                        "growth.law = \"{}\" needs its growth factor s: give growth.s (a number \
+                         or an expression of x, y) or the face field 'growth_factor'",
+                        g.law.name()
+                    )))
+                }
+                (None, None) => vec![0.0; mesh.faces.len()],
             },
             direction: Vec::new(),
         };
-        if g.law == GrowthLaw::MachineDirection || settings.moisture.enabled {
+        if law.is_some_and(|l| l.needs_direction()) || settings.moisture.enabled {
             let dirs = mesh.face_field("machine_direction", 3)?;
             for f in 0..mesh.faces.len() {
                 let (d, what) = match dirs {
@@ -826,49 +844,12 @@ impl GrowthInputs {
     }
 }
 
-/// A rest form that a growth law cannot produce.
-#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
-#[non_exhaustive]
-pub enum GrowthError {
-    /// A swelling stretch `1 + μ m` that is not positive.
-    #[error(
-        "growth at face {face}: the stretch 1 + mu m = 1 + {worst_h} is not positive (mu {mu_h}, \
-         moisture top {top_h}, bottom {bottom_h}): a length cannot become ≤ 0"
-    , worst_h = crate::math::human(*.worst), mu_h = crate::math::human(*.mu), top_h = crate::math::human(*.top), bottom_h = crate::math::human(*.bottom))]
-    Stretch {
-        /// The face.
-        face: usize,
-        /// The most negative `μ m`.
-        worst: Real,
-        /// The coefficient.
-        mu: Real,
-        /// Moisture on the top side.
-        top: Real,
-        /// Moisture on the bottom side.
-        bottom: Real,
-    },
-    /// The law's `ā` is not positive definite (or `b̄` is not finite).
-    #[error(
-        "growth at face {face}: growth.law {law:?} makes abar non-positive-definite (moisture \
-         top {}, bottom {})",
-        crate::math::human(*.top),
-        crate::math::human(*.bottom)
-    )]
-    NotPositiveDefinite {
-        /// The face.
-        face: usize,
-        /// The law.
-        law: crate::settings::GrowthLaw,
-        /// Moisture on the top side.
-        top: Real,
-        /// Moisture on the bottom side.
-        bottom: Real,
-    },
-}
+pub use crate::rest::laws::GrowthError;
 
-/// The rest forms of face `f` under `settings.growth.law`, from its reference forms, thickness
-/// and surface moisture `(m_top, m_bottom)`. Errors (without the face, which the caller names):
-/// a stretch `1 + μ m ≤ 0`, or an ā that is not positive definite.
+/// The rest forms and thickness ratio of face `f` under `settings.growth.law`
+/// ([`crate::rest::laws`]), from its reference forms, thickness and surface moisture
+/// `(m_top, m_bottom)`. Errors name the face: a stretch `1 + μ m ≤ 0`, or an ā that is not
+/// positive definite.
 pub fn growth_face(
     settings: &Settings,
     inputs: &GrowthInputs,
@@ -876,59 +857,18 @@ pub fn growth_face(
     reference: (Sym2, Sym2),
     h: Real,
     moisture: (Real, Real),
-) -> Result<(Sym2, Sym2), GrowthError> {
-    use crate::settings::GrowthLaw;
-    let g = &settings.growth;
-    let (a0, b0) = reference;
-    let (mt, mb) = moisture;
-    // (coefficient, applies to the top moisture, applies to the bottom moisture).
-    let coefficients: &[(Real, bool, bool)] = match g.law {
-        GrowthLaw::LinearSwelling => &[(g.mu, true, true)],
-        GrowthLaw::Bilayer => &[(g.mu_top, true, false), (g.mu_bottom, false, true)],
-        GrowthLaw::MachineDirection => &[(g.mu, true, true), (g.mu_perp, true, true)],
-        _ => &[],
+) -> Result<crate::rest::laws::Grown, GrowthError> {
+    let input = crate::rest::laws::FaceInput {
+        face: f,
+        a0: reference.0,
+        b0: reference.1,
+        h,
+        m_top: moisture.0,
+        m_bottom: moisture.1,
+        s: inputs.s.get(f).copied().unwrap_or(0.0),
+        direction: inputs.direction.get(f).map_or([1.0, 0.0], |d| d.0),
     };
-    for &(mu, top, bottom) in coefficients {
-        let worst = match (top, bottom) {
-            (true, true) => (mu * mt).min(mu * mb),
-            (true, false) => mu * mt,
-            _ => mu * mb,
-        };
-        if 1.0 + worst <= 0.0 || worst.is_nan() {
-            return Err(GrowthError::Stretch {
-                face: f,
-                worst,
-                mu,
-                top: mt,
-                bottom: mb,
-            });
-        }
-    }
-    let (a, b) = match g.law {
-        GrowthLaw::None => (a0, b0),
-        GrowthLaw::Isotropic => crate::growth::isotropic(&a0, &b0, inputs.s[f]),
-        GrowthLaw::LinearSwelling => crate::growth::linear_swelling(&a0, &b0, h, mt, mb, g.mu),
-        GrowthLaw::Bilayer => crate::growth::bilayer(&a0, &b0, h, mt, mb, g.mu_top, g.mu_bottom),
-        GrowthLaw::MachineDirection => crate::growth::machine_direction(
-            &a0,
-            &b0,
-            h,
-            mt,
-            mb,
-            g.mu,
-            g.mu_perp,
-            inputs.direction[f].0,
-        ),
-    };
-    if !(a[0] > 0.0 && crate::math::sym_det(&a) > 0.0 && b.iter().all(|v| v.is_finite())) {
-        return Err(GrowthError::NotPositiveDefinite {
-            face: f,
-            law: g.law,
-            top: mt,
-            bottom: mb,
-        });
-    }
-    Ok((a, b))
+    crate::rest::laws::grow_face(&settings.growth, &input)
 }
 
 /// A reference-Cartesian direction as barycentric coordinates of face `f`: its projection on the

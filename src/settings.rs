@@ -129,7 +129,7 @@ pub struct Material {
     /// membrane: no bending energy) (default: `"midedge_sin"`).
     pub bending: BendingModel,
     /// Membrane material: `"koiter"` (St Venant–Kirchhoff, seed 000), `"neo_hookean"` or
-    /// `"mooney_rivlin"` (incompressible rubber), `"baraff_witkin"` (strain-limiting cloth,
+    /// `"mooney_rivlin"` or `"gent"` (incompressible rubber), `"baraff_witkin"` (strain-limiting cloth,
     /// seed 003) (default: `"koiter"`).
     pub model: MaterialModel,
     /// Mooney–Rivlin `c₁` (Pa, default: `0`; required > 0 with `model = "mooney_rivlin"`).
@@ -139,6 +139,8 @@ pub struct Material {
     /// MorphoShell's bend stiffening γ: the bending density `W_b` becomes `W_b + W_b²/(γ μ t)`
     /// (dimensionless, > 0; default: none = off; [`crate::energy::stiffening`]).
     pub bend_stiffening: Option<Real>,
+    /// Gent rubber's limiting extensibility.
+    pub gent: crate::config::gent::GentSettings,
     /// Baraff–Witkin constants and warp direction.
     pub baraff_witkin: BaraffWitkinSettings,
     /// The prism element's density law and thickness mode.
@@ -156,10 +158,25 @@ pub enum MaterialModel {
     NeoHookean,
     /// Incompressible Mooney–Rivlin with `c1`, `c2`.
     MooneyRivlin,
+    /// Incompressible Gent rubber, μ = E/(2(1+ν)), with `[material.gent] jm`.
+    Gent,
     /// Strain-limiting Baraff–Witkin (seed 003).
     BaraffWitkin,
     /// Seed 002's three-prism element with a thickness (`[material.prism]`).
     Prism,
+}
+
+impl MaterialModel {
+    /// Every material, in declaration order (the registry must have an entry for each; a test
+    /// in `energy::registry` checks it).
+    pub const ALL: [MaterialModel; 6] = [
+        MaterialModel::Koiter,
+        MaterialModel::NeoHookean,
+        MaterialModel::MooneyRivlin,
+        MaterialModel::Gent,
+        MaterialModel::BaraffWitkin,
+        MaterialModel::Prism,
+    ];
 }
 
 /// The 3D strain energy of the prism element.
@@ -306,6 +323,7 @@ impl Default for Material {
             c1: 0.0,
             c2: 0.0,
             bend_stiffening: None,
+            gent: Default::default(),
             baraff_witkin: BaraffWitkinSettings::default(),
             prism: PrismSettings::default(),
         }
@@ -379,21 +397,62 @@ impl Default for Rest {
     }
 }
 
-/// Which rest-form law computes the target forms (see [`crate::growth`]).
+/// Which rest-form law computes the target forms (see [`crate::rest::laws`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum GrowthLaw {
     /// No growth law: the targets come from `[rest]`.
     #[default]
     None,
-    /// `ā = e^{2s} a⁰`, `b̄ = e^{2s} b⁰`, s from the face field `growth_factor` or `growth.s`.
+    /// Uniform volumetric growth: `ā = e^{2s} a⁰`, `b̄ = e^s b⁰`, `h̄ = e^s h`, s from the face
+    /// field `growth_factor` or `growth.s`.
     Isotropic,
+    /// In-plane growth at fixed thickness: `ā = e^{2s} a⁰`, `b̄ = e^{2s} b⁰`.
+    IsotropicInPlane,
+    /// Seed 000's law as printed: `ā = e^{2s} a⁰`, `b̄ = b⁰`.
+    IsotropicMetricOnly,
     /// Linear differential swelling from the top and bottom moisture, coefficient `mu`.
     LinearSwelling,
     /// Piecewise-constant bilayer, coefficients `mu_top` and `mu_bottom`.
     Bilayer,
     /// Linear swelling with a machine direction: `mu` along it, `mu_perp` across it.
     MachineDirection,
+}
+
+impl GrowthLaw {
+    /// Every law, `"none"` first (the registry in `rest::laws` has an entry for each other one).
+    pub const ALL: [GrowthLaw; 7] = [
+        GrowthLaw::None,
+        GrowthLaw::Isotropic,
+        GrowthLaw::IsotropicInPlane,
+        GrowthLaw::IsotropicMetricOnly,
+        GrowthLaw::LinearSwelling,
+        GrowthLaw::Bilayer,
+        GrowthLaw::MachineDirection,
+    ];
+
+    /// The law's settings value, as in the settings file.
+    pub fn name(self) -> &'static str {
+        match self {
+            GrowthLaw::None => "none",
+            GrowthLaw::Isotropic => "isotropic",
+            GrowthLaw::IsotropicInPlane => "isotropic_in_plane",
+            GrowthLaw::IsotropicMetricOnly => "isotropic_metric_only",
+            GrowthLaw::LinearSwelling => "linear_swelling",
+            GrowthLaw::Bilayer => "bilayer",
+            GrowthLaw::MachineDirection => "machine_direction",
+        }
+    }
+
+    /// The `[growth]` coefficients the law needs (each must be given).
+    pub fn coefficients(self) -> &'static [&'static str] {
+        match self {
+            GrowthLaw::LinearSwelling => &["mu"],
+            GrowthLaw::Bilayer => &["mu_top", "mu_bottom"],
+            GrowthLaw::MachineDirection => &["mu", "mu_perp"],
+            _ => &[],
+        }
+    }
 }
 
 /// `[growth]`: the rest-form laws of seed 000 §3. Per-face mesh fields take precedence over the
@@ -405,21 +464,22 @@ pub struct Growth {
     /// The law (default: `"none"`).
     pub law: GrowthLaw,
     /// Moisture–length coefficient μ along the machine direction, or isotropic (per unit
-    /// moisture, default `0`).
-    pub mu: Real,
-    /// Moisture–length coefficient μ⊥ across the machine direction (default `0`).
-    pub mu_perp: Real,
-    /// Bilayer: coefficient of the top layer (default `0`).
-    pub mu_top: Real,
-    /// Bilayer: coefficient of the bottom layer (default `0`).
-    pub mu_bottom: Real,
+    /// moisture; required by `"linear_swelling"` and `"machine_direction"`).
+    pub mu: Option<Real>,
+    /// Moisture–length coefficient μ⊥ across the machine direction (required by
+    /// `"machine_direction"`).
+    pub mu_perp: Option<Real>,
+    /// Bilayer: coefficient of the top layer (required by `"bilayer"`).
+    pub mu_top: Option<Real>,
+    /// Bilayer: coefficient of the bottom layer (required by `"bilayer"`).
+    pub mu_bottom: Option<Real>,
     /// Uniform moisture at the top surface (dimensionless fraction, default `0`).
     pub moisture_top: Real,
     /// Uniform moisture at the bottom surface (default `0`).
     pub moisture_bottom: Real,
-    /// Conformal growth factor s of the isotropic law: a number or an expression of the
-    /// reference x, y (default `0`).
-    pub s: Field,
+    /// Conformal growth factor s of the isotropic laws: a number or an expression of the
+    /// reference x, y (the isotropic laws need it or the face field `growth_factor`).
+    pub s: Option<Field>,
     /// Uniform machine direction in reference Cartesian coordinates (default `[1, 0, 0]`).
     pub machine_direction: [Real; 3],
 }
@@ -428,13 +488,13 @@ impl Default for Growth {
     fn default() -> Self {
         Growth {
             law: GrowthLaw::None,
-            mu: 0.0,
-            mu_perp: 0.0,
-            mu_top: 0.0,
-            mu_bottom: 0.0,
+            mu: None,
+            mu_perp: None,
+            mu_top: None,
+            mu_bottom: None,
             moisture_top: 0.0,
             moisture_bottom: 0.0,
-            s: Field::Value(0.0),
+            s: None,
             machine_direction: [1.0, 0.0, 0.0],
         }
     }
@@ -1383,6 +1443,9 @@ impl Settings {
             })
         };
         let m = &self.material;
+        if let Err(e) = m.gent.validate(m.model == MaterialModel::Gent) {
+            return inv(&e.key, e.reason);
+        }
         if m.model == MaterialModel::MooneyRivlin {
             if !(m.c1.is_finite() && m.c1 > 0.0) {
                 return inv(
@@ -1640,10 +1703,28 @@ impl Settings {
         let ck = Check(name);
         let g = &self.growth;
         for (k, v) in [
-            ("growth.mu", g.mu),
-            ("growth.mu_perp", g.mu_perp),
-            ("growth.mu_top", g.mu_top),
-            ("growth.mu_bottom", g.mu_bottom),
+            ("mu", g.mu),
+            ("mu_perp", g.mu_perp),
+            ("mu_top", g.mu_top),
+            ("mu_bottom", g.mu_bottom),
+        ] {
+            if v.is_none() && g.law.coefficients().contains(&k) {
+                return ck.inv(
+                    &format!("growth.{k}"),
+                    format!(
+                        "growth.law = \"{}\" needs its coefficient {k} (per unit moisture); \
+                         it needs {}",
+                        g.law.name(),
+                        g.law.coefficients().join(" and ")
+                    ),
+                );
+            }
+        }
+        for (k, v) in [
+            ("growth.mu", g.mu.unwrap_or(0.0)),
+            ("growth.mu_perp", g.mu_perp.unwrap_or(0.0)),
+            ("growth.mu_top", g.mu_top.unwrap_or(0.0)),
+            ("growth.mu_bottom", g.mu_bottom.unwrap_or(0.0)),
             ("growth.moisture_top", g.moisture_top),
             ("growth.moisture_bottom", g.moisture_bottom),
         ] {
@@ -1659,14 +1740,14 @@ impl Settings {
             }
         }
         match &g.s {
-            Field::Value(v) if !v.is_finite() => {
+            Some(Field::Value(v)) if !v.is_finite() => {
                 return ck.inv(
                     "growth.s",
                     format!("must be finite, got {v_h}", v_h = crate::math::human(v)),
                 )
             }
-            Field::Expr(_) => {
-                if let Err(e) = g.s.compile() {
+            Some(s @ Field::Expr(_)) => {
+                if let Err(e) = s.compile() {
                     return ck.inv("growth.s", e.to_string());
                 }
             }

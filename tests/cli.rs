@@ -709,7 +709,7 @@ fn growth_laws_curl_strips_and_reject_bad_input() {
         &law(0.1, 0.0).replace("mu = 0.01", "mu = -20"),
     );
     expect_bad(&["neg.toml", "s.vtk"], p, "face 0");
-    let md = "[material]\nthickness = 0.001\n[growth]\nlaw = \"machine_direction\"\nmu = 0.01\nmachine_direction = [0, 0, 1]\nmoisture_top = 0.1\n";
+    let md = "[material]\nthickness = 0.001\n[growth]\nlaw = \"machine_direction\"\nmu = 0.01\nmu_perp = 0.0\nmachine_direction = [0, 0, 1]\nmoisture_top = 0.1\n";
     write(p, "md.toml", md);
     expect_bad(&["md.toml", "s.vtk"], p, "machine_direction");
     write(

@@ -250,6 +250,20 @@ fn bad_loads_materials_and_constraints_are_refused() {
         &["material.c1"],
     );
     refuses(
+        "[material]\nmodel = \"gent\"\n",
+        "r.vtk",
+        dir,
+        &["material.gent.jm", "needs the limiting extensibility"],
+    );
+    for jm in ["0", "-3", "nan"] {
+        refuses(
+            &format!("[material]\nmodel = \"gent\"\ngent = {{ jm = {jm} }}\n"),
+            "r.vtk",
+            dir,
+            &["material.gent.jm", "must be > 0"],
+        );
+    }
+    refuses(
         "[[loads.point]]\nforce = [0, 0, 1]\ninside = { min = [5, 5, 5], max = [6, 6, 6] }\n",
         "r.vtk",
         dir,

@@ -2,15 +2,16 @@
 //! summation order, so results are reproducible): the shell faces first, then the vertex terms
 //! (ground, friction, inertia, gravity), then the loads. Only what the scene enables is built.
 //!
-//! Adding a membrane material or a bending model is one file plus one line in [`shell_term`];
+//! Adding a membrane material is one file plus one entry in [`MATERIALS`]; a bending model, one
+//! file plus one arm in `with_bending` and one line in [`BENDINGS`];
 //! adding a load or obstacle is one file plus one line in [`terms`].
 
 use super::bending::{
     average::MidedgeAverage, midedge_angle::MidedgeAngle, none::NoBending, patch::PatchFit,
 };
 use super::membrane::{
-    baraff_witkin, koiter::Koiter, mooney_rivlin::MooneyRivlin, neo_hookean::NeoHookean,
-    prism::Prism, Membrane,
+    baraff_witkin, gent::Gent, koiter::Koiter, mooney_rivlin::MooneyRivlin,
+    neo_hookean::NeoHookean, prism::Prism, Membrane,
 };
 use super::shell::Shell;
 use super::term::{Term, VertexTerm};
@@ -47,16 +48,82 @@ fn with_bending<M: Membrane>(scene: &Scene, m: M) -> Box<dyn Term> {
     }
 }
 
-/// The shell face term: the membrane material × the bending model. One line per material.
+/// A registered membrane material: its settings value, the `[material]` lines a small test
+/// scene uses for it, and the shell term it builds with the scene's bending model.
+pub struct MaterialEntry {
+    /// `material.model`.
+    pub model: MaterialModel,
+    /// `[material]` lines for a test scene (its constants; the finite-difference, thread-count
+    /// and restart tests iterate over [`MATERIALS`] with these).
+    pub example: &'static str,
+    /// The shell term.
+    pub build: fn(&Scene) -> Result<Box<dyn Term>, MeshError>,
+}
+
+/// Every membrane material, one entry each.
+pub const MATERIALS: &[MaterialEntry] = &[
+    MaterialEntry {
+        model: MaterialModel::Koiter,
+        example: "model = \"koiter\"",
+        build: |s| Ok(with_bending(s, Koiter)),
+    },
+    MaterialEntry {
+        model: MaterialModel::NeoHookean,
+        example: "model = \"neo_hookean\"",
+        build: |s| Ok(with_bending(s, NeoHookean)),
+    },
+    MaterialEntry {
+        model: MaterialModel::MooneyRivlin,
+        example: "model = \"mooney_rivlin\"\nc1 = 3e5\nc2 = 1e5",
+        build: |s| {
+            let m = &s.settings.material;
+            Ok(with_bending(s, MooneyRivlin { c1: m.c1, c2: m.c2 }))
+        },
+    },
+    MaterialEntry {
+        model: MaterialModel::Gent,
+        // A small J_m, so that the lock shapes the energy at the small strains of test scenes.
+        example: "model = \"gent\"\npoisson = 0.5\ngent = { jm = 0.5 }",
+        build: |s| {
+            Ok(with_bending(
+                s,
+                Gent {
+                    jm: s.settings.material.gent.jm(),
+                },
+            ))
+        },
+    },
+    MaterialEntry {
+        model: MaterialModel::BaraffWitkin,
+        example: "model = \"baraff_witkin\"\nbaraff_witkin = { direction = [1, 1, 0] }",
+        build: |s| Ok(with_bending(s, baraff_witkin::from_scene(s)?)),
+    },
+    MaterialEntry {
+        model: MaterialModel::Prism,
+        example: "model = \"prism\"\npoisson = 0.45",
+        build: |s| Ok(with_bending(s, Prism::new(s))),
+    },
+];
+
+/// Every bending model with its `[material]` line, for the tests that iterate over them.
+pub const BENDINGS: &[(BendingModel, &str)] = &[
+    (
+        BendingModel::MidedgeAverage,
+        "bending = \"midedge_average\"",
+    ),
+    (BendingModel::PatchFit, "bending = \"patch_fit\""),
+    (BendingModel::MidedgeSin, "bending = \"midedge_sin\""),
+    (BendingModel::MidedgeTan, "bending = \"midedge_tan\""),
+    (BendingModel::None, "bending = \"none\""),
+];
+
+/// The shell face term: the membrane material × the bending model, from [`MATERIALS`].
 pub fn shell_term(scene: &Scene) -> Result<Box<dyn Term>, MeshError> {
-    let m = &scene.settings.material;
-    Ok(match m.model {
-        MaterialModel::Koiter => with_bending(scene, Koiter),
-        MaterialModel::NeoHookean => with_bending(scene, NeoHookean),
-        MaterialModel::MooneyRivlin => with_bending(scene, MooneyRivlin { c1: m.c1, c2: m.c2 }),
-        MaterialModel::BaraffWitkin => with_bending(scene, baraff_witkin::from_scene(scene)?),
-        MaterialModel::Prism => with_bending(scene, Prism::new(scene)),
-    })
+    let model = scene.settings.material.model;
+    match MATERIALS.iter().find(|e| e.model == model) {
+        Some(e) => (e.build)(scene),
+        None => unreachable!("material {model:?} has no registry entry (a test checks this)"),
+    }
 }
 
 /// Every term the scene enables, in assembly order.
@@ -103,4 +170,27 @@ pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
         t.extend(load(scene)?);
     }
     Ok(t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every material the settings accept has exactly one entry, and its example names it.
+    #[test]
+    fn every_material_is_registered_once() {
+        for m in MaterialModel::ALL {
+            let n = MATERIALS.iter().filter(|e| e.model == m).count();
+            assert_eq!(n, 1, "{m:?}");
+        }
+        for e in MATERIALS {
+            let name = serde_json::to_string(&e.model).unwrap();
+            assert!(
+                e.example.contains(&format!("model = {name}")),
+                "{}",
+                e.example
+            );
+        }
+        assert_eq!(MATERIALS.len(), MaterialModel::ALL.len());
+    }
 }

@@ -269,6 +269,7 @@ impl Moisture {
                     sc.thickness[f],
                     m,
                 )
+                .map(|g| (g.abar, g.bbar))
             })
             .collect()
     }

@@ -110,6 +110,17 @@ impl<'a> Potential<'a> {
         }
     }
 
+    /// The rest thickness of face `f` at this potential's dial (m): the reference thickness,
+    /// scaled by a growth law that grows it ([`crate::rest::RestForms::thickness_ratio`]).
+    #[inline(always)]
+    pub fn thickness(&self, f: usize) -> Real {
+        let sc = self.scene;
+        match sc.grown_thickness.get(f) {
+            None => sc.thickness[f],
+            Some(&r) => sc.thickness[f] * sc.rest.thickness_ratio(r, self.dial),
+        }
+    }
+
     /// Koiter elastic (+ damping) density of face `f`.
     #[inline(always)]
     pub fn density(&self, f: usize) -> KoiterDensity {
@@ -118,7 +129,7 @@ impl<'a> Potential<'a> {
         }
         let sc = self.scene;
         let (abar, bbar) = self.rest_forms(f);
-        let (ws, wb) = KoiterDensity::weights(&abar, sc.thickness[f], sc.stretch_factor);
+        let (ws, wb) = KoiterDensity::weights(&abar, self.thickness(f), sc.stretch_factor);
         let ws = ws * self.stretch_scale;
         // A pure membrane has no bending energy (b ≡ 0, whatever b̄ the mesh's shape gives).
         let wb = if sc.settings.material.bending == crate::settings::BendingModel::None {
@@ -134,7 +145,7 @@ impl<'a> Potential<'a> {
                 sc.settings.material.bend_stiffening,
                 0.5 * crate::math::sym_det(&abar).max(0.0).sqrt(),
                 sc.lame[f].beta,
-                sc.thickness[f],
+                self.thickness(f),
             ),
         };
         if let Some(dm) = &self.damping {

@@ -6,10 +6,12 @@
 use shellsim::assembly::{ElementMap, Pattern, Want};
 use shellsim::energy::bending::none::NoBending;
 use shellsim::energy::membrane::baraff_witkin::BaraffWitkinFace;
+use shellsim::energy::membrane::gent::GentFace;
 use shellsim::energy::membrane::mooney_rivlin::MooneyRivlinFace;
 use shellsim::energy::membrane::neo_hookean::NeoHookeanFace;
 use shellsim::energy::membrane::{MembraneLaw, WithKoiterBending};
 use shellsim::energy::projection::jacobi_eigen;
+use shellsim::energy::registry;
 use shellsim::energy::shell::shell_element;
 use shellsim::energy::term::{LowRank, Stencil, Term};
 use shellsim::energy::{HessianProjection, KoiterDensity};
@@ -156,21 +158,10 @@ fn check_term(sc: &Scene, p: &Pattern, pot: &Potential, x: &[Vec3], phi: &[Real]
     );
 }
 
-const MATERIALS: [&str; 7] = [
-    "model = \"koiter\"",
-    "model = \"neo_hookean\"",
-    "model = \"mooney_rivlin\"\nc1 = 3e5\nc2 = 1e5",
-    "model = \"baraff_witkin\"\nbaraff_witkin = { direction = [1, 1, 0] }",
-    "model = \"prism\"\npoisson = 0.45",
+/// The prism element's other laws and thickness modes, beyond its registry example.
+const MATERIAL_VARIANTS: [&str; 2] = [
     "model = \"prism\"\npoisson = 0.5\nprism = { law = \"neo_hookean\" }",
     "model = \"prism\"\npoisson = 0.4\nprism = { law = \"neo_hookean\", thickness = \"pbd\" }",
-];
-const BENDING: [&str; 5] = [
-    "bending = \"midedge_average\"",
-    "bending = \"patch_fit\"",
-    "bending = \"midedge_sin\"",
-    "bending = \"midedge_tan\"",
-    "bending = \"none\"",
 ];
 
 /// Every registered shell term (material × bending model), with damping and inertia in a
@@ -178,8 +169,12 @@ const BENDING: [&str; 5] = [
 #[test]
 fn every_registered_term_matches_finite_differences() {
     let mut checked = std::collections::BTreeSet::new();
-    for mat in MATERIALS {
-        for bend in BENDING {
+    let materials = registry::MATERIALS
+        .iter()
+        .map(|e| e.example)
+        .chain(MATERIAL_VARIANTS);
+    for mat in materials {
+        for &(_, bend) in registry::BENDINGS {
             let settings = format!(
                 "[material]\n{mat}\n{bend}\nthickness = 0.05\n[solver]\nmode = \"dynamic\"\n\
                  [loads]\ngravity = [0, 0, -9.81]\n[contact]\nenabled = true\npoint = [0, 0, \
@@ -499,7 +494,9 @@ fn baraff_witkin_is_rotation_invariant() {
 
 /// The energy and the nominal stress `∂W/∂λ₁` of the rubber membranes under in-plane stretches
 /// (λ₁, λ₂) with λ₃ = 1/(λ₁λ₂), uniaxial (λ₂ = λ₁^(−1/2)) and equibiaxial (λ₂ = λ₁), against
-/// `W = c₁(I₁ − 3) + c₂(I₂ − 3)`, `I₁ = λ₁² + λ₂² + λ₃²`, `I₂ = λ₁²λ₂² + λ₁⁻² + λ₂⁻²`.
+/// `W = c₁(I₁ − 3) + c₂(I₂ − 3)`, `I₁ = λ₁² + λ₂² + λ₃²`, `I₂ = λ₁²λ₂² + λ₁⁻² + λ₂⁻²`, and
+/// Gent's `W = −(μ J_m/2) ln(1 − (I₁ − 3)/J_m)` with `μ = 2c₁`, whose stress is the neo-Hookean
+/// one divided by `1 − (I₁ − 3)/J_m`.
 #[test]
 fn rubber_membranes_closed_form_energy_and_stress() {
     // Unit right triangle, ā = I, h = 2: rest volume V = 1.
@@ -507,6 +504,9 @@ fn rubber_membranes_closed_form_energy_and_stress() {
     let (c1, c2) = (0.3, 0.1);
     let nh = NeoHookeanFace::new(&abar, 2.0, 2.0 * c1, 1.0);
     let mr = MooneyRivlinFace { nh, w2: c2 };
+    // Above the largest I₁ − 3 below (21.5, equibiaxial λ = 3.5), where the lock is strong.
+    let jm = 25.0;
+    let gent = GentFace { nh, jm };
     for l1 in [0.7, 1.0, 1.3, 2.0, 3.5] {
         for (kind, l2) in [("uniaxial", 1.0 / Real::sqrt(l1)), ("equibiaxial", l1)] {
             let l3 = 1.0 / (l1 * l2);
@@ -516,14 +516,18 @@ fn rubber_membranes_closed_form_energy_and_stress() {
             let w_mr = w_nh + c2 * (i2 - 3.0);
             let p_nh = 2.0 * c1 * (l1 - 1.0 / (l1 * l1 * l1 * l2 * l2));
             let p_mr = p_nh + 2.0 * c2 * (l1 * l2 * l2 - 1.0 / (l1 * l1 * l1));
+            let w_gent = -c1 * jm * (1.0 - (i1 - 3.0) / jm).ln();
+            let p_gent = p_nh / (1.0 - (i1 - 3.0) / jm);
             let a = Sym2::new(l1 * l1, 0.0, l2 * l2);
             // ∂W/∂λ₁ = ∂W/∂a11 · 2λ₁.
             let nh_law = |a: &Sym2, g: &mut Sym2| nh.eval(a, Some((g, &mut Mat3::zeros())));
             let mr_law = |a: &Sym2, g: &mut Sym2| mr.eval(a, Some((g, &mut Mat3::zeros())));
+            let gent_law = |a: &Sym2, g: &mut Sym2| gent.eval(a, Some((g, &mut Mat3::zeros())));
             type Law<'a> = &'a dyn Fn(&Sym2, &mut Sym2) -> Real;
             for (name, law, w, p) in [
                 ("neo-Hookean", &nh_law as Law, w_nh, p_nh),
                 ("Mooney-Rivlin", &mr_law as Law, w_mr, p_mr),
+                ("Gent", &gent_law as Law, w_gent, p_gent),
             ] {
                 let mut ga = Sym2::zeros();
                 let e = law(&a, &mut ga);
@@ -539,6 +543,41 @@ fn rubber_membranes_closed_form_energy_and_stress() {
             }
         }
     }
+}
+
+/// Gent rubber with `J_m → ∞` is the neo-Hookean law: energy, gradient and Hessian agree to
+/// round-off at `J_m = 10¹⁴` (the difference is of order ψ/J_m ≈ 10⁻¹⁴), on stretches and
+/// shears well away from the lock; and the energy is `+∞` at and beyond it.
+#[test]
+fn gent_tends_to_neo_hookean_and_locks() {
+    let abar = Sym2::new(1.2, 0.3, 0.9);
+    let nh = NeoHookeanFace::new(&abar, 0.01, 4e5, 1.0);
+    let gent = GentFace { nh, jm: 1e14 };
+    for a in [
+        Sym2::new(1.2, 0.3, 0.9),
+        Sym2::new(2.5, -0.4, 1.1),
+        Sym2::new(0.8, 0.1, 3.0),
+    ] {
+        let (mut g0, mut h0, mut g1, mut h1) =
+            (Sym2::zeros(), Mat3::zeros(), Sym2::zeros(), Mat3::zeros());
+        let e0 = nh.eval(&a, Some((&mut g0, &mut h0)));
+        let e1 = gent.eval(&a, Some((&mut g1, &mut h1)));
+        assert!(
+            (e1 - e0).abs() <= 1e-12 * e0.abs().max(nh.w),
+            "{e1} vs {e0}"
+        );
+        assert!(
+            (g1 - g0).norm() <= 1e-12 * g0.norm().max(nh.w),
+            "{g1} vs {g0}"
+        );
+        assert!((h1 - h0).norm() <= 1e-12 * h0.norm(), "{h1} vs {h0}");
+    }
+    // Equibiaxial λ with 2λ² + λ⁻⁴ − 3 = J_m: locked.
+    let locked = GentFace { nh, jm: 1.0 };
+    let (mut g, mut h) = (Sym2::zeros(), Mat3::zeros());
+    let big = Sym2::new(1.2 * 4.0, 0.3 * 4.0, 0.9 * 4.0);
+    assert_eq!(locked.eval(&big, Some((&mut g, &mut h))), Real::INFINITY);
+    assert!(g.iter().chain(h.iter()).all(|v| v.is_finite()));
 }
 
 /// A test global term: a tether `E = k/2 (wᵀx − c)²` over every position DOF, whose Hessian

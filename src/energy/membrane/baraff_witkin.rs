@@ -159,7 +159,7 @@ impl Membrane for BaraffWitkin {
             law: BaraffWitkinFace::new(
                 &abar,
                 &self.directions[f],
-                pot.scene.thickness[f],
+                pot.thickness(f),
                 l * s,
                 m * s,
                 self.r,

@@ -7,11 +7,13 @@
 //! * [`koiter`]: St Venant–Kirchhoff / Koiter (seed 000), the default;
 //! * [`neo_hookean`]: incompressible neo-Hookean rubber;
 //! * [`mooney_rivlin`]: incompressible Mooney–Rivlin rubber;
+//! * [`gent`]: incompressible Gent rubber (limited chain extensibility);
 //! * [`baraff_witkin`]: seed 003's strain-limiting Baraff–Witkin cloth;
 //! * [`prism`]: seed 002's three-prism element with a thickness (3D St Venant–Kirchhoff or
 //!   neo-Hookean), incompressible or with the seed's position-based volume preservation.
 
 pub mod baraff_witkin;
+pub mod gent;
 pub mod koiter;
 pub mod mooney_rivlin;
 pub mod neo_hookean;

@@ -71,7 +71,7 @@ impl Membrane for MooneyRivlin {
     #[inline]
     fn density(&self, pot: &Potential, f: usize) -> Self::Density {
         let (abar, _) = pot.rest_forms(f);
-        let h = pot.scene.thickness[f];
+        let h = pot.thickness(f);
         let s = pot.stretch_scale;
         let nh = NeoHookeanFace::new(&abar, h, 2.0 * self.c1, s);
         let vol = h * 0.5 * crate::math::sym_det(&abar).max(0.0).sqrt();

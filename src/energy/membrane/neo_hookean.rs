@@ -83,7 +83,7 @@ impl Membrane for NeoHookean {
         let (abar, _) = pot.rest_forms(f);
         let sc = pot.scene;
         WithKoiterBending {
-            law: NeoHookeanFace::new(&abar, sc.thickness[f], sc.lame[f].beta, pot.stretch_scale),
+            law: NeoHookeanFace::new(&abar, pot.thickness(f), sc.lame[f].beta, pot.stretch_scale),
             koiter: bending_wells(pot, f),
         }
     }

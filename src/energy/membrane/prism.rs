@@ -216,7 +216,7 @@ impl Prism {
                     let (abar, _) = pot.rest_forms(f);
                     let t = sc.mesh.faces[f];
                     let a = crate::geometry::first_fundamental_form(&t.map(|v| x[v]));
-                    sc.thickness[f] * (sym_det(&abar) / sym_det(&a)).max(0.0).sqrt()
+                    pot.thickness(f) * (sym_det(&abar) / sym_det(&a)).max(0.0).sqrt()
                 }
             })
             .collect()
@@ -232,7 +232,7 @@ impl Prism {
             let t = sc.mesh.faces[f];
             let [p0, p1, p2] = t.map(|v| x[v]);
             now += 0.5 * (p1 - p0).cross(&(p2 - p0)).norm() * hf;
-            rest += 0.5 * sym_det(&abar).max(0.0).sqrt() * sc.thickness[f];
+            rest += 0.5 * sym_det(&abar).max(0.0).sqrt() * pot.thickness(f);
         }
         now / rest
     }
@@ -259,7 +259,7 @@ impl Prism {
         let nv = x.len();
         let rho = sc.settings.material.density;
         let rest_vol: Vec<Real> = (0..nf)
-            .map(|f| 0.5 * sym_det(&pot.rest_forms(f).0).max(0.0).sqrt() * sc.thickness[f])
+            .map(|f| 0.5 * sym_det(&pot.rest_forms(f).0).max(0.0).sqrt() * pot.thickness(f))
             .collect();
         let v0: Real = rest_vol.iter().sum();
         // Weights: real vertices then virtual ones.
@@ -335,7 +335,7 @@ impl Prism {
                     "the position-based projection turned the prism inside out (thickness {}; \
                      rest thickness {})",
                     crate::math::human(h[f]),
-                    crate::math::human(sc.thickness[f])
+                    crate::math::human(pot.thickness(f))
                 ),
             });
         }
@@ -371,7 +371,7 @@ impl Membrane for Prism {
     fn density(&self, pot: &Potential, f: usize) -> Self::Density {
         let (abar, _) = pot.rest_forms(f);
         let sc = pot.scene;
-        let h0 = sc.thickness[f];
+        let h0 = pot.thickness(f);
         let c = match self.mode {
             PrismThickness::Incompressible => None,
             PrismThickness::Pbd => {

@@ -1,7 +1,10 @@
 //! Rest fundamental forms per face (ā, b̄ in each face's barycentric coordinates, seed 000 §3)
 //! and their dial from initial to target values.
 //!
-//! Growth and swelling laws only ever rewrite a [`RestForms`]; kernels never branch on them.
+//! Growth and swelling laws ([`laws`], one file each) only ever rewrite a [`RestForms`]; kernels
+//! never branch on them.
+
+pub mod laws;
 
 use crate::geometry::{first_fundamental_form, midedge_average_b};
 use crate::math::{Mat2, Real, Sym2, Vec3};
@@ -64,6 +67,17 @@ impl RestForms {
             None => self.abar0[f] * (1.0 - sa) + self.abar1[f] * sa,
         };
         (a, self.bbar0[f] * (1.0 - sb) + self.bbar1[f] * sb)
+    }
+
+    /// The rest thickness over the reference thickness at dial `s`, given its dial-1 value
+    /// `r1` (from a growth law that scales the thickness): interpolated linearly with ā's dial.
+    #[inline]
+    pub fn thickness_ratio(&self, r1: Real, s: Real) -> Real {
+        if s >= 1.0 {
+            return r1;
+        }
+        let sa = self.split(s).0;
+        (1.0 - sa) + r1 * sa
     }
 
     /// Number of faces.

@@ -1,0 +1,71 @@
+//! Piecewise-constant bilayer (`growth.law = "bilayer"`; van Rees, Vouga & Mahadevan, PNAS
+//! 2017): the top half has metric `(1 + μ⁺ m⁺)²(a⁰ + 2z b⁰)`, the bottom half
+//! `(1 + μ⁻ m⁻)²(a⁰ + 2z b⁰)`, projected as in [`super`]. For a flat reference,
+//! `ā = (ḡ⁺ + ḡ⁻)/2`, `b̄ = 3(ḡ⁺ − ḡ⁻)/(4h)`: van Rees' equivalence, which with equal layers
+//! reproduces Timoshenko's κ = 3Δε/(2h). The thickness is kept. Coefficients: `growth.mu_top`,
+//! `growth.mu_bottom` (per unit moisture). Units: ā in m², b̄ in m.
+
+use super::{
+    check_stretch, project_through_thickness, reference_metric, FaceInput, Grown, GrowthError,
+    RestLaw,
+};
+use crate::math::{Real, Sym2};
+use crate::settings::Growth;
+
+/// The bilayer law with `growth.mu_top` and `growth.mu_bottom`.
+pub struct Bilayer;
+
+/// Piecewise-constant bilayer: top half swells by `1 + mu_top m_top`, bottom half by
+/// `1 + mu_bottom m_bottom`.
+pub fn bilayer(
+    a0: &Sym2,
+    b0: &Sym2,
+    h: Real,
+    m_top: Real,
+    m_bottom: Real,
+    mu_top: Real,
+    mu_bottom: Real,
+) -> (Sym2, Sym2) {
+    project_through_thickness(h, |z| {
+        let s = if z > 0.0 {
+            1.0 + mu_top * m_top
+        } else {
+            1.0 + mu_bottom * m_bottom
+        };
+        reference_metric(a0, b0, z) * (s * s)
+    })
+}
+
+impl RestLaw for Bilayer {
+    fn grow(&self, g: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
+        let (mt, mb) = (g.mu_top.unwrap_or(0.0), g.mu_bottom.unwrap_or(0.0));
+        check_stretch(i, mt, true, false)?;
+        check_stretch(i, mb, false, true)?;
+        let (abar, bbar) = bilayer(&i.a0, &i.b0, i.h, i.m_top, i.m_bottom, mt, mb);
+        Ok(Grown {
+            abar,
+            bbar,
+            thickness_ratio: 1.0,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::close;
+    use super::*;
+
+    #[test]
+    fn bilayer_is_van_rees_and_timoshenko() {
+        let a0 = Sym2::new(1.0, 0.0, 1.0);
+        let (h, de) = (0.002, 0.002);
+        // Layers stretched by 1 ± Δε/2: μ = 1, m± = ±Δε/2.
+        let (a, b) = bilayer(&a0, &Sym2::zeros(), h, de / 2.0, -de / 2.0, 1.0, 1.0);
+        let (gp, gm) = ((1.0 + de / 2.0).powi(2), (1.0 - de / 2.0).powi(2));
+        assert!(close(&a, &(a0 * ((gp + gm) / 2.0)), 1e-14));
+        assert!(close(&b, &(a0 * (3.0 * (gp - gm) / (4.0 * h))), 1e-13));
+        // Timoshenko, equal layers: κ = 3Δε/(2h) (to O(Δε²)).
+        let kappa = b[0] / a[0];
+        assert!((kappa / (1.5 * de / h) - 1.0).abs() < 1e-5, "{kappa}");
+    }
+}

@@ -1,0 +1,27 @@
+//! Seed 000's isotropic growth as printed (§3, "Isotropic Growth";
+//! `growth.law = "isotropic_metric_only"`): the metric grows, the second form does not,
+//!
+//! `ā = e^{2s} a⁰`, `b̄ = b⁰`, `h̄ = h`.
+//!
+//! On a flat sheet it equals the other isotropic laws (but for the thickness under the
+//! volumetric one); on a curved shell the reference curvature `ā⁻¹b̄` falls by `e^{-2s}`.
+//! Units: ā in m², b̄ in m, s dimensionless.
+
+use super::{FaceInput, Grown, GrowthError, RestLaw};
+use crate::settings::Growth;
+
+/// Seed 000's printed law.
+pub struct IsotropicMetricOnly;
+
+impl RestLaw for IsotropicMetricOnly {
+    fn grow(&self, _: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
+        Ok(Grown {
+            abar: i.a0 * (2.0 * i.s).exp(),
+            bbar: i.b0,
+            thickness_ratio: 1.0,
+        })
+    }
+    fn needs_s(&self) -> bool {
+        true
+    }
+}

@@ -1,0 +1,101 @@
+//! Linear differential swelling with a machine direction (`growth.law = "machine_direction"`,
+//! seed 000 §3): with `d` the direction (barycentric), `d⊥` its `a⁰`-orthogonal complement,
+//! `P = [d d⊥]` and `M(z) = diag(1 + μ m(z), 1 + μ⊥ m(z))` in the `(d, d⊥)` basis,
+//! `ḡ(z) = P⁻ᵀ M(z) Pᵀ (a⁰ + 2z b⁰) P M(z) P⁻¹` (seed 000's `TᵀMT⁻ᵀ(·)T⁻¹MT` with `T = P⁻¹`),
+//! projected as in [`super`]. With `μ⊥ = μ` it is [`super::linear_swelling`]. The thickness is
+//! kept. Coefficients: `growth.mu` along, `growth.mu_perp` across (per unit moisture); the
+//! direction from the face field `machine_direction` or `growth.machine_direction`.
+//! Units: ā in m², b̄ in m.
+
+use super::{
+    check_stretch, moisture_at, project_through_thickness, reference_metric, FaceInput, Grown,
+    GrowthError, RestLaw,
+};
+use crate::math::{sym_to_mat, Mat2, Real, Sym2};
+use crate::settings::Growth;
+
+/// Swelling with a machine direction, `growth.mu` along it and `growth.mu_perp` across.
+pub struct MachineDirection;
+
+/// Linear swelling with a machine direction `d` (barycentric, non-zero): `mu` along `d`,
+/// `mu_perp` across it (see the module doc).
+#[allow(clippy::too_many_arguments)]
+pub fn machine_direction(
+    a0: &Sym2,
+    b0: &Sym2,
+    h: Real,
+    m_top: Real,
+    m_bottom: Real,
+    mu: Real,
+    mu_perp: Real,
+    d: [Real; 2],
+) -> (Sym2, Sym2) {
+    let a = sym_to_mat(a0);
+    let dv = crate::math::Vec2::new(d[0], d[1]);
+    // d⊥ ⟂ d in the metric a⁰: rotate a⁰d by 90° in the plane.
+    let ad = a * dv;
+    let dp = crate::math::Vec2::new(-ad.y, ad.x);
+    let p = Mat2::new(dv.x, dp.x, dv.y, dp.y);
+    let pinv = p.try_inverse().unwrap_or_else(Mat2::identity);
+    project_through_thickness(h, |z| {
+        let m = moisture_at(z, h, m_top, m_bottom);
+        let mz = Mat2::new(1.0 + mu * m, 0.0, 0.0, 1.0 + mu_perp * m);
+        pinv.transpose() * mz * p.transpose() * reference_metric(a0, b0, z) * p * mz * pinv
+    })
+}
+
+impl RestLaw for MachineDirection {
+    fn grow(&self, g: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
+        let (mu, mp) = (g.mu.unwrap_or(0.0), g.mu_perp.unwrap_or(0.0));
+        check_stretch(i, mu, true, true)?;
+        check_stretch(i, mp, true, true)?;
+        let (abar, bbar) =
+            machine_direction(&i.a0, &i.b0, i.h, i.m_top, i.m_bottom, mu, mp, i.direction);
+        Ok(Grown {
+            abar,
+            bbar,
+            thickness_ratio: 1.0,
+        })
+    }
+    fn needs_direction(&self) -> bool {
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::close;
+    use super::super::linear_swelling::linear_swelling;
+    use super::*;
+
+    #[test]
+    fn machine_direction_limits() {
+        let a0 = Sym2::new(1.0, 0.3, 1.2);
+        let b0 = Sym2::new(0.2, 0.0, -0.1);
+        let (h, mt, mb) = (0.01, 0.3, 0.1);
+        // μ⊥ = μ: the isotropic law, for any direction.
+        let iso = linear_swelling(&a0, &b0, h, mt, mb, 0.2);
+        let md = machine_direction(&a0, &b0, h, mt, mb, 0.2, 0.2, [0.3, 0.7]);
+        assert!(close(&md.0, &iso.0, 1e-13) && close(&md.1, &iso.1, 1e-12));
+        // μ⊥ = 0, flat identity metric, d = e1: only the d direction stretches.
+        let (a, b) = machine_direction(
+            &Sym2::new(1.0, 0.0, 1.0),
+            &Sym2::zeros(),
+            h,
+            0.2,
+            0.2,
+            0.5,
+            0.0,
+            [1.0, 0.0],
+        );
+        assert!(
+            close(&a, &Sym2::new(1.1f64.powi(2), 0.0, 1.0), 1e-14),
+            "{a:?}"
+        );
+        assert!(b.amax() < 1e-13);
+        // The direction's length does not matter.
+        let m1 = machine_direction(&a0, &b0, h, mt, mb, 0.3, 0.1, [0.3, 0.7]);
+        let m2 = machine_direction(&a0, &b0, h, mt, mb, 0.3, 0.1, [0.9, 2.1]);
+        assert!(close(&m1.0, &m2.0, 1e-13) && close(&m1.1, &m2.1, 1e-12));
+    }
+}

@@ -1,0 +1,289 @@
+//! Rest-form laws (seed 000 §3, "Choosing Rest Fundamental Forms"), one file each behind
+//! [`RestLaw`], with the registry [`LAWS`]: pure functions from per-face inputs to the rest forms
+//! `(ā, b̄)` of a face, in its barycentric frame, and its rest thickness.
+//!
+//! ## One derivation for every law
+//! Each law prescribes the rest *metric of the 3D shell* at every height `z ∈ [−h/2, h/2]` above
+//! the mid-surface, `ḡ(z)` (a 2×2 tensor in the face's barycentric frame). The Koiter energy
+//! only sees the part of `ḡ` linear in `z`, `ḡ(z) ≈ ā + 2z b̄` (shellsim's sign: offsetting
+//! toward the normal by `z` turns `a` into `a + 2z b`, so that a positive `b̄` bulges toward the
+//! normal). shellsim takes the least-squares projection of `ḡ` onto linear functions of `z`:
+//!
+//! `ā = (1/h) ∫ ḡ(z) dz`,   `b̄ = (6/h³) ∫ z ḡ(z) dz`,
+//!
+//! evaluated with 3-point Gauss–Legendre quadrature on each half `[−h/2, 0]`, `[0, h/2]`, which
+//! is exact for every law below (each is a polynomial of degree ≤ 3 in `z` on each half).
+//!
+//! The reference shell's own metric at height `z` is `a⁰ + 2z b⁰`.
+//!
+//! * **No growth**: `ḡ = a⁰ + 2z b⁰`, so `(ā, b̄) = (a⁰, b⁰)`.
+//! * **Isotropic growth** with conformal factor `s`, three laws (see `REFERENCES.md`, "Growth
+//!   of a curved shell"), which agree on flat sheets except for the thickness:
+//!   - [`isotropic`] (`"isotropic"`, the default): uniform volumetric growth. Every length grows by
+//!     `e^s`, the thickness included, so the grown shell is a scaled copy: at grown height
+//!     `z' = e^s z` its metric is `e^{2s}(a⁰ + 2z b⁰) = e^{2s} a⁰ + 2z' e^s b⁰`, hence
+//!     `ā = e^{2s} a⁰`, `b̄ = e^s b⁰`, `h̄ = e^s h`. A curved shell grows stress-free.
+//!   - [`isotropic_in_plane`] (`"isotropic_in_plane"`): every layer grows in-plane by `e^s` at
+//!     fixed thickness, `ḡ = e^{2s}(a⁰ + 2z b⁰)`, so `ā = e^{2s} a⁰`, `b̄ = e^{2s} b⁰`: the
+//!     reference curvature `ā⁻¹b̄` is kept, the thickness is not scaled, and a curved shell is
+//!     frustrated (a 60° cap of radius 1 m grown by s = ln 0.9 at h = 0.1 m and E = 1 MPa
+//!     keeps 2.6 J).
+//!   - [`isotropic_metric_only`] (`"isotropic_metric_only"`): seed 000 as printed,
+//!     `ā = e^{2s} a⁰`, `b̄ = b⁰`.
+//! * **Linear differential swelling**: moisture varies linearly from `m⁻` (bottom, `z = −h/2`)
+//!   to `m⁺` (top, `z = +h/2`), and lengths scale by `1 + μ m(z)`:
+//!   `ḡ = (1 + μ m(z))² (a⁰ + 2z b⁰)`. With `s₀ = 1 + μ(m⁺ + m⁻)/2` and `s₁ = μ(m⁺ − m⁻)/h`:
+//!   `ā = (s₀² + s₁²h²/12) a⁰ + (s₀ s₁ h²/3) b⁰`, `b̄ = s₀ s₁ a⁰ + (s₀² + 3 s₁²h²/20) b⁰`.
+//!   Seed 000 gives two different expressions: `ā` from the end values `(ḡ⁺ + ḡ⁻)/2` (which
+//!   weights the `z²` term by h²/4 instead of h²/12) and `b̄ = (ḡ⁻ − ḡ⁺)/(2h)` (the same `s₀s₁`
+//!   term, opposite sign convention); the projection is the one consistent with the energy.
+//!   `m⁺ = m⁻` leaves a flat sheet flat; a wetter top (`m⁺ > m⁻`, μ > 0) gives `b̄ > 0`: the
+//!   sheet bulges toward the wet side's normal, i.e. curls away from the water.
+//! * **Piecewise-constant bilayer** (van Rees et al. 2017): the top half has metric
+//!   `(1 + μ⁺ m⁺)²(a⁰ + 2z b⁰)`, the bottom half `(1 + μ⁻ m⁻)²(a⁰ + 2z b⁰)`. For a flat
+//!   reference, `ā = (ḡ⁺ + ḡ⁻)/2`, `b̄ = 3(ḡ⁺ − ḡ⁻)/(4h)`: van Rees' equivalence, which with
+//!   equal layers reproduces Timoshenko's κ = 3Δε/(2h).
+//! * **Linear differential swelling with a machine direction** `d` (a barycentric vector): with
+//!   `d⊥` its `a⁰`-orthogonal complement, `P = [d d⊥]` and
+//!   `M(z) = diag(1 + μ m(z), 1 + μ⊥ m(z))` in the `(d, d⊥)` basis,
+//!   `ḡ(z) = P⁻ᵀ M(z) Pᵀ (a⁰ + 2z b⁰) P M(z) P⁻¹` (seed 000's `TᵀMT⁻ᵀ(·)T⁻¹MT` with
+//!   `T = P⁻¹`). With `μ⊥ = μ` it is the isotropic linear swelling above.
+//!
+//! The moisture laws ([`linear_swelling`], [`bilayer`], [`machine_direction`]) keep the thickness:
+//! seed 000's paper scenes use them, and its model swells the paper in-plane only (the
+//! through-thickness swelling of paper does not enter the Koiter energy of a flat sheet).
+//!
+//! Units: `a`, `ā` in m² (barycentric), `b`, `b̄` in m, `h` in m, moisture `m` dimensionless
+//! (seed 000 uses percent; shellsim uses fractions), `μ` per unit moisture.
+
+pub mod bilayer;
+pub mod isotropic;
+pub mod isotropic_in_plane;
+pub mod isotropic_metric_only;
+pub mod linear_swelling;
+pub mod machine_direction;
+
+use crate::math::{mat_to_sym, sym_to_mat, Mat2, Real, Sym2};
+use crate::settings::{Growth, GrowthLaw};
+
+/// What a law reads for one face.
+#[derive(Clone, Copy, Debug)]
+pub struct FaceInput {
+    /// The face (for errors).
+    pub face: usize,
+    /// The reference forms `(a⁰, b⁰)` (m², m).
+    pub a0: Sym2,
+    /// See `a0`.
+    pub b0: Sym2,
+    /// The reference thickness (m).
+    pub h: Real,
+    /// Moisture at the top surface (`z = +h/2`).
+    pub m_top: Real,
+    /// Moisture at the bottom surface.
+    pub m_bottom: Real,
+    /// The conformal factor `s` of the isotropic laws.
+    pub s: Real,
+    /// The machine direction (barycentric; `[1, 0]` when no law needs it).
+    pub direction: [Real; 2],
+}
+
+/// What a law gives for one face.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grown {
+    /// ā (m²).
+    pub abar: Sym2,
+    /// b̄ (m).
+    pub bbar: Sym2,
+    /// The rest thickness over the reference thickness, `h̄/h`.
+    pub thickness_ratio: Real,
+}
+
+/// A rest-form law: `[growth]`'s coefficients and a face's inputs → its rest forms.
+pub trait RestLaw: Sync {
+    /// The grown forms of one face. Errors name the face.
+    fn grow(&self, g: &Growth, input: &FaceInput) -> Result<Grown, GrowthError>;
+    /// True when the law reads the machine direction.
+    fn needs_direction(&self) -> bool {
+        false
+    }
+    /// True when the law reads the conformal factor `s` (`growth.s` or the face field
+    /// `growth_factor`, one of which must be given).
+    fn needs_s(&self) -> bool {
+        false
+    }
+}
+
+/// Every rest-form law, one line each.
+pub const LAWS: &[(GrowthLaw, &dyn RestLaw)] = &[
+    (GrowthLaw::Isotropic, &isotropic::Isotropic),
+    (
+        GrowthLaw::IsotropicInPlane,
+        &isotropic_in_plane::IsotropicInPlane,
+    ),
+    (
+        GrowthLaw::IsotropicMetricOnly,
+        &isotropic_metric_only::IsotropicMetricOnly,
+    ),
+    (GrowthLaw::LinearSwelling, &linear_swelling::LinearSwelling),
+    (GrowthLaw::Bilayer, &bilayer::Bilayer),
+    (
+        GrowthLaw::MachineDirection,
+        &machine_direction::MachineDirection,
+    ),
+];
+
+/// The law of `growth.law` (`None` for `"none"`).
+pub fn law(which: GrowthLaw) -> Option<&'static dyn RestLaw> {
+    LAWS.iter().find(|(l, _)| *l == which).map(|(_, r)| *r)
+}
+
+/// The grown forms of a face under `g.law`, checked: ā positive definite, b̄ and the thickness
+/// finite and positive. `"none"` keeps the reference forms.
+pub fn grow_face(g: &Growth, input: &FaceInput) -> Result<Grown, GrowthError> {
+    let Some(l) = law(g.law) else {
+        return Ok(Grown {
+            abar: input.a0,
+            bbar: input.b0,
+            thickness_ratio: 1.0,
+        });
+    };
+    let out = l.grow(g, input)?;
+    let a = out.abar;
+    if !(a[0] > 0.0
+        && crate::math::sym_det(&a) > 0.0
+        && out.bbar.iter().all(|v| v.is_finite())
+        && out.thickness_ratio.is_finite()
+        && out.thickness_ratio > 0.0)
+    {
+        return Err(GrowthError::NotPositiveDefinite {
+            face: input.face,
+            law: g.law,
+            top: input.m_top,
+            bottom: input.m_bottom,
+        });
+    }
+    Ok(out)
+}
+
+/// A rest form that a growth law cannot produce.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum GrowthError {
+    /// A swelling stretch `1 + μ m` that is not positive.
+    #[error(
+        "growth at face {face}: the stretch 1 + mu m = 1 + {worst_h} is not positive (mu {mu_h}, \
+         moisture top {top_h}, bottom {bottom_h}): a length cannot become ≤ 0"
+    , worst_h = crate::math::human(*.worst), mu_h = crate::math::human(*.mu), top_h = crate::math::human(*.top), bottom_h = crate::math::human(*.bottom))]
+    Stretch {
+        /// The face.
+        face: usize,
+        /// The most negative `μ m`.
+        worst: Real,
+        /// The coefficient.
+        mu: Real,
+        /// Moisture on the top side.
+        top: Real,
+        /// Moisture on the bottom side.
+        bottom: Real,
+    },
+    /// The law's `ā` is not positive definite (or `b̄` or the thickness is not finite).
+    #[error(
+        "growth at face {face}: growth.law {law:?} makes abar non-positive-definite (moisture \
+         top {}, bottom {})",
+        crate::math::human(*.top),
+        crate::math::human(*.bottom)
+    )]
+    NotPositiveDefinite {
+        /// The face.
+        face: usize,
+        /// The law.
+        law: GrowthLaw,
+        /// Moisture on the top side.
+        top: Real,
+        /// Moisture on the bottom side.
+        bottom: Real,
+    },
+}
+
+/// `Ok` when the stretch `1 + μ m` is positive for the moisture the coefficient applies to
+/// (`top`, `bottom`: whether it acts on that side).
+pub(crate) fn check_stretch(
+    input: &FaceInput,
+    mu: Real,
+    top: bool,
+    bottom: bool,
+) -> Result<(), GrowthError> {
+    let (mt, mb) = (input.m_top, input.m_bottom);
+    let worst = match (top, bottom) {
+        (true, true) => (mu * mt).min(mu * mb),
+        (true, false) => mu * mt,
+        _ => mu * mb,
+    };
+    if 1.0 + worst <= 0.0 || worst.is_nan() {
+        return Err(GrowthError::Stretch {
+            face: input.face,
+            worst,
+            mu,
+            top: mt,
+            bottom: mb,
+        });
+    }
+    Ok(())
+}
+
+/// Gauss–Legendre nodes and weights on [−1, 1] (3 points, exact to degree 5).
+const GAUSS3: [(Real, Real); 3] = [
+    (-0.774_596_669_241_483_4, 5.0 / 9.0),
+    (0.0, 8.0 / 9.0),
+    (0.774_596_669_241_483_4, 5.0 / 9.0),
+];
+
+/// Projects a through-thickness metric `g(z)` onto `ā + 2z b̄` (see the module doc). `g` may be
+/// discontinuous at `z = 0`; it is sampled strictly inside each half.
+pub fn project_through_thickness(h: Real, g: impl Fn(Real) -> Mat2) -> (Sym2, Sym2) {
+    let mut mean = Mat2::zeros();
+    let mut moment = Mat2::zeros();
+    for (lo, hi) in [(-0.5 * h, 0.0), (0.0, 0.5 * h)] {
+        let (c, r) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+        for (t, w) in GAUSS3 {
+            let z = c + r * t;
+            let gz = g(z);
+            mean += gz * (w * r);
+            moment += gz * (w * r * z);
+        }
+    }
+    let abar = mean / h;
+    let bbar = moment * (6.0 / (h * h * h));
+    (mat_to_sym(&abar), mat_to_sym(&bbar))
+}
+
+/// The reference shell's metric at height `z`: `a⁰ + 2z b⁰`.
+#[inline]
+pub(crate) fn reference_metric(a0: &Sym2, b0: &Sym2, z: Real) -> Mat2 {
+    sym_to_mat(a0) + sym_to_mat(b0) * (2.0 * z)
+}
+
+/// Moisture at height `z`, linear between `m_bottom` at `−h/2` and `m_top` at `+h/2`.
+#[inline]
+pub(crate) fn moisture_at(z: Real, h: Real, m_top: Real, m_bottom: Real) -> Real {
+    0.5 * (m_top + m_bottom) + (m_top - m_bottom) * z / h
+}
+
+#[cfg(test)]
+pub(crate) fn close(a: &Sym2, b: &Sym2, tol: Real) -> bool {
+    (a - b).amax() <= tol * (1.0 + b.amax())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every law the settings accept (but `"none"`) has exactly one entry.
+    #[test]
+    fn every_law_is_registered_once() {
+        for l in GrowthLaw::ALL {
+            let n = LAWS.iter().filter(|(k, _)| *k == l).count();
+            assert_eq!(n, usize::from(l != GrowthLaw::None), "{l:?}");
+        }
+    }
+}
