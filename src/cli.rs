@@ -580,7 +580,7 @@ pub(crate) fn import_text(
             let draft = crate::morphoshell::to_toml(&m, name, Some(0.0))?;
             let settings = Settings::from_str_with(&draft, name, &[])?;
             let scene = Scene::build(read_mesh(mp)?, settings)?;
-            let sc = crate::integrate::explicit::Scales::of(&scene);
+            let sc = crate::scales::Scales::of(&scene);
             let t_bend = 2.0 * std::f64::consts::PI / sc.omega_long;
             Some(m.get("slide_speed_prefactor") * sc.length / t_bend)
         }
@@ -650,6 +650,7 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
     let settings = Settings::load(&settings_path, &cli.set)?;
     let mesh = read_mesh(&mesh_path)?;
     let mut scene = Scene::build(mesh, settings)?;
+    crate::integrate::check_scene(&scene)?;
     crate::output::check_fields(&scene, &settings_path.display().to_string())?;
     crate::solve::newton::VERBOSE.store(cli.verbose, std::sync::atomic::Ordering::Relaxed);
     let restart = if cli.continue_series {

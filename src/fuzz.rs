@@ -315,7 +315,9 @@ impl Harness {
                     match Settings::from_str_with(&text, "fuzz", &[]) {
                         Err(_) => false,
                         Ok(s) => match &self.mesh {
-                            Some(m) => Scene::build(m.clone(), s).is_ok(),
+                            Some(m) => Scene::build(m.clone(), s)
+                                .and_then(|sc| crate::integrate::check_scene(&sc))
+                                .is_ok(),
                             None => true,
                         },
                     }

@@ -40,7 +40,6 @@ pub mod fields;
 pub mod fuzz;
 pub mod geometry;
 pub mod integrate;
-pub mod lce;
 pub mod math;
 pub mod mesh;
 pub mod morphoshell;
@@ -49,6 +48,9 @@ pub mod provenance;
 pub mod render;
 pub mod rest;
 pub mod restart;
+pub mod scales;
+/// The liquid-crystal director law, kept at its earlier path.
+pub use rest::lce;
 pub mod scene;
 pub mod settings;
 pub mod solve;

@@ -48,7 +48,7 @@ fn colour(t: Real) -> [Real; 3] {
 
 /// The largest picture side, in pixels, that `render` and `plot` draw (a render's supersampled
 /// buffers at 8192 × 8192 take about 1.9 GB).
-pub const MAX_SIDE: usize = 8192;
+pub use crate::config::view::MAX_SIDE;
 
 /// A buffer of `n` copies of `v`, or an error saying how much memory the picture needed
 /// (never an abort on a failed allocation).
@@ -257,34 +257,7 @@ impl Canvas {
 
 /// Viewing direction: the unit vector from the scene toward the eye, and the screen's up.
 pub fn view(spec: &str) -> Result<(Vec3, Vec3)> {
-    let (az, el): (Real, Real) = match spec {
-        "iso" => (-60.0, 20.0),
-        "top" => (-90.0, 90.0),
-        "bottom" => (-90.0, -90.0),
-        "front" => (-90.0, 0.0),
-        "back" => (90.0, 0.0),
-        "side" => (0.0, 0.0),
-        other => {
-            let (a, e) = other.split_once(',').ok_or_else(|| {
-                anyhow!(
-                    "--view '{other}': use iso, top, bottom, front, back, side, or \
-                     AZIMUTH,ELEVATION in degrees (e.g. 30,20)"
-                )
-            })?;
-            let a: Real = a
-                .trim()
-                .parse()
-                .map_err(|_| anyhow!("--view '{other}': azimuth '{a}' is not a number"))?;
-            let e: Real = e
-                .trim()
-                .parse()
-                .map_err(|_| anyhow!("--view '{other}': elevation '{e}' is not a number"))?;
-            if !(a.is_finite() && (-90.0..=90.0).contains(&e)) {
-                bail!("--view '{other}': the elevation must lie in [-90, 90] degrees");
-            }
-            (a, e)
-        }
-    };
+    let (az, el) = crate::config::view::angles(spec).map_err(|e| anyhow!(e))?;
     let (a, e) = (az.to_radians(), el.to_radians());
     let eye = Vec3::new(e.cos() * a.cos(), e.cos() * a.sin(), e.sin());
     // Up: the z axis projected on the screen; looking along z, the y axis.

@@ -211,7 +211,7 @@ impl Scene {
                 rest.bbar1 = b1;
             }
             TargetForms::Lce => {
-                rest.lce = crate::lce::build(&mesh, &settings)?;
+                rest.lce = crate::rest::lce::build(&mesh, &settings)?;
                 rest.abar1 = rest.lce.iter().map(|l| l.metric(1.0)).collect();
                 rest.bbar1 = vec![Sym2::zeros(); nf];
             }
@@ -441,9 +441,6 @@ impl Scene {
         scene.terms = crate::energy::term::Terms(std::sync::Arc::new(
             crate::energy::registry::terms(&scene)?,
         ));
-        if scene.settings.solver.mode == crate::settings::Mode::Explicit {
-            crate::integrate::explicit::check(&scene).map_err(|r| scene.mesh.invalid(r))?;
-        }
         Ok(scene)
     }
 

@@ -2,7 +2,7 @@
 //! (unknown keys are errors), `--set key=value` overrides, and validation with messages that
 //! name the key. The full reference with examples is `docs/settings.md`.
 
-use crate::energy::{HessianProjection, StretchConvention};
+use crate::config::shell::{HessianProjection, StretchConvention};
 use crate::math::Real;
 use crate::mesh::io::Format;
 use serde::{Deserialize, Serialize};
@@ -298,8 +298,8 @@ impl Softening {
 
 impl BendingModel {
     /// The edge-DOF variant, if this model has edge DOFs.
-    pub fn angle_variant(self) -> Option<crate::energy::midedge_angle::AngleVariant> {
-        use crate::energy::midedge_angle::AngleVariant;
+    pub fn angle_variant(self) -> Option<crate::config::shell::AngleVariant> {
+        use crate::config::shell::AngleVariant;
         match self {
             BendingModel::MidedgeSin => Some(AngleVariant::Sin),
             BendingModel::MidedgeTan => Some(AngleVariant::Tan),
@@ -343,7 +343,7 @@ pub enum TargetForms {
     /// Per-face `abar_info` (required) and `bbar_info` (optional, default 0) mesh fields, in
     /// reference Cartesian coordinates (MorphoShell's files).
     Mesh,
-    /// The liquid-crystal director law ([`crate::lce`]): per face a director angle θ, a stretch
+    /// The liquid-crystal director law ([`crate::rest::lce`]): per face a director angle θ, a stretch
     /// λ and a ratio ν, from `[rest.lce]` or from the mesh's `abar_info` read as (θ, λ, ν).
     Lce,
 }
@@ -2361,11 +2361,11 @@ impl Settings {
             }
         }
         if o.snapshots != Snapshots::None {
-            crate::render::view(&o.snapshot_view)
+            crate::config::view::angles(&o.snapshot_view)
                 .map(|_| ())
-                .or_else(|e| ck.inv("output.snapshot_view", format!("{e:#}")))?;
+                .or_else(|e| ck.inv("output.snapshot_view", e))?;
             let [w, h] = o.snapshot_size;
-            let max = crate::render::MAX_SIDE;
+            let max = crate::config::view::MAX_SIDE;
             if !(64..=max).contains(&w) || !(64..=max).contains(&h) {
                 return ck.inv(
                     "output.snapshot_size",

@@ -3,9 +3,14 @@
 //! [`crate::math`]; `crate::settings` embeds the sections and turns an [`Invalid`] into the
 //! settings error that names the file.
 //!
-//! * [`gent`]: `[material.gent]`, Gent rubber's limiting extensibility `J_m`.
+//! * [`gent`]: `[material.gent]`, Gent rubber's limiting extensibility `J_m`;
+//! * [`shell`]: the values the shell kernels dispatch on (bending variant, stretching
+//!   convention, Hessian projection);
+//! * [`view`]: a picture's view direction (`--view`, `output.snapshot_view`).
 
 pub mod gent;
+pub mod shell;
+pub mod view;
 
 use crate::math::Real;
 

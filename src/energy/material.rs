@@ -30,17 +30,7 @@ impl Lame2d {
     }
 }
 
-/// Which stretching normalisation to use.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum StretchConvention {
-    /// Standard Koiter, strain `(a − ā)/2`: seed 000's `h/4 ‖ā⁻¹a − I‖²_SV`.
-    #[default]
-    Koiter,
-    /// MorphoShell's handbook and code: strain `a − ā` without the ½, a stretching energy 4×
-    /// larger. Offered so that MorphoShell users can reproduce earlier results.
-    Morphoshell,
-}
+pub use crate::config::shell::StretchConvention;
 
 impl StretchConvention {
     /// Multiplier on the stretching term.

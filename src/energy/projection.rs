@@ -4,23 +4,7 @@
 
 use crate::math::{Real, SMat, SVec};
 
-/// How to treat negative eigenvalues of an element Hessian.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum HessianProjection {
-    /// Use the exact Hessian; indefiniteness is handled by the solver's diagonal shift.
-    None,
-    /// Exact Hessian when it factorises, the Gauss–Newton Hessian for iterations where it does
-    /// not (default: quadratic convergence near a minimum, robust far from one).
-    #[default]
-    Adaptive,
-    /// Always the Gauss–Newton Hessian (positive semi-definite by construction).
-    GaussNewton,
-    /// Clamp negative eigenvalues to zero.
-    ClampZero,
-    /// Replace eigenvalues by their absolute values.
-    Abs,
-}
+pub use crate::config::shell::HessianProjection;
 
 /// Projects a symmetric `N×N` matrix in place: `H = V max(Λ, 0) Vᵀ` or `V |Λ| Vᵀ`, with the
 /// eigensystem from [`jacobi_eigen`] (no allocation).

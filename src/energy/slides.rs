@@ -325,7 +325,7 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn super::term::Term>>, MeshErr
             )));
         }
     }
-    let sc = crate::integrate::explicit::Scales::of(scene);
+    let sc = crate::scales::Scales::of(scene);
     let drag = s.drag.unwrap_or_else(|| {
         let mass: Real = scene.mass.iter().sum();
         let rate = scene.settings.explicit.damping_prefactor_wait.max(1.0) * 2.0 * sc.omega_long;

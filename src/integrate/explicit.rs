@@ -79,87 +79,8 @@ use crate::output::{ExplicitReport, Writer};
 use crate::scene::Scene;
 use crate::settings::EquilibriumTest;
 use crate::solve::{Potential, State};
-use std::f64::consts::PI;
 
-/// The time and force scales of a scene's explicit dynamics (module doc).
-#[derive(Clone, Copy, Debug)]
-pub struct Scales {
-    /// Density ρ (kg/m³).
-    pub rho: Real,
-    /// Smallest shear modulus μ (Pa).
-    pub mu: Real,
-    /// Smallest thickness t (m).
-    pub t: Real,
-    /// Flexural rigidity `μ t³ / (6(1 − ν))` (N·m).
-    pub flexural: Real,
-    /// Smallest altitude of the reference triangles (m).
-    pub a_min: Real,
-    /// The sample length L: the reference perimeter (m).
-    pub length: Real,
-    /// The time step at prefactor 1 (s).
-    pub dt_unit: Real,
-    /// Angular frequency of the longest bending mode, `√(D/(ρt)) (2π/L)²` (rad/s).
-    pub omega_long: Real,
-    /// The long time `max(2π/ω_L, L √(ρ/μ))` (s).
-    pub long_time: Real,
-}
-
-impl Scales {
-    /// The scales of `scene`.
-    pub fn of(scene: &Scene) -> Scales {
-        let m = &scene.settings.material;
-        let rho = m.density;
-        let mu = scene
-            .lame
-            .iter()
-            .map(|l| l.beta)
-            .fold(Real::INFINITY, Real::min);
-        let t = scene
-            .thickness
-            .iter()
-            .copied()
-            .fold(Real::INFINITY, Real::min);
-        let flexural = mu * t * t * t / (6.0 * (1.0 - m.poisson));
-        let mesh = &scene.mesh;
-        let mut a_min = Real::INFINITY;
-        for f in 0..mesh.faces.len() {
-            let [p0, p1, p2] = mesh.face_positions(f);
-            let twice_area = (p1 - p0).cross(&(p2 - p0)).norm();
-            for (a, b) in [(p0, p1), (p1, p2), (p2, p0)] {
-                a_min = a_min.min(twice_area / (b - a).norm());
-            }
-        }
-        let topo = &scene.topo;
-        let perimeter: Real = topo
-            .edges
-            .iter()
-            .zip(&topo.edge_faces)
-            .filter(|(_, ef)| ef[1] == crate::mesh::topology::NONE)
-            .map(|(e, _)| (mesh.positions[e[1]] - mesh.positions[e[0]]).norm())
-            .sum();
-        let length = if perimeter > 0.0 {
-            perimeter
-        } else {
-            PI * mesh.bbox_diagonal()
-        };
-        let dt_unit = (0.185 * (rho / mu).sqrt() * a_min)
-            .min((rho * t / flexural).sqrt() * a_min * a_min / (2.0 * PI));
-        let k = 2.0 * PI / length;
-        let omega_long = (flexural / (rho * t)).sqrt() * k * k;
-        let long_time = (2.0 * PI / omega_long).max(length * (rho / mu).sqrt());
-        Scales {
-            rho,
-            mu,
-            t,
-            flexural,
-            a_min,
-            length,
-            dt_unit,
-            omega_long,
-            long_time,
-        }
-    }
-}
+pub use crate::scales::Scales;
 
 /// Checks, before anything is written, that an explicit run of `scene` makes sense and
 /// bounds its work; the error names the settings keys. A vertex must be free to move; the drag
@@ -314,9 +235,10 @@ fn advance_node(x: &mut Vec3, v: &mut Vec3, f: Vec3, inv_m: Real, c: Real, dt: R
     *x += *v * dt;
 }
 
-/// A pointer for writes by several threads to entries that each belongs to one of them.
+/// A pointer for writes by several threads to entries that each belongs to one of them, with
+/// the slice's length (checked in debug builds).
 #[derive(Clone, Copy)]
-struct Disjoint(*mut Vec3);
+struct Disjoint(*mut Vec3, usize);
 // SAFETY: shared only by `Step::take`, whose parts write disjoint entries.
 unsafe impl Send for Disjoint {}
 unsafe impl Sync for Disjoint {}
@@ -328,6 +250,7 @@ impl Disjoint {
     /// `u` is in bounds and no other thread touches it meanwhile.
     #[inline(always)]
     unsafe fn at<'a>(self, u: usize) -> &'a mut Vec3 {
+        debug_assert!(u < self.1, "Disjoint::at({u}) beyond {}", self.1);
         unsafe { &mut *self.0.add(u) }
     }
 }
@@ -422,7 +345,10 @@ impl Step {
             v.len() == n && self.next.len() == n && inv_m.len() == n && pinned.len() >= 3 * n,
             "a step built for another scene"
         );
-        let (vp, np) = (Disjoint(v.as_mut_ptr()), Disjoint(self.next.as_mut_ptr()));
+        let (vp, np) = (
+            Disjoint(v.as_mut_ptr(), v.len()),
+            Disjoint(self.next.as_mut_ptr(), self.next.len()),
+        );
         let old: &[Vec3] = x;
         let hook = move |nodes: &[u32], sums: &[Real], fixed: &[bool]| {
             let mut at = 0;

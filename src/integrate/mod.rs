@@ -792,6 +792,15 @@ pub fn run(
     Ok(s.summary)
 }
 
+/// Checks what the scene's driver needs before anything is written (the explicit driver's
+/// bounds, [`explicit::check`]); the error names the mesh file.
+pub fn check_scene(scene: &Scene) -> Result<(), crate::mesh::MeshError> {
+    if scene.settings.solver.mode == crate::settings::Mode::Explicit {
+        explicit::check(scene).map_err(|r| scene.mesh.invalid(r))?;
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::{OutputClock, StepControl};

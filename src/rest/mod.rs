@@ -5,6 +5,7 @@
 //! never branch on them.
 
 pub mod laws;
+pub mod lce;
 
 use crate::geometry::{first_fundamental_form, midedge_average_b};
 use crate::math::{Mat2, Real, Sym2, Vec3};
@@ -25,8 +26,8 @@ pub struct RestForms {
     /// The order in which ā and b̄ are dialled.
     pub order: DialOrder,
     /// The director law per face, which dials ā through its stretch instead of linearly
-    /// (empty without it; [`crate::lce`]).
-    pub lce: Vec<crate::lce::LceFace>,
+    /// (empty without it; [`lce`]).
+    pub lce: Vec<lce::LceFace>,
 }
 
 impl RestForms {
@@ -55,7 +56,7 @@ impl RestForms {
 
     /// Rest forms at dial factor `s ∈ [0, 1]`: linear interpolation of each form at its own dial
     /// ([`Self::split`]), as MorphoShell's dial (convex combinations keep ā positive definite);
-    /// under the director law ā follows its stretch instead ([`crate::lce`]).
+    /// under the director law ā follows its stretch instead ([`lce`]).
     #[inline]
     pub fn at(&self, f: usize, s: Real) -> (Sym2, Sym2) {
         if s >= 1.0 {

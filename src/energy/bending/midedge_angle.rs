@@ -46,14 +46,7 @@ use crate::geometry::{
 use crate::math::{Mat3, Real, SMat, SVec, Sym2, Vec3};
 use crate::scene::Scene;
 
-/// The function `g` of `q = h g(θ/2 + σφ)`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum AngleVariant {
-    /// `g = sin`: the mid-edge normal's offset.
-    Sin,
-    /// `g = tan`.
-    Tan,
-}
+pub use crate::config::shell::AngleVariant;
 
 impl AngleVariant {
     /// `(g, g', g'')` at `t`.

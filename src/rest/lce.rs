@@ -20,9 +20,9 @@
 //!
 //! Units: θ in rad, λ and ν dimensionless, `ā` in m² (barycentric).
 
+use super::{pull_back, reference_frame};
 use crate::math::{Mat2, Real, Sym2, Vec2};
 use crate::mesh::{Mesh, MeshError};
-use crate::rest::{pull_back, reference_frame};
 use crate::settings::Settings;
 
 /// One face's director law.
