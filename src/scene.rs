@@ -347,11 +347,29 @@ impl Scene {
         // Free: no vertex that carries the sheet is held (unused vertices are held, inertly).
         let free = unused.len() < nv && (0..nv).all(|v| is_unused[v] || !fixed[v]);
         let gravity = settings.loads.gravity.iter().any(|&g| g != 0.0);
-        if free && gravity && settings.solver.mode == crate::settings::Mode::Static {
+        let obstacles = !settings.obstacles.is_empty();
+        if free && gravity && !obstacles && settings.solver.mode == crate::settings::Mode::Static {
             return Err(mesh.invalid(
                 "static mode under gravity (loads.gravity) needs fixed vertices: a free sheet has no \
                  equilibrium. Fix some (constraint_indicators, constraints.fix_tags or \
                  constraints.fix_boxes) or use solver.mode = \"dynamic\"",
+            ));
+        }
+        let on_plane = settings
+            .obstacles
+            .iter()
+            .any(|o| o.shape == Some(crate::config::obstacle::ShapeKind::Plane));
+        if free
+            && obstacles
+            && !on_plane
+            && (gravity || settings.loads.any_external())
+            && settings.solver.mode == crate::settings::Mode::Static
+        {
+            return Err(mesh.invalid(
+                "obstacles: a free sheet under loads in static mode can rest only on a plane \
+                 obstacle: Newton's first step of a free sheet is unbounded and can carry it \
+                 through a finite obstacle (a sphere, capsule, cylinder or box). Add a plane, fix \
+                 some vertices, or use solver.mode = \"dynamic\"",
             ));
         }
         if settings.contact.enabled && free && settings.solver.mode == crate::settings::Mode::Static
@@ -395,18 +413,20 @@ impl Scene {
                 node_fixed[nv + e] = true;
             }
         }
-        let pinned_dofs = if free && settings.solver.mode == crate::settings::Mode::Static {
-            let mut pins = rigid_pins(&mesh, &fixed);
-            // Dead loads are not invariant under rotations: pinning rotational DOFs would make
-            // the pins carry a reaction. Only the translation is pinned then (balanced loads are
-            // invariant under it); rotations the loads leave free get the solver's tiny shift.
-            if settings.loads.any_external() {
-                pins.truncate(3);
-            }
-            pins
-        } else {
-            Vec::new()
-        };
+        // Obstacles hold the sheet where they touch it: pins would carry their reaction.
+        let pinned_dofs =
+            if free && !obstacles && settings.solver.mode == crate::settings::Mode::Static {
+                let mut pins = rigid_pins(&mesh, &fixed);
+                // Dead loads are not invariant under rotations: pinning rotational DOFs would make
+                // the pins carry a reaction. Only the translation is pinned then (balanced loads are
+                // invariant under it); rotations the loads leave free get the solver's tiny shift.
+                if settings.loads.any_external() {
+                    pins.truncate(3);
+                }
+                pins
+            } else {
+                Vec::new()
+            };
         let mean_edge = mesh.mean_edge_length();
         let eh = young
             .iter()

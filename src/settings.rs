@@ -96,6 +96,8 @@ pub struct Settings {
     pub contact: Contact,
     /// Two horizontal glass slides squeezing the sheet (MorphoShell's).
     pub slides: Slides,
+    /// Rigid obstacles (`[[obstacles]]`), fixed or moved with the dial.
+    pub obstacles: Vec<crate::config::obstacle::ObstacleSettings>,
     /// Fixed vertices.
     pub constraints: Constraints,
     /// Output files.
@@ -1538,6 +1540,15 @@ impl Settings {
         self.validate_loads(name)?;
         self.validate_gas(name)?;
         self.validate_contact(name)?;
+        for (i, o) in self.obstacles.iter().enumerate() {
+            if let Err(e) = o.shape(i) {
+                return Err(SettingsError::Invalid {
+                    path: name.to_string(),
+                    key: e.key,
+                    reason: e.reason,
+                });
+            }
+        }
         self.validate_constraints(name)?;
         self.validate_output(name)?;
         Ok(())

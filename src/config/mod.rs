@@ -6,9 +6,11 @@
 //! * [`gent`]: `[material.gent]`, Gent rubber's limiting extensibility `J_m`;
 //! * [`shell`]: the values the shell kernels dispatch on (bending variant, stretching
 //!   convention, Hessian projection);
-//! * [`view`]: a picture's view direction (`--view`, `output.snapshot_view`).
+//! * [`view`]: a picture's view direction (`--view`, `output.snapshot_view`);
+//! * [`obstacle`]: `[[obstacles]]`, rigid obstacles.
 
 pub mod gent;
+pub mod obstacle;
 pub mod shell;
 pub mod view;
 

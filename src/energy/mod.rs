@@ -6,12 +6,14 @@
 //! * [`term`]: the contracts (element, vertex and low-rank global terms).
 //! * [`registry`]: settings → the list of terms.
 //! * [`shell`]: membrane material × bending model, composed by one chain rule.
-//! * [`membrane`]: the membrane materials (Koiter, neo-Hookean, Mooney–Rivlin, Baraff–Witkin).
+//! * [`membrane`]: the membrane materials (Koiter, neo-Hookean, Mooney–Rivlin, Gent,
+//!   Baraff–Witkin, the prism element).
 //! * [`bending`]: the bending models (mid-edge average, patch fit, edge-DOF sin/tan, none).
 //! * [`material`]: plane-stress Lamé parameters and the Koiter density (stretching, bending and
 //!   Kelvin–Voigt damping wells).
 //! * [`gravity`], [`inertia`], [`ground`]: vertex terms.
 //! * [`loads`]: point forces, tractions and pressure, scaled by the dial (the load factor).
+//! * [`obstacles`]: rigid spheres, capsules, cylinders, planes and boxes, fixed or moved.
 //! * [`gas`]: an enclosed gas (amount, pressure or volume control) with its rank-one stiffness.
 //! * [`projection`]: optional per-element projection of a Hessian to positive semi-definite.
 
@@ -23,6 +25,7 @@ pub mod inertia;
 pub mod loads;
 pub mod material;
 pub mod membrane;
+pub mod obstacles;
 pub mod projection;
 pub mod registry;
 pub mod shell;

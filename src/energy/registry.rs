@@ -166,6 +166,7 @@ pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
         super::loads::moment::term,
         super::gas::term,
         super::slides::term,
+        super::obstacles::term,
     ] {
         t.extend(load(scene)?);
     }

@@ -74,6 +74,7 @@ impl RunConfig {
             .fold(Real::INFINITY, Real::min);
         let loaded = s.loads.any_external()
             || !scene.prescribed.is_empty()
+            || !s.obstacles.is_empty()
             || s.gas.control != crate::settings::GasControl::None;
         let softening = match st.membrane_continuation {
             Softening::Auto(_) if loaded => 1.0,

@@ -492,6 +492,37 @@ fn baraff_witkin_is_rotation_invariant() {
     }
 }
 
+/// Every obstacle shape, moved with the dial into a deformed strip so that some vertices are
+/// in contact (on both branches of the smoothed penalty), against finite differences.
+#[test]
+fn obstacles_match_finite_differences() {
+    for shape in [
+        "shape = \"sphere\"\ncenter = [0.5, 0.25, -0.5]\nradius = 0.45",
+        "shape = \"capsule\"\na = [0.3, 0.25, -0.5]\nb = [0.7, 0.3, -0.5]\nradius = 0.45",
+        "shape = \"cylinder\"\npoint = [0.5, 0.25, -0.5]\naxis = [0.2, 1, 0]\nradius = 0.45",
+        "shape = \"plane\"\npoint = [0, 0, -0.05]\nnormal = [0.1, 0, 1]",
+        "shape = \"box\"\nmin = [0.2, 0.1, -1]\nmax = [0.8, 0.35, -0.05]",
+    ] {
+        let sc = strip_scene(&format!(
+            "[material]\nthickness = 0.05\n[constraints]\nfix_boxes = [{{ min = [-1, -1, -1], \
+             max = [0.01, 2, 1] }}]\n[[obstacles]]\n{shape}\ndisplacement = [0, 0, 0.2]\n"
+        ));
+        let p = Pattern::for_scene(&sc);
+        let x = deformed(&sc);
+        let phi = vec![0.0; sc.num_edge_dofs()];
+        let pot = Potential {
+            dial: 0.6,
+            ..Potential::new(&sc, &p)
+        };
+        let i = (0..sc.terms.len())
+            .find(|&i| sc.terms[i].name() == "obstacles")
+            .unwrap();
+        let e = sc.terms[i].energies(&pot, &p.maps[i], &x, &phi);
+        assert!(e.iter().any(|(_, v)| *v > 0.0), "{shape}: no contact");
+        check_term(&sc, &p, &pot, &x, &phi, i);
+    }
+}
+
 /// The energy and the nominal stress `∂W/∂λ₁` of the rubber membranes under in-plane stretches
 /// (λ₁, λ₂) with λ₃ = 1/(λ₁λ₂), uniaxial (λ₂ = λ₁^(−1/2)) and equibiaxial (λ₂ = λ₁), against
 /// `W = c₁(I₁ − 3) + c₂(I₂ − 3)`, `I₁ = λ₁² + λ₂² + λ₃²`, `I₂ = λ₁²λ₂² + λ₁⁻² + λ₂⁻²`, and

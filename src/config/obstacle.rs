@@ -1,0 +1,316 @@
+//! `[[obstacles]]`: rigid obstacles the sheet rests on or is pressed by, one table each.
+//!
+//! ```toml
+//! [[obstacles]]
+//! shape = "sphere"          # "sphere", "capsule", "cylinder", "plane" or "box"
+//! center = [0, 0, -0.3]     # sphere
+//! radius = 0.25             # sphere, capsule, cylinder (m)
+//! displacement = [0, 0, 0]  # moved linearly with the dial to this offset at dial 1 (m)
+//! ```
+//!
+//! Shapes and their keys: `sphere` (`center`, `radius`); `capsule` (the segment `a`–`b` and
+//! `radius`); `cylinder` (infinite: a `point` on its axis, the `axis` direction, `radius`);
+//! `plane` (a `point` and the `normal` toward the sheet's side); `box` (axis-aligned, `min` and
+//! `max` corners). Common keys: `displacement` (m, default none: the obstacle is fixed),
+//! `stiffness` (Pa/m, default: the area-weighted mean E/h of the sheet) and `smoothing` (m,
+//! default: the mean thickness over 100), as the ground's (`[contact]`).
+//!
+//! The raw table is flat (every key optional, unknown keys refused); [`ObstacleSettings::shape`]
+//! validates it into a [`Shape`] that carries exactly its variant's parameters.
+
+use super::Invalid;
+use crate::math::Real;
+use serde::{Deserialize, Serialize};
+
+/// One `[[obstacles]]` table as written.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ObstacleSettings {
+    /// `"sphere"`, `"capsule"`, `"cylinder"`, `"plane"` or `"box"` (required).
+    pub shape: Option<ShapeKind>,
+    /// Sphere centre (m).
+    pub center: Option<[Real; 3]>,
+    /// Radius of a sphere, capsule or cylinder (m, > 0).
+    pub radius: Option<Real>,
+    /// Capsule segment ends (m).
+    pub a: Option<[Real; 3]>,
+    /// See `a`.
+    pub b: Option<[Real; 3]>,
+    /// A point on a cylinder's axis or on a plane (m).
+    pub point: Option<[Real; 3]>,
+    /// Cylinder axis direction (non-zero).
+    pub axis: Option<[Real; 3]>,
+    /// Plane normal, toward the sheet's side (non-zero).
+    pub normal: Option<[Real; 3]>,
+    /// Box corners (m), `min < max` on every axis.
+    pub min: Option<[Real; 3]>,
+    /// See `min`.
+    pub max: Option<[Real; 3]>,
+    /// Offset reached at dial 1, linear in the dial (m; default: fixed).
+    pub displacement: [Real; 3],
+    /// Penalty stiffness k (Pa/m; default: the sheet's area-weighted mean E/h).
+    pub stiffness: Option<Real>,
+    /// Smoothing length δ (m; default: the sheet's mean thickness / 100).
+    pub smoothing: Option<Real>,
+}
+
+/// The shape names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShapeKind {
+    /// A sphere.
+    Sphere,
+    /// A segment with a radius.
+    Capsule,
+    /// An infinite circular cylinder.
+    Cylinder,
+    /// A plane.
+    Plane,
+    /// An axis-aligned box.
+    Box,
+}
+
+/// A validated shape with its parameters (m; directions of unit length).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    /// Centre and radius.
+    Sphere {
+        /// Centre.
+        center: [Real; 3],
+        /// Radius.
+        radius: Real,
+    },
+    /// Segment ends and radius.
+    Capsule {
+        /// One end.
+        a: [Real; 3],
+        /// The other end.
+        b: [Real; 3],
+        /// Radius.
+        radius: Real,
+    },
+    /// A point on the axis, the unit axis, the radius.
+    Cylinder {
+        /// A point on the axis.
+        point: [Real; 3],
+        /// Unit axis.
+        axis: [Real; 3],
+        /// Radius.
+        radius: Real,
+    },
+    /// A point and the unit normal toward the sheet.
+    Plane {
+        /// A point on the plane.
+        point: [Real; 3],
+        /// Unit normal.
+        normal: [Real; 3],
+    },
+    /// Corners.
+    Box {
+        /// Lower corner.
+        min: [Real; 3],
+        /// Upper corner.
+        max: [Real; 3],
+    },
+}
+
+/// Largest coordinate or length accepted (m), as for the mesh.
+const MAX_COORD: Real = 1e30;
+
+fn finite3(key: &str, v: [Real; 3]) -> Result<[Real; 3], Invalid> {
+    if v.iter().all(|c| c.is_finite() && c.abs() <= MAX_COORD) {
+        Ok(v)
+    } else {
+        Err(Invalid::new(
+            key,
+            format!("must be finite (within ±1e30 m), got {v:?}"),
+        ))
+    }
+}
+
+fn unit(key: &str, v: [Real; 3]) -> Result<[Real; 3], Invalid> {
+    let v = finite3(key, v)?;
+    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if !(n > 0.0 && n.is_finite()) {
+        return Err(Invalid::new(
+            key,
+            format!("must be a non-zero direction, got {v:?}"),
+        ));
+    }
+    Ok(v.map(|c| c / n))
+}
+
+impl ObstacleSettings {
+    /// The validated shape of obstacle `i` (keys named `obstacles[i].KEY`): the shape's own
+    /// keys present and valid, no key of another shape, and finite common keys.
+    pub fn shape(&self, i: usize) -> Result<Shape, Invalid> {
+        let key = |k: &str| format!("obstacles[{i}].{k}");
+        let need3 = |k: &str, v: Option<[Real; 3]>| -> Result<[Real; 3], Invalid> {
+            let v = v.ok_or_else(|| Invalid::new(&key(k), "is required by this shape"))?;
+            finite3(&key(k), v)
+        };
+        let radius = || -> Result<Real, Invalid> {
+            let r = self
+                .radius
+                .ok_or_else(|| Invalid::new(&key("radius"), "is required by this shape"))?;
+            if r.is_finite() && r > 0.0 && r <= MAX_COORD {
+                Ok(r)
+            } else {
+                Err(Invalid::new(
+                    &key("radius"),
+                    format!("must be > 0 (m), got {}", crate::math::human(r)),
+                ))
+            }
+        };
+        let kind = self.shape.ok_or_else(|| {
+            Invalid::new(
+                &key("shape"),
+                "is required: \"sphere\", \"capsule\", \"cylinder\", \"plane\" or \"box\"",
+            )
+        })?;
+        let used: &[&str] = match kind {
+            ShapeKind::Sphere => &["center", "radius"],
+            ShapeKind::Capsule => &["a", "b", "radius"],
+            ShapeKind::Cylinder => &["point", "axis", "radius"],
+            ShapeKind::Plane => &["point", "normal"],
+            ShapeKind::Box => &["min", "max"],
+        };
+        let given = [
+            ("center", self.center.is_some()),
+            ("radius", self.radius.is_some()),
+            ("a", self.a.is_some()),
+            ("b", self.b.is_some()),
+            ("point", self.point.is_some()),
+            ("axis", self.axis.is_some()),
+            ("normal", self.normal.is_some()),
+            ("min", self.min.is_some()),
+            ("max", self.max.is_some()),
+        ];
+        if let Some((k, _)) = given.iter().find(|(k, g)| *g && !used.contains(k)) {
+            return Err(Invalid::new(
+                &key(k),
+                format!(
+                    "is not a key of shape {kind:?} (its keys: {})",
+                    used.join(", ")
+                ),
+            ));
+        }
+        finite3(&key("displacement"), self.displacement)?;
+        for (k, v) in [("stiffness", self.stiffness), ("smoothing", self.smoothing)] {
+            if let Some(v) = v {
+                super::positive(&key(k), v, "")?;
+            }
+        }
+        Ok(match kind {
+            ShapeKind::Sphere => Shape::Sphere {
+                center: need3("center", self.center)?,
+                radius: radius()?,
+            },
+            ShapeKind::Capsule => {
+                let (a, b) = (need3("a", self.a)?, need3("b", self.b)?);
+                if a == b {
+                    return Err(Invalid::new(
+                        &key("b"),
+                        "must differ from a (use a sphere for a point)",
+                    ));
+                }
+                Shape::Capsule {
+                    a,
+                    b,
+                    radius: radius()?,
+                }
+            }
+            ShapeKind::Cylinder => Shape::Cylinder {
+                point: need3("point", self.point)?,
+                axis: unit(
+                    &key("axis"),
+                    self.axis
+                        .ok_or_else(|| Invalid::new(&key("axis"), "is required by this shape"))?,
+                )?,
+                radius: radius()?,
+            },
+            ShapeKind::Plane => Shape::Plane {
+                point: need3("point", self.point)?,
+                normal: unit(
+                    &key("normal"),
+                    self.normal
+                        .ok_or_else(|| Invalid::new(&key("normal"), "is required by this shape"))?,
+                )?,
+            },
+            ShapeKind::Box => {
+                let (min, max) = (need3("min", self.min)?, need3("max", self.max)?);
+                if (0..3).any(|k| min[k] >= max[k]) {
+                    return Err(Invalid::new(
+                        &key("max"),
+                        format!("must exceed min on every axis: min {min:?}, max {max:?}"),
+                    ));
+                }
+                Shape::Box { min, max }
+            }
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(t: &str) -> ObstacleSettings {
+        toml::from_str(t).unwrap()
+    }
+
+    #[test]
+    fn shapes_validate_with_their_keys_only() {
+        let s = parse("shape = \"sphere\"\ncenter = [0, 0, 1]\nradius = 0.5");
+        assert!(matches!(s.shape(0), Ok(Shape::Sphere { radius: 0.5, .. })));
+        for (t, k) in [
+            (
+                "shape = \"sphere\"\ncenter = [0, 0, 1]",
+                "obstacles[3].radius",
+            ),
+            (
+                "shape = \"sphere\"\ncenter = [0, 0, 1]\nradius = 0",
+                "obstacles[3].radius",
+            ),
+            (
+                "shape = \"sphere\"\ncenter = [0, 0, 1]\nradius = -1",
+                "obstacles[3].radius",
+            ),
+            (
+                "shape = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 0, 0]",
+                "obstacles[3].normal",
+            ),
+            (
+                "shape = \"cylinder\"\npoint = [0, 0, 0]\naxis = [0, 0, 0]\nradius = 1",
+                "obstacles[3].axis",
+            ),
+            (
+                "shape = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 0, 1]\nradius = 1",
+                "obstacles[3].radius",
+            ),
+            (
+                "shape = \"box\"\nmin = [0, 0, 0]\nmax = [1, 0, 1]",
+                "obstacles[3].max",
+            ),
+            (
+                "shape = \"capsule\"\na = [0, 0, 0]\nb = [0, 0, 0]\nradius = 1",
+                "obstacles[3].b",
+            ),
+            ("center = [0, 0, 0]", "obstacles[3].shape"),
+            (
+                "shape = \"plane\"\npoint = [0, 0, nan]\nnormal = [0, 0, 1]",
+                "obstacles[3].point",
+            ),
+        ] {
+            assert_eq!(parse(t).shape(3).unwrap_err().key, k, "{t}");
+        }
+        let p = parse("shape = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 0, 2]");
+        assert_eq!(
+            p.shape(0),
+            Ok(Shape::Plane {
+                point: [0.0; 3],
+                normal: [0.0, 0.0, 1.0]
+            })
+        );
+    }
+}

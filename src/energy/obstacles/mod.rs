@@ -1,0 +1,273 @@
+//! Rigid obstacles (`[[obstacles]]`): spheres, capsules, infinite cylinders, planes and boxes,
+//! fixed or moved with the dial, that the sheet's surfaces rest on or are pressed by. One file
+//! per shape gives its signed distance `d(x)` with `∇d` and `∇²d` ([`Distance`]); this term
+//! turns them into the ground's smoothed one-sided penalty ([`crate::solve::contact`]).
+//!
+//! **Energy.** Vertex `v`'s gap to obstacle `o` is `g = d_o(x_v − s u_o) − h_v/2`, with `u_o`
+//! the obstacle's `displacement`, `s` the dial (clamped to [0, 1]) and `h_v` the mean thickness
+//! of the faces around `v` (the sheet's surface, not its mid-surface, touches). With the
+//! penetration `p = max(0, −g)`:
+//!
+//! `E = Σ_o Σ_v k_o A_v ψ(p)`,
+//! `∂E/∂x_v = −k_o A_v ψ′(p) ∇d`, `∂²E/∂x_v² = k_o A_v (ψ″(p) ∇d∇dᵀ − ψ′(p) ∇²d)`,
+//!
+//! `ψ` the C² penalty of [`crate::solve::contact::penalty`] with smoothing δ, `A_v` the vertex's
+//! reference area, `k_o` the stiffness (Pa/m). Defaults as for the ground: `k = E/h` and
+//! `δ = h/100`, area-weighted over the sheet. The curvature part `−ψ′∇²d` is negative
+//! semi-definite on convex obstacles; the solver's Hessian handling (the adaptive projection,
+//! the diagonal shift) takes care of it. Frictionless; a vertex term in every driver.
+//!
+//! `log.csv` gets, per obstacle `i`, the force it exerts on the sheet
+//! (`obstacle{i}_force_x/y/z`, N) and the smallest gap (`obstacle{i}_gap`, m).
+//!
+//! Units: positions m, k Pa/m, A m², energies J. DOF order: `x[v]`.
+
+pub mod capsule;
+pub mod cuboid;
+pub mod cylinder;
+pub mod plane;
+pub mod sphere;
+
+use super::term::{Term, VertexKernel, VertexTerm};
+use crate::config::obstacle::Shape;
+use crate::math::{Mat3, Real, Vec3};
+use crate::mesh::MeshError;
+use crate::scene::Scene;
+use crate::solve::contact::penalty;
+use crate::solve::Potential;
+
+/// A shape's signed distance (m, negative inside), its gradient and its Hessian (1/m) at `x`.
+pub trait Distance {
+    /// `(d, ∇d, ∇²d)`.
+    fn distance(&self, x: &Vec3) -> (Real, Vec3, Mat3);
+}
+
+/// `(r − R, w/r, (P − uuᵀ)/r)` for the offset `w` from the nearest point of a core (a point, a
+/// segment, an axis), `r = ‖w‖`: the distance to a round surface of radius `R` about it. `P`
+/// projects onto the directions in which the core does not extend. At `r = 0` (on the core,
+/// deep inside) the direction is undefined: no gradient.
+#[inline]
+pub(crate) fn round_distance(w: Vec3, radius: Real, proj: &Mat3) -> (Real, Vec3, Mat3) {
+    let r = w.norm();
+    if r == 0.0 {
+        return (-radius, Vec3::zeros(), Mat3::zeros());
+    }
+    let u = w / r;
+    (r - radius, u, (proj - u * u.transpose()) / r)
+}
+
+/// A validated shape, dispatched by a `match` (no virtual call per vertex).
+#[derive(Clone, Copy, Debug)]
+pub enum Body {
+    /// See [`sphere`].
+    Sphere(sphere::Sphere),
+    /// See [`capsule`].
+    Capsule(capsule::Capsule),
+    /// See [`cylinder`].
+    Cylinder(cylinder::Cylinder),
+    /// See [`plane`].
+    Plane(plane::Plane),
+    /// See [`cuboid`].
+    Box(cuboid::Cuboid),
+}
+
+impl Body {
+    /// The body of a validated shape.
+    pub fn of(s: &Shape) -> Body {
+        let v = |a: &[Real; 3]| Vec3::from(*a);
+        match s {
+            Shape::Sphere { center, radius } => Body::Sphere(sphere::Sphere {
+                center: v(center),
+                radius: *radius,
+            }),
+            Shape::Capsule { a, b, radius } => Body::Capsule(capsule::Capsule {
+                a: v(a),
+                b: v(b),
+                radius: *radius,
+            }),
+            Shape::Cylinder {
+                point,
+                axis,
+                radius,
+            } => Body::Cylinder(cylinder::Cylinder {
+                point: v(point),
+                axis: v(axis),
+                radius: *radius,
+            }),
+            Shape::Plane { point, normal } => Body::Plane(plane::Plane {
+                point: v(point),
+                normal: v(normal),
+            }),
+            Shape::Box { min, max } => Body::Box(cuboid::Cuboid {
+                min: v(min),
+                max: v(max),
+            }),
+        }
+    }
+}
+
+impl Distance for Body {
+    #[inline]
+    fn distance(&self, x: &Vec3) -> (Real, Vec3, Mat3) {
+        match self {
+            Body::Sphere(s) => s.distance(x),
+            Body::Capsule(s) => s.distance(x),
+            Body::Cylinder(s) => s.distance(x),
+            Body::Plane(s) => s.distance(x),
+            Body::Box(s) => s.distance(x),
+        }
+    }
+}
+
+/// One obstacle with its contact law.
+#[derive(Clone, Copy, Debug)]
+pub struct Obstacle {
+    /// Its shape at dial 0.
+    pub body: Body,
+    /// Offset at dial 1 (m).
+    pub displacement: Vec3,
+    /// Penalty stiffness k (Pa/m).
+    pub stiffness: Real,
+    /// Smoothing length δ (m).
+    pub smoothing: Real,
+}
+
+/// Every obstacle, with the per-vertex areas and half thicknesses.
+pub struct Obstacles {
+    /// The obstacles.
+    pub list: Vec<Obstacle>,
+    /// Reference area per vertex A_v (m²).
+    pub area: Vec<Real>,
+    /// Half thickness per vertex h_v/2 (m).
+    pub half_thickness: Vec<Real>,
+}
+
+impl Obstacles {
+    /// Penetration, `∇d` and `∇²d` of vertex `v` at `x` against obstacle `o` at dial `s`.
+    #[inline]
+    fn contact(&self, o: &Obstacle, v: usize, x: &Vec3, s: Real) -> (Real, Vec3, Mat3) {
+        let (d, n, h) = o.body.distance(&(x - o.displacement * s.clamp(0.0, 1.0)));
+        (self.half_thickness[v] - d, n, h)
+    }
+}
+
+impl VertexKernel for Obstacles {
+    #[inline]
+    fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
+        let mut out: Option<(Real, Vec3, Mat3)> = None;
+        for o in &self.list {
+            let (p, n, hd) = self.contact(o, v, x, pot.dial);
+            if p <= 0.0 {
+                continue;
+            }
+            let (psi, dpsi, ddpsi) = penalty(p, o.smoothing);
+            let ka = o.stiffness * self.area[v];
+            let e = ka * psi;
+            let g = -n * (ka * dpsi);
+            let h = (n * n.transpose() * ddpsi - hd * dpsi) * ka;
+            out = Some(match out {
+                None => (e, g, h),
+                Some((e0, g0, h0)) => (e0 + e, g0 + g, h0 + h),
+            });
+        }
+        out
+    }
+
+    fn observables(&self, pot: &Potential, x: &[Vec3]) -> Vec<(String, Real)> {
+        let mut out = Vec::new();
+        for (i, o) in self.list.iter().enumerate() {
+            let (mut f, mut gap) = (Vec3::zeros(), Real::INFINITY);
+            for (v, xv) in x.iter().enumerate() {
+                if self.area[v] == 0.0 {
+                    continue;
+                }
+                let (p, n, _) = self.contact(o, v, xv, pot.dial);
+                gap = gap.min(-p);
+                if p > 0.0 {
+                    f += n * (o.stiffness * self.area[v] * penalty(p, o.smoothing).1);
+                }
+            }
+            for (k, c) in ["x", "y", "z"].iter().zip(f.iter()) {
+                out.push((format!("obstacle{i}_force_{k}"), *c));
+            }
+            out.push((format!("obstacle{i}_gap"), gap));
+        }
+        out
+    }
+}
+
+/// The obstacles term of a scene with `[[obstacles]]`, else `None`. Errors name the obstacle
+/// and the vertex: a shape that starts closer to a vertex than half its thickness (inside the
+/// sheet; touching, to 1e-9 of the half thickness, is allowed).
+pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
+    let list = &scene.settings.obstacles;
+    if list.is_empty() {
+        return Ok(None);
+    }
+    let mesh = &scene.mesh;
+    let nv = mesh.positions.len();
+    let (mut area, mut h_area) = (vec![0.0; nv], vec![0.0; nv]);
+    let (mut total, mut e_over_h, mut h_mean) = (0.0, 0.0, 0.0);
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let a = mesh.face_area(f);
+        let h = scene.thickness[f];
+        total += a;
+        e_over_h += a * scene.young[f] / h;
+        h_mean += a * h;
+        for &v in face {
+            area[v] += a / 3.0;
+            h_area[v] += a / 3.0 * h;
+        }
+    }
+    let total = total.max(Real::MIN_POSITIVE);
+    let half_thickness: Vec<Real> = (0..nv)
+        .map(|v| {
+            if area[v] > 0.0 {
+                0.5 * h_area[v] / area[v]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let mut obstacles = Vec::with_capacity(list.len());
+    for (i, o) in list.iter().enumerate() {
+        let shape = o
+            .shape(i)
+            .map_err(|e| mesh.invalid(format!("{}: {}", e.key, e.reason)))?;
+        obstacles.push(Obstacle {
+            body: Body::of(&shape),
+            displacement: Vec3::from(o.displacement),
+            stiffness: o.stiffness.unwrap_or(e_over_h / total),
+            smoothing: o.smoothing.unwrap_or(h_mean / total / 100.0),
+        });
+    }
+    let term = Obstacles {
+        list: obstacles,
+        area,
+        half_thickness,
+    };
+    for (i, o) in term.list.iter().enumerate() {
+        for v in (0..nv).filter(|&v| term.area[v] > 0.0) {
+            let (p, _, _) = term.contact(o, v, &mesh.positions[v], 0.0);
+            // Touching is allowed (up to round-off of the half thickness).
+            if p > 1e-9 * term.half_thickness[v] {
+                let x = mesh.positions[v];
+                return Err(mesh.invalid(format!(
+                    "obstacles[{i}] starts inside the sheet: vertex {v} at ({}, {}, {}) is {} m \
+                     inside its surface offset by half the thickness ({} m); move the obstacle \
+                     away or let its displacement bring it in",
+                    crate::math::human(x.x),
+                    crate::math::human(x.y),
+                    crate::math::human(x.z),
+                    crate::math::human(p),
+                    crate::math::human(term.half_thickness[v])
+                )));
+            }
+        }
+    }
+    Ok(Some(Box::new(VertexTerm {
+        name: "obstacles",
+        report: true,
+        kernel: term,
+    })))
+}
