@@ -15,7 +15,8 @@
 //! reference area, `k_o` the stiffness (Pa/m). Defaults as for the ground: `k = E/h` and
 //! `δ = h/100`, area-weighted over the sheet. The curvature part `−ψ′∇²d` is negative
 //! semi-definite on convex obstacles; the solver's Hessian handling (the adaptive projection,
-//! the diagonal shift) takes care of it. Frictionless; a vertex term in every driver.
+//! the diagonal shift) takes care of it. Frictionless; a vertex term, so every driver sums it,
+//! but the explicit step resolves only stiffnesses of order ρh/Δt², far below the default.
 //!
 //! `log.csv` gets, per obstacle `i`, the force it exerts on the sheet
 //! (`obstacle{i}_force_x/y/z`, N) and the smallest gap (`obstacle{i}_gap`, m).
