@@ -13,10 +13,10 @@
 //!
 //! `ψ` the C² penalty of [`crate::solve::contact::penalty`] with smoothing δ, `A_v` the vertex's
 //! reference area, `k_o` the stiffness (Pa/m). Defaults as for the ground: `k = E/h` and
-//! `δ = h/100`, area-weighted over the sheet. The curvature part `−ψ′∇²d` is negative
+//! `δ = h/100`, area-weighted over the sheet; in explicit mode `k` is at most `ρ h / Δt²`, the
+//! stiffest spring the explicit step Δt resolves (ω Δt = 1, ω² = k/(ρh)). The curvature part `−ψ′∇²d` is negative
 //! semi-definite on convex obstacles; the solver's Hessian handling (the adaptive projection,
-//! the diagonal shift) takes care of it. Frictionless; a vertex term, so every driver sums it,
-//! but the explicit step resolves only stiffnesses of order ρh/Δt², far below the default.
+//! the diagonal shift) takes care of it. Frictionless; a vertex term, so every driver sums it.
 //!
 //! `log.csv` gets, per obstacle `i`, the force it exerts on the sheet
 //! (`obstacle{i}_force_x/y/z`, N) and the smallest gap (`obstacle{i}_gap`, m).
@@ -221,6 +221,15 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
         }
     }
     let total = total.max(Real::MIN_POSITIVE);
+    // The explicit step Δt resolves a vertex spring k A_v with ω Δt ≤ 2, ω² = k A_v / m_v =
+    // k / (ρ h): the default stiffness there is ρ h / Δt² (ω Δt = 1) when it is below E/h.
+    let mut k_default = e_over_h / total;
+    if scene.settings.solver.mode == crate::settings::Mode::Explicit {
+        let dt =
+            scene.settings.explicit.time_step_prefactor * crate::scales::Scales::of(scene).dt_unit;
+        let rho_h = scene.settings.material.density * h_mean / total;
+        k_default = k_default.min(rho_h / (dt * dt));
+    }
     let half_thickness: Vec<Real> = (0..nv)
         .map(|v| {
             if area[v] > 0.0 {
@@ -238,7 +247,7 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
         obstacles.push(Obstacle {
             body: Body::of(&shape),
             displacement: Vec3::from(o.displacement),
-            stiffness: o.stiffness.unwrap_or(e_over_h / total),
+            stiffness: o.stiffness.unwrap_or(k_default),
             smoothing: o.smoothing.unwrap_or(h_mean / total / 100.0),
         });
     }
