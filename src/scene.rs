@@ -941,44 +941,77 @@ pub fn rigid_pins(mesh: &Mesh, unused: &[bool]) -> Vec<usize> {
     pins
 }
 
+/// What a contact penalty on the sheet's surfaces needs per vertex, and its defaults: the
+/// reference area `A_v` (one third of its faces', m²), the half thickness `h_v/2` (the mean of
+/// its faces', area-weighted, m), and over the sheet the area-weighted means of E/h (Pa/m, the
+/// default stiffness) and of h (m; the default smoothing is a hundredth of it).
+pub struct ContactAreas {
+    /// `A_v` (m²).
+    pub area: Vec<Real>,
+    /// `h_v/2` (m).
+    pub half_thickness: Vec<Real>,
+    /// Area-weighted mean of E/h (Pa/m).
+    pub e_over_h: Real,
+    /// Area-weighted mean thickness (m).
+    pub h_mean: Real,
+}
+
+impl ContactAreas {
+    /// The contact data of `mesh` with per-face `thickness` and `young` (Pa).
+    pub fn of(mesh: &Mesh, thickness: &[Real], young: &[Real]) -> ContactAreas {
+        let nv = mesh.positions.len();
+        let mut area = vec![0.0; nv];
+        let mut h_area = vec![0.0; nv];
+        let (mut total, mut e_over_h, mut h_mean) = (0.0, 0.0, 0.0);
+        for (f, face) in mesh.faces.iter().enumerate() {
+            let a = mesh.face_area(f);
+            total += a;
+            e_over_h += a * young[f] / thickness[f];
+            h_mean += a * thickness[f];
+            for &v in face {
+                area[v] += a / 3.0;
+                h_area[v] += a / 3.0 * thickness[f];
+            }
+        }
+        let total = total.max(Real::MIN_POSITIVE);
+        let half_thickness = (0..nv)
+            .map(|v| {
+                if area[v] > 0.0 {
+                    0.5 * h_area[v] / area[v]
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        ContactAreas {
+            area,
+            half_thickness,
+            e_over_h: e_over_h / total,
+            h_mean: h_mean / total,
+        }
+    }
+}
+
 /// The ground of `[contact]` with the per-vertex areas and half thicknesses it needs (see
-/// [`crate::solve::contact`]); `"auto"` stiffness is the area-weighted mean of E/h, `"auto"`
-/// smoothing is the area-weighted mean h over 100.
+/// [`crate::solve::contact`] and [`ContactAreas`]); `"auto"` stiffness is the area-weighted
+/// mean of E/h, `"auto"` smoothing is the area-weighted mean h over 100.
 fn build_ground(
     mesh: &Mesh,
     c: &crate::settings::Contact,
     thickness: &[Real],
     young: &[Real],
 ) -> crate::solve::contact::Ground {
-    let nv = mesh.positions.len();
-    let mut area = vec![0.0; nv];
-    let mut h_area = vec![0.0; nv];
-    let (mut total, mut e_over_h, mut h_mean) = (0.0, 0.0, 0.0);
-    for (f, face) in mesh.faces.iter().enumerate() {
-        let a = mesh.face_area(f);
-        total += a;
-        e_over_h += a * young[f] / thickness[f];
-        h_mean += a * thickness[f];
-        for &v in face {
-            area[v] += a / 3.0;
-            h_area[v] += a / 3.0 * thickness[f];
-        }
-    }
-    let total = total.max(Real::MIN_POSITIVE);
-    let half_thickness = (0..nv)
-        .map(|v| {
-            if area[v] > 0.0 {
-                0.5 * h_area[v] / area[v]
-            } else {
-                0.0
-            }
-        })
-        .collect();
+    let ContactAreas {
+        area,
+        half_thickness,
+        e_over_h,
+        h_mean,
+    } = ContactAreas::of(mesh, thickness, young);
     crate::solve::contact::Ground {
         point: Vec3::from(c.point),
         normal: Vec3::from(c.normal).normalize(),
-        stiffness: c.stiffness.or(e_over_h / total),
-        smoothing: c.smoothing.or(h_mean / total / 100.0),
+        stiffness: c.stiffness.or(e_over_h),
+        smoothing: c.smoothing.or(h_mean / 100.0),
         friction: c.friction,
         slip_speed: c.slip_speed,
         area,

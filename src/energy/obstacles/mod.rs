@@ -207,38 +207,16 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
     }
     let mesh = &scene.mesh;
     let nv = mesh.positions.len();
-    let (mut area, mut h_area) = (vec![0.0; nv], vec![0.0; nv]);
-    let (mut total, mut e_over_h, mut h_mean) = (0.0, 0.0, 0.0);
-    for (f, face) in mesh.faces.iter().enumerate() {
-        let a = mesh.face_area(f);
-        let h = scene.thickness[f];
-        total += a;
-        e_over_h += a * scene.young[f] / h;
-        h_mean += a * h;
-        for &v in face {
-            area[v] += a / 3.0;
-            h_area[v] += a / 3.0 * h;
-        }
-    }
-    let total = total.max(Real::MIN_POSITIVE);
+    let c = crate::scene::ContactAreas::of(mesh, &scene.thickness, &scene.young);
     // The explicit step Δt resolves a vertex spring k A_v with ω Δt ≤ 2, ω² = k A_v / m_v =
     // k / (ρ h): the default stiffness there is ρ h / Δt² (ω Δt = 1) when it is below E/h.
-    let mut k_default = e_over_h / total;
+    let mut k_default = c.e_over_h;
     if scene.settings.solver.mode == crate::settings::Mode::Explicit {
         let dt =
             scene.settings.explicit.time_step_prefactor * crate::scales::Scales::of(scene).dt_unit;
-        let rho_h = scene.settings.material.density * h_mean / total;
+        let rho_h = scene.settings.material.density * c.h_mean;
         k_default = k_default.min(rho_h / (dt * dt));
     }
-    let half_thickness: Vec<Real> = (0..nv)
-        .map(|v| {
-            if area[v] > 0.0 {
-                0.5 * h_area[v] / area[v]
-            } else {
-                0.0
-            }
-        })
-        .collect();
     let mut obstacles = Vec::with_capacity(list.len());
     for (i, o) in list.iter().enumerate() {
         let shape = o
@@ -248,13 +226,13 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
             body: Body::of(&shape),
             displacement: Vec3::from(o.displacement),
             stiffness: o.stiffness.unwrap_or(k_default),
-            smoothing: o.smoothing.unwrap_or(h_mean / total / 100.0),
+            smoothing: o.smoothing.unwrap_or(c.h_mean / 100.0),
         });
     }
     let term = Obstacles {
         list: obstacles,
-        area,
-        half_thickness,
+        area: c.area,
+        half_thickness: c.half_thickness,
     };
     for (i, o) in term.list.iter().enumerate() {
         for v in (0..nv).filter(|&v| term.area[v] > 0.0) {
