@@ -41,12 +41,9 @@ impl RestLaw for Bilayer {
         let (mt, mb) = (g.mu_top.unwrap_or(0.0), g.mu_bottom.unwrap_or(0.0));
         check_stretch(i, mt, true, false)?;
         check_stretch(i, mb, false, true)?;
-        let (abar, bbar) = bilayer(&i.a0, &i.b0, i.h, i.m_top, i.m_bottom, mt, mb);
-        Ok(Grown {
-            abar,
-            bbar,
-            thickness_ratio: 1.0,
-        })
+        Ok(Grown::at_fixed_thickness(bilayer(
+            &i.a0, &i.b0, i.h, i.m_top, i.m_bottom, mt, mb,
+        )))
     }
 }
 

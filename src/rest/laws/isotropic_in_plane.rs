@@ -22,12 +22,9 @@ pub fn isotropic_in_plane(a0: &Sym2, b0: &Sym2, s: Real) -> (Sym2, Sym2) {
 
 impl RestLaw for IsotropicInPlane {
     fn grow(&self, _: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
-        let (abar, bbar) = isotropic_in_plane(&i.a0, &i.b0, i.s);
-        Ok(Grown {
-            abar,
-            bbar,
-            thickness_ratio: 1.0,
-        })
+        Ok(Grown::at_fixed_thickness(isotropic_in_plane(
+            &i.a0, &i.b0, i.s,
+        )))
     }
     fn needs_s(&self) -> bool {
         true

@@ -15,11 +15,7 @@ pub struct IsotropicMetricOnly;
 
 impl RestLaw for IsotropicMetricOnly {
     fn grow(&self, _: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
-        Ok(Grown {
-            abar: i.a0 * (2.0 * i.s).exp(),
-            bbar: i.b0,
-            thickness_ratio: 1.0,
-        })
+        Ok(Grown::at_fixed_thickness((i.a0 * (2.0 * i.s).exp(), i.b0)))
     }
     fn needs_s(&self) -> bool {
         true

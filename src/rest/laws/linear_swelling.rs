@@ -42,12 +42,9 @@ impl RestLaw for LinearSwelling {
     fn grow(&self, g: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
         let mu = g.mu.unwrap_or(0.0);
         check_stretch(i, mu, true, true)?;
-        let (abar, bbar) = linear_swelling(&i.a0, &i.b0, i.h, i.m_top, i.m_bottom, mu);
-        Ok(Grown {
-            abar,
-            bbar,
-            thickness_ratio: 1.0,
-        })
+        Ok(Grown::at_fixed_thickness(linear_swelling(
+            &i.a0, &i.b0, i.h, i.m_top, i.m_bottom, mu,
+        )))
     }
 }
 

@@ -49,13 +49,16 @@ impl RestLaw for MachineDirection {
         let (mu, mp) = (g.mu.unwrap_or(0.0), g.mu_perp.unwrap_or(0.0));
         check_stretch(i, mu, true, true)?;
         check_stretch(i, mp, true, true)?;
-        let (abar, bbar) =
-            machine_direction(&i.a0, &i.b0, i.h, i.m_top, i.m_bottom, mu, mp, i.direction);
-        Ok(Grown {
-            abar,
-            bbar,
-            thickness_ratio: 1.0,
-        })
+        Ok(Grown::at_fixed_thickness(machine_direction(
+            &i.a0,
+            &i.b0,
+            i.h,
+            i.m_top,
+            i.m_bottom,
+            mu,
+            mp,
+            i.direction,
+        )))
     }
     fn needs_direction(&self) -> bool {
         true

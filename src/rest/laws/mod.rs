@@ -98,6 +98,17 @@ pub struct Grown {
     pub thickness_ratio: Real,
 }
 
+impl Grown {
+    /// Rest forms `(ā, b̄)` of a law that keeps the thickness.
+    pub fn at_fixed_thickness((abar, bbar): (Sym2, Sym2)) -> Grown {
+        Grown {
+            abar,
+            bbar,
+            thickness_ratio: 1.0,
+        }
+    }
+}
+
 /// A rest-form law: `[growth]`'s coefficients and a face's inputs → its rest forms.
 pub trait RestLaw: Sync {
     /// The grown forms of one face. Errors name the face.
