@@ -1548,6 +1548,26 @@ impl Settings {
                     reason: e.reason,
                 });
             }
+            let invalid = |reason: &str| SettingsError::Invalid {
+                path: name.to_string(),
+                key: format!("obstacles[{i}].friction"),
+                reason: reason.to_string(),
+            };
+            if o.friction > 0.0 && self.solver.mode == Mode::Static {
+                return Err(invalid(
+                    "friction needs solver.mode = \"dynamic\" or \"explicit\": a static solve \
+                     has no slip over a time for friction to resist",
+                ));
+            }
+            if o.friction > 0.0
+                && self.solver.mode == Mode::Explicit
+                && o.displacement.iter().any(|&c| c != 0.0)
+            {
+                return Err(invalid(
+                    "friction on a moving obstacle needs solver.mode = \"dynamic\" (explicit \
+                     stick/slip acts against fixed obstacles only)",
+                ));
+            }
         }
         self.validate_constraints(name)?;
         self.validate_output(name)?;

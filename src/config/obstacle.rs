@@ -13,7 +13,10 @@
 //! `plane` (a `point` and the `normal` toward the sheet's side); `box` (axis-aligned, `min` and
 //! `max` corners). Common keys: `displacement` (m, default none: the obstacle is fixed),
 //! `stiffness` (Pa/m, default: the area-weighted mean E/h of the sheet) and `smoothing` (m,
-//! default: the mean thickness over 100), as the ground's (`[contact]`).
+//! default: the mean thickness over 100), as the ground's (`[contact]`), and `friction` (the
+//! Coulomb coefficient μ, default 0; the smoothed Coulomb law of the ground in dynamic mode, with
+//! `contact.slip_speed`, and stick/slip in explicit mode, on a fixed obstacle only there; static
+//! solves have no slip to resist, so friction there is refused).
 //!
 //! The raw table is flat (every key optional, unknown keys refused); [`ObstacleSettings::shape`]
 //! validates it into a [`Shape`] that carries exactly its variant's parameters.
@@ -52,6 +55,9 @@ pub struct ObstacleSettings {
     pub stiffness: Option<Real>,
     /// Smoothing length δ (m; default: the sheet's mean thickness / 100).
     pub smoothing: Option<Real>,
+    /// Coulomb friction coefficient μ between the sheet and the obstacle (default 0:
+    /// frictionless; dynamic and explicit modes).
+    pub friction: Real,
 }
 
 /// The shape names.
@@ -200,6 +206,15 @@ impl ObstacleSettings {
             if let Some(v) = v {
                 super::positive(&key(k), v, "")?;
             }
+        }
+        if !(self.friction.is_finite() && self.friction >= 0.0) {
+            return Err(Invalid::new(
+                &key("friction"),
+                format!(
+                    "must be a Coulomb coefficient ≥ 0, got {}",
+                    crate::math::human(self.friction)
+                ),
+            ));
         }
         Ok(match kind {
             ShapeKind::Sphere => Shape::Sphere {

@@ -166,10 +166,10 @@ pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
         super::loads::moment::term,
         super::gas::term,
         super::slides::term,
-        super::obstacles::term,
     ] {
         t.extend(load(scene)?);
     }
+    t.extend(super::obstacles::terms(scene)?);
     Ok(t)
 }
 

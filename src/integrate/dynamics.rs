@@ -119,7 +119,7 @@ pub(super) fn run_dynamic(
         s.frame(writer, &pot, &state, &v, t0)?;
     }
     // Friction: the lagged normal forces, carried from step to step.
-    let mut lag = FrictionLag::new(sc, &state.x, cf.slip_speed);
+    let mut lag = FrictionLag::new(sc, &state.x, dial_now, cf.slip_speed);
     let mut t = t0;
     // The next output time after the start (a restart resumes the output grid).
     let mut clock = OutputClock::new(t0, tm.output_interval, tm.end);
@@ -228,11 +228,12 @@ pub(super) fn run_dynamic(
                 gravity: s.config.gravity,
                 rest_override: moisture.as_ref().map(|_| &trial_targets[..]),
                 mass: trial_mass,
-                friction: lag.as_ref().map(|l| l.friction(&state.x, h)),
+                friction: lag.as_ref().map(|l| l.friction(&state.x, dial_now, h)),
                 ..Potential::new(sc, s.pattern)
             };
             let rep = s.solve(&pot, &mut trial, opts);
-            let again = rep.converged && lag.as_mut().is_some_and(|l| l.resolve(sc, &trial.x));
+            let again =
+                rep.converged && lag.as_mut().is_some_and(|l| l.resolve(sc, &trial.x, dial));
             if !again {
                 break rep;
             }

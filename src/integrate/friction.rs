@@ -3,8 +3,10 @@
 //! from the solution, and the step is re-solved until `λ` changes by at most
 //! [`FRICTION_LAG_TOL`] of its largest entry or [`FRICTION_LAG_MAX`] solves were made (the last
 //! one is accepted). `λ` carries over to the next step, so a resting contact needs one solve
-//! per step. See [`crate::solve::contact`] for the friction potential.
+//! per step. The ground's `λ` is kept per vertex; an obstacle's normal force and normal are taken
+//! at the lagged iterate's positions and dial, which the lag keeps. See [`crate::solve::contact`] for the friction potential.
 
+use crate::energy::obstacles::Obstacles;
 use crate::math::{Real, Vec3};
 use crate::scene::Scene;
 use crate::solve::potential::Friction;
@@ -14,10 +16,18 @@ pub const FRICTION_LAG_TOL: Real = 1e-3;
 /// ... or after this many solves of one step.
 pub const FRICTION_LAG_MAX: usize = 6;
 
-/// The lagged normal forces of a scene with friction.
+/// The lagged normal forces of a scene with friction: the ground's per vertex, and the
+/// positions and dial of the friction iterate that the obstacles' normal forces and normals are
+/// taken at.
 pub struct FrictionLag {
-    /// Normal contact force per vertex (N), lagged.
+    /// Normal contact force per vertex against a frictional ground (N), lagged; empty without.
     lambda: Vec<Real>,
+    /// The frictional obstacles (for their normal forces), if any.
+    obstacles: Option<Obstacles>,
+    /// Positions of the lagged iterate (m).
+    x_lag: Vec<Vec3>,
+    /// Dial of the lagged iterate.
+    dial_lag: Real,
     /// Slip speed ε_v of the smoothed friction (m/s).
     slip_speed: Real,
     /// Solves of the current step.
@@ -25,12 +35,23 @@ pub struct FrictionLag {
 }
 
 impl FrictionLag {
-    /// The lag of `scene` started at positions `x`, with the smoothed friction's slip speed
-    /// (`contact.slip_speed`, m/s), or `None` without a frictional ground.
-    pub fn new(scene: &Scene, x: &[Vec3], slip_speed: Real) -> Option<FrictionLag> {
-        let g = scene.ground.as_ref().filter(|g| g.friction > 0.0)?;
+    /// The lag of `scene` started at positions `x` and dial `dial`, with the smoothed
+    /// friction's slip speed (`contact.slip_speed`, m/s), or `None` without a frictional ground
+    /// or obstacle.
+    pub fn new(scene: &Scene, x: &[Vec3], dial: Real, slip_speed: Real) -> Option<FrictionLag> {
+        let ground = scene.ground.as_ref().filter(|g| g.friction > 0.0);
+        let obstacles = crate::energy::obstacles::build(scene)
+            .ok()
+            .flatten()
+            .filter(Obstacles::has_friction);
+        if ground.is_none() && obstacles.is_none() {
+            return None;
+        }
         Some(FrictionLag {
-            lambda: g.normal_forces(x),
+            lambda: ground.map_or_else(Vec::new, |g| g.normal_forces(x)),
+            obstacles,
+            x_lag: x.to_vec(),
+            dial_lag: dial,
             slip_speed,
             solves: 0,
         })
@@ -41,29 +62,46 @@ impl FrictionLag {
         self.solves = 0;
     }
 
-    /// The friction term of a step of length `h` from `x_prev`, with the current `λ`.
-    pub fn friction<'a>(&'a self, x_prev: &'a [Vec3], h: Real) -> Friction<'a> {
+    /// The friction term of a step of length `h` from `x_prev` at dial `dial_prev`, with the
+    /// current lag.
+    pub fn friction<'a>(&'a self, x_prev: &'a [Vec3], dial_prev: Real, h: Real) -> Friction<'a> {
         Friction {
             x_prev,
+            dial_prev,
             normal_force: &self.lambda,
+            x_lag: &self.x_lag,
+            dial_lag: self.dial_lag,
             eps: self.slip_speed * h,
         }
     }
 
-    /// Updates `λ` from a converged solve at `trial`. Returns whether the step must be solved
-    /// again (λ moved by more than the tolerance and the solve limit is not reached).
-    pub fn resolve(&mut self, scene: &Scene, trial: &[Vec3]) -> bool {
-        let Some(g) = scene.ground.as_ref() else {
-            return false;
-        };
+    /// Updates the lag from a converged solve at `trial` and dial `dial`. Returns whether the
+    /// step must be solved again (a normal force moved by more than the tolerance of the
+    /// largest, and the solve limit is not reached).
+    pub fn resolve(&mut self, scene: &Scene, trial: &[Vec3], dial: Real) -> bool {
         self.solves += 1;
-        let new = g.normal_forces(trial);
-        let scale = new.iter().fold(0.0, |m: Real, v| m.max(*v));
-        let diff = new
-            .iter()
-            .zip(&self.lambda)
-            .fold(0.0, |m: Real, (a, b)| m.max((a - b).abs()));
-        self.lambda = new;
+        let (mut scale, mut diff) = (0.0 as Real, 0.0 as Real);
+        if let Some(g) = scene.ground.as_ref().filter(|_| !self.lambda.is_empty()) {
+            let new = g.normal_forces(trial);
+            scale = new.iter().fold(scale, |m, v| m.max(*v));
+            diff = new
+                .iter()
+                .zip(&self.lambda)
+                .fold(diff, |m, (a, b)| m.max((a - b).abs()));
+            self.lambda = new;
+        }
+        if let Some(o) = &self.obstacles {
+            for (v, (xt, xl)) in trial.iter().zip(&self.x_lag).enumerate() {
+                for k in (0..o.list.len()).filter(|&k| o.list[k].friction > 0.0) {
+                    let new = o.normal_force(k, v, xt, dial);
+                    let old = o.normal_force(k, v, xl, self.dial_lag);
+                    scale = scale.max(new);
+                    diff = diff.max((new - old).abs());
+                }
+            }
+        }
+        self.x_lag.copy_from_slice(trial);
+        self.dial_lag = dial;
         diff > FRICTION_LAG_TOL * scale && self.solves < FRICTION_LAG_MAX
     }
 }

@@ -135,23 +135,29 @@ impl Ground {
         x0: &Vec3,
         eps: Real,
     ) -> (Real, Vec3, [[Real; 3]; 3]) {
-        let n = self.normal;
-        let d = x - x0;
-        let u = d - n * n.dot(&d);
-        let s = u.norm();
-        let w = self.friction * lambda;
-        let (f0, f1, df1) = friction_profile(s, eps);
-        // f₁/s → 2/ε as s → 0 (the stiff sticking spring).
-        let f1_over_s = if s > 0.0 { f1 / s } else { 2.0 / eps };
-        let uhat = if s > 0.0 { u / s } else { Vec3::zeros() };
-        let mut h = [[0.0; 3]; 3];
-        for (a, row) in h.iter_mut().enumerate() {
-            for (b, e) in row.iter_mut().enumerate() {
-                let t = Real::from(u8::from(a == b)) - n[a] * n[b];
-                let uu = uhat[a] * uhat[b];
-                *e = w * (df1 * uu + f1_over_s * (t - uu));
-            }
-        }
-        (w * f0, u * (w * f1_over_s), h)
+        friction_potential(self.friction * lambda, &self.normal, &(x - x0), eps)
     }
+}
+
+/// The smoothed Coulomb dissipation `w f₀(‖u‖)` of a vertex moved by `d` over the step across a
+/// surface of unit normal `n`, `u = (I − nnᵀ) d` its slip and `w = μ λ` (N) the friction bound:
+/// energy (J), gradient `w f₁(s)/s u` (N) and the 3×3 Hessian block
+/// `w (f₁′ ûûᵀ + f₁/s (T − ûûᵀ))` (N/m, positive semi-definite); module doc for `f₀`, `f₁`.
+#[inline]
+pub fn friction_potential(w: Real, n: &Vec3, d: &Vec3, eps: Real) -> (Real, Vec3, [[Real; 3]; 3]) {
+    let u = d - n * n.dot(d);
+    let s = u.norm();
+    let (f0, f1, df1) = friction_profile(s, eps);
+    // f₁/s → 2/ε as s → 0 (the stiff sticking spring).
+    let f1_over_s = if s > 0.0 { f1 / s } else { 2.0 / eps };
+    let uhat = if s > 0.0 { u / s } else { Vec3::zeros() };
+    let mut h = [[0.0; 3]; 3];
+    for (a, row) in h.iter_mut().enumerate() {
+        for (b, e) in row.iter_mut().enumerate() {
+            let t = Real::from(u8::from(a == b)) - n[a] * n[b];
+            let uu = uhat[a] * uhat[b];
+            *e = w * (df1 * uu + f1_over_s * (t - uu));
+        }
+    }
+    (w * f0, u * (w * f1_over_s), h)
 }

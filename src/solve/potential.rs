@@ -40,13 +40,22 @@ pub struct Damping<'a> {
     pub b_prev: &'a [Sym2],
 }
 
-/// Friction over one step (dynamics with `contact.friction > 0`; see [`super::contact`]).
+/// Friction over one step (dynamics with a frictional ground or obstacle; see
+/// [`super::contact`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Friction<'a> {
     /// Positions at the start of the step (m).
     pub x_prev: &'a [Vec3],
-    /// Lagged normal force per vertex (N).
+    /// Dial at the start of the step (a moving obstacle's slip is relative to it).
+    pub dial_prev: Real,
+    /// Lagged normal force per vertex against the ground (N; empty without a frictional
+    /// ground).
     pub normal_force: &'a [Real],
+    /// Positions of the friction iterate the obstacles' normal forces and normals are lagged
+    /// at (m), ...
+    pub x_lag: &'a [Vec3],
+    /// ... at this dial.
+    pub dial_lag: Real,
     /// Slip smoothing ε = ε_v Δt (m).
     pub eps: Real,
 }
@@ -73,8 +82,8 @@ pub struct Potential<'a> {
     pub rest_override: Option<&'a [(Sym2, Sym2)]>,
     /// Lumped vertex masses (kg): the scene's, or moisture-dependent ones.
     pub mass: &'a [Real],
-    /// Friction against the ground (the normal contact term is on whenever the scene has a
-    /// ground).
+    /// Friction against the ground and the obstacles (their normal contact terms are on
+    /// whenever the scene has them).
     pub friction: Option<Friction<'a>>,
     /// Per-face Koiter densities computed once for a fixed dial (the explicit driver's waiting
     /// phase, where millions of gradient evaluations share one rest state); `None` computes

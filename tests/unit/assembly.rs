@@ -340,7 +340,10 @@ fn ground_contact_and_friction_match_finite_differences() {
     let pot = Potential {
         friction: Some(shellsim::solve::potential::Friction {
             x_prev: &x_prev,
+            dial_prev: 1.0,
             normal_force: &lambda,
+            x_lag: &x,
+            dial_lag: 1.0,
             eps: 0.003,
         }),
         ..Potential::new(&sc, &p)

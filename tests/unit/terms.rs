@@ -207,7 +207,10 @@ fn every_registered_term_matches_finite_differences() {
                 gravity: Vec3::new(0.0, 0.0, -9.81),
                 friction: Some(shellsim::solve::potential::Friction {
                     x_prev: &xhat,
+                    dial_prev: 0.7,
                     normal_force: &normal,
+                    x_lag: &xhat,
+                    dial_lag: 0.7,
                     eps: 1e-3,
                 }),
                 ..Potential::new(&sc, &p)
@@ -493,7 +496,9 @@ fn baraff_witkin_is_rotation_invariant() {
 }
 
 /// Every obstacle shape, moved with the dial into a deformed strip so that some vertices are
-/// in contact (on both branches of the smoothed penalty), against finite differences.
+/// in contact (on both branches of the smoothed penalty), and its friction (dynamic mode, the
+/// normals lagged at other positions and dial, the obstacle moving over the step, slips on both
+/// branches of the smoothed Coulomb law), against finite differences.
 #[test]
 fn obstacles_match_finite_differences() {
     for shape in [
@@ -504,22 +509,48 @@ fn obstacles_match_finite_differences() {
         "shape = \"box\"\nmin = [0.2, 0.1, -1]\nmax = [0.8, 0.35, -0.05]",
     ] {
         let sc = strip_scene(&format!(
-            "[material]\nthickness = 0.05\n[constraints]\nfix_boxes = [{{ min = [-1, -1, -1], \
-             max = [0.01, 2, 1] }}]\n[[obstacles]]\n{shape}\ndisplacement = [0, 0, 0.2]\n"
+            "[material]\nthickness = 0.05\n[solver]\nmode = \"dynamic\"\n[constraints]\n\
+             fix_boxes = [{{ min = [-1, -1, -1], max = [0.01, 2, 1] }}]\n[[obstacles]]\n{shape}\n\
+             displacement = [0, 0, 0.2]\nfriction = 0.4\n"
         ));
         let p = Pattern::for_scene(&sc);
         let x = deformed(&sc);
         let phi = vec![0.0; sc.num_edge_dofs()];
+        let mut rng = Rng::new(5);
+        let x_prev: Vec<Vec3> = x
+            .iter()
+            .map(|v| v + Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * 0.004)
+            .collect();
+        let x_lag: Vec<Vec3> = x.iter().map(|v| v + Vec3::new(0.0, 0.0, -0.002)).collect();
         let pot = Potential {
             dial: 0.6,
+            friction: Some(shellsim::solve::potential::Friction {
+                x_prev: &x_prev,
+                dial_prev: 0.55,
+                normal_force: &[],
+                x_lag: &x_lag,
+                dial_lag: 0.58,
+                eps: 0.003,
+            }),
             ..Potential::new(&sc, &p)
         };
-        let i = (0..sc.terms.len())
-            .find(|&i| sc.terms[i].name() == "obstacles")
-            .unwrap();
-        let e = sc.terms[i].energies(&pot, &p.maps[i], &x, &phi);
-        assert!(e.iter().any(|(_, v)| *v > 0.0), "{shape}: no contact");
-        check_term(&sc, &p, &pot, &x, &phi, i);
+        for name in ["obstacles", "obstacle_friction"] {
+            let i = (0..sc.terms.len())
+                .find(|&i| sc.terms[i].name() == name)
+                .unwrap();
+            let e = sc.terms[i].eval(
+                &pot,
+                &p.maps[i],
+                &x,
+                &phi,
+                Want::Energy,
+                HessianProjection::None,
+                &mut [],
+                &mut [],
+            );
+            assert!(e > 0.0, "{shape}: {name}: no contact");
+            check_term(&sc, &p, &pot, &x, &phi, i);
+        }
     }
 }
 

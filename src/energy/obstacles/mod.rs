@@ -16,9 +16,13 @@
 //! `δ = h/100`, area-weighted over the sheet; in explicit mode `k` is at most `ρ h / Δt²`, the
 //! stiffest spring the explicit step Δt resolves (ω Δt = 1, ω² = k/(ρh)). The curvature part `−ψ′∇²d` is negative
 //! semi-definite on convex obstacles; the solver's Hessian handling (the adaptive projection,
-//! the diagonal shift) takes care of it. Frictionless; a vertex term, so every driver sums it.
+//! the diagonal shift) takes care of it. A vertex term, so every driver sums it.
 //!
-//! `log.csv` gets, per obstacle `i`, the force it exerts on the sheet
+//! **Friction** (`friction` μ > 0): in dynamic mode a second term, [`ObstacleFriction`], the
+//! ground's lagged, smoothed Coulomb dissipation with the obstacle's normal; in explicit mode
+//! stick/slip in the step ([`Obstacles`]' `explicit_step`), against fixed obstacles.
+//!
+//! `log.csv` gets, per obstacle `i`, the normal force it exerts on the sheet
 //! (`obstacle{i}_force_x/y/z`, N) and the smallest gap (`obstacle{i}_gap`, m).
 //!
 //! Units: positions m, k Pa/m, A m², energies J. DOF order: `x[v]`.
@@ -34,7 +38,7 @@ use crate::config::obstacle::Shape;
 use crate::math::{Mat3, Real, Vec3};
 use crate::mesh::MeshError;
 use crate::scene::Scene;
-use crate::solve::contact::penalty;
+use crate::solve::contact::{friction_potential, penalty};
 use crate::solve::Potential;
 
 /// A shape's signed distance (m, negative inside), its gradient and its Hessian (1/m) at `x`.
@@ -123,6 +127,8 @@ impl Distance for Body {
 /// One obstacle with its contact law.
 #[derive(Clone, Copy, Debug)]
 pub struct Obstacle {
+    /// Coulomb coefficient μ (0: frictionless).
+    pub friction: Real,
     /// Its shape at dial 0.
     pub body: Body,
     /// Offset at dial 1 (m).
@@ -134,6 +140,7 @@ pub struct Obstacle {
 }
 
 /// Every obstacle, with the per-vertex areas and half thicknesses.
+#[derive(Clone, Debug)]
 pub struct Obstacles {
     /// The obstacles.
     pub list: Vec<Obstacle>,
@@ -149,6 +156,58 @@ impl Obstacles {
     fn contact(&self, o: &Obstacle, v: usize, x: &Vec3, s: Real) -> (Real, Vec3, Mat3) {
         let (d, n, h) = o.body.distance(&(x - o.displacement * s.clamp(0.0, 1.0)));
         (self.half_thickness[v] - d, n, h)
+    }
+
+    /// Whether any obstacle has friction.
+    pub fn has_friction(&self) -> bool {
+        self.list.iter().any(|o| o.friction > 0.0)
+    }
+
+    /// The normal force `λ = k A_v ψ′(p)` (N) on vertex `v` at `x` from obstacle `k` at dial `s`.
+    #[inline]
+    pub fn normal_force(&self, k: usize, v: usize, x: &Vec3, s: Real) -> Real {
+        let o = &self.list[k];
+        let (p, _, _) = self.contact(o, v, x, s);
+        if p <= 0.0 {
+            return 0.0;
+        }
+        o.stiffness * self.area[v] * penalty(p, o.smoothing).1
+    }
+}
+
+/// The obstacles' lagged, smoothed Coulomb friction in dynamic mode, the ground's law
+/// ([`crate::solve::contact::friction_potential`]) against each frictional obstacle `o`:
+///
+/// `D_v = Σ_o μ_o λ_o f₀(‖T_o (x_v − x⁰_v − u_o Δs)‖)`,
+///
+/// with `λ_o = k_o A_v ψ′(p)` and the tangent projector `T_o = I − n nᵀ`, `n = ∇d_o`, both taken
+/// at the friction lag's iterate ([`crate::solve::potential::Friction::x_lag`]), and
+/// `u_o Δs` the obstacle's own motion over the step (the slip is relative to it). Only while the
+/// potential carries a [`crate::solve::potential::Friction`]. Units: N, m, J. DOF order: `x[v]`.
+pub struct ObstacleFriction(pub Obstacles);
+
+impl VertexKernel for ObstacleFriction {
+    #[inline]
+    fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
+        let fr = pot.friction.as_ref()?;
+        let obs = &self.0;
+        let mut out: Option<(Real, Vec3, Mat3)> = None;
+        for o in obs.list.iter().filter(|o| o.friction > 0.0) {
+            let (p, n, _) = obs.contact(o, v, &fr.x_lag[v], fr.dial_lag);
+            if p <= 0.0 {
+                continue;
+            }
+            let lambda = o.stiffness * obs.area[v] * penalty(p, o.smoothing).1;
+            let moved = o.displacement * (pot.dial.clamp(0.0, 1.0) - fr.dial_prev.clamp(0.0, 1.0));
+            let d = x - fr.x_prev[v] - moved;
+            let (e, g, h) = friction_potential(o.friction * lambda, &n, &d, fr.eps);
+            let h = Mat3::from_fn(|r, c| h[r][c]);
+            out = Some(match out {
+                None => (e, g, h),
+                Some((e0, g0, h0)) => (e0 + e, g0 + g, h0 + h),
+            });
+        }
+        out
     }
 }
 
@@ -174,6 +233,45 @@ impl VertexKernel for Obstacles {
         out
     }
 
+    /// Explicit mode: Coulomb stick/slip against each frictional obstacle, as the slides'
+    /// ([`crate::energy::slides`]) with the obstacle's normal `n = ∇d`: with `N = k A_v ψ′(p)`
+    /// and `v*` the velocity the step would reach, `T v*` its tangential part, the vertex sticks
+    /// (its tangential force and velocity are removed) when `|T v*| ≤ Δt μ N / m`, else it
+    /// slides with the force `μ N T v*/|T v*|` against that velocity.
+    fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
+        let fixed = &pot.scene.fixed;
+        for (i, xi) in x.iter().enumerate() {
+            if fixed[i] {
+                continue;
+            }
+            for o in self.list.iter().filter(|o| o.friction > 0.0) {
+                let (p, n, _) = self.contact(o, i, xi, pot.dial);
+                if p <= 0.0 {
+                    continue;
+                }
+                let limit = o.friction * o.stiffness * self.area[i] * penalty(p, o.smoothing).1;
+                let m = pot.mass[i];
+                let gi = Vec3::new(g[3 * i], g[3 * i + 1], g[3 * i + 2]);
+                let reach = v[i] - gi * (dt / m);
+                let tangential = reach - n * n.dot(&reach);
+                let speed = tangential.norm();
+                let gi = if speed <= dt * limit / m {
+                    // Friction stops the vertex within the step: it sticks.
+                    v[i] = n * n.dot(&v[i]);
+                    n * n.dot(&gi)
+                } else {
+                    // It slides, and friction opposes that velocity.
+                    gi + tangential * (limit / speed)
+                };
+                g[3 * i..3 * i + 3].copy_from_slice(gi.as_slice());
+            }
+        }
+    }
+
+    fn acts_on_explicit_steps(&self) -> bool {
+        self.has_friction()
+    }
+
     fn observables(&self, pot: &Potential, x: &[Vec3]) -> Vec<(String, Real)> {
         let mut out = Vec::new();
         for (i, o) in self.list.iter().enumerate() {
@@ -197,10 +295,10 @@ impl VertexKernel for Obstacles {
     }
 }
 
-/// The obstacles term of a scene with `[[obstacles]]`, else `None`. Errors name the obstacle
-/// and the vertex: a shape that starts closer to a vertex than half its thickness (inside the
+/// The obstacles of a scene with `[[obstacles]]`, else `None`. Errors name the obstacle and
+/// the vertex: a shape that starts closer to a vertex than half its thickness (inside the
 /// sheet; touching, to 1e-9 of the half thickness, is allowed).
-pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
+pub fn build(scene: &Scene) -> Result<Option<Obstacles>, MeshError> {
     let list = &scene.settings.obstacles;
     if list.is_empty() {
         return Ok(None);
@@ -227,6 +325,7 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
             displacement: Vec3::from(o.displacement),
             stiffness: o.stiffness.unwrap_or(k_default),
             smoothing: o.smoothing.unwrap_or(c.h_mean / 100.0),
+            friction: o.friction,
         });
     }
     let term = Obstacles {
@@ -253,9 +352,29 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
             }
         }
     }
-    Ok(Some(Box::new(VertexTerm {
+    Ok(Some(term))
+}
+
+/// The terms of a scene with `[[obstacles]]`: their contact (with explicit stick/slip), and in
+/// dynamic mode their friction when any has some.
+pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
+    let Some(obstacles) = build(scene)? else {
+        return Ok(Vec::new());
+    };
+    let dynamic = scene.settings.solver.mode == crate::settings::Mode::Dynamic;
+    let friction =
+        (dynamic && obstacles.has_friction()).then(|| ObstacleFriction(obstacles.clone()));
+    let mut t: Vec<Box<dyn Term>> = vec![Box::new(VertexTerm {
         name: "obstacles",
         report: true,
-        kernel: term,
-    })))
+        kernel: obstacles,
+    })];
+    if let Some(kernel) = friction {
+        t.push(Box::new(VertexTerm {
+            name: "obstacle_friction",
+            report: false,
+            kernel,
+        }));
+    }
+    Ok(t)
 }
