@@ -431,6 +431,7 @@ fn balloon(c: &mut Criterion) {
         inertia: Some(Inertia {
             inv_dt2: 900.0,
             xhat: &xhat,
+            dofs_hat: &[],
         }),
         ..Potential::new(&sc, &p)
     };

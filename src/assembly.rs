@@ -1,7 +1,9 @@
 //! Global assembly of energy, gradient and sparse Hessian over the terms of a scene.
 //!
 //! DOFs are grouped in *nodes*: vertex `v` (node `v`) owns the 3 DOFs `3v..3v+3` (`x, y, z`);
-//! with edge DOFs, edge `e` (node `nv + e`) owns the single DOF `3 nv + e`. The sparsity pattern
+//! with edge DOFs, edge `e` (node `nv + e`) owns the single DOF `3 nv + e`; the global DOFs
+//! that terms declare follow as single-DOF nodes ([`crate::energy::term::GlobalDof`]). The
+//! sparsity pattern
 //! (lower triangle, compressed sparse columns) is the union of every term's stencil
 //! ([`crate::energy::term::Stencil`]) and is built once per mesh, together with one
 //! [`ElementMap`] per term: where each element's entries go, and a greedy colouring of blocks of
@@ -24,12 +26,12 @@ use rayon::prelude::*;
 /// The Hessian's sparsity pattern and, per term, where its elements' entries go.
 #[derive(Clone, Debug)]
 pub struct Pattern {
-    /// Number of DOFs (3 × vertices + edge DOFs).
+    /// Number of DOFs (3 × vertices + scalar DOFs).
     pub n: usize,
     /// Number of vertices.
     pub num_vertices: usize,
-    /// Number of edge DOFs (0 unless a term declares them).
-    pub num_edge_dofs: usize,
+    /// Number of scalar DOFs: edge DOFs, then global DOFs (0 unless terms declare them).
+    pub num_scalar_dofs: usize,
     /// CSC column pointers (lower triangle).
     pub col_ptr: Vec<usize>,
     /// CSC row indices.
@@ -170,13 +172,13 @@ impl Pattern {
     /// The pattern of a scene: the union of its terms' stencils, edge DOFs when a term has them.
     pub fn for_scene(scene: &crate::scene::Scene) -> Pattern {
         let stencils: Vec<Stencil> = scene.terms.iter().map(|t| t.stencil(scene)).collect();
-        let mut p = Self::build(&scene.mesh.positions, scene.num_edge_dofs(), &stencils);
+        let mut p = Self::build(&scene.mesh.positions, scene.num_scalar_dofs(), &stencils);
         p.pin(&scene.pinned_dofs);
         p
     }
 
     /// Builds the pattern of the vertices at `positions` (which only order the elements into
-    /// spatially coherent blocks) and `ne` edge nodes from the stencils.
+    /// spatially coherent blocks) and `ne` single-DOF nodes (edges, globals) from the stencils.
     pub fn build(positions: &[Vec3], ne: usize, stencils: &[Stencil]) -> Pattern {
         let nv = positions.len();
         let nodes = nv + ne;
@@ -277,7 +279,7 @@ impl Pattern {
         Pattern {
             n,
             num_vertices: nv,
-            num_edge_dofs: ne,
+            num_scalar_dofs: ne,
             col_ptr,
             row_idx,
             maps,

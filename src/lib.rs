@@ -23,7 +23,7 @@
 //! // a non-zero gradient.
 //! let mut grad = vec![0.0; pattern.n];
 //! // Edge DOFs (the default bending model has one per edge) start at 0.
-//! let phi = vec![0.0; scene.num_edge_dofs()];
+//! let phi = vec![0.0; scene.num_scalar_dofs()];
 //! let e = pot.eval(&scene.mesh.positions, &phi, Want::Gradient, &mut grad, &mut []);
 //! assert!(e > 0.0 && grad.iter().any(|g| g.abs() > 0.0));
 //! ```

@@ -60,6 +60,36 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
         ));
     }
     let driver = read_driver_state(path)?;
+    let mut state = state;
+    if !scene.globals.is_empty() {
+        // The global DOFs (a force-controlled obstacle's offset) are in the state file only.
+        let ne = scene.num_edge_dofs();
+        match &driver {
+            Some(d) if d.globals.len() == scene.globals.len() => {
+                if let Some(k) = d.globals.iter().position(|q| !q.is_finite()) {
+                    return Err(bad(format!(
+                        "its state file gives {} the value {}",
+                        scene.globals[k].name, d.globals[k]
+                    )));
+                }
+                state.dofs[ne..].copy_from_slice(&d.globals);
+            }
+            _ => warnings.push(format!(
+                "{name}: its state file gives no value for {}; {} from the settings' start",
+                scene
+                    .globals
+                    .iter()
+                    .map(|g| g.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                if scene.globals.len() == 1 {
+                    "it starts"
+                } else {
+                    "they start"
+                }
+            )),
+        }
+    }
     if driver.is_none() {
         warnings.push(format!(
             "{name}: no {} beside it; the step control, holds and moisture start afresh, so \
@@ -206,7 +236,7 @@ pub fn restart_from_frame(
         }
         None => None,
     };
-    let mut phi = vec![0.0; scene.num_edge_dofs()];
+    let mut phi = vec![0.0; scene.num_scalar_dofs()];
     if scene.has_edge_dofs() {
         match frame.face_field("edge_angles", 3)? {
             Some(f) => {

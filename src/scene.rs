@@ -61,6 +61,8 @@ pub struct Scene {
     pub ground: Option<crate::solve::contact::Ground>,
     /// The energy terms the settings enable, in assembly order ([`crate::energy::registry`]).
     pub terms: crate::energy::term::Terms,
+    /// The global DOFs the terms declared, in node order after the edge nodes.
+    pub globals: Vec<crate::energy::term::GlobalDof>,
     /// Vertices on prescribed paths and their displacement at dial 1 (m); they are fixed.
     pub prescribed: Vec<(usize, Vec3)>,
 }
@@ -359,10 +361,11 @@ impl Scene {
             .obstacles
             .iter()
             .any(|o| o.shape == Some(crate::config::obstacle::ShapeKind::Plane));
+        let pressed = settings.obstacles.iter().any(|o| o.force.is_some());
         if free
             && obstacles
             && !on_plane
-            && (gravity || settings.loads.any_external())
+            && (gravity || settings.loads.any_external() || pressed)
             && settings.solver.mode == crate::settings::Mode::Static
         {
             return Err(mesh.invalid(
@@ -456,11 +459,12 @@ impl Scene {
             grown_thickness,
             ground,
             terms: Default::default(),
+            globals: Vec::new(),
             prescribed,
         };
-        scene.terms = crate::energy::term::Terms(std::sync::Arc::new(
-            crate::energy::registry::terms(&scene)?,
-        ));
+        let mut terms = crate::energy::registry::terms(&scene)?;
+        scene.bind_globals(&mut terms);
+        scene.terms = crate::energy::term::Terms(std::sync::Arc::new(terms));
         Ok(scene)
     }
 
@@ -534,6 +538,31 @@ impl Scene {
     /// Whether the bending model has one DOF per edge.
     pub fn has_edge_dofs(&self) -> bool {
         !self.edge_sign.is_empty()
+    }
+
+    /// Numbers the global DOFs of `terms` after the vertex and edge nodes (term order), tells
+    /// each term its first node, records them in [`Scene::globals`] and leaves their nodes free.
+    pub fn bind_globals(&mut self, terms: &mut [Box<dyn crate::energy::term::Term>]) {
+        let nv = self.num_vertices();
+        let mut next = nv + self.num_edge_dofs();
+        self.globals.clear();
+        for t in terms.iter_mut() {
+            let g = t.globals();
+            if !g.is_empty() {
+                t.bind_globals(next);
+                next += g.len();
+                self.globals.extend(g);
+            }
+        }
+        if !self.globals.is_empty() {
+            self.node_fixed.resize(nv + self.num_edge_dofs(), false);
+            self.node_fixed.resize(next, false);
+        }
+    }
+
+    /// Number of scalar DOFs after the vertices: the edge DOFs, then the global DOFs.
+    pub fn num_scalar_dofs(&self) -> usize {
+        self.num_edge_dofs() + self.globals.len()
     }
 
     /// Number of edge DOFs (0 without them).

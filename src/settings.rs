@@ -1548,13 +1548,36 @@ impl Settings {
                     reason: e.reason,
                 });
             }
-            let invalid = |reason: &str| SettingsError::Invalid {
+            let control = o.control(i).map_err(|e| SettingsError::Invalid {
                 path: name.to_string(),
-                key: format!("obstacles[{i}].friction"),
+                key: e.key,
+                reason: e.reason,
+            })?;
+            let invalid = |key: &str, reason: &str| SettingsError::Invalid {
+                path: name.to_string(),
+                key: format!("obstacles[{i}].{key}"),
                 reason: reason.to_string(),
             };
+            if let crate::config::obstacle::Control::Pressed { mass, .. } = control {
+                if self.solver.mode == Mode::Explicit {
+                    return Err(invalid(
+                        "force",
+                        "force control needs solver.mode = \"static\" or \"dynamic\" (the \
+                         explicit driver moves vertices only; [slides] offer a pressed plane \
+                         there)",
+                    ));
+                }
+                if self.solver.mode == Mode::Dynamic && mass.is_none() {
+                    return Err(invalid(
+                        "mass",
+                        "is required by a force-controlled obstacle in dynamic mode (kg, its \
+                         inertia)",
+                    ));
+                }
+            }
             if o.friction > 0.0 && self.solver.mode == Mode::Static {
                 return Err(invalid(
+                    "friction",
                     "friction needs solver.mode = \"dynamic\" or \"explicit\": a static solve \
                      has no slip over a time for friction to resist",
                 ));
@@ -1564,6 +1587,7 @@ impl Settings {
                 && o.displacement.iter().any(|&c| c != 0.0)
             {
                 return Err(invalid(
+                    "friction",
                     "friction on a moving obstacle needs solver.mode = \"dynamic\" (explicit \
                      stick/slip acts against fixed obstacles only)",
                 ));

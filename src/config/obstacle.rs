@@ -18,6 +18,11 @@
 //! `contact.slip_speed`, and stick/slip in explicit mode, on a fixed obstacle only there; static
 //! solves have no slip to resist, so friction there is refused).
 //!
+//! Force control: `force = [Fx, Fy, Fz]` (N, reached at dial 1, linear in the dial) pushes the
+//! obstacle along its direction instead of moving it by `displacement`; its offset along the
+//! force is a global DOF of the solve, and `mass` (kg) its inertia, required in dynamic mode.
+//! Static and dynamic modes; frictionless.
+//!
 //! The raw table is flat (every key optional, unknown keys refused); [`ObstacleSettings::shape`]
 //! validates it into a [`Shape`] that carries exactly its variant's parameters.
 
@@ -58,6 +63,30 @@ pub struct ObstacleSettings {
     /// Coulomb friction coefficient μ between the sheet and the obstacle (default 0:
     /// frictionless; dynamic and explicit modes).
     pub friction: Real,
+    /// A force (N) that pushes the obstacle along its direction, reached at dial 1 (linear in
+    /// the dial): the obstacle's offset along it is then a global DOF (instead of
+    /// `displacement`).
+    pub force: Option<[Real; 3]>,
+    /// The mass (kg) of a force-controlled obstacle, its inertia in dynamic mode (required
+    /// there).
+    pub mass: Option<Real>,
+}
+
+/// How an obstacle moves: with the dial, or pushed by a force.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Control {
+    /// Offset `displacement` × dial (m; zero: fixed).
+    Moved([Real; 3]),
+    /// Pushed along the unit `direction` by the force `magnitude` × dial (N), with the mass
+    /// (kg; dynamic mode).
+    Pressed {
+        /// Unit direction of the force.
+        direction: [Real; 3],
+        /// Its magnitude at dial 1 (N).
+        magnitude: Real,
+        /// The obstacle's mass (kg), when given.
+        mass: Option<Real>,
+    },
 }
 
 /// The shape names.
@@ -147,6 +176,51 @@ fn unit(key: &str, v: [Real; 3]) -> Result<[Real; 3], Invalid> {
 }
 
 impl ObstacleSettings {
+    /// The validated motion of obstacle `i`: `force` (a non-zero direction, finite) excludes a
+    /// non-zero `displacement` and `friction`; `mass` is positive and only with a force.
+    pub fn control(&self, i: usize) -> Result<Control, Invalid> {
+        let key = |k: &str| format!("obstacles[{i}].{k}");
+        let Some(f) = self.force else {
+            if self.mass.is_some() {
+                return Err(Invalid::new(
+                    &key("mass"),
+                    "is the mass of a force-controlled obstacle: give `force` too, or drop it",
+                ));
+            }
+            return Ok(Control::Moved(self.displacement));
+        };
+        let f = finite3(&key("force"), f)?;
+        let magnitude = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
+        if !(magnitude > 0.0 && magnitude.is_finite()) {
+            return Err(Invalid::new(
+                &key("force"),
+                format!("must be non-zero: its direction is the obstacle's, got {f:?}"),
+            ));
+        }
+        if self.displacement.iter().any(|&c| c != 0.0) {
+            return Err(Invalid::new(
+                &key("displacement"),
+                "and force exclude each other: a force-controlled obstacle moves where the force \
+                 balances the sheet's push",
+            ));
+        }
+        if self.friction > 0.0 {
+            return Err(Invalid::new(
+                &key("friction"),
+                "is not available on a force-controlled obstacle (its slip would couple to its \
+                 offset); press with a frictionless obstacle, or move it by `displacement`",
+            ));
+        }
+        if let Some(m) = self.mass {
+            super::positive(&key("mass"), m, " kg")?;
+        }
+        Ok(Control::Pressed {
+            direction: f.map(|c| c / magnitude),
+            magnitude,
+            mass: self.mass,
+        })
+    }
+
     /// The validated shape of obstacle `i` (keys named `obstacles[i].KEY`): the shape's own
     /// keys present and valid, no key of another shape, and finite common keys.
     pub fn shape(&self, i: usize) -> Result<Shape, Invalid> {

@@ -84,6 +84,24 @@ pub struct LowRank {
     pub u: Vec<Real>,
 }
 
+/// A global scalar DOF that a term declares (a force-controlled obstacle's offset along its
+/// force): one node of one DOF after the vertex and edge nodes, free, carried in
+/// [`crate::solve::State::dofs`] after the edge DOFs, saved with every frame for a restart.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GlobalDof {
+    /// Its name in `log.csv` (the value, in its unit).
+    pub name: String,
+    /// Newton's residual scale: the length (m) that turns the DOF's gradient into a force
+    /// (1 for a translation, whose gradient already is one).
+    pub length: Real,
+    /// The largest change of the DOF in one Newton iteration (a force-controlled obstacle
+    /// moves at most half the sheet's thickness, so that a long first step cannot carry it
+    /// through the sheet).
+    pub max_step: Real,
+    /// Its inertia in dynamics (kg for a translation).
+    pub mass: Real,
+}
+
 /// A tracked state in a restart frame that cannot be used.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("face {face}: {reason}")]
@@ -101,6 +119,17 @@ pub trait Term: Send + Sync {
 
     /// The elements and their DOF nodes.
     fn stencil(&self, scene: &Scene) -> Stencil;
+
+    /// The global DOFs the term owns (default: none). The scene numbers them after the vertex
+    /// and edge nodes, in term order, and tells the term its first node with
+    /// [`Term::bind_globals`] before its stencil is asked for.
+    fn globals(&self) -> Vec<GlobalDof> {
+        Vec::new()
+    }
+
+    /// Gives the term the node id of its first global DOF (see [`Term::globals`]); its DOF in
+    /// [`crate::solve::State::dofs`] is `node − vertices`.
+    fn bind_globals(&mut self, _first_node: usize) {}
 
     /// Adds the term's energy (returned), gradient and Hessian (lower triangle, pattern order)
     /// at positions `x` and edge DOFs `phi` into `grad`/`values` as `want` says, skipping fixed

@@ -73,6 +73,16 @@ pub(super) fn run_dynamic(
     let n = state.x.len();
     let mut v = v0.unwrap_or_else(|| vec![Vec3::zeros(); n]);
     let mut xhat = state.x.clone();
+    // The global DOFs (after the edge DOFs) have inertia too: their velocities and prediction.
+    let ne = sc.num_edge_dofs();
+    let mut w = vec![0.0; sc.globals.len()];
+    if let Some(d) = driver
+        .as_ref()
+        .filter(|d| d.global_velocities.len() == w.len())
+    {
+        w.copy_from_slice(&d.global_velocities);
+    }
+    let mut dofs_hat = state.dofs.clone();
     let mut trial = state.clone();
     let damping = tm.damping > 0.0;
     let (mut a_prev, mut b_prev) = if damping {
@@ -109,6 +119,7 @@ pub(super) fn run_dynamic(
                 holds_reached,
                 moisture: moisture.as_ref().map(|m| m.u.clone()),
                 diffusion_substep: moisture.as_ref().map(|m| m.diffusion.next_substep()),
+                global_velocities: w.clone(),
                 ..Default::default()
             }
         };
@@ -151,7 +162,11 @@ pub(super) fn run_dynamic(
         // prediction can carry their prescribed position into every trial.
         sc.prescribe(&mut xhat, dial);
         trial.x.copy_from_slice(&xhat);
-        trial.dofs.copy_from_slice(&state.dofs);
+        dofs_hat.copy_from_slice(&state.dofs);
+        for (k, wk) in w.iter().enumerate() {
+            dofs_hat[ne + k] += wk * h;
+        }
+        trial.dofs.copy_from_slice(&dofs_hat);
         let moisture_clock = Instant::now();
         if moisture.is_some() {
             progress.update(
@@ -219,6 +234,7 @@ pub(super) fn run_dynamic(
                 inertia: Some(Inertia {
                     inv_dt2: 1.0 / (h * h),
                     xhat: &xhat,
+                    dofs_hat: &dofs_hat,
                 }),
                 damping: damping.then_some(Damping {
                     eta_over_dt: tm.damping / h,
@@ -270,6 +286,9 @@ pub(super) fn run_dynamic(
         }
         for ((vi, t), x) in v.iter_mut().zip(&trial.x).zip(&state.x) {
             *vi = (t - x) / h;
+        }
+        for (k, wk) in w.iter_mut().enumerate() {
+            *wk = (trial.dofs[ne + k] - state.dofs[ne + k]) / h;
         }
         state.copy_from(&trial);
         sc.accept(&state.x, &state.dofs);

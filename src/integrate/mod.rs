@@ -431,6 +431,7 @@ impl<'a> Solver<'a> {
         let clock = Instant::now();
         let mut driver = self.driver.clone();
         driver.mode = self.summary.mode.clone();
+        driver.globals = state.dofs[self.scene.num_edge_dofs()..].to_vec();
         for t in self.scene.terms.iter() {
             let saved = t.saved_state();
             if !saved.is_empty() {
@@ -663,6 +664,11 @@ pub struct DriverState {
     pub explicit: std::collections::BTreeMap<String, Real>,
     /// The explicit driver's positions at its last equilibrium window (x, y, z per vertex).
     pub window_positions: Option<Vec<Real>>,
+    /// The global DOFs' values ([`crate::energy::term::GlobalDof`]; frames carry no field for
+    /// them), in node order.
+    pub globals: Vec<Real>,
+    /// Their velocities (dynamics).
+    pub global_velocities: Vec<Real>,
 }
 
 impl DriverState {

@@ -197,7 +197,7 @@ impl Workspace {
             step: vec![0.0; n],
             trial: State {
                 x: vec![Vec3::zeros(); pattern.num_vertices],
-                dofs: vec![0.0; pattern.num_edge_dofs],
+                dofs: vec![0.0; pattern.num_scalar_dofs],
             },
             indefinite: false,
         }
@@ -499,7 +499,7 @@ pub fn newton(
         // Backtracking line search. Near convergence Φ changes at round-off level; allow a
         // round-off slack so that a tiny, correct step is not rejected.
         let slack = 1e-13 * e.abs().max(Real::MIN_POSITIVE);
-        let mut alpha = 1.0;
+        let mut alpha = pot.step_bound(&ws.step);
         let mut accepted = false;
         for _ in 0..40 {
             ws.trial.set_step(state, &ws.step, alpha);

@@ -26,6 +26,8 @@ pub struct Inertia<'a> {
     pub inv_dt2: Real,
     /// Predicted positions x_n + Δt v_n (m).
     pub xhat: &'a [Vec3],
+    /// Predicted scalar DOFs q_n + Δt q̇_n (the global DOFs' inertia; empty: at rest).
+    pub dofs_hat: &'a [Real],
 }
 
 /// Kelvin–Voigt damping of seed 000: the elastic form with targets at the previous step's
@@ -178,14 +180,37 @@ impl<'a> Potential<'a> {
         self.eval_projected(x, phi, want, HessianProjection::None, grad, values)
     }
 
-    /// The relative residual of a gradient: `max(‖g_x‖∞, ‖g_φ‖∞ / ℓ) / F`, with `F` the scene's
-    /// force scale and `ℓ` its mean edge length (an edge DOF's gradient is a moment, N·m).
+    /// The relative residual of a gradient: `max(‖g_x‖∞, ‖g_φ‖∞ / ℓ, maxₖ |g_k| / ℓ_k) / F`,
+    /// with `F` the scene's force scale, `ℓ` its mean edge length (an edge DOF's gradient is a
+    /// moment, N·m) and `ℓ_k` global DOF k's declared length
+    /// ([`crate::energy::term::GlobalDof::length`]).
     pub fn residual(&self, grad: &[Real]) -> Real {
         let nx = 3 * self.pattern.num_vertices;
+        let ne = nx + self.scene.num_edge_dofs();
         let gx = grad[..nx].iter().fold(0.0 as Real, |m, v| m.max(v.abs()));
-        let gp = grad[nx..].iter().fold(0.0 as Real, |m, v| m.max(v.abs()));
+        let gp = grad[nx..ne].iter().fold(0.0 as Real, |m, v| m.max(v.abs()));
+        let gg = grad[ne..]
+            .iter()
+            .zip(&self.scene.globals)
+            .fold(0.0 as Real, |m, (v, g)| m.max(v.abs() / g.length));
         let f = self.scene.force_scale.max(Real::MIN_POSITIVE);
-        gx.max(gp / self.scene.mean_edge) / f
+        gx.max(gp / self.scene.mean_edge).max(gg) / f
+    }
+
+    /// The largest fraction of a Newton step `step` (DOF order) that moves no global DOF by more
+    /// than its [`crate::energy::term::GlobalDof::max_step`] (1 when none would).
+    pub fn step_bound(&self, step: &[Real]) -> Real {
+        let ne = 3 * self.pattern.num_vertices + self.scene.num_edge_dofs();
+        step[ne..]
+            .iter()
+            .zip(&self.scene.globals)
+            .fold(1.0, |a: Real, (d, g)| {
+                if d.abs() * a > g.max_step {
+                    g.max_step / d.abs()
+                } else {
+                    a
+                }
+            })
     }
 
     /// As [`Potential::eval`], with the element Hessians projected as `projection` says.

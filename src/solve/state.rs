@@ -20,7 +20,7 @@ impl State {
     pub fn reference(scene: &Scene) -> State {
         State {
             x: scene.mesh.positions.clone(),
-            dofs: vec![0.0; scene.num_edge_dofs()],
+            dofs: vec![0.0; scene.num_scalar_dofs()],
         }
     }
 

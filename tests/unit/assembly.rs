@@ -278,6 +278,7 @@ fn assembled_derivatives(model: &str) {
         inertia: Some(shellsim::solve::potential::Inertia {
             inv_dt2: 1e4,
             xhat: &xhat,
+            dofs_hat: &[],
         }),
         damping: Some(shellsim::solve::potential::Damping {
             eta_over_dt: 0.5,

@@ -198,6 +198,7 @@ fn every_registered_term_matches_finite_differences() {
                 inertia: Some(Inertia {
                     inv_dt2: 1e4,
                     xhat: &xhat,
+                    dofs_hat: &[],
                 }),
                 damping: Some(Damping {
                     eta_over_dt: 3.0,
@@ -552,6 +553,45 @@ fn obstacles_match_finite_differences() {
             check_term(&sc, &p, &pot, &x, &phi, i);
         }
     }
+}
+
+/// A force-controlled sphere pressed into a deformed strip, its offset a global DOF (the last
+/// scalar DOF), with its inertia in dynamics, against finite differences: the coupling of every
+/// vertex to the offset, the force's work and the inertia.
+#[test]
+fn a_force_controlled_obstacle_matches_finite_differences() {
+    let sc = strip_scene(
+        "[material]\nthickness = 0.05\n[solver]\nmode = \"dynamic\"\n[constraints]\n\
+         fix_boxes = [{ min = [-1, -1, -1], max = [0.01, 2, 1] }]\n[[obstacles]]\n\
+         shape = \"sphere\"\ncenter = [0.5, 0.25, 0.6]\nradius = 0.45\nforce = [0.2, 0, -3]\n\
+         mass = 0.7\n",
+    );
+    assert_eq!(sc.globals.len(), 1);
+    assert_eq!(sc.globals[0].name, "obstacle0_offset");
+    let p = Pattern::for_scene(&sc);
+    let x = deformed(&sc);
+    let mut phi = vec![0.0; sc.num_scalar_dofs()];
+    let k = phi.len() - 1;
+    phi[k] = 0.13;
+    let mut dofs_hat = phi.clone();
+    dofs_hat[k] = 0.11;
+    let xhat = x.clone();
+    let pot = Potential {
+        dial: 0.8,
+        inertia: Some(Inertia {
+            inv_dt2: 1e4,
+            xhat: &xhat,
+            dofs_hat: &dofs_hat,
+        }),
+        ..Potential::new(&sc, &p)
+    };
+    let i = (0..sc.terms.len())
+        .find(|&i| sc.terms[i].name() == "pressed_obstacles")
+        .unwrap();
+    let obs = sc.terms[i].observables(&pot, &x, &phi);
+    let gap = obs.iter().find(|(n, _)| n == "obstacle0_gap").unwrap().1;
+    assert!(gap < -0.01, "no deep contact: gap {gap}");
+    check_term(&sc, &p, &pot, &x, &phi, i);
 }
 
 /// The energy and the nominal stress `∂W/∂λ₁` of the rubber membranes under in-plane stretches

@@ -22,6 +22,9 @@
 //! ground's lagged, smoothed Coulomb dissipation with the obstacle's normal; in explicit mode
 //! stick/slip in the step ([`Obstacles`]' `explicit_step`), against fixed obstacles.
 //!
+//! **Force control** (`force`): such an obstacle is its own term, [`pressed::Pressed`], whose
+//! offset along the force is a global DOF of the solve; this term skips it.
+//!
 //! `log.csv` gets, per obstacle `i`, the normal force it exerts on the sheet
 //! (`obstacle{i}_force_x/y/z`, N) and the smallest gap (`obstacle{i}_gap`, m).
 //!
@@ -31,10 +34,11 @@ pub mod capsule;
 pub mod cuboid;
 pub mod cylinder;
 pub mod plane;
+pub mod pressed;
 pub mod sphere;
 
 use super::term::{Term, VertexKernel, VertexTerm};
-use crate::config::obstacle::Shape;
+use crate::config::obstacle::{Control, Shape};
 use crate::math::{Mat3, Real, Vec3};
 use crate::mesh::MeshError;
 use crate::scene::Scene;
@@ -129,6 +133,9 @@ impl Distance for Body {
 pub struct Obstacle {
     /// Coulomb coefficient μ (0: frictionless).
     pub friction: Real,
+    /// Force control: the unit direction, the force at dial 1 (N) and the mass (kg, 0 when
+    /// none); such an obstacle is its own term ([`pressed`]), skipped by [`Obstacles`].
+    pub pressed: Option<(Vec3, Real, Real)>,
     /// Its shape at dial 0.
     pub body: Body,
     /// Offset at dial 1 (m).
@@ -215,7 +222,7 @@ impl VertexKernel for Obstacles {
     #[inline]
     fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
         let mut out: Option<(Real, Vec3, Mat3)> = None;
-        for o in &self.list {
+        for o in self.list.iter().filter(|o| o.pressed.is_none()) {
             let (p, n, hd) = self.contact(o, v, x, pot.dial);
             if p <= 0.0 {
                 continue;
@@ -275,6 +282,9 @@ impl VertexKernel for Obstacles {
     fn observables(&self, pot: &Potential, x: &[Vec3]) -> Vec<(String, Real)> {
         let mut out = Vec::new();
         for (i, o) in self.list.iter().enumerate() {
+            if o.pressed.is_some() {
+                continue;
+            }
             let (mut f, mut gap) = (Vec3::zeros(), Real::INFINITY);
             for (v, xv) in x.iter().enumerate() {
                 if self.area[v] == 0.0 {
@@ -317,10 +327,18 @@ pub fn build(scene: &Scene) -> Result<Option<Obstacles>, MeshError> {
     }
     let mut obstacles = Vec::with_capacity(list.len());
     for (i, o) in list.iter().enumerate() {
-        let shape = o
-            .shape(i)
-            .map_err(|e| mesh.invalid(format!("{}: {}", e.key, e.reason)))?;
+        let invalid = |e: crate::config::Invalid| mesh.invalid(format!("{}: {}", e.key, e.reason));
+        let shape = o.shape(i).map_err(invalid)?;
+        let pressed = match o.control(i).map_err(invalid)? {
+            Control::Moved(_) => None,
+            Control::Pressed {
+                direction,
+                magnitude,
+                mass,
+            } => Some((Vec3::from(direction), magnitude, mass.unwrap_or(0.0))),
+        };
         obstacles.push(Obstacle {
+            pressed,
             body: Body::of(&shape),
             displacement: Vec3::from(o.displacement),
             stiffness: o.stiffness.unwrap_or(k_default),
@@ -361,6 +379,31 @@ pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
     let Some(obstacles) = build(scene)? else {
         return Ok(Vec::new());
     };
+    let h_mean = crate::scene::ContactAreas::of(&scene.mesh, &scene.thickness, &scene.young).h_mean;
+    let pressed: Vec<Box<dyn Term>> = obstacles
+        .list
+        .iter()
+        .enumerate()
+        .filter_map(|(index, o)| {
+            let (direction, force, mass) = o.pressed?;
+            Some(Box::new(pressed::Pressed {
+                index,
+                body: o.body,
+                direction,
+                force,
+                mass,
+                stiffness: o.stiffness,
+                smoothing: o.smoothing,
+                sheet: Obstacles {
+                    list: Vec::new(),
+                    area: obstacles.area.clone(),
+                    half_thickness: obstacles.half_thickness.clone(),
+                },
+                max_step: h_mean / 2.0,
+                node: usize::MAX,
+            }) as Box<dyn Term>)
+        })
+        .collect();
     let dynamic = scene.settings.solver.mode == crate::settings::Mode::Dynamic;
     let friction =
         (dynamic && obstacles.has_friction()).then(|| ObstacleFriction(obstacles.clone()));
@@ -376,5 +419,6 @@ pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
             kernel,
         }));
     }
+    t.extend(pressed);
     Ok(t)
 }
