@@ -177,6 +177,47 @@ impl Pattern {
         p
     }
 
+    /// The pattern of `scene` at the state `(x, phi)` when a term's elements there
+    /// ([`crate::energy::term::Term::stencil_at`]) differ from `self`'s; `None` when none do.
+    /// The caller keeps its symbolic factorisation when the new pattern's union
+    /// ([`Pattern::same_union`]) is unchanged.
+    pub fn refreshed(
+        &self,
+        scene: &crate::scene::Scene,
+        x: &[Vec3],
+        phi: &[Real],
+    ) -> Option<Pattern> {
+        let mut changed = false;
+        let fresh: Vec<Option<Stencil>> = scene
+            .terms
+            .iter()
+            .zip(&self.maps)
+            .map(|(t, map)| {
+                let st = t.stencil_at(scene, x, phi)?;
+                changed |= st.nodes != map.nodes || st.slot_dofs.len() != map.slots;
+                Some(st)
+            })
+            .collect();
+        if !changed {
+            return None;
+        }
+        let stencils: Vec<Stencil> = scene
+            .terms
+            .iter()
+            .zip(fresh)
+            .map(|(t, st)| st.unwrap_or_else(|| t.stencil(scene)))
+            .collect();
+        let mut p = Self::build(&scene.mesh.positions, scene.num_scalar_dofs(), &stencils);
+        p.pin(&scene.pinned_dofs);
+        Some(p)
+    }
+
+    /// Whether `other` has the same entries (the union of the stencils), so that a symbolic
+    /// factorisation of one serves the other.
+    pub fn same_union(&self, other: &Pattern) -> bool {
+        self.n == other.n && self.col_ptr == other.col_ptr && self.row_idx == other.row_idx
+    }
+
     /// Builds the pattern of the vertices at `positions` (which only order the elements into
     /// spatially coherent blocks) and `ne` single-DOF nodes (edges, globals) from the stencils.
     pub fn build(positions: &[Vec3], ne: usize, stencils: &[Stencil]) -> Pattern {

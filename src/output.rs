@@ -157,6 +157,10 @@ fn not_finite(v: &Real) -> bool {
     !v.is_finite()
 }
 
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
 /// The run summary written to `summary.json`.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Summary {
@@ -188,6 +192,13 @@ pub struct Summary {
     pub indefinite_iterations: usize,
     /// Saddle points detected and escaped by perturbation.
     pub saddle_escapes: usize,
+    /// Steps before which a term's elements changed (a new sparsity pattern); left out when 0.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub element_changes: usize,
+    /// Of those, the ones that changed the union of the stencils (a new symbolic
+    /// factorisation); left out when 0.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub pattern_rebuilds: usize,
     /// Vertices.
     pub vertices: usize,
     /// Faces.

@@ -2,6 +2,8 @@
 #![allow(clippy::needless_range_loop)]
 #[path = "unit/assembly.rs"]
 mod assembly;
+#[path = "unit/changing.rs"]
+mod changing;
 #[path = "unit/closed.rs"]
 mod closed;
 #[path = "unit/diffusion.rs"]

@@ -120,6 +120,18 @@ pub trait Term: Send + Sync {
     /// The elements and their DOF nodes.
     fn stencil(&self, scene: &Scene) -> Stencil;
 
+    /// For a term whose elements change during a run (contact pairs), its elements at the
+    /// state `(x, phi)`, in an order that depends on nothing but that state (so that assembly
+    /// stays bitwise independent of the threads); `None` (default) for a term whose elements
+    /// are fixed by [`Term::stencil`]. The drivers ask before every implicit step (a static
+    /// continuation step, a time step); the sparsity pattern is rebuilt when some term's
+    /// elements changed, and the symbolic factorisation only when the union of the stencils
+    /// changed ([`crate::assembly::Pattern::refreshed`]). The explicit driver does not follow
+    /// changing elements: such a scene is refused there.
+    fn stencil_at(&self, _scene: &Scene, _x: &[Vec3], _phi: &[Real]) -> Option<Stencil> {
+        None
+    }
+
     /// The global DOFs the term owns (default: none). The scene numbers them after the vertex
     /// and edge nodes, in term order, and tells the term its first node with
     /// [`Term::bind_globals`] before its stencil is asked for.

@@ -125,7 +125,8 @@ pub(super) fn run_dynamic(
         };
     }
     {
-        let pot = accepted(s.potential(dial_now), moisture.as_ref(), &targets);
+        let pat = s.pattern();
+        let pot = accepted(s.potential(&pat, dial_now), moisture.as_ref(), &targets);
         s.driver = record!(t0);
         s.frame(writer, &pot, &state, &v, t0)?;
     }
@@ -141,6 +142,8 @@ pub(super) fn run_dynamic(
             failure = Some(f);
             break;
         }
+        // Terms whose elements change (contact pairs) follow the state at the step's start.
+        s.refresh(&state)?;
         let h = clock.step_from(t, steps.step).min(tm.end - t);
         let (dial, reaches_hold) = if holding {
             (dial_now, false)
@@ -228,6 +231,7 @@ pub(super) fn run_dynamic(
         if let Some(l) = &mut lag {
             l.start_step();
         }
+        let pat = s.pattern();
         let rep = loop {
             let pot = Potential {
                 dial,
@@ -245,7 +249,7 @@ pub(super) fn run_dynamic(
                 rest_override: moisture.as_ref().map(|_| &trial_targets[..]),
                 mass: trial_mass,
                 friction: lag.as_ref().map(|l| l.friction(&state.x, dial_now, h)),
-                ..Potential::new(sc, s.pattern)
+                ..Potential::new(sc, &pat)
             };
             let rep = s.solve(&pot, &mut trial, opts);
             let again =
@@ -269,7 +273,8 @@ pub(super) fn run_dynamic(
         // Projections after the implicit step (seed 002's volume preservation), before the
         // velocities are taken from the positions (its Algorithm 1, lines 10–12).
         let projected = {
-            let pot = accepted(s.potential(dial), moisture.as_ref(), &trial_targets);
+            let pat = s.pattern();
+            let pot = accepted(s.potential(&pat, dial), moisture.as_ref(), &trial_targets);
             sc.project(&pot, &mut trial)
         };
         if let Err(e) = projected {
@@ -326,8 +331,9 @@ pub(super) fn run_dynamic(
         let mut stop = false;
         let mut released = false;
         if tm.stop_at_equilibrium || holding {
-            let pot = accepted(s.potential(dial), moisture.as_ref(), &targets);
-            let mut g = vec![0.0; s.pattern.n];
+            let pat = s.pattern();
+            let pot = accepted(s.potential(&pat, dial), moisture.as_ref(), &targets);
+            let mut g = vec![0.0; pat.n];
             pot.eval(&state.x, &state.dofs, Want::Gradient, &mut g, &mut []);
             let r = pot.residual(&g);
             let en = Writer::energies(&pot, &state, &v);
@@ -349,7 +355,8 @@ pub(super) fn run_dynamic(
             if let Some(m) = &moisture {
                 m.publish(writer);
             }
-            let pot = accepted(s.potential(dial), moisture.as_ref(), &targets);
+            let pat = s.pattern();
+            let pot = accepted(s.potential(&pat, dial), moisture.as_ref(), &targets);
             s.driver = record!(t);
             s.frame(writer, &pot, &state, &v, t)?;
             clock.passed(t, h, eps_t);
@@ -364,7 +371,8 @@ pub(super) fn run_dynamic(
     s.driver = record!(t);
     s.summary.converged = failure.is_none();
     s.summary.reason = failure.map(|f| f.to_string()).unwrap_or_default();
-    let pot = accepted(s.potential(dial_now), moisture.as_ref(), &targets);
+    let pat = s.pattern();
+    let pot = accepted(s.potential(&pat, dial_now), moisture.as_ref(), &targets);
     s.summary.energy = Writer::energies(&pot, &state, &v);
     if s.summary.reason.is_empty() {
         return Ok(());

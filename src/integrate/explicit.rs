@@ -486,6 +486,15 @@ pub(super) fn run_explicit(
         driver,
     } = from;
     let sc = s.scene;
+    if s.changing {
+        return Err(RunError::Unsupported(
+            "a term's elements change during the run (Term::stencil_at), which the explicit \
+             driver does not follow: use solver.mode = \"dynamic\""
+                .into(),
+        ));
+    }
+    // The pattern is fixed: the explicit driver assembles gradients only, on its elements.
+    let pat = s.pattern();
     let cf = sc.settings.explicit.clone();
     let holds = sc.settings.dial.holds.clone();
     let sca = Scales::of(sc);
@@ -515,7 +524,7 @@ pub(super) fn run_explicit(
 
     // The mesh's stability limit, measured at the start (gradient only).
     let omega2 = {
-        let pot = s.potential(0.0);
+        let pot = s.potential(&pat, 0.0);
         max_frequency_squared(&pot, &state.x, 60)
     };
     let stable_prefactor = (omega2 > 0.0).then(|| 2.0 / (omega2.sqrt() * sca.dt_unit));
@@ -565,9 +574,9 @@ pub(super) fn run_explicit(
     }
     let mut holds_reached = 0;
     let mut v = v0.unwrap_or_else(|| vec![Vec3::zeros(); n]);
-    let mut g = vec![0.0; s.pattern.n];
+    let mut g = vec![0.0; pat.n];
     // The frames' residuals are taken here: `g` carries a test step's forces to its update.
-    let mut scratch = vec![0.0; s.pattern.n];
+    let mut scratch = vec![0.0; pat.n];
     let mut t = t0;
     let frame_interval = sca.long_time / cf.frames_per_long_time;
     let mut next_frame = t0 + frame_interval;
@@ -577,7 +586,7 @@ pub(super) fn run_explicit(
     // target's energy in the starting shape (a compatible target relaxes to Φ ≈ 0, where a
     // test relative to Φ alone would ask for round-off).
     let mut energy_floor = {
-        let pot = s.potential(1.0);
+        let pot = s.potential(&pat, 1.0);
         1e-6 * gradient(&pot, &state.x, &mut g).abs()
     };
     let mut window = Window {
@@ -643,7 +652,7 @@ pub(super) fn run_explicit(
         };
     }
     {
-        let pot = s.potential(dial);
+        let pot = s.potential(&pat, dial);
         s.summary.residual = residual_at(&pot, &state.x, &mut scratch);
         s.driver = state_now!();
         s.frame(writer, &pot, &state, &v, t)?;
@@ -654,14 +663,14 @@ pub(super) fn run_explicit(
     // The steps' gradients run on a team of spinning threads: a step is too short for rayon's
     // sleeping workers to be woken twice per step (`crate::team`).
     let team = crate::team::Team::new(rayon::current_num_threads());
-    let mut step = Step::new(&s.potential(dial), true);
+    let mut step = Step::new(&s.potential(&pat, dial), true);
     let stop = team.activate(|| -> Result<Stop, RunError> {
         Ok(loop {
             if let Some(f) = super::interruption("t", t) {
                 break Stop::Other(f.to_string());
             }
             if phase == Phase::Wait && frozen.as_ref().is_none_or(|(d, _)| *d != dial) {
-                let pot = s.potential(dial);
+                let pot = s.potential(&pat, dial);
                 frozen = Some((dial, (0..sc.num_faces()).map(|f| pot.density(f)).collect()));
             }
             let pot = Potential {
@@ -669,7 +678,7 @@ pub(super) fn run_explicit(
                     .as_ref()
                     .filter(|(d, _)| *d == dial)
                     .map(|(_, v)| &v[..]),
-                ..s.potential(dial)
+                ..s.potential(&pat, dial)
             };
             sc.prescribe(&mut state.x, dial);
             // Terms whose own state follows the sheet (a moving slide) catch up with it first.
@@ -771,7 +780,7 @@ pub(super) fn run_explicit(
                     report.holds_reached = holds_reached;
                     s.summary.holds_reached = holds_reached;
                     phase = Phase::Dial;
-                    let pot = s.potential(dial);
+                    let pot = s.potential(&pat, dial);
                     s.summary.residual = residual_at(&pot, &state.x, &mut scratch);
                     next_frame = t + frame_interval;
                     s.driver = state_now!();
@@ -820,7 +829,7 @@ pub(super) fn run_explicit(
                 }
             }
             if t >= next_frame {
-                let pot = s.potential(dial);
+                let pot = s.potential(&pat, dial);
                 let healthy = state.x.iter().all(|p| p.iter().all(|c| c.is_finite()));
                 if !healthy {
                     break Stop::Unstable(format!(
@@ -860,7 +869,7 @@ pub(super) fn run_explicit(
     let wall = clock.elapsed().as_secs_f64();
     report.microseconds_per_face_step =
         1e6 * wall / (steps.max(1) as Real * sc.num_faces() as Real);
-    let pot = s.potential(dial);
+    let pot = s.potential(&pat, dial);
     s.summary.residual = residual_at(&pot, &state.x, &mut scratch);
     s.summary.time = Some(t);
     s.summary.dial = dial;

@@ -68,6 +68,9 @@ pub enum RunError {
     /// A restart's driver state does not fit the scene.
     #[error("restart: {0}")]
     Restart(String),
+    /// The scene asks for something its driver does not do.
+    #[error("{0}")]
+    Unsupported(String),
 }
 
 /// Why a run stopped before converging (exit 1); its text is `summary.json`'s `reason`.
@@ -282,7 +285,11 @@ const MAX_UPDATES: usize = 50;
 
 struct Solver<'a> {
     scene: &'a Scene,
-    pattern: &'a Pattern,
+    /// The current sparsity pattern (replaced when a term's elements change, see
+    /// [`Solver::refresh`]); potentials borrow a clone of the handle ([`Solver::pattern`]).
+    pattern: std::sync::Arc<Pattern>,
+    /// Whether some term's elements change during the run.
+    changing: bool,
     /// The run's controls, from the validated settings.
     config: config::RunConfig,
     lin: LinearSolver,
@@ -319,9 +326,14 @@ impl Counters {
 }
 
 impl<'a> Solver<'a> {
-    fn new(scene: &'a Scene, pattern: &'a Pattern, threads: usize) -> Result<Self, RunError> {
-        let lin = LinearSolver::new(pattern)?;
-        let ws = Workspace::new(pattern);
+    fn new(scene: &'a Scene, pattern: Pattern, threads: usize) -> Result<Self, RunError> {
+        let lin = LinearSolver::new(&pattern)?;
+        let ws = Workspace::new(&pattern);
+        let changing = scene.terms.iter().any(|t| {
+            let x = &scene.mesh.positions;
+            t.stencil_at(scene, x, &vec![0.0; scene.num_scalar_dofs()])
+                .is_some()
+        });
         let config = config::RunConfig::new(scene);
         let summary = Summary {
             mode: match config.mode {
@@ -338,7 +350,8 @@ impl<'a> Solver<'a> {
         };
         Ok(Solver {
             scene,
-            pattern,
+            pattern: std::sync::Arc::new(pattern),
+            changing,
             config,
             lin,
             ws,
@@ -349,16 +362,52 @@ impl<'a> Solver<'a> {
         })
     }
 
-    fn potential(&self, dial: Real) -> Potential<'a> {
-        self.potential_scaled(dial, 1.0)
+    /// The current pattern, for potentials to borrow.
+    fn pattern(&self) -> std::sync::Arc<Pattern> {
+        self.pattern.clone()
     }
 
-    fn potential_scaled(&self, dial: Real, stretch_scale: Real) -> Potential<'a> {
+    /// Follows the terms whose elements change to the state `state`: a new pattern when their
+    /// elements there differ, a new symbolic factorisation only when the union of the stencils
+    /// changed. Returns whether the pattern was replaced (take a new [`Solver::pattern`]).
+    fn refresh(&mut self, state: &State) -> Result<bool, RunError> {
+        if !self.changing {
+            return Ok(false);
+        }
+        let Some(p) = self.pattern.refreshed(self.scene, &state.x, &state.dofs) else {
+            return Ok(false);
+        };
+        self.summary.element_changes += 1;
+        if !p.same_union(&self.pattern) {
+            self.lin = LinearSolver::new(&p)?;
+            self.ws = Workspace::new(&p);
+            self.summary.pattern_rebuilds += 1;
+        }
+        self.pattern = std::sync::Arc::new(p);
+        Ok(true)
+    }
+
+    fn potential<'p>(&self, pattern: &'p Pattern, dial: Real) -> Potential<'p>
+    where
+        'a: 'p,
+    {
+        self.potential_scaled(pattern, dial, 1.0)
+    }
+
+    fn potential_scaled<'p>(
+        &self,
+        pattern: &'p Pattern,
+        dial: Real,
+        stretch_scale: Real,
+    ) -> Potential<'p>
+    where
+        'a: 'p,
+    {
         Potential {
             dial,
             gravity: self.config.gravity,
             stretch_scale,
-            ..Potential::new(self.scene, self.pattern)
+            ..Potential::new(self.scene, pattern)
         }
     }
 
@@ -376,6 +425,10 @@ impl<'a> Solver<'a> {
     /// another solve. The report sums the iterations of every solve; more than
     /// [`MAX_UPDATES`] updates is a failure.
     fn solve(&mut self, pot: &Potential, state: &mut State, opts: NewtonOptions) -> NewtonReport {
+        assert!(
+            std::ptr::eq(pot.pattern, &*self.pattern),
+            "a potential on a replaced pattern was solved"
+        );
         let mut total = NewtonReport::default();
         for _ in 0..MAX_UPDATES {
             let rep = newton(pot, &mut self.lin, &mut self.ws, state, opts);
@@ -453,8 +506,8 @@ impl<'a> Solver<'a> {
         if !self.lin.is_factored() {
             // The first step: the Hessian at the start (dial `from`).
             let at = Potential { dial: from, ..*pot };
-            let mut values = vec![0.0; self.pattern.nnz()];
-            let mut g = vec![0.0; self.pattern.n];
+            let mut values = vec![0.0; pot.pattern.nnz()];
+            let mut g = vec![0.0; pot.pattern.n];
             at.eval(&state.x, &state.dofs, Want::Hessian, &mut g, &mut values);
             let lr = at.low_rank(&state.x, &state.dofs);
             let mut shifted = vec![0.0; values.len()];
@@ -490,9 +543,10 @@ impl<'a> Solver<'a> {
     /// Tests `H + δI ≻ 0` at `state` (see module doc).
     fn is_stable(&mut self, dial: Real, state: &State) -> bool {
         let (x, phi) = (&state.x, &state.dofs);
-        let pot = self.potential(dial);
-        let mut values = vec![0.0; self.pattern.nnz()];
-        let mut g = vec![0.0; self.pattern.n];
+        let pattern = self.pattern();
+        let pot = self.potential(&pattern, dial);
+        let mut values = vec![0.0; pattern.nnz()];
+        let mut g = vec![0.0; pattern.n];
         pot.eval(x, phi, Want::Hessian, &mut g, &mut values);
         // One factorisation of H + 1e-9·mean|diag|·I, with the dense low-rank part through
         // the inertia (an indefinite sparse part is fine when the whole is positive definite).
@@ -718,8 +772,7 @@ pub fn run(
     threads: usize,
     initial: Option<InitialState>,
 ) -> Result<Summary, RunError> {
-    let pattern = Pattern::for_scene(scene);
-    let mut s = Solver::new(scene, &pattern, threads)?;
+    let mut s = Solver::new(scene, Pattern::for_scene(scene), threads)?;
     let (mut state, v, start, dial, driver) = match initial {
         Some(st) => (st.state, st.v, Some(st.time), st.dial, st.driver),
         None => (State::reference(scene), None, None, None, None),

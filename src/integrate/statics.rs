@@ -24,7 +24,8 @@ pub(super) fn run_static(
     let zeros = vec![Vec3::zeros(); state.x.len()];
     let dial_start = restart.unwrap_or(0.0).clamp(0.0, 1.0);
     {
-        let pot = s.potential(dial_start);
+        let pat = s.pattern();
+        let pot = s.potential(&pat, dial_start);
         s.driver = super::DriverState {
             time: dial_start,
             dial: dial_start,
@@ -73,7 +74,9 @@ pub(super) fn run_static(
         };
         trial.copy_from(&state);
         s.scene.prescribe(&mut trial.x, target);
-        let pot = s.potential_scaled(target, target_scale);
+        s.refresh(&trial)?;
+        let pat = s.pattern();
+        let pot = s.potential_scaled(&pat, target, target_scale);
         if target != dial {
             s.predict(&pot, dial, &mut trial);
         }
@@ -123,7 +126,8 @@ pub(super) fn run_static(
                 s.summary.holds_reached += 1;
             }
             if (cont_frames || at_hold) && dial < 1.0 {
-                let pot = s.potential(dial);
+                let pat = s.pattern();
+                let pot = s.potential(&pat, dial);
                 s.driver = super::DriverState::at_dial(dial, &steps);
                 s.frame(writer, &pot, &state, &zeros, dial)?;
             }
@@ -176,7 +180,9 @@ pub(super) fn run_static(
                 amp,
                 seed.wrapping_add(escapes as u64),
             );
-            let pot = s.potential(1.0);
+            s.refresh(&state)?;
+            let pat = s.pattern();
+            let pot = s.potential(&pat, 1.0);
             let rep = s.solve(
                 &pot,
                 &mut state,
@@ -195,7 +201,8 @@ pub(super) fn run_static(
     s.summary.dial = dial;
     s.summary.converged = failure.is_none();
     s.summary.reason = failure.map(|f| f.to_string()).unwrap_or_default();
-    let pot = s.potential(dial);
+    let pat = s.pattern();
+    let pot = s.potential(&pat, dial);
     s.summary.energy = Writer::energies(&pot, &state, &zeros);
     s.driver = super::DriverState::at_dial(dial, &steps);
     // The series' time of a static frame is its dial (a failed run's last frame included).
