@@ -100,43 +100,14 @@ struct Parts {
     pinned: bool,
 }
 
-/// Work fused into the parts of an element term's gradient ([`with_owned_nodes`]): called once
+/// Work fused into the parts of an element term's gradient ([`assemble_gradient_to_owners`],
+/// from [`crate::solve::Potential::owned`]): called once
 /// per part, on the thread that runs it, right after the part has summed the gradient of the
 /// nodes it owns, with those node ids, their sums (3 entries per vertex node, 1 per edge node,
 /// in the nodes' order; N for vertices, N·m for edge DOFs; fixed nodes included and not
 /// masked) and the term's mask of fixed nodes (by node id), whose entries the unfused gradient
 /// leaves at zero. Each node of the term's elements is owned by exactly one part.
 pub type OwnedNodes<'a> = dyn Fn(&[u32], &[Real], &[bool]) + Sync + 'a;
-
-thread_local! {
-    /// The hook set by [`with_owned_nodes`] on this thread, until a gradient takes it.
-    static OWNED: std::cell::Cell<Option<*const OwnedNodes<'static>>> =
-        const { std::cell::Cell::new(None) };
-}
-
-/// Runs `f` with `hook` fused into the first element-term gradient that [`assemble_elements`]
-/// assembles on this thread inside it: that gradient's parts call `hook` with the nodes they
-/// own, and the pass that adds the parts' sums into the gradient is skipped (the term leaves
-/// `grad` untouched; the hook has the sums). Returns what `f` returns and whether a gradient
-/// took the hook. The explicit driver uses this to advance each node on the thread that summed
-/// its force, while that thread still has it in cache.
-pub fn with_owned_nodes<R>(hook: &OwnedNodes<'_>, f: impl FnOnce() -> R) -> (R, bool) {
-    struct Restore(Option<*const OwnedNodes<'static>>);
-    impl Drop for Restore {
-        fn drop(&mut self) {
-            OWNED.with(|o| o.set(self.0));
-        }
-    }
-    // SAFETY: only the lifetime is erased. The pointer is dereferenced by a gradient called
-    // inside `f`, while `hook` is borrowed, and it is removed from the thread-local when `f`
-    // returns or unwinds.
-    let ptr =
-        unsafe { std::mem::transmute::<*const OwnedNodes<'_>, *const OwnedNodes<'static>>(hook) };
-    let _restore = Restore(OWNED.with(|o| o.replace(Some(ptr))));
-    let r = f();
-    let taken = OWNED.with(|o| o.get().is_none());
-    (r, taken)
-}
 
 /// Elements per energy block. A term's energy is summed in blocks of this many consecutive
 /// elements along the Morton curve, each block in that order, then the blocks' sums in that
@@ -586,6 +557,25 @@ impl Shared {
     }
 }
 
+/// The gradient of one element term fused with `hook`: each part of the gradient's partition
+/// (the owner-computes gradient) hands the sums of the nodes it owns to `hook`, on the thread that
+/// summed them, instead of adding them into a gradient vector; returns the energy. Terms call
+/// it instead of [`assemble_elements`] for a gradient when the potential carries a hook
+/// ([`crate::solve::Potential::owned`]): the explicit driver's fused step advances each node
+/// there, while its thread still has it in cache.
+pub fn assemble_gradient_to_owners<const N: usize, const S: usize, K>(
+    map: &ElementMap,
+    kernel: K,
+    fixed: &[bool],
+    hook: &OwnedNodes<'_>,
+) -> Real
+where
+    K: Fn(usize, &[usize], Option<&mut SVec<N>>, Option<&mut SMat<N, N>>) -> Real + Sync,
+{
+    assert_eq!(map.slots, S, "element map and kernel disagree on the slots");
+    gather_gradient::<N, S, K>(map, &kernel, fixed, &mut [], Some(hook))
+}
+
 /// Accumulates one element term into `grad` (len n) and `values` (len nnz) as `want` says and
 /// returns its energy ([`ElementMap::sum_energies`]). `kernel(e, nodes, grad, hess)` evaluates
 /// element `e` with `N` local DOFs and `S` slots (slot `s` at `map.local[s]`); `fixed` is per
@@ -614,7 +604,7 @@ where
         return map.sum_energies(&es);
     }
     if want == Want::Gradient {
-        return gather_gradient::<N, S, K>(map, &kernel, fixed, grad);
+        return gather_gradient::<N, S, K>(map, &kernel, fixed, grad, None);
     }
     let mut local = [0usize; S];
     local.copy_from_slice(&map.local);
@@ -850,8 +840,8 @@ impl ElementMap {
 /// threads; elements on a part boundary are evaluated more than once (1.0–2.6% of them on the
 /// explicit bench's meshes, 8632 to 793 faces, on two threads).
 /// The parts run on the calling thread's active [`crate::team::Team`] when there is one (one
-/// part per team thread), otherwise on rayon's pool. Inside [`with_owned_nodes`], each part
-/// hands its nodes' sums to the hook instead, and `grad` is left alone.
+/// part per team thread), otherwise on rayon's pool. With `hook`, each part hands its nodes'
+/// sums to it instead, and `grad` is left alone ([`assemble_gradient_to_owners`]).
 /// Every entry is the same sum in the same order whatever the partition, so results are
 /// bitwise identical for any number of threads. Returns the energy
 /// ([`ElementMap::sum_energies`]).
@@ -860,14 +850,12 @@ fn gather_gradient<const N: usize, const S: usize, K>(
     kernel: &K,
     fixed: &[bool],
     grad: &mut [Real],
+    hook: Option<&OwnedNodes<'_>>,
 ) -> Real
 where
     K: Fn(usize, &[usize], Option<&mut SVec<N>>, Option<&mut SMat<N, N>>) -> Real + Sync,
 {
     assert_eq!(map.dofs, N, "element map and kernel disagree on the DOFs");
-    // SAFETY: a hook in the thread-local is borrowed by the `with_owned_nodes` call this one
-    // runs inside.
-    let hook = OWNED.with(|o| o.take()).map(|h| unsafe { &*h });
     crate::team::with_active(|team| {
         let threads = team.map_or_else(rayon::current_num_threads, |t| t.threads());
         gather_gradient_on::<N, S, K>(map, kernel, fixed, grad, team, threads, hook)

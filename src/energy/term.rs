@@ -418,6 +418,14 @@ impl<K: ElementKernel<N, S>, const N: usize, const S: usize> Term for ElementTer
         values: &mut [Real],
     ) -> Real {
         let gn = projection == HessianProjection::GaussNewton;
+        if let (Want::Gradient, Some(hook)) = (want, pot.owned) {
+            return crate::assembly::assemble_gradient_to_owners::<N, S, _>(
+                map,
+                |e, nodes, g, h| self.kernel.eval(pot, e, nodes, x, phi, gn, g, h),
+                &pot.scene.node_fixed,
+                hook,
+            );
+        }
         assemble_elements::<N, S, _>(
             map,
             |e, nodes, g, h| self.kernel.eval(pot, e, nodes, x, phi, gn, g, h),

@@ -260,7 +260,8 @@ impl Disjoint {
 /// When the scene's only term goes through [`crate::assembly::assemble_elements`] and does
 /// not act on the step ([`crate::energy::term::Term::acts_on_explicit_steps`]), each vertex is
 /// advanced inside the gradient's parallel parts, by the part that owns it, right after that
-/// part has summed its force ([`crate::assembly::with_owned_nodes`]). The new positions go
+/// part has summed its force ([`crate::assembly::assemble_gradient_to_owners`], through
+/// [`crate::solve::Potential::owned`]). The new positions go
 /// into a second buffer, since other parts may still be reading the old ones, and the two are
 /// swapped when the parts are done. A step is then one parallel region with no serial pass over
 /// the nodes, and no core rereads the forces and positions another core has just written. The
@@ -350,7 +351,11 @@ impl Step {
             Disjoint(self.next.as_mut_ptr(), self.next.len()),
         );
         let old: &[Vec3] = x;
-        let hook = move |nodes: &[u32], sums: &[Real], fixed: &[bool]| {
+        // Whether the term's gradient handed its parts to the hook (a term that does not
+        // assemble through the parts writes `g` instead).
+        let taken = std::sync::atomic::AtomicBool::new(false);
+        let hook = |nodes: &[u32], sums: &[Real], fixed: &[bool]| {
+            taken.store(true, std::sync::atomic::Ordering::Relaxed);
             let mut at = 0;
             for &u in nodes {
                 let u = u as usize;
@@ -377,8 +382,12 @@ impl Step {
                 }
             }
         };
-        let (energy, taken) = crate::assembly::with_owned_nodes(&hook, || gradient(pot, old, g));
-        if !taken {
+        let fused = Potential {
+            owned: Some(&hook),
+            ..*pot
+        };
+        let energy = gradient(&fused, old, g);
+        if !taken.load(std::sync::atomic::Ordering::Relaxed) {
             // The term did not assemble through the parts: `g` is its gradient.
             advance(x, v, g, inv_m, c, dt);
             return energy;

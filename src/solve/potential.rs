@@ -91,6 +91,10 @@ pub struct Potential<'a> {
     /// phase, where millions of gradient evaluations share one rest state); `None` computes
     /// them per evaluation.
     pub frozen: Option<&'a [KoiterDensity]>,
+    /// The explicit driver's fused step ([`crate::assembly::OwnedNodes`]): an element term's
+    /// gradient hands each part's node sums to it instead of writing the gradient vector
+    /// ([`crate::assembly::assemble_gradient_to_owners`]). `None` everywhere else.
+    pub owned: Option<&'a crate::assembly::OwnedNodes<'a>>,
 }
 
 impl<'a> Potential<'a> {
@@ -109,6 +113,7 @@ impl<'a> Potential<'a> {
             mass: &scene.mass,
             friction: None,
             frozen: None,
+            owned: None,
         }
     }
 
