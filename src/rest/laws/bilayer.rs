@@ -37,6 +37,9 @@ pub fn bilayer(
 }
 
 impl RestLaw for Bilayer {
+    fn example(&self) -> &'static str {
+        "mu_top = 0.05\nmu_bottom = 0.01\nmoisture_top = 0.4\nmoisture_bottom = 0.3"
+    }
     fn grow(&self, g: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
         let (mt, mb) = (g.mu_top.unwrap_or(0.0), g.mu_bottom.unwrap_or(0.0));
         check_stretch(i, mt, true, false)?;

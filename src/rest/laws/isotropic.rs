@@ -21,6 +21,9 @@ pub fn isotropic(a0: &Sym2, b0: &Sym2, s: Real) -> (Sym2, Sym2, Real) {
 }
 
 impl RestLaw for Isotropic {
+    fn example(&self) -> &'static str {
+        "s = \"0.05 * x\""
+    }
     fn grow(&self, _: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
         let (abar, bbar, thickness_ratio) = isotropic(&i.a0, &i.b0, i.s);
         Ok(Grown {

@@ -21,6 +21,9 @@ pub fn isotropic_in_plane(a0: &Sym2, b0: &Sym2, s: Real) -> (Sym2, Sym2) {
 }
 
 impl RestLaw for IsotropicInPlane {
+    fn example(&self) -> &'static str {
+        "s = \"0.05 * x\""
+    }
     fn grow(&self, _: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
         Ok(Grown::at_fixed_thickness(isotropic_in_plane(
             &i.a0, &i.b0, i.s,

@@ -14,6 +14,9 @@ use crate::settings::Growth;
 pub struct IsotropicMetricOnly;
 
 impl RestLaw for IsotropicMetricOnly {
+    fn example(&self) -> &'static str {
+        "s = \"0.05 * x\""
+    }
     fn grow(&self, _: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
         Ok(Grown::at_fixed_thickness((i.a0 * (2.0 * i.s).exp(), i.b0)))
     }

@@ -39,6 +39,9 @@ pub fn linear_swelling(
 }
 
 impl RestLaw for LinearSwelling {
+    fn example(&self) -> &'static str {
+        "mu = 0.05\nmoisture_top = 0.4\nmoisture_bottom = 0.1"
+    }
     fn grow(&self, g: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
         let mu = g.mu.unwrap_or(0.0);
         check_stretch(i, mu, true, true)?;

@@ -45,6 +45,9 @@ pub fn machine_direction(
 }
 
 impl RestLaw for MachineDirection {
+    fn example(&self) -> &'static str {
+        "mu = 0.02\nmu_perp = 0.06\nmoisture_top = 0.4\nmoisture_bottom = 0.1\nmachine_direction = [1, 1, 0]"
+    }
     fn grow(&self, g: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
         let (mu, mp) = (g.mu.unwrap_or(0.0), g.mu_perp.unwrap_or(0.0));
         check_stretch(i, mu, true, true)?;

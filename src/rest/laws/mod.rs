@@ -113,6 +113,9 @@ impl Grown {
 pub trait RestLaw: Sync {
     /// The grown forms of one face. Errors name the face.
     fn grow(&self, g: &Growth, input: &FaceInput) -> Result<Grown, GrowthError>;
+    /// The `[growth]` keys besides `law` of a valid example on a flat sheet, for the tests that
+    /// every registered law passes (restarts).
+    fn example(&self) -> &'static str;
     /// True when the law reads the machine direction.
     fn needs_direction(&self) -> bool {
         false
