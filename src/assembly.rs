@@ -100,7 +100,7 @@ struct Parts {
     pinned: bool,
 }
 
-/// Work fused into the parts of an element term's gradient ([`assemble_gradient_to_owners`],
+/// Work fused into the parts of an element term's gradient ([`assemble_elements_owned`],
 /// from [`crate::solve::Potential::owned`]): called once
 /// per part, on the thread that runs it, right after the part has summed the gradient of the
 /// nodes it owns, with those node ids, their sums (3 entries per vertex node, 1 per edge node,
@@ -557,30 +557,12 @@ impl Shared {
     }
 }
 
-/// The gradient of one element term fused with `hook`: each part of the gradient's partition
-/// (the owner-computes gradient) hands the sums of the nodes it owns to `hook`, on the thread that
-/// summed them, instead of adding them into a gradient vector; returns the energy. Terms call
-/// it instead of [`assemble_elements`] for a gradient when the potential carries a hook
-/// ([`crate::solve::Potential::owned`]): the explicit driver's fused step advances each node
-/// there, while its thread still has it in cache.
-pub fn assemble_gradient_to_owners<const N: usize, const S: usize, K>(
-    map: &ElementMap,
-    kernel: K,
-    fixed: &[bool],
-    hook: &OwnedNodes<'_>,
-) -> Real
-where
-    K: Fn(usize, &[usize], Option<&mut SVec<N>>, Option<&mut SMat<N, N>>) -> Real + Sync,
-{
-    assert_eq!(map.slots, S, "element map and kernel disagree on the slots");
-    gather_gradient::<N, S, K>(map, &kernel, fixed, &mut [], Some(hook))
-}
-
 /// Accumulates one element term into `grad` (len n) and `values` (len nnz) as `want` says and
 /// returns its energy ([`ElementMap::sum_energies`]). `kernel(e, nodes, grad, hess)` evaluates
 /// element `e` with `N` local DOFs and `S` slots (slot `s` at `map.local[s]`); `fixed` is per
 /// node. `S` must equal `map.slots`.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 pub fn assemble_elements<const N: usize, const S: usize, K>(
     map: &ElementMap,
     kernel: K,
@@ -590,6 +572,31 @@ pub fn assemble_elements<const N: usize, const S: usize, K>(
     grad: &mut [Real],
     values: &mut [Real],
     col_ptr: &[usize],
+) -> Real
+where
+    K: Fn(usize, &[usize], Option<&mut SVec<N>>, Option<&mut SMat<N, N>>) -> Real + Sync,
+{
+    assemble_elements_owned::<N, S, K>(
+        map, kernel, fixed, projection, want, grad, values, col_ptr, None,
+    )
+}
+
+/// [`assemble_elements`], with the explicit driver's fused step: given `owned` (from
+/// [`crate::solve::Potential::owned`]) and asked for a gradient, each part of the gradient's
+/// partition hands the sums of the nodes it owns to the hook, on the thread that summed them,
+/// instead of adding them into `grad`, which is left alone ([`OwnedNodes`]). Element terms
+/// pass their potential's hook here.
+#[allow(clippy::too_many_arguments)]
+pub fn assemble_elements_owned<const N: usize, const S: usize, K>(
+    map: &ElementMap,
+    kernel: K,
+    fixed: &[bool],
+    projection: HessianProjection,
+    want: Want,
+    grad: &mut [Real],
+    values: &mut [Real],
+    col_ptr: &[usize],
+    owned: Option<&OwnedNodes<'_>>,
 ) -> Real
 where
     K: Fn(usize, &[usize], Option<&mut SVec<N>>, Option<&mut SMat<N, N>>) -> Real + Sync,
@@ -604,7 +611,7 @@ where
         return map.sum_energies(&es);
     }
     if want == Want::Gradient {
-        return gather_gradient::<N, S, K>(map, &kernel, fixed, grad, None);
+        return gather_gradient::<N, S, K>(map, &kernel, fixed, grad, owned);
     }
     let mut local = [0usize; S];
     local.copy_from_slice(&map.local);
@@ -841,7 +848,7 @@ impl ElementMap {
 /// explicit bench's meshes, 8632 to 793 faces, on two threads).
 /// The parts run on the calling thread's active [`crate::team::Team`] when there is one (one
 /// part per team thread), otherwise on rayon's pool. With `hook`, each part hands its nodes'
-/// sums to it instead, and `grad` is left alone ([`assemble_gradient_to_owners`]).
+/// sums to it instead, and `grad` is left alone ([`assemble_elements_owned`]).
 /// Every entry is the same sum in the same order whatever the partition, so results are
 /// bitwise identical for any number of threads. Returns the energy
 /// ([`ElementMap::sum_energies`]).

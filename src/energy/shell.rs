@@ -336,15 +336,7 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
         values: &mut [Real],
     ) -> Real {
         let gn = projection == super::HessianProjection::GaussNewton;
-        if let (crate::assembly::Want::Gradient, Some(hook)) = (want, pot.owned) {
-            return crate::assembly::assemble_gradient_to_owners::<N, S, _>(
-                map,
-                |e, nodes, g, h| ElementKernel::<N, S>::eval(self, pot, e, nodes, x, phi, gn, g, h),
-                &pot.scene.node_fixed,
-                hook,
-            );
-        }
-        crate::assembly::assemble_elements::<N, S, _>(
+        crate::assembly::assemble_elements_owned::<N, S, _>(
             map,
             |e, nodes, g, h| ElementKernel::<N, S>::eval(self, pot, e, nodes, x, phi, gn, g, h),
             &pot.scene.node_fixed,
@@ -353,6 +345,7 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
             grad,
             values,
             &pot.pattern.col_ptr,
+            pot.owned,
         )
     }
 

@@ -16,7 +16,7 @@
 //!
 //! Dispatch is once per term: a term's element loop is monomorphic.
 
-use crate::assembly::{assemble_elements, ElementMap, Want};
+use crate::assembly::{assemble_elements, assemble_elements_owned, ElementMap, Want};
 use crate::energy::HessianProjection;
 use crate::math::{Mat3, Real, SMat, SVec, Vec3};
 use crate::scene::Scene;
@@ -418,15 +418,7 @@ impl<K: ElementKernel<N, S>, const N: usize, const S: usize> Term for ElementTer
         values: &mut [Real],
     ) -> Real {
         let gn = projection == HessianProjection::GaussNewton;
-        if let (Want::Gradient, Some(hook)) = (want, pot.owned) {
-            return crate::assembly::assemble_gradient_to_owners::<N, S, _>(
-                map,
-                |e, nodes, g, h| self.kernel.eval(pot, e, nodes, x, phi, gn, g, h),
-                &pot.scene.node_fixed,
-                hook,
-            );
-        }
-        assemble_elements::<N, S, _>(
+        assemble_elements_owned::<N, S, _>(
             map,
             |e, nodes, g, h| self.kernel.eval(pot, e, nodes, x, phi, gn, g, h),
             &pot.scene.node_fixed,
@@ -439,6 +431,7 @@ impl<K: ElementKernel<N, S>, const N: usize, const S: usize> Term for ElementTer
             grad,
             values,
             &pot.pattern.col_ptr,
+            pot.owned,
         )
     }
 }

@@ -260,7 +260,7 @@ impl Disjoint {
 /// When the scene's only term goes through [`crate::assembly::assemble_elements`] and does
 /// not act on the step ([`crate::energy::term::Term::acts_on_explicit_steps`]), each vertex is
 /// advanced inside the gradient's parallel parts, by the part that owns it, right after that
-/// part has summed its force ([`crate::assembly::assemble_gradient_to_owners`], through
+/// part has summed its force ([`crate::assembly::assemble_elements_owned`], through
 /// [`crate::solve::Potential::owned`]). The new positions go
 /// into a second buffer, since other parts may still be reading the old ones, and the two are
 /// swapped when the parts are done. A step is then one parallel region with no serial pass over
@@ -353,8 +353,9 @@ impl Step {
         let old: &[Vec3] = x;
         // Whether the term's gradient handed its parts to the hook (a term that does not
         // assemble through the parts writes `g` instead).
-        let taken = std::sync::atomic::AtomicBool::new(false);
-        let hook = |nodes: &[u32], sums: &[Real], fixed: &[bool]| {
+        let taken_flag = std::sync::atomic::AtomicBool::new(false);
+        let taken = &taken_flag;
+        let hook = move |nodes: &[u32], sums: &[Real], fixed: &[bool]| {
             taken.store(true, std::sync::atomic::Ordering::Relaxed);
             let mut at = 0;
             for &u in nodes {
@@ -387,7 +388,7 @@ impl Step {
             ..*pot
         };
         let energy = gradient(&fused, old, g);
-        if !taken.load(std::sync::atomic::Ordering::Relaxed) {
+        if !taken_flag.load(std::sync::atomic::Ordering::Relaxed) {
             // The term did not assemble through the parts: `g` is its gradient.
             advance(x, v, g, inv_m, c, dt);
             return energy;

@@ -93,7 +93,7 @@ pub struct Potential<'a> {
     pub frozen: Option<&'a [KoiterDensity]>,
     /// The explicit driver's fused step ([`crate::assembly::OwnedNodes`]): an element term's
     /// gradient hands each part's node sums to it instead of writing the gradient vector
-    /// ([`crate::assembly::assemble_gradient_to_owners`]). `None` everywhere else.
+    /// ([`crate::assembly::assemble_elements_owned`]). `None` everywhere else.
     pub owned: Option<&'a crate::assembly::OwnedNodes<'a>>,
 }
 
