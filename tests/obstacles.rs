@@ -447,3 +447,52 @@ fn a_force_controlled_sphere_presses_with_its_force() {
         "a restart changed the sphere's offset"
     );
 }
+
+/// A disk (radius 0.5 m, h = 5 mm, 347 vertices) dropped onto a sphere (radius 0.3 m) under
+/// gravity, with friction μ = 0.5 (frictionless, its symmetric drape is unstable and it slides
+/// off): it drapes over the sphere and comes to rest, where the sphere's normal and friction
+/// forces together carry its weight ρ h A g to 1e-6 (measured 3e-8), with no sideways force
+/// left (1e-6 of the weight; measured 3e-8). The friction matters: the wrapped disk squeezes the
+/// sphere with 47.3 N against its 38.5 N weight, and friction holds its bending spring-back
+/// with 8.9 N (downward). The frames report the friction of the accepted step's own lag.
+#[test]
+fn a_sheet_draped_over_a_sphere_rests_on_its_contact_force() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    shellsim(
+        &[
+            "mesh", "disk", "--radius", "0.5", "--edge", "0.05", "-o", "disk.vtk",
+        ],
+        d,
+    );
+    let mesh = shellsim::mesh::io::read_mesh(&d.join("disk.vtk")).unwrap();
+    let area: f64 = (0..mesh.faces.len()).map(|f| mesh.face_area(f)).sum();
+    let (rho, h, g) = (1000.0, 0.005, 9.81);
+    let weight = rho * h * area * g;
+    let settings = format!(
+        "[material]\nyoung = 1e6\npoisson = 0.3\nthickness = {h}\ndensity = {rho}\n\
+         [solver]\nmode = \"dynamic\"\n[time]\nend = 4\ndt = 1e-3\ndt_max = 0.05\n\
+         output_interval = 1\ndamping = 0.05\n[loads]\ngravity = [0, 0, -{g}]\n\
+         [[obstacles]]\nshape = \"sphere\"\ncenter = [0, 0, -0.3026]\nradius = 0.3\n\
+         friction = 0.5\n"
+    );
+    let row = run(d, &settings, "disk.vtk", "drape", "2");
+    let normal = force(&row, 0);
+    let friction = ["x", "y", "z"].map(|k| row[&format!("obstacle0_friction_{k}")]);
+    let total: Vec<f64> = (0..3).map(|k| normal[k] + friction[k]).collect();
+    println!(
+        "normal {normal:?} N, friction {friction:?} N, total {total:?} N, weight {weight} N, \
+         kinetic {} J",
+        row["energy_kinetic"]
+    );
+    assert!(
+        (total[2] / weight - 1.0).abs() < 1e-6,
+        "{total:?} vs {weight}"
+    );
+    assert!(
+        total[0].abs() < 1e-6 * weight && total[1].abs() < 1e-6 * weight,
+        "{total:?}"
+    );
+    let f = friction.iter().map(|c| c * c).sum::<f64>().sqrt();
+    assert!(f > 1e-2 * weight, "no friction acts: {friction:?}");
+}

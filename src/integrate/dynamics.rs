@@ -131,7 +131,12 @@ pub(super) fn run_dynamic(
         s.frame(writer, &pot, &state, &v, t0)?;
     }
     // Friction: the lagged normal forces, carried from step to step.
+    let obstacles = !sc.settings.obstacles.is_empty();
     let mut lag = FrictionLag::new(sc, &state.x, dial_now, cf.slip_speed);
+    // With friction, the last accepted step (its start, its start's dial, its length): frames
+    // report the friction forces of that step. The first frame reports none.
+    let mut last_step: Option<(Vec<Vec3>, Real, Real)> =
+        lag.as_ref().map(|_| (state.x.clone(), dial_now, 0.0));
     let mut t = t0;
     // The next output time after the start (a restart resumes the output grid).
     let mut clock = OutputClock::new(t0, tm.output_interval, tm.end);
@@ -164,7 +169,15 @@ pub(super) fn run_dynamic(
         // Vertices on prescribed paths are fixed: their inertia is not assembled, so the
         // prediction can carry their prescribed position into every trial.
         sc.prescribe(&mut xhat, dial);
-        trial.x.copy_from_slice(&xhat);
+        if obstacles {
+            // Newton starts from the last state, not the prediction: the prediction of a sheet
+            // falling onto an obstacle lies deep inside it, where the penalty's curvature and
+            // the friction's lagged normals make the first iterations wander.
+            trial.x.copy_from_slice(&state.x);
+            sc.prescribe(&mut trial.x, dial);
+        } else {
+            trial.x.copy_from_slice(&xhat);
+        }
         dofs_hat.copy_from_slice(&state.dofs);
         for (k, wk) in w.iter().enumerate() {
             dofs_hat[ne + k] += wk * h;
@@ -295,6 +308,11 @@ pub(super) fn run_dynamic(
         for (k, wk) in w.iter_mut().enumerate() {
             *wk = (trial.dofs[ne + k] - state.dofs[ne + k]) / h;
         }
+        if let Some(last) = &mut last_step {
+            // The step the frames' friction forces are taken over.
+            last.0.copy_from_slice(&state.x);
+            (last.1, last.2) = (dial_now, h);
+        }
         state.copy_from(&trial);
         sc.accept(&state.x, &state.dofs);
         if let Some(m) = &mut moisture {
@@ -356,7 +374,13 @@ pub(super) fn run_dynamic(
                 m.publish(writer);
             }
             let pat = s.pattern();
-            let pot = accepted(s.potential(&pat, dial), moisture.as_ref(), &targets);
+            let pot = Potential {
+                friction: match (&lag, &last_step) {
+                    (Some(l), Some((x0, d0, h0))) if *h0 > 0.0 => Some(l.solved(x0, *d0, *h0)),
+                    _ => None,
+                },
+                ..accepted(s.potential(&pat, dial), moisture.as_ref(), &targets)
+            };
             s.driver = record!(t);
             s.frame(writer, &pot, &state, &v, t)?;
             clock.passed(t, h, eps_t);

@@ -28,6 +28,9 @@ pub struct FrictionLag {
     x_lag: Vec<Vec3>,
     /// Dial of the lagged iterate.
     dial_lag: Real,
+    /// The lag the last solve used (`lambda`, `x_lag`, `dial_lag` before its update): the
+    /// friction forces of the accepted step.
+    solved: (Vec<Real>, Vec<Vec3>, Real),
     /// Slip speed ε_v of the smoothed friction (m/s).
     slip_speed: Real,
     /// Solves of the current step.
@@ -47,8 +50,10 @@ impl FrictionLag {
         if ground.is_none() && obstacles.is_none() {
             return None;
         }
+        let lambda = ground.map_or_else(Vec::new, |g| g.normal_forces(x));
         Some(FrictionLag {
-            lambda: ground.map_or_else(Vec::new, |g| g.normal_forces(x)),
+            solved: (lambda.clone(), x.to_vec(), dial),
+            lambda,
             obstacles,
             x_lag: x.to_vec(),
             dial_lag: dial,
@@ -75,11 +80,28 @@ impl FrictionLag {
         }
     }
 
+    /// The friction term of the last solve (the lag it used) over the step of length `h` from
+    /// `x_prev` at dial `dial_prev`: at the accepted state, its forces are the friction forces
+    /// that balance the step (the frames report them).
+    pub fn solved<'a>(&'a self, x_prev: &'a [Vec3], dial_prev: Real, h: Real) -> Friction<'a> {
+        Friction {
+            x_prev,
+            dial_prev,
+            normal_force: &self.solved.0,
+            x_lag: &self.solved.1,
+            dial_lag: self.solved.2,
+            eps: self.slip_speed * h,
+        }
+    }
+
     /// Updates the lag from a converged solve at `trial` and dial `dial`. Returns whether the
     /// step must be solved again (a normal force moved by more than the tolerance of the
     /// largest, and the solve limit is not reached).
     pub fn resolve(&mut self, scene: &Scene, trial: &[Vec3], dial: Real) -> bool {
         self.solves += 1;
+        self.solved.0.clone_from(&self.lambda);
+        self.solved.1.copy_from_slice(&self.x_lag);
+        self.solved.2 = self.dial_lag;
         let (mut scale, mut diff) = (0.0 as Real, 0.0 as Real);
         if let Some(g) = scene.ground.as_ref().filter(|_| !self.lambda.is_empty()) {
             let new = g.normal_forces(trial);

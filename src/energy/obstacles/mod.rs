@@ -193,26 +193,71 @@ impl Obstacles {
 /// potential carries a [`crate::solve::potential::Friction`]. Units: N, m, J. DOF order: `x[v]`.
 pub struct ObstacleFriction(pub Obstacles);
 
+impl ObstacleFriction {
+    /// Energy, gradient and Hessian of vertex `v` at `x` against obstacle `o` (module doc of
+    /// [`ObstacleFriction`]); `None` out of contact at the lagged iterate.
+    #[inline]
+    fn one(
+        &self,
+        fr: &crate::solve::potential::Friction,
+        dial: Real,
+        o: &Obstacle,
+        v: usize,
+        x: &Vec3,
+    ) -> Option<(Real, Vec3, [[Real; 3]; 3])> {
+        let obs = &self.0;
+        let (p, n, _) = obs.contact(o, v, &fr.x_lag[v], fr.dial_lag);
+        if p <= 0.0 {
+            return None;
+        }
+        let lambda = o.stiffness * obs.area[v] * penalty(p, o.smoothing).1;
+        let moved = o.displacement * (dial.clamp(0.0, 1.0) - fr.dial_prev.clamp(0.0, 1.0));
+        let d = x - fr.x_prev[v] - moved;
+        Some(friction_potential(o.friction * lambda, &n, &d, fr.eps))
+    }
+}
+
 impl VertexKernel for ObstacleFriction {
     #[inline]
     fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
         let fr = pot.friction.as_ref()?;
-        let obs = &self.0;
         let mut out: Option<(Real, Vec3, Mat3)> = None;
-        for o in obs.list.iter().filter(|o| o.friction > 0.0) {
-            let (p, n, _) = obs.contact(o, v, &fr.x_lag[v], fr.dial_lag);
-            if p <= 0.0 {
+        for o in self.0.list.iter().filter(|o| o.friction > 0.0) {
+            let Some((e, g, h)) = self.one(fr, pot.dial, o, v, x) else {
                 continue;
-            }
-            let lambda = o.stiffness * obs.area[v] * penalty(p, o.smoothing).1;
-            let moved = o.displacement * (pot.dial.clamp(0.0, 1.0) - fr.dial_prev.clamp(0.0, 1.0));
-            let d = x - fr.x_prev[v] - moved;
-            let (e, g, h) = friction_potential(o.friction * lambda, &n, &d, fr.eps);
+            };
             let h = Mat3::from_fn(|r, c| h[r][c]);
             out = Some(match out {
                 None => (e, g, h),
                 Some((e0, g0, h0)) => (e0 + e, g0 + g, h0 + h),
             });
+        }
+        out
+    }
+
+    /// Per frictional obstacle `i`, the friction force it exerted on the sheet over the last
+    /// step (`obstacle{i}_friction_x/y/z`, N; 0 where the frame's potential carries no step,
+    /// the first frame), so that the normal and friction forces together balance the loads.
+    fn observables(&self, pot: &Potential, x: &[Vec3]) -> Vec<(String, Real)> {
+        let mut out = Vec::new();
+        for (i, o) in self.0.list.iter().enumerate() {
+            if o.friction <= 0.0 {
+                continue;
+            }
+            let mut f = Vec3::zeros();
+            if let Some(fr) = pot.friction.as_ref() {
+                for (v, xv) in x.iter().enumerate() {
+                    if pot.scene.fixed[v] {
+                        continue;
+                    }
+                    if let Some((_, g, _)) = self.one(fr, pot.dial, o, v, xv) {
+                        f -= g;
+                    }
+                }
+            }
+            for (k, c) in ["x", "y", "z"].iter().zip(f.iter()) {
+                out.push((format!("obstacle{i}_friction_{k}"), *c));
+            }
         }
         out
     }
