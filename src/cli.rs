@@ -258,7 +258,7 @@ pub(crate) struct MeshArgs {
     #[arg(long, conflicts_with_all = ["checkerboard", "grading"])]
     delaunay: bool,
     /// Write abar_info/bbar_info for an analytic case (enlarged_square, spherical_cap,
-    /// hyperboloid, rhombus, cylinder, cone, gcm_cone, bilayer_strip).
+    /// hyperboloid, rhombus, cylinder, cone, gcm_cone, bilayer_strip, conformal_cap).
     #[arg(long)]
     program: Option<String>,
     /// Per-face thickness written as ref_thicknesses (m).
@@ -271,7 +271,8 @@ pub(crate) struct MeshArgs {
 
 #[derive(clap::Args, Debug)]
 pub(crate) struct ErrorArgs {
-    /// Analytic case (enlarged_square, spherical_cap, hyperboloid, rhombus, cylinder).
+    /// Analytic case (enlarged_square, spherical_cap, hyperboloid, rhombus, cylinder, cone,
+    /// gcm_cone, bilayer_strip, conformal_cap).
     case: String,
     /// A frame written by shellsim (its reference positions are positions − displacement).
     frame: PathBuf,

@@ -2175,3 +2175,17 @@ fn every_registered_model_and_law_restarts_exactly() {
         }
     }
 }
+
+/// The help of `error CASE` and of `mesh --program` names every analytic case the commands
+/// accept.
+#[test]
+fn help_lists_every_analytic_case() {
+    let d = tmp();
+    for args in [&["error", "--help"][..], &["mesh", "--help"][..]] {
+        let r = run(args, d.path());
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        for c in shellsim::cases::Case::ALL {
+            assert!(r.stdout.contains(c.name()), "{args:?} omits {}", c.name());
+        }
+    }
+}
