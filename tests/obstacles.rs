@@ -42,6 +42,35 @@ fn run(dir: &Path, settings: &str, mesh: &str, tag: &str, threads: &str) -> Hash
     last_log_row(&out)
 }
 
+/// Writes a disk of radius 0.5 m with target edge `edge` (m) to `d/file`.
+fn disk(d: &Path, edge: &str, file: &str) {
+    shellsim(
+        &[
+            "mesh", "disk", "--radius", "0.5", "--edge", edge, "-o", file,
+        ],
+        d,
+    );
+}
+
+/// The weight ρ h A g (N) of the sheet `d/file`, A its area.
+fn weight_of(d: &Path, file: &str, rho: f64, h: f64, g: f64) -> f64 {
+    let mesh = shellsim::mesh::io::read_mesh(&d.join(file)).unwrap();
+    let area: f64 = (0..mesh.faces.len()).map(|f| mesh.face_area(f)).sum();
+    rho * h * area * g
+}
+
+/// The force `f` (N) carries `weight` upward with no sideways part, each to 1e-6 of the weight.
+fn assert_carries(f: &[f64], weight: f64, label: &str) {
+    assert!(
+        (f[2] / weight - 1.0).abs() < 1e-6,
+        "{label}: {f:?} vs {weight}"
+    );
+    assert!(
+        f[0].abs() < 1e-6 * weight && f[1].abs() < 1e-6 * weight,
+        "{label}: {f:?}"
+    );
+}
+
 fn force(row: &HashMap<String, f64>, i: usize) -> [f64; 3] {
     ["x", "y", "z"].map(|k| row[&format!("obstacle{i}_force_{k}")])
 }
@@ -56,12 +85,7 @@ fn force(row: &HashMap<String, f64>, i: usize) -> [f64; 3] {
 fn a_disk_pressed_onto_a_plane_balances_and_ignores_threads() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    shellsim(
-        &[
-            "mesh", "disk", "--radius", "0.5", "--edge", "0.05", "-o", "disk.vtk",
-        ],
-        d,
-    );
+    disk(d, "0.05", "disk.vtk");
     for (tag, press) in [
         (
             "sphere",
@@ -107,16 +131,9 @@ fn a_disk_pressed_onto_a_plane_balances_and_ignores_threads() {
 fn sheets_resting_on_obstacles_carry_their_weight() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    shellsim(
-        &[
-            "mesh", "disk", "--radius", "0.5", "--edge", "0.05", "-o", "disk.vtk",
-        ],
-        d,
-    );
-    let mesh = shellsim::mesh::io::read_mesh(&d.join("disk.vtk")).unwrap();
-    let area: f64 = (0..mesh.faces.len()).map(|f| mesh.face_area(f)).sum();
+    disk(d, "0.05", "disk.vtk");
     let (rho, h, g) = (1000.0, 0.005, 9.81);
-    let weight = rho * h * area * g;
+    let weight = weight_of(d, "disk.vtk", rho, h, g);
     for (tag, obstacle) in [
         (
             "plane",
@@ -135,14 +152,7 @@ fn sheets_resting_on_obstacles_carry_their_weight() {
         let row = run(d, &settings, "disk.vtk", tag, "2");
         let f = force(&row, 0);
         println!("{tag}: obstacle force {f:?} N, weight {weight} N");
-        assert!(
-            (f[2] / weight - 1.0).abs() < 1e-6,
-            "{tag}: {f:?} vs {weight}"
-        );
-        assert!(
-            f[0].abs() < 1e-6 * weight && f[1].abs() < 1e-6 * weight,
-            "{f:?}"
-        );
+        assert_carries(&f, weight, tag);
     }
 }
 
@@ -151,12 +161,7 @@ fn sheets_resting_on_obstacles_carry_their_weight() {
 fn bad_obstacles_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    shellsim(
-        &[
-            "mesh", "disk", "--radius", "0.5", "--edge", "0.2", "-o", "d.vtk",
-        ],
-        d,
-    );
+    disk(d, "0.2", "d.vtk");
     for (text, needles) in [
         (
             "shape = \"sphere\"\ncenter = [0, 0, 0.1]\nradius = 0.2",
@@ -240,12 +245,17 @@ fn bad_obstacles_are_refused() {
     }
 }
 
+/// The last frame of `out` (the last row of its log) and that row.
+fn last_frame(out: &Path) -> (shellsim::mesh::Mesh, HashMap<String, f64>) {
+    let row = last_log_row(out);
+    let frame = out.join(format!("frame_{:05}.vtu", row["frame"] as usize));
+    (shellsim::mesh::io::read_mesh(&frame).unwrap(), row)
+}
+
 /// Mean velocity and displacement of the vertices in the last frame of `out` (m/s, m), and its
 /// time (s).
 fn last_frame_motion(out: &Path) -> ([f64; 3], [f64; 3], f64) {
-    let row = last_log_row(out);
-    let frame = out.join(format!("frame_{:05}.vtu", row["frame"] as usize));
-    let m = shellsim::mesh::io::read_mesh(&frame).unwrap();
+    let (m, row) = last_frame(out);
     let n = m.positions.len() as f64;
     let mean = |name: &str| {
         let f = &m.vertex_fields[name];
@@ -368,12 +378,7 @@ fn frame_globals(out: &Path, frame: usize) -> (Vec<f64>, Vec<f64>) {
 fn a_force_controlled_sphere_presses_with_its_force() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    shellsim(
-        &[
-            "mesh", "disk", "--radius", "0.5", "--edge", "0.05", "-o", "disk.vtk",
-        ],
-        d,
-    );
+    disk(d, "0.05", "disk.vtk");
     let base = "[material]\nyoung = 1e6\npoisson = 0.3\nthickness = 0.005\n\
                 [[obstacles]]\nshape = \"plane\"\npoint = [0, 0, -0.0025]\nnormal = [0, 0, 1]\n";
     let statics = format!(
@@ -430,16 +435,10 @@ fn a_force_controlled_sphere_presses_with_its_force() {
         d,
     );
     assert_eq!(code, 0, "{err}");
-    let last = |o: &str| {
-        let mut frames: Vec<_> = std::fs::read_dir(d.join(o))
-            .unwrap()
-            .filter_map(|e| e.ok().map(|e| e.file_name().to_string_lossy().into_owned()))
-            .filter(|n| n.ends_with(".vtu"))
-            .collect();
-        frames.sort();
-        shellsim::mesh::io::read_mesh(&d.join(o).join(frames.last().unwrap())).unwrap()
-    };
-    let (x, y) = (last("drop"), last("again"));
+    let (x, y) = (
+        last_frame(&d.join("drop")).0,
+        last_frame(&d.join("again")).0,
+    );
     assert_eq!(x.positions, y.positions, "a restart changed the positions");
     assert_eq!(
         frame_globals(&d.join("drop"), 25).0,
@@ -459,16 +458,9 @@ fn a_force_controlled_sphere_presses_with_its_force() {
 fn a_sheet_draped_over_a_sphere_rests_on_its_contact_force() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    shellsim(
-        &[
-            "mesh", "disk", "--radius", "0.5", "--edge", "0.05", "-o", "disk.vtk",
-        ],
-        d,
-    );
-    let mesh = shellsim::mesh::io::read_mesh(&d.join("disk.vtk")).unwrap();
-    let area: f64 = (0..mesh.faces.len()).map(|f| mesh.face_area(f)).sum();
+    disk(d, "0.05", "disk.vtk");
     let (rho, h, g) = (1000.0, 0.005, 9.81);
-    let weight = rho * h * area * g;
+    let weight = weight_of(d, "disk.vtk", rho, h, g);
     let settings = format!(
         "[material]\nyoung = 1e6\npoisson = 0.3\nthickness = {h}\ndensity = {rho}\n\
          [solver]\nmode = \"dynamic\"\n[time]\nend = 4\ndt = 1e-3\ndt_max = 0.05\n\
@@ -485,14 +477,7 @@ fn a_sheet_draped_over_a_sphere_rests_on_its_contact_force() {
          kinetic {} J",
         row["energy_kinetic"]
     );
-    assert!(
-        (total[2] / weight - 1.0).abs() < 1e-6,
-        "{total:?} vs {weight}"
-    );
-    assert!(
-        total[0].abs() < 1e-6 * weight && total[1].abs() < 1e-6 * weight,
-        "{total:?}"
-    );
+    assert_carries(&total, weight, "drape");
     let f = friction.iter().map(|c| c * c).sum::<f64>().sqrt();
     assert!(f > 1e-2 * weight, "no friction acts: {friction:?}");
 }

@@ -65,6 +65,25 @@ pub(crate) fn round_distance(w: Vec3, radius: Real, proj: &Mat3) -> (Real, Vec3,
     (r - radius, u, (proj - u * u.transpose()) / r)
 }
 
+/// The penalty `k A ψ(p)` of a vertex of stiffness × area `ka` at penetration `p > 0` against
+/// a surface of unit normal `n` and distance Hessian `hd`, smoothing `delta`: energy (J),
+/// gradient `−ka ψ′ n` (N) and Hessian `ka (ψ″ nnᵀ − ψ′ ∇²d)` (N/m) in the vertex's coordinates.
+#[inline]
+pub(crate) fn penalty_term(
+    ka: Real,
+    delta: Real,
+    p: Real,
+    n: &Vec3,
+    hd: &Mat3,
+) -> (Real, Vec3, Mat3) {
+    let (psi, dpsi, ddpsi) = penalty(p, delta);
+    (
+        ka * psi,
+        -n * (ka * dpsi),
+        (n * n.transpose() * ddpsi - hd * dpsi) * ka,
+    )
+}
+
 /// A validated shape, dispatched by a `match` (no virtual call per vertex).
 #[derive(Clone, Copy, Debug)]
 pub enum Body {
@@ -155,6 +174,8 @@ pub struct Obstacles {
     pub area: Vec<Real>,
     /// Half thickness per vertex h_v/2 (m).
     pub half_thickness: Vec<Real>,
+    /// The sheet's area-weighted mean thickness (m).
+    pub h_mean: Real,
 }
 
 impl Obstacles {
@@ -178,6 +199,12 @@ impl Obstacles {
         if p <= 0.0 {
             return 0.0;
         }
+        self.pressure_force(o, v, p)
+    }
+
+    /// `k A_v ψ′(p)` (N): the normal force of obstacle `o` on vertex `v` at penetration `p > 0`.
+    #[inline]
+    fn pressure_force(&self, o: &Obstacle, v: usize, p: Real) -> Real {
         o.stiffness * self.area[v] * penalty(p, o.smoothing).1
     }
 }
@@ -210,7 +237,7 @@ impl ObstacleFriction {
         if p <= 0.0 {
             return None;
         }
-        let lambda = o.stiffness * obs.area[v] * penalty(p, o.smoothing).1;
+        let lambda = obs.pressure_force(o, v, p);
         let moved = o.displacement * (dial.clamp(0.0, 1.0) - fr.dial_prev.clamp(0.0, 1.0));
         let d = x - fr.x_prev[v] - moved;
         Some(friction_potential(o.friction * lambda, &n, &d, fr.eps))
@@ -272,11 +299,7 @@ impl VertexKernel for Obstacles {
             if p <= 0.0 {
                 continue;
             }
-            let (psi, dpsi, ddpsi) = penalty(p, o.smoothing);
-            let ka = o.stiffness * self.area[v];
-            let e = ka * psi;
-            let g = -n * (ka * dpsi);
-            let h = (n * n.transpose() * ddpsi - hd * dpsi) * ka;
+            let (e, g, h) = penalty_term(o.stiffness * self.area[v], o.smoothing, p, &n, &hd);
             out = Some(match out {
                 None => (e, g, h),
                 Some((e0, g0, h0)) => (e0 + e, g0 + g, h0 + h),
@@ -338,7 +361,7 @@ impl VertexKernel for Obstacles {
                 let (p, n, _) = self.contact(o, v, xv, pot.dial);
                 gap = gap.min(-p);
                 if p > 0.0 {
-                    f += n * (o.stiffness * self.area[v] * penalty(p, o.smoothing).1);
+                    f += n * self.pressure_force(o, v, p);
                 }
             }
             for (k, c) in ["x", "y", "z"].iter().zip(f.iter()) {
@@ -395,6 +418,7 @@ pub fn build(scene: &Scene) -> Result<Option<Obstacles>, MeshError> {
         list: obstacles,
         area: c.area,
         half_thickness: c.half_thickness,
+        h_mean: c.h_mean,
     };
     for (i, o) in term.list.iter().enumerate() {
         for v in (0..nv).filter(|&v| term.area[v] > 0.0) {
@@ -424,7 +448,6 @@ pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
     let Some(obstacles) = build(scene)? else {
         return Ok(Vec::new());
     };
-    let h_mean = crate::scene::ContactAreas::of(&scene.mesh, &scene.thickness, &scene.young).h_mean;
     let pressed: Vec<Box<dyn Term>> = obstacles
         .list
         .iter()
@@ -443,8 +466,9 @@ pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
                     list: Vec::new(),
                     area: obstacles.area.clone(),
                     half_thickness: obstacles.half_thickness.clone(),
+                    h_mean: obstacles.h_mean,
                 },
-                max_step: h_mean / 2.0,
+                max_step: obstacles.h_mean / 2.0,
                 node: usize::MAX,
             }) as Box<dyn Term>)
         })

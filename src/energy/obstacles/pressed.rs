@@ -28,7 +28,6 @@ use crate::energy::term::{GlobalDof, Stencil, Term};
 use crate::math::{Mat3, Real, SMat, SVec, Vec3};
 use crate::mesh::topology::NONE;
 use crate::scene::Scene;
-use crate::solve::contact::penalty;
 use crate::solve::Potential;
 
 /// One force-controlled obstacle.
@@ -65,12 +64,12 @@ impl Pressed {
         if p <= 0.0 {
             return None;
         }
-        let (psi, dpsi, ddpsi) = penalty(p, self.smoothing);
-        let ka = self.stiffness * self.sheet.area[v];
-        Some((
-            ka * psi,
-            -n * (ka * dpsi),
-            (n * n.transpose() * ddpsi - hd * dpsi) * ka,
+        Some(super::penalty_term(
+            self.stiffness * self.sheet.area[v],
+            self.smoothing,
+            p,
+            &n,
+            &hd,
         ))
     }
 
