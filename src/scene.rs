@@ -4,8 +4,9 @@
 use crate::energy::Lame2d;
 use crate::math::{Real, Sym2, Vec3};
 use crate::mesh::{Mesh, MeshError, Topology};
-use crate::rest::{pulled_back_targets, RestForms};
-use crate::settings::{Settings, TargetForms};
+use crate::rest::laws::GrowthInputs;
+use crate::rest::RestForms;
+use crate::settings::Settings;
 
 /// Everything the integrators need, derived once.
 #[derive(Clone, Debug)]
@@ -101,27 +102,15 @@ fn positive_face_field(
 }
 
 impl Scene {
-    /// Validates the mesh and builds the scene. Errors name the file, field and index.
+    /// Validates the mesh and builds the scene, in stages: the mesh and its topology, the
+    /// material per face, the rest forms (reference, targets, growth), the masses, the supports,
+    /// the checks that the problem is posed, the ground, and last the terms the settings enable
+    /// (the registry). Errors name the file, field and index.
     pub fn build(mut mesh: Mesh, settings: Settings) -> Result<Scene, MeshError> {
         let unused = mesh.validate()?;
         let corner_shift = mesh.anchor_faces_at_wide_angles();
         let topo = Topology::build(&mesh)?;
-        // A reference mesh folded flat onto itself across an edge has no mid-edge normal there.
-        let normal = |f: usize| {
-            let [a, b, c] = mesh.face_positions(f);
-            (b - a).cross(&(c - a)).normalize()
-        };
-        for (e, ef) in topo.edge_faces.iter().enumerate() {
-            if ef[1] != crate::mesh::topology::NONE
-                && normal(ef[0]).dot(&normal(ef[1])) < -1.0 + 1e-9
-            {
-                return Err(mesh.invalid(format!(
-                    "faces {} and {} are folded onto each other across edge {:?} (their normals \
-                     are opposite): the reference surface must not fold back on itself",
-                    ef[0], ef[1], topo.edges[e]
-                )));
-            }
-        }
+        check_not_folded(&mesh, &topo)?;
         let mut warnings = Vec::new();
         if !unused.is_empty() {
             warnings.push(format!(
@@ -132,275 +121,37 @@ impl Scene {
             ));
         }
         warnings.extend(mesh.unknown_field_warnings());
-        let nf = mesh.faces.len();
         let nv = mesh.positions.len();
         let m = &settings.material;
-        let thickness = positive_face_field(
-            &mesh,
-            "ref_thicknesses",
-            crate::mesh::MAX_COORDINATE,
-            ("use_mesh_thickness", m.use_mesh_thickness),
-        )?
-        .unwrap_or_else(|| vec![m.thickness; nf]);
-        // A shell is thin: a thickness beyond 10× the sheet's size is no shell (and overflows).
-        let size = mesh.bbox_diagonal();
-        if let Some(f) = thickness.iter().position(|&h| h > 10.0 * size) {
-            return Err(mesh.invalid(format!(
-                "thickness {} m at face {f} is more than 10× the sheet's size ({size_h} m): \
-                 not a thin shell",
-                crate::math::human(thickness[f]),
-                size_h = crate::math::human(size)
-            )));
-        }
-        let young = match positive_face_field(
-            &mesh,
-            "ref_shear_moduli",
-            crate::settings::MAX_MODULUS,
-            ("use_mesh_shear_modulus", m.use_mesh_shear_modulus),
-        )? {
-            Some(mu) => mu.iter().map(|mu| 2.0 * mu * (1.0 + m.poisson)).collect(),
-            None => vec![m.young; nf],
-        };
-        let lame = young
-            .iter()
-            .map(|&e| Lame2d::from_young_poisson(e, m.poisson))
-            .collect();
-
-        let mut rest = RestForms::no_growth(&mesh, &topo);
-        let edge_sign = if m.bending.angle_variant().is_some() {
-            edge_signs(&topo)
-        } else {
-            Vec::new()
-        };
-        if let Some(variant) = m.bending.angle_variant() {
-            // The reference curvature in the edge-DOF model's own terms (φ = 0), so that a curved
-            // input mesh is stress-free under "no growth" for the tan variant too (sin at φ = 0
-            // is the average).
-            let zeros = vec![0.0; topo.edges.len()];
-            let (_, b0) =
-                midedge_angle_forms(&mesh, &topo, &edge_sign, variant, &mesh.positions, &zeros);
-            rest.bbar1.clone_from(&b0);
-            rest.bbar0 = b0;
-        }
-        match settings.rest.target {
-            TargetForms::None => {}
-            TargetForms::Uniform => {
-                let a = settings_form(&mesh, &settings.rest.abar, "rest.abar")?;
-                let b = settings_form(&mesh, &settings.rest.bbar, "rest.bbar")?;
-                let (a1, b1) =
-                    pulled_back_targets(&mesh, |f| a[f], |f| b[f], "rest.target = \"uniform\"")?;
-                rest.abar1 = a1;
-                rest.bbar1 = b1;
-            }
-            TargetForms::Mesh => {
-                let af = mesh.face_field("abar_info", 3)?.ok_or_else(|| {
-                    mesh.invalid(
-                        "rest.target = \"mesh\" needs the per-face field 'abar_info' (3 components \
-                         xx, xy, yy)",
-                    )
-                })?;
-                let bf = mesh.face_field("bbar_info", 3)?;
-                let (a1, b1) = pulled_back_targets(
-                    &mesh,
-                    |f| Sym2::from_column_slice(af.get(f)),
-                    |f| {
-                        bf.map(|b| Sym2::from_column_slice(b.get(f)))
-                            .unwrap_or_else(Sym2::zeros)
-                    },
-                    "abar_info/bbar_info",
-                )?;
-                rest.abar1 = a1;
-                rest.bbar1 = b1;
-            }
-            TargetForms::Lce => {
-                rest.lce = crate::rest::lce::build(&mesh, &settings)?;
-                rest.abar1 = rest.lce.iter().map(|l| l.metric(1.0)).collect();
-                rest.bbar1 = vec![Sym2::zeros(); nf];
-            }
-        }
-        rest.order = settings.dial.order;
-
-        let growth = GrowthInputs::read(&mesh, &settings)?;
-        let mut grown_thickness = Vec::new();
-        if settings.growth.law != crate::settings::GrowthLaw::None {
-            for (f, &h) in thickness.iter().enumerate() {
-                let m = if settings.moisture.enabled {
-                    (settings.moisture.initial, settings.moisture.initial)
-                } else {
-                    (growth.moisture_top[f], growth.moisture_bottom[f])
-                };
-                let reference = (rest.abar0[f], rest.bbar0[f]);
-                let g = growth_face(&settings, &growth, f, reference, h, m)
-                    .map_err(|e| mesh.invalid(e.to_string()))?;
-                rest.abar1[f] = g.abar;
-                rest.bbar1[f] = g.bbar;
-                if g.thickness_ratio != 1.0 {
-                    grown_thickness.resize(nf, 1.0);
-                    grown_thickness[f] = g.thickness_ratio;
-                }
-            }
-        }
+        let FaceMaterial {
+            thickness,
+            young,
+            lame,
+        } = face_material(&mesh, m)?;
+        let RestStage {
+            rest,
+            edge_sign,
+            growth,
+            grown_thickness,
+        } = rest_forms(&mesh, &topo, &settings, &thickness)?;
         if settings.moisture.enabled {
             check_moisture_regions(&mesh, &settings)?;
         }
-
-        let mut mass = vec![0.0; nv];
-        for (f, face) in mesh.faces.iter().enumerate() {
-            let area = mesh.face_area(f);
-            let mf = m.density * thickness[f] * area / 3.0;
-            for &v in face {
-                mass[v] += mf;
-            }
-        }
-
+        let mass = lumped_masses(&mesh, &thickness, m.density);
         let is_unused = unused_mask(nv, &unused);
-        let mut fixed: Vec<bool> = is_unused.clone();
-        let c = &settings.constraints;
-        if c.use_constraint_indicators {
-            if let Some(ci) = mesh.vertex_field("constraint_indicators", 1)? {
-                for (v, &val) in ci.data.iter().enumerate() {
-                    fixed[v] |= val != 0.0;
-                }
-            }
-        }
-        if !c.fix_tags.is_empty() {
-            let tags = mesh.vertex_field("node_tags", 1)?.ok_or_else(|| {
-                mesh.invalid("constraints.fix_tags needs the per-vertex field 'node_tags'")
-            })?;
-            for (v, &t) in tags.data.iter().enumerate() {
-                fixed[v] |= c.fix_tags.contains(&(t.round() as i64));
-            }
-            // A tag that fixes nothing is a mistake (a load selecting nothing is one too).
-            for (i, &tag) in c.fix_tags.iter().enumerate() {
-                if !tags.data.iter().any(|&t| t.round() as i64 == tag) {
-                    return Err(mesh.invalid(format!(
-                        "constraints.fix_tags[{i}] = {tag} selects no vertex: no value of \
-                         'node_tags' is {tag}"
-                    )));
-                }
-            }
-        }
-        for (i, b) in c.fix_boxes.iter().enumerate() {
-            let mut any = false;
-            for (v, p) in mesh.positions.iter().enumerate() {
-                let inside = (0..3).all(|k| p[k] >= b.min[k] && p[k] <= b.max[k]);
-                fixed[v] |= inside;
-                any |= inside;
-            }
-            if !any {
-                return Err(mesh.invalid(format!(
-                    "constraints.fix_boxes[{i}] (min {:?}, max {:?}) selects no vertex",
-                    b.min, b.max
-                )));
-            }
-        }
-        let mut clamped_edges = Vec::new();
-        for (i, sel) in c.clamp.iter().enumerate() {
-            let what = format!("constraints.clamp[{i}]");
-            let mut on = vec![false; nv];
-            for v in crate::energy::loads::select_vertices(&mesh, sel, &what)? {
-                on[v] = true;
-            }
-            let before = clamped_edges.len();
-            for (e, ends) in topo.edges.iter().enumerate() {
-                let ef = topo.edge_faces[e];
-                if ef[1] == crate::mesh::topology::NONE && on[ends[0]] && on[ends[1]] {
-                    clamped_edges.push(e);
-                }
-            }
-            // The clamped boundary vertices and their edge neighbours (one ring) are held: the
-            // first row of faces stays rigid, which fixes the boundary's rotation.
-            let mut ring = vec![false; nv];
-            for &e in &clamped_edges[before..] {
-                for v in topo.edges[e] {
-                    ring[v] = true;
-                }
-            }
-            for ends in &topo.edges {
-                if ring[ends[0]] || ring[ends[1]] {
-                    fixed[ends[0]] = true;
-                    fixed[ends[1]] = true;
-                }
-            }
-            if clamped_edges.len() == before {
-                return Err(mesh.invalid(format!(
-                    "{what} selects no boundary edge: a clamp acts on a boundary, and both ends of \
-                     a boundary edge must be selected"
-                )));
-            }
-        }
-        let mut prescribed = Vec::new();
-        for (i, pd) in c.displacement.iter().enumerate() {
-            let what = format!("constraints.displacement[{i}]");
-            for v in crate::energy::loads::select_vertices(&mesh, &pd.on, &what)? {
-                if fixed[v] || prescribed.iter().any(|&(u, _)| u == v) {
-                    return Err(mesh.invalid(format!(
-                        "{what}: vertex {v} is already fixed or given another prescribed path; a \
-                         vertex is either held, or moved along one path"
-                    )));
-                }
-                prescribed.push((v, Vec3::from(pd.displacement)));
-            }
-        }
-        for &(v, _) in &prescribed {
-            fixed[v] = true;
-        }
-
+        let Supports {
+            fixed,
+            clamped_edges,
+            prescribed,
+        } = supports(&mesh, &topo, &settings.constraints, &is_unused)?;
         // Free: no vertex that carries the sheet is held (unused vertices are held, inertly).
         let free = unused.len() < nv && (0..nv).all(|v| is_unused[v] || !fixed[v]);
-        let gravity = settings.loads.gravity.iter().any(|&g| g != 0.0);
-        let obstacles = !settings.obstacles.is_empty();
-        if free && gravity && !obstacles && settings.solver.mode == crate::settings::Mode::Static {
-            return Err(mesh.invalid(
-                "static mode under gravity (loads.gravity) needs fixed vertices: a free sheet has no \
-                 equilibrium. Fix some (constraint_indicators, constraints.fix_tags or \
-                 constraints.fix_boxes) or use solver.mode = \"dynamic\"",
-            ));
-        }
-        let on_plane = settings
-            .obstacles
-            .iter()
-            .any(|o| o.shape == Some(crate::config::obstacle::ShapeKind::Plane));
-        let pressed = settings.obstacles.iter().any(|o| o.force.is_some());
-        if free
-            && obstacles
-            && !on_plane
-            && (gravity || settings.loads.any_external() || pressed)
-            && settings.solver.mode == crate::settings::Mode::Static
-        {
-            return Err(mesh.invalid(
-                "obstacles: a free sheet under loads in static mode can rest only on a plane \
-                 obstacle: Newton's first step of a free sheet is unbounded and can carry it \
-                 through a finite obstacle (a sphere, capsule, cylinder or box). Add a plane, fix \
-                 some vertices, or use solver.mode = \"dynamic\"",
-            ));
-        }
-        if settings.contact.enabled && free && settings.solver.mode == crate::settings::Mode::Static
-        {
-            return Err(mesh.invalid(
-                "static mode with a ground (contact.enabled) needs fixed vertices: a free sheet on \
-                 a frictionless plane slides and spins freely. Fix some vertices or use \
-                 solver.mode = \"dynamic\"",
-            ));
-        }
+        check_posed(&mesh, &settings, free)?;
         let ground = settings
             .contact
             .enabled
-            .then(|| build_ground(&mesh, &settings.contact, &thickness, &young));
-        if let Some(g) = &ground {
-            // A start deep inside the ground would be thrown out by the penalty's full force.
-            for (v, x) in mesh.positions.iter().enumerate() {
-                let p = g.penetration(v, x);
-                if g.area[v] > 0.0 && p > g.smoothing {
-                    return Err(mesh.invalid(format!(
-                        "vertex {v} starts {p_h} m inside the ground (its surface, mid-surface \
-                         − h/2, is below the plane through contact.point with contact.normal); \
-                         move the plane or the mesh",
-                        p_h = crate::math::human(p)
-                    )));
-                }
-            }
-        }
+            .then(|| build_ground(&mesh, &settings.contact, &thickness, &young))
+            .transpose()?;
         let patches = if m.bending == crate::settings::BendingModel::PatchFit {
             let (p, w) = crate::energy::patch::build_patches(&mesh)?;
             warnings.extend(w);
@@ -417,19 +168,21 @@ impl Scene {
             }
         }
         // Obstacles hold the sheet where they touch it: pins would carry their reaction.
-        let pinned_dofs =
-            if free && !obstacles && settings.solver.mode == crate::settings::Mode::Static {
-                let mut pins = rigid_pins(&mesh, &fixed);
-                // Dead loads are not invariant under rotations: pinning rotational DOFs would make
-                // the pins carry a reaction. Only the translation is pinned then (balanced loads are
-                // invariant under it); rotations the loads leave free get the solver's tiny shift.
-                if settings.loads.any_external() {
-                    pins.truncate(3);
-                }
-                pins
-            } else {
-                Vec::new()
-            };
+        let pinned_dofs = if free
+            && settings.obstacles.is_empty()
+            && settings.solver.mode == crate::settings::Mode::Static
+        {
+            let mut pins = rigid_pins(&mesh, &fixed);
+            // Dead loads are not invariant under rotations: pinning rotational DOFs would make
+            // the pins carry a reaction. Only the translation is pinned then (balanced loads are
+            // invariant under it); rotations the loads leave free get the solver's tiny shift.
+            if settings.loads.any_external() {
+                pins.truncate(3);
+            }
+            pins
+        } else {
+            Vec::new()
+        };
         let mean_edge = mesh.mean_edge_length();
         let eh = young
             .iter()
@@ -676,6 +429,295 @@ impl Scene {
     }
 }
 
+/// Rejects a reference mesh folded flat onto itself across an edge: it has no mid-edge normal
+/// there.
+fn check_not_folded(mesh: &Mesh, topo: &Topology) -> Result<(), MeshError> {
+    let normal = |f: usize| {
+        let [a, b, c] = mesh.face_positions(f);
+        (b - a).cross(&(c - a)).normalize()
+    };
+    for (e, ef) in topo.edge_faces.iter().enumerate() {
+        if ef[1] != crate::mesh::topology::NONE && normal(ef[0]).dot(&normal(ef[1])) < -1.0 + 1e-9 {
+            return Err(mesh.invalid(format!(
+                "faces {} and {} are folded onto each other across edge {:?} (their normals \
+                 are opposite): the reference surface must not fold back on itself",
+                ef[0], ef[1], topo.edges[e]
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The material of every face.
+struct FaceMaterial {
+    /// Thickness (m).
+    thickness: Vec<Real>,
+    /// Young's modulus (Pa).
+    young: Vec<Real>,
+    /// Plane-stress Lamé parameters.
+    lame: Vec<Lame2d>,
+}
+
+/// Per face: the thickness, Young's modulus and the plane-stress Lamé parameters, from the
+/// mesh's fields when the settings use them, else the settings' uniform values.
+fn face_material(mesh: &Mesh, m: &crate::settings::Material) -> Result<FaceMaterial, MeshError> {
+    let nf = mesh.faces.len();
+    let thickness = positive_face_field(
+        mesh,
+        "ref_thicknesses",
+        crate::mesh::MAX_COORDINATE,
+        ("use_mesh_thickness", m.use_mesh_thickness),
+    )?
+    .unwrap_or_else(|| vec![m.thickness; nf]);
+    // A shell is thin: a thickness beyond 10× the sheet's size is no shell (and overflows).
+    let size = mesh.bbox_diagonal();
+    if let Some(f) = thickness.iter().position(|&h| h > 10.0 * size) {
+        return Err(mesh.invalid(format!(
+            "thickness {} m at face {f} is more than 10× the sheet's size ({size_h} m): \
+             not a thin shell",
+            crate::math::human(thickness[f]),
+            size_h = crate::math::human(size)
+        )));
+    }
+    let young = match positive_face_field(
+        mesh,
+        "ref_shear_moduli",
+        crate::settings::MAX_MODULUS,
+        ("use_mesh_shear_modulus", m.use_mesh_shear_modulus),
+    )? {
+        Some(mu) => mu.iter().map(|mu| 2.0 * mu * (1.0 + m.poisson)).collect(),
+        None => vec![m.young; nf],
+    };
+    let lame = young
+        .iter()
+        .map(|&e| Lame2d::from_young_poisson(e, m.poisson))
+        .collect();
+
+    Ok(FaceMaterial {
+        thickness,
+        young,
+        lame,
+    })
+}
+
+/// The rest state of the body.
+struct RestStage {
+    /// The rest forms at dial 0 and 1.
+    rest: RestForms,
+    /// The edge-DOF models' orientation signs, else empty.
+    edge_sign: Vec<[Real; 3]>,
+    /// The growth law's inputs.
+    growth: GrowthInputs,
+    /// The grown thickness ratio per face, empty unless the law scales it.
+    grown_thickness: Vec<Real>,
+}
+
+/// The rest forms at dial 0 (the reference mesh's, in the bending model's own terms) and dial 1
+/// (the target law's, then the growth law's, [`crate::rest::laws::targets`]).
+fn rest_forms(
+    mesh: &Mesh,
+    topo: &Topology,
+    settings: &Settings,
+    thickness: &[Real],
+) -> Result<RestStage, MeshError> {
+    let m = &settings.material;
+    let mut rest = RestForms::no_growth(mesh, topo);
+    let edge_sign = if m.bending.angle_variant().is_some() {
+        edge_signs(topo)
+    } else {
+        Vec::new()
+    };
+    if let Some(variant) = m.bending.angle_variant() {
+        // The reference curvature in the edge-DOF model's own terms (φ = 0), so that a curved
+        // input mesh is stress-free under "no growth" for the tan variant too (sin at φ = 0
+        // is the average).
+        let zeros = vec![0.0; topo.edges.len()];
+        let (_, b0) = midedge_angle_forms(mesh, topo, &edge_sign, variant, &mesh.positions, &zeros);
+        rest.bbar1.clone_from(&b0);
+        rest.bbar0 = b0;
+    }
+    let (growth, grown_thickness) =
+        crate::rest::laws::targets(&mut rest, mesh, settings, thickness)?;
+    Ok(RestStage {
+        rest,
+        edge_sign,
+        growth,
+        grown_thickness,
+    })
+}
+
+/// Lumped mass per vertex: Σ ρ h A / 3 over its faces, reference areas (kg).
+fn lumped_masses(mesh: &Mesh, thickness: &[Real], density: Real) -> Vec<Real> {
+    let nv = mesh.positions.len();
+    let mut mass = vec![0.0; nv];
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let area = mesh.face_area(f);
+        let mf = density * thickness[f] * area / 3.0;
+        for &v in face {
+            mass[v] += mf;
+        }
+    }
+
+    mass
+}
+
+/// What `[constraints]` holds.
+struct Supports {
+    /// True for held vertices (unused ones, indicators, tags, boxes, clamp rings, paths).
+    fixed: Vec<bool>,
+    /// The clamped boundary edges.
+    clamped_edges: Vec<usize>,
+    /// Vertices on prescribed paths and their displacement at dial 1 (m).
+    prescribed: Vec<(usize, Vec3)>,
+}
+
+/// The supports of `[constraints]` on `mesh`, with the unused vertices held. Errors name the key
+/// that selects nothing or a vertex given two constraints.
+fn supports(
+    mesh: &Mesh,
+    topo: &Topology,
+    c: &crate::settings::Constraints,
+    is_unused: &[bool],
+) -> Result<Supports, MeshError> {
+    let nv = mesh.positions.len();
+    let mut fixed: Vec<bool> = is_unused.to_vec();
+    if c.use_constraint_indicators {
+        if let Some(ci) = mesh.vertex_field("constraint_indicators", 1)? {
+            for (v, &val) in ci.data.iter().enumerate() {
+                fixed[v] |= val != 0.0;
+            }
+        }
+    }
+    if !c.fix_tags.is_empty() {
+        let tags = mesh.vertex_field("node_tags", 1)?.ok_or_else(|| {
+            mesh.invalid("constraints.fix_tags needs the per-vertex field 'node_tags'")
+        })?;
+        for (v, &t) in tags.data.iter().enumerate() {
+            fixed[v] |= c.fix_tags.contains(&(t.round() as i64));
+        }
+        // A tag that fixes nothing is a mistake (a load selecting nothing is one too).
+        for (i, &tag) in c.fix_tags.iter().enumerate() {
+            if !tags.data.iter().any(|&t| t.round() as i64 == tag) {
+                return Err(mesh.invalid(format!(
+                    "constraints.fix_tags[{i}] = {tag} selects no vertex: no value of \
+                     'node_tags' is {tag}"
+                )));
+            }
+        }
+    }
+    for (i, b) in c.fix_boxes.iter().enumerate() {
+        let mut any = false;
+        for (v, p) in mesh.positions.iter().enumerate() {
+            let inside = (0..3).all(|k| p[k] >= b.min[k] && p[k] <= b.max[k]);
+            fixed[v] |= inside;
+            any |= inside;
+        }
+        if !any {
+            return Err(mesh.invalid(format!(
+                "constraints.fix_boxes[{i}] (min {:?}, max {:?}) selects no vertex",
+                b.min, b.max
+            )));
+        }
+    }
+    let mut clamped_edges = Vec::new();
+    for (i, sel) in c.clamp.iter().enumerate() {
+        let what = format!("constraints.clamp[{i}]");
+        let mut on = vec![false; nv];
+        for v in crate::energy::loads::select_vertices(mesh, sel, &what)? {
+            on[v] = true;
+        }
+        let before = clamped_edges.len();
+        for (e, ends) in topo.edges.iter().enumerate() {
+            let ef = topo.edge_faces[e];
+            if ef[1] == crate::mesh::topology::NONE && on[ends[0]] && on[ends[1]] {
+                clamped_edges.push(e);
+            }
+        }
+        // The clamped boundary vertices and their edge neighbours (one ring) are held: the
+        // first row of faces stays rigid, which fixes the boundary's rotation.
+        let mut ring = vec![false; nv];
+        for &e in &clamped_edges[before..] {
+            for v in topo.edges[e] {
+                ring[v] = true;
+            }
+        }
+        for ends in &topo.edges {
+            if ring[ends[0]] || ring[ends[1]] {
+                fixed[ends[0]] = true;
+                fixed[ends[1]] = true;
+            }
+        }
+        if clamped_edges.len() == before {
+            return Err(mesh.invalid(format!(
+                "{what} selects no boundary edge: a clamp acts on a boundary, and both ends of \
+                 a boundary edge must be selected"
+            )));
+        }
+    }
+    let mut prescribed = Vec::new();
+    for (i, pd) in c.displacement.iter().enumerate() {
+        let what = format!("constraints.displacement[{i}]");
+        for v in crate::energy::loads::select_vertices(mesh, &pd.on, &what)? {
+            if fixed[v] || prescribed.iter().any(|&(u, _)| u == v) {
+                return Err(mesh.invalid(format!(
+                    "{what}: vertex {v} is already fixed or given another prescribed path; a \
+                     vertex is either held, or moved along one path"
+                )));
+            }
+            prescribed.push((v, Vec3::from(pd.displacement)));
+        }
+    }
+    for &(v, _) in &prescribed {
+        fixed[v] = true;
+    }
+
+    Ok(Supports {
+        fixed,
+        clamped_edges,
+        prescribed,
+    })
+}
+
+/// Rejects the settings under which a `free` sheet (nothing held) has no equilibrium for the
+/// static solver: gravity without obstacles, loads with only finite obstacles, a ground.
+fn check_posed(mesh: &Mesh, settings: &Settings, free: bool) -> Result<(), MeshError> {
+    let gravity = settings.loads.gravity.iter().any(|&g| g != 0.0);
+    let obstacles = !settings.obstacles.is_empty();
+    if free && gravity && !obstacles && settings.solver.mode == crate::settings::Mode::Static {
+        return Err(mesh.invalid(
+            "static mode under gravity (loads.gravity) needs fixed vertices: a free sheet has no \
+             equilibrium. Fix some (constraint_indicators, constraints.fix_tags or \
+             constraints.fix_boxes) or use solver.mode = \"dynamic\"",
+        ));
+    }
+    let on_plane = settings
+        .obstacles
+        .iter()
+        .any(|o| o.shape == Some(crate::config::obstacle::ShapeKind::Plane));
+    let pressed = settings.obstacles.iter().any(|o| o.force.is_some());
+    if free
+        && obstacles
+        && !on_plane
+        && (gravity || settings.loads.any_external() || pressed)
+        && settings.solver.mode == crate::settings::Mode::Static
+    {
+        return Err(mesh.invalid(
+            "obstacles: a free sheet under loads in static mode can rest only on a plane \
+             obstacle: Newton's first step of a free sheet is unbounded and can carry it \
+             through a finite obstacle (a sphere, capsule, cylinder or box). Add a plane, fix \
+             some vertices, or use solver.mode = \"dynamic\"",
+        ));
+    }
+    if settings.contact.enabled && free && settings.solver.mode == crate::settings::Mode::Static {
+        return Err(mesh.invalid(
+            "static mode with a ground (contact.enabled) needs fixed vertices: a free sheet on \
+             a frictionless plane slides and spins freely. Fix some vertices or use \
+             solver.mode = \"dynamic\"",
+        ));
+    }
+    Ok(())
+}
+
 /// First and second fundamental forms of every face under an edge-DOF bending model, at
 /// positions `x` and edge DOFs `phi`.
 fn midedge_angle_forms(
@@ -754,184 +796,6 @@ fn check_moisture_regions(mesh: &Mesh, settings: &Settings) -> Result<(), MeshEr
         }
     }
     Ok(())
-}
-
-/// A settings field (number or expression of x, y) at every face's reference centroid; a
-/// non-finite value is an error naming the face.
-pub fn settings_field(
-    mesh: &Mesh,
-    field: &crate::settings::Field,
-    key: &str,
-) -> Result<Vec<Real>, MeshError> {
-    let e = field
-        .compile()
-        .map_err(|e| mesh.invalid(format!("{key}: {e}")))?;
-    (0..mesh.faces.len())
-        .map(|f| {
-            let [p0, p1, p2] = mesh.face_positions(f);
-            let c = (p0 + p1 + p2) / 3.0;
-            let v = e.eval(c.x, c.y);
-            if v.is_finite() {
-                Ok(v)
-            } else {
-                Err(mesh.invalid(format!(
-                    "{key} is {v} at face {f} (centroid x = {}, y = {})",
-                    c.x, c.y
-                )))
-            }
-        })
-        .collect()
-}
-
-/// A symmetric 2×2 form `[xx, xy, yy]` of settings fields (numbers or expressions of x, y) at
-/// every face, in reference Cartesian coordinates, sampled on the edges as
-/// [`crate::rest::sample_on_edges`] does; a non-finite value is an error naming the face.
-fn settings_form(
-    mesh: &Mesh,
-    form: &[crate::settings::Field; 3],
-    key: &str,
-) -> Result<Vec<Sym2>, MeshError> {
-    let e = form
-        .iter()
-        .enumerate()
-        .map(|(i, c)| {
-            c.compile()
-                .map_err(|e| mesh.invalid(format!("{key}[{i}]: {e}")))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    (0..mesh.faces.len())
-        .map(|f| {
-            let at =
-                |x: Real, y: Real| Sym2::new(e[0].eval(x, y), e[1].eval(x, y), e[2].eval(x, y));
-            let m = crate::rest::sample_on_edges(mesh, f, at);
-            if m.iter().all(|v| v.is_finite()) {
-                Ok(crate::rest::push_forward(
-                    &crate::rest::reference_frame(mesh, f),
-                    &m,
-                ))
-            } else {
-                Err(mesh.invalid(format!("{key} is not finite on an edge of face {f}")))
-            }
-        })
-        .collect()
-}
-
-/// A per-face scalar field with a uniform fallback, checked finite (naming the face).
-fn face_values(mesh: &Mesh, name: &str, uniform: Real) -> Result<Vec<Real>, MeshError> {
-    match mesh.face_field(name, 1)? {
-        Some(f) => {
-            if let Some(i) = f.data.iter().position(|v| !v.is_finite()) {
-                return Err(mesh.invalid(format!("face field '{name}' is not finite at face {i}")));
-            }
-            Ok(f.data.clone())
-        }
-        None => Ok(vec![uniform; mesh.faces.len()]),
-    }
-}
-
-/// Per-face inputs of the growth laws, read once from the mesh fields and settings.
-#[derive(Clone, Debug, Default)]
-pub struct GrowthInputs {
-    /// Moisture at the top surface.
-    pub moisture_top: Vec<Real>,
-    /// Moisture at the bottom surface.
-    pub moisture_bottom: Vec<Real>,
-    /// Conformal factor s of the isotropic law.
-    pub s: Vec<Real>,
-    /// Machine direction per face: barycentric coordinates, and the unit 3D vector in the face
-    /// plane (for the diffusivity). Empty unless the law or the diffusion needs it.
-    pub direction: Vec<([Real; 2], Vec3)>,
-}
-
-impl GrowthInputs {
-    fn read(mesh: &Mesh, settings: &Settings) -> Result<Self, MeshError> {
-        let g = &settings.growth;
-        let law = crate::rest::laws::law(g.law);
-        let mut out = GrowthInputs {
-            moisture_top: face_values(mesh, "moisture_top", g.moisture_top)?,
-            moisture_bottom: face_values(mesh, "moisture_bottom", g.moisture_bottom)?,
-            s: match (mesh.face_field("growth_factor", 1)?, &g.s) {
-                (Some(_), _) => face_values(mesh, "growth_factor", 0.0)?,
-                (None, Some(s)) => settings_field(mesh, s, "growth.s")?,
-                (None, None) if law.is_some_and(|l| l.needs_s()) => {
-                    return Err(mesh.invalid(format!(
-                        "growth.law = \"{}\" needs its growth factor s: give growth.s (a number \
-                         or an expression of x, y) or the face field 'growth_factor'",
-                        g.law.name()
-                    )))
-                }
-                (None, None) => vec![0.0; mesh.faces.len()],
-            },
-            direction: Vec::new(),
-        };
-        if law.is_some_and(|l| l.needs_direction()) || settings.moisture.enabled {
-            let dirs = mesh.face_field("machine_direction", 3)?;
-            for f in 0..mesh.faces.len() {
-                let (d, what) = match dirs {
-                    Some(df) => (
-                        Vec3::from_column_slice(df.get(f)),
-                        "face field 'machine_direction'",
-                    ),
-                    None => (Vec3::from(g.machine_direction), "growth.machine_direction"),
-                };
-                let d2 = barycentric_direction(mesh, f, &d).ok_or_else(|| {
-                    mesh.invalid(format!(
-                        "{what} at face {f} is [{}, {}, {}]: it must be finite, non-zero and not \
-                         normal to the face",
-                        d.x, d.y, d.z
-                    ))
-                })?;
-                let [p0, p1, p2] = mesh.face_positions(f);
-                let d3 = ((p1 - p0) * d2[0] + (p2 - p0) * d2[1]).normalize();
-                out.direction.push((d2, d3));
-            }
-        }
-        Ok(out)
-    }
-}
-
-pub use crate::rest::laws::GrowthError;
-
-/// The rest forms and thickness ratio of face `f` under `settings.growth.law`
-/// ([`crate::rest::laws`]), from its reference forms, thickness and surface moisture
-/// `(m_top, m_bottom)`. Errors name the face: a stretch `1 + μ m ≤ 0`, or an ā that is not
-/// positive definite.
-pub fn growth_face(
-    settings: &Settings,
-    inputs: &GrowthInputs,
-    f: usize,
-    reference: (Sym2, Sym2),
-    h: Real,
-    moisture: (Real, Real),
-) -> Result<crate::rest::laws::Grown, GrowthError> {
-    let input = crate::rest::laws::FaceInput {
-        face: f,
-        a0: reference.0,
-        b0: reference.1,
-        h,
-        m_top: moisture.0,
-        m_bottom: moisture.1,
-        s: inputs.s.get(f).copied().unwrap_or(0.0),
-        direction: inputs.direction.get(f).map_or([1.0, 0.0], |d| d.0),
-    };
-    crate::rest::laws::grow_face(&settings.growth, &input)
-}
-
-/// A reference-Cartesian direction as barycentric coordinates of face `f`: its projection on the
-/// face plane written in the basis `e1, e2`. `None` if it is zero, non-finite or normal to the
-/// face (projection below 1e-6 of its length).
-pub(crate) fn barycentric_direction(mesh: &Mesh, f: usize, d: &Vec3) -> Option<[Real; 2]> {
-    let n = d.norm();
-    if !(n.is_finite() && n > 0.0) {
-        return None;
-    }
-    let [p0, p1, p2] = mesh.face_positions(f);
-    let (e1, e2) = (p1 - p0, p2 - p0);
-    let gram = crate::math::Mat2::new(e1.dot(&e1), e1.dot(&e2), e1.dot(&e2), e2.dot(&e2));
-    let rhs = crate::math::Vec2::new(e1.dot(d), e2.dot(d));
-    let c = gram.try_inverse()? * rhs;
-    let proj = e1 * c.x + e2 * c.y;
-    (proj.norm() > 1e-6 * n).then_some([c.x, c.y])
 }
 
 /// Six position DOFs whose fixing removes the rigid motions of a free sheet without
@@ -1023,20 +887,21 @@ impl ContactAreas {
 
 /// The ground of `[contact]` with the per-vertex areas and half thicknesses it needs (see
 /// [`crate::solve::contact`] and [`ContactAreas`]); `"auto"` stiffness is the area-weighted
-/// mean of E/h, `"auto"` smoothing is the area-weighted mean h over 100.
+/// mean of E/h, `"auto"` smoothing is the area-weighted mean h over 100. A vertex that starts
+/// deeper inside than the smoothing is an error naming it.
 fn build_ground(
     mesh: &Mesh,
     c: &crate::settings::Contact,
     thickness: &[Real],
     young: &[Real],
-) -> crate::solve::contact::Ground {
+) -> Result<crate::solve::contact::Ground, MeshError> {
     let ContactAreas {
         area,
         half_thickness,
         e_over_h,
         h_mean,
     } = ContactAreas::of(mesh, thickness, young);
-    crate::solve::contact::Ground {
+    let g = crate::solve::contact::Ground {
         point: Vec3::from(c.point),
         normal: Vec3::from(c.normal).normalize(),
         stiffness: c.stiffness.or(e_over_h),
@@ -1045,7 +910,20 @@ fn build_ground(
         slip_speed: c.slip_speed,
         area,
         half_thickness,
+    };
+    // A start deep inside the ground would be thrown out by the penalty's full force.
+    for (v, x) in mesh.positions.iter().enumerate() {
+        let p = g.penetration(v, x);
+        if g.area[v] > 0.0 && p > g.smoothing {
+            return Err(mesh.invalid(format!(
+                "vertex {v} starts {p_h} m inside the ground (its surface, mid-surface \
+                 − h/2, is below the plane through contact.point with contact.normal); \
+                 move the plane or the mesh",
+                p_h = crate::math::human(p)
+            )));
+        }
     }
+    Ok(g)
 }
 
 fn unused_mask(nv: usize, unused: &[usize]) -> Vec<bool> {

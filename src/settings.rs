@@ -350,6 +350,16 @@ pub enum TargetForms {
     Lce,
 }
 
+impl TargetForms {
+    /// Every value, for the registry test.
+    pub const ALL: [TargetForms; 4] = [
+        TargetForms::None,
+        TargetForms::Uniform,
+        TargetForms::Mesh,
+        TargetForms::Lce,
+    ];
+}
+
 /// The director law's per-face values, numbers or expressions of the reference x, y (m) at each
 /// face's centroid.
 #[derive(Clone, Debug, Serialize, Deserialize)]

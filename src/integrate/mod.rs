@@ -58,7 +58,7 @@ pub enum RunError {
     Linear(#[from] LinearError),
     /// The moisture state made the rest forms invalid.
     #[error("moisture: {0}")]
-    Growth(#[from] crate::scene::GrowthError),
+    Growth(#[from] crate::rest::laws::GrowthError),
     /// The moisture boundary conditions contradict each other.
     #[error("moisture: {0}")]
     Surface(#[from] crate::diffusion::SurfaceError),
@@ -163,7 +163,7 @@ pub enum RunFailure {
         /// The time reached (s).
         t: Real,
         /// What went wrong.
-        source: crate::scene::GrowthError,
+        source: crate::rest::laws::GrowthError,
     },
 }
 

@@ -249,7 +249,7 @@ impl Moisture {
         &self,
         sc: &Scene,
         u: &[Real],
-    ) -> Result<Vec<(Sym2, Sym2)>, crate::scene::GrowthError> {
+    ) -> Result<Vec<(Sym2, Sym2)>, crate::rest::laws::GrowthError> {
         (0..sc.num_faces())
             .map(|f| {
                 let (mut top, mut bottom) = self.diffusion.surface_moisture(u, f);
@@ -261,8 +261,8 @@ impl Moisture {
                 }
                 let m = (top, bottom);
                 let reference = (sc.rest.abar0[f], sc.rest.bbar0[f]);
-                crate::scene::growth_face(
-                    &sc.settings,
+                crate::rest::laws::growth_face(
+                    &sc.settings.growth,
                     &sc.growth,
                     f,
                     reference,

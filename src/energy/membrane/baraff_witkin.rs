@@ -187,7 +187,7 @@ pub fn from_scene(scene: &crate::scene::Scene) -> Result<BaraffWitkin, crate::me
             ),
             None => (Vec3::from(bw.direction), "material.baraff_witkin.direction"),
         };
-        let c = crate::scene::barycentric_direction(mesh, f, &d).ok_or_else(|| {
+        let c = crate::rest::barycentric_direction(mesh, f, &d).ok_or_else(|| {
             mesh.invalid(format!(
                 "{what} at face {f} is [{}, {}, {}]: it must be finite, non-zero and not normal \
                  to the face",

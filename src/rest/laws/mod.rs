@@ -53,18 +53,39 @@
 //! seed 000's paper scenes use them, and its model swells the paper in-plane only (the
 //! through-thickness swelling of paper does not enter the Koiter energy of a flat sheet).
 //!
+//! ## Target laws
+//! The forms at dial 1 come first from a [`TargetLaw`] (`rest.target`, registry [`TARGETS`]), which
+//! replaces the reference forms by forms given outright, and then from the growth law above,
+//! which transforms them face by face:
+//!
+//! * [`uniform_forms`] (`"uniform"`): `rest.abar`, `rest.bbar` from the settings, numbers or
+//!   expressions of the reference x, y;
+//! * [`mesh_forms`] (`"mesh"`): the face fields `abar_info`, `bbar_info` of MorphoShell's files;
+//! * [`lce`] (`"lce"`): the liquid-crystal director law, which also dials ā through its own
+//!   stretch rather than linearly ([`RestForms::at`]).
+//!
+//! `"none"` keeps the reference forms.
+//!
 //! Units: `a`, `ā` in m² (barycentric), `b`, `b̄` in m, `h` in m, moisture `m` dimensionless
 //! (seed 000 uses percent; shellsim uses fractions), `μ` per unit moisture.
 
 pub mod bilayer;
+pub mod inputs;
 pub mod isotropic;
 pub mod isotropic_in_plane;
 pub mod isotropic_metric_only;
+pub mod lce;
 pub mod linear_swelling;
 pub mod machine_direction;
+pub mod mesh_forms;
+pub mod uniform_forms;
 
+pub use inputs::GrowthInputs;
+
+use super::RestForms;
 use crate::math::{mat_to_sym, sym_to_mat, Mat2, Real, Sym2};
-use crate::settings::{Growth, GrowthLaw};
+use crate::mesh::{Mesh, MeshError};
+use crate::settings::{Growth, GrowthLaw, Rest, Settings, TargetForms};
 
 /// What a law reads for one face.
 #[derive(Clone, Copy, Debug)]
@@ -177,6 +198,101 @@ pub fn grow_face(g: &Growth, input: &FaceInput) -> Result<Grown, GrowthError> {
         });
     }
     Ok(out)
+}
+
+/// What a target law gives: per face the forms at dial 1 (barycentric, m² and m), and the
+/// director data of a law that dials ā through its own stretch (else empty).
+#[derive(Clone, Debug, Default)]
+pub struct Targets {
+    /// ā at dial 1 (m²).
+    pub abar: Vec<Sym2>,
+    /// b̄ at dial 1 (m).
+    pub bbar: Vec<Sym2>,
+    /// The director law per face ([`lce`]), else empty.
+    pub lce: Vec<lce::LceFace>,
+}
+
+/// A target law: the `[rest]` settings and the mesh → the forms at dial 1 of every face.
+pub trait TargetLaw: Sync {
+    /// The targets. Errors name the key or field and the face.
+    fn targets(&self, mesh: &Mesh, rest: &Rest) -> Result<Targets, MeshError>;
+}
+
+/// Every target law, one line each (`"none"` has none: the reference forms stay).
+pub const TARGETS: &[(TargetForms, &dyn TargetLaw)] = &[
+    (TargetForms::Uniform, &uniform_forms::UniformForms),
+    (TargetForms::Mesh, &mesh_forms::MeshForms),
+    (TargetForms::Lce, &lce::Director),
+];
+
+/// The target law of `rest.target` (`None` for `"none"`).
+pub fn target_law(which: TargetForms) -> Option<&'static dyn TargetLaw> {
+    TARGETS.iter().find(|(l, _)| *l == which).map(|(_, r)| *r)
+}
+
+/// The forms at dial 1: `rest`'s dial-0 forms replaced by the target law's, then transformed by
+/// the growth law face by face (at the reference thickness `thickness` and, with `[moisture]`,
+/// its initial moisture on both sides). Returns the growth inputs (the moisture driver grows
+/// from them again each step) and, per face, the rest thickness over the reference one when
+/// the law scales it (else empty).
+pub fn targets(
+    rest: &mut RestForms,
+    mesh: &Mesh,
+    settings: &Settings,
+    thickness: &[Real],
+) -> Result<(GrowthInputs, Vec<Real>), MeshError> {
+    if let Some(law) = target_law(settings.rest.target) {
+        let t = law.targets(mesh, &settings.rest)?;
+        rest.abar1 = t.abar;
+        rest.bbar1 = t.bbar;
+        rest.lce = t.lce;
+    }
+    rest.order = settings.dial.order;
+    let growth = GrowthInputs::read(mesh, settings)?;
+    let mut grown_thickness = Vec::new();
+    if settings.growth.law != GrowthLaw::None {
+        for (f, &h) in thickness.iter().enumerate() {
+            let m = if settings.moisture.enabled {
+                (settings.moisture.initial, settings.moisture.initial)
+            } else {
+                (growth.moisture_top[f], growth.moisture_bottom[f])
+            };
+            let reference = (rest.abar0[f], rest.bbar0[f]);
+            let g = growth_face(&settings.growth, &growth, f, reference, h, m)
+                .map_err(|e| mesh.invalid(e.to_string()))?;
+            rest.abar1[f] = g.abar;
+            rest.bbar1[f] = g.bbar;
+            if g.thickness_ratio != 1.0 {
+                grown_thickness.resize(thickness.len(), 1.0);
+                grown_thickness[f] = g.thickness_ratio;
+            }
+        }
+    }
+    Ok((growth, grown_thickness))
+}
+
+/// The rest forms and thickness ratio of face `f` under `growth.law`, from its reference forms, thickness and surface moisture
+/// `(m_top, m_bottom)`. Errors name the face: a stretch `1 + μ m ≤ 0`, or an ā that is not
+/// positive definite.
+pub fn growth_face(
+    growth: &Growth,
+    inputs: &GrowthInputs,
+    f: usize,
+    reference: (Sym2, Sym2),
+    h: Real,
+    moisture: (Real, Real),
+) -> Result<Grown, GrowthError> {
+    let input = FaceInput {
+        face: f,
+        a0: reference.0,
+        b0: reference.1,
+        h,
+        m_top: moisture.0,
+        m_bottom: moisture.1,
+        s: inputs.s.get(f).copied().unwrap_or(0.0),
+        direction: inputs.direction.get(f).map_or([1.0, 0.0], |d| d.0),
+    };
+    grow_face(growth, &input)
 }
 
 /// A rest form that a growth law cannot produce.
@@ -298,6 +414,10 @@ mod tests {
         for l in GrowthLaw::ALL {
             let n = LAWS.iter().filter(|(k, _)| *k == l).count();
             assert_eq!(n, usize::from(l != GrowthLaw::None), "{l:?}");
+        }
+        for l in TargetForms::ALL {
+            let n = TARGETS.iter().filter(|(k, _)| *k == l).count();
+            assert_eq!(n, usize::from(l != TargetForms::None), "{l:?}");
         }
     }
 }

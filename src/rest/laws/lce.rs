@@ -20,10 +20,26 @@
 //!
 //! Units: θ in rad, λ and ν dimensionless, `ā` in m² (barycentric).
 
-use super::{pull_back, reference_frame};
+use super::{TargetLaw, Targets};
 use crate::math::{Mat2, Real, Sym2, Vec2};
 use crate::mesh::{Mesh, MeshError};
-use crate::settings::Settings;
+use crate::rest::frame::{pull_back, reference_frame};
+use crate::settings::Rest;
+
+/// The law of `rest.target = "lce"`: ā at dial 1 from the director, b̄ = 0, and the director
+/// data that dials ā through the stretch.
+pub struct Director;
+
+impl TargetLaw for Director {
+    fn targets(&self, mesh: &Mesh, rest: &Rest) -> Result<Targets, MeshError> {
+        let lce = build(mesh, rest)?;
+        Ok(Targets {
+            abar: lce.iter().map(|l| l.metric(1.0)).collect(),
+            bbar: vec![Sym2::zeros(); lce.len()],
+            lce,
+        })
+    }
+}
 
 /// One face's director law.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -65,7 +81,7 @@ impl LceFace {
 /// given (numbers or expressions of x, y at each face's reference centroid), else from the
 /// mesh's `abar_info`, which carries (θ, λ, ν) per face in this mode as in MorphoShell. Errors
 /// name the face and the source: a missing director, a non-finite value, λ ≤ 0.
-pub fn build(mesh: &Mesh, settings: &Settings) -> Result<Vec<LceFace>, MeshError> {
+pub fn build(mesh: &Mesh, rest: &Rest) -> Result<Vec<LceFace>, MeshError> {
     if !mesh.is_flat_xy() {
         return Err(mesh.invalid(
             "rest.target = \"lce\" gives the director in reference Cartesian (x, y) coordinates, \
@@ -73,7 +89,7 @@ pub fn build(mesh: &Mesh, settings: &Settings) -> Result<Vec<LceFace>, MeshError
         ));
     }
     let nf = mesh.faces.len();
-    let values: Vec<[Real; 3]> = match &settings.rest.lce {
+    let values: Vec<[Real; 3]> = match &rest.lce {
         Some(l) => {
             let keys = ["rest.lce.theta", "rest.lce.lambda", "rest.lce.nu"];
             let e = [&l.theta, &l.lambda, &l.nu]
@@ -108,7 +124,7 @@ pub fn build(mesh: &Mesh, settings: &Settings) -> Result<Vec<LceFace>, MeshError
                 .collect()
         }
     };
-    let source = if settings.rest.lce.is_some() {
+    let source = if rest.lce.is_some() {
         "[rest.lce]"
     } else {
         "abar_info (θ, λ, ν)"

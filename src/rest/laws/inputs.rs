@@ -1,0 +1,111 @@
+//! The per-face inputs of the growth laws ([`GrowthInputs`]), read once from the mesh's fields
+//! and the `[growth]` settings: the surface moisture, the conformal factor and the machine
+//! direction.
+
+use crate::math::{Real, Vec3};
+use crate::mesh::{Mesh, MeshError};
+use crate::rest::barycentric_direction;
+use crate::settings::Settings;
+
+/// A per-face scalar field with a uniform fallback, checked finite (naming the face).
+fn face_values(mesh: &Mesh, name: &str, uniform: Real) -> Result<Vec<Real>, MeshError> {
+    match mesh.face_field(name, 1)? {
+        Some(f) => {
+            if let Some(i) = f.data.iter().position(|v| !v.is_finite()) {
+                return Err(mesh.invalid(format!("face field '{name}' is not finite at face {i}")));
+            }
+            Ok(f.data.clone())
+        }
+        None => Ok(vec![uniform; mesh.faces.len()]),
+    }
+}
+
+/// Per-face inputs of the growth laws, read once from the mesh fields and settings.
+#[derive(Clone, Debug, Default)]
+pub struct GrowthInputs {
+    /// Moisture at the top surface.
+    pub moisture_top: Vec<Real>,
+    /// Moisture at the bottom surface.
+    pub moisture_bottom: Vec<Real>,
+    /// Conformal factor s of the isotropic law.
+    pub s: Vec<Real>,
+    /// Machine direction per face: barycentric coordinates, and the unit 3D vector in the face
+    /// plane (for the diffusivity). Empty unless the law or the diffusion needs it.
+    pub direction: Vec<([Real; 2], Vec3)>,
+}
+
+impl GrowthInputs {
+    /// Reads them for `settings.growth.law` (the machine direction also for `[moisture]`, whose
+    /// diffusivity follows it). Errors name the field or key and the face.
+    pub fn read(mesh: &Mesh, settings: &Settings) -> Result<Self, MeshError> {
+        let g = &settings.growth;
+        let law = super::law(g.law);
+        let mut out = GrowthInputs {
+            moisture_top: face_values(mesh, "moisture_top", g.moisture_top)?,
+            moisture_bottom: face_values(mesh, "moisture_bottom", g.moisture_bottom)?,
+            s: match (mesh.face_field("growth_factor", 1)?, &g.s) {
+                (Some(_), _) => face_values(mesh, "growth_factor", 0.0)?,
+                (None, Some(s)) => settings_field(mesh, s, "growth.s")?,
+                (None, None) if law.is_some_and(|l| l.needs_s()) => {
+                    return Err(mesh.invalid(format!(
+                        "growth.law = \"{}\" needs its growth factor s: give growth.s (a number \
+                         or an expression of x, y) or the face field 'growth_factor'",
+                        g.law.name()
+                    )))
+                }
+                (None, None) => vec![0.0; mesh.faces.len()],
+            },
+            direction: Vec::new(),
+        };
+        if law.is_some_and(|l| l.needs_direction()) || settings.moisture.enabled {
+            let dirs = mesh.face_field("machine_direction", 3)?;
+            for f in 0..mesh.faces.len() {
+                let (d, what) = match dirs {
+                    Some(df) => (
+                        Vec3::from_column_slice(df.get(f)),
+                        "face field 'machine_direction'",
+                    ),
+                    None => (Vec3::from(g.machine_direction), "growth.machine_direction"),
+                };
+                let d2 = barycentric_direction(mesh, f, &d).ok_or_else(|| {
+                    mesh.invalid(format!(
+                        "{what} at face {f} is [{}, {}, {}]: it must be finite, non-zero and not \
+                         normal to the face",
+                        d.x, d.y, d.z
+                    ))
+                })?;
+                let [p0, p1, p2] = mesh.face_positions(f);
+                let d3 = ((p1 - p0) * d2[0] + (p2 - p0) * d2[1]).normalize();
+                out.direction.push((d2, d3));
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// A settings field (number or expression of x, y) at every face's reference centroid; a
+/// non-finite value is an error naming the face.
+pub fn settings_field(
+    mesh: &Mesh,
+    field: &crate::settings::Field,
+    key: &str,
+) -> Result<Vec<Real>, MeshError> {
+    let e = field
+        .compile()
+        .map_err(|e| mesh.invalid(format!("{key}: {e}")))?;
+    (0..mesh.faces.len())
+        .map(|f| {
+            let [p0, p1, p2] = mesh.face_positions(f);
+            let c = (p0 + p1 + p2) / 3.0;
+            let v = e.eval(c.x, c.y);
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(mesh.invalid(format!(
+                    "{key} is {v} at face {f} (centroid x = {}, y = {})",
+                    c.x, c.y
+                )))
+            }
+        })
+        .collect()
+}
