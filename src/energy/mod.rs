@@ -12,8 +12,12 @@
 //! * [`material`]: plane-stress Lamé parameters and the Koiter density (stretching, bending and
 //!   Kelvin–Voigt damping wells).
 //! * [`gravity`], [`inertia`], [`ground`]: vertex terms.
-//! * [`loads`]: point forces, tractions and pressure, scaled by the dial (the load factor).
-//! * [`obstacles`]: rigid spheres, capsules, cylinders, planes and boxes, fixed or moved.
+//! * [`loads`]: point forces, tractions, pressure and tracked moments, scaled by the dial (the
+//!   load factor).
+//! * [`obstacles`]: rigid spheres, capsules, cylinders, planes and boxes, fixed, moved on a path
+//!   or pushed by a force (their offset a global DOF), with Coulomb friction.
+//! * [`slides`]: MorphoShell's glass slides, fixed or pressed, with stick/slip friction.
+//! * [`stiffening`]: MorphoShell's bend stiffening, `W_b + W_b²/(γ μ t)`.
 //! * [`gas`]: an enclosed gas (amount, pressure or volume control) with its rank-one stiffness.
 //! * [`projection`]: optional per-element projection of a Hessian to positive semi-definite.
 

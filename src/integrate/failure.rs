@@ -1,0 +1,171 @@
+//! What stops a run: the errors that end it ([`RunError`]), the failures a driver reports
+//! ([`RunFailure`]), and the signals that interrupt it.
+
+use crate::math::Real;
+use crate::output::OutputError;
+use crate::solve::linear::LinearError;
+use crate::solve::SolveError;
+
+/// Errors that stop a run (as opposed to non-convergence, which is reported in the summary).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RunError {
+    /// Output could not be written.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// The linear solver could not be set up.
+    #[error(transparent)]
+    Linear(#[from] LinearError),
+    /// The moisture state made the rest forms invalid.
+    #[error("moisture: {0}")]
+    Growth(#[from] crate::rest::laws::GrowthError),
+    /// The moisture boundary conditions contradict each other.
+    #[error("moisture: {0}")]
+    Surface(#[from] crate::diffusion::SurfaceError),
+    /// The moisture regions or fields are invalid.
+    #[error("moisture: {0}")]
+    Regions(#[from] crate::mesh::MeshError),
+    /// A restart's driver state does not fit the scene.
+    #[error("restart: {0}")]
+    Restart(String),
+    /// The scene asks for something its driver does not do.
+    #[error("{0}")]
+    Unsupported(String),
+}
+
+/// Why a run stopped before converging (exit 1); its text is `summary.json`'s `reason`.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RunFailure {
+    /// Statics: the dial increment was halved below `solver.min_continuation_step`.
+    #[error("continuation step fell below {min_h} at dial {dial:.6}: {cause}", min_h = crate::math::human(*.min))]
+    ContinuationStep {
+        /// The minimum increment.
+        min: Real,
+        /// The dial reached.
+        dial: Real,
+        /// The last solve's failure.
+        cause: SolveError,
+    },
+    /// Statics under a prescribed gas pressure: no equilibrium beyond a pressure (a limit
+    /// point of the pressure–volume curve, or a snap).
+    #[error(
+        "no equilibrium found beyond a gauge pressure of {} Pa (dial {dial:.6}, enclosed volume {} m³): the balloon's pressure has a maximum there (its limit point: a rubber sphere's pressure peaks at a stretch of 7^(1/6) = 1.38) and a higher pressure has no equilibrium nearby. Prescribe the volume (gas.control = \"volume\") or the amount of gas (\"amount\") to follow the curve through it. Last solve: {cause}",
+        crate::math::human(*.pressure),
+        crate::math::human(*.volume)
+    )]
+    PressureLimit {
+        /// The last gauge pressure with an equilibrium (Pa).
+        pressure: Real,
+        /// Its dial.
+        dial: Real,
+        /// The enclosed volume there (m³).
+        volume: Real,
+        /// The last solve's failure.
+        cause: SolveError,
+    },
+    /// Statics: raising the stretching weight back to 1 failed.
+    #[error("membrane continuation stalled at stretching weight {scale_h}: {cause}", scale_h = crate::math::human(*.scale))]
+    MembraneContinuation {
+        /// The stretching weight reached.
+        scale: Real,
+        /// The last solve's failure.
+        cause: SolveError,
+    },
+    /// Statics: the equilibrium stayed a saddle after every perturbation.
+    #[error("equilibrium is a saddle (Hessian indefinite) after {escapes} perturbations")]
+    Saddle {
+        /// Perturb-and-resolve attempts made.
+        escapes: usize,
+    },
+    /// Statics: a solve after a saddle perturbation failed.
+    #[error("after escaping a saddle: {0}")]
+    AfterSaddle(SolveError),
+    /// Dynamics: the time step was halved below `time.dt_min`.
+    #[error("time step fell below dt_min = {dt_min_h} at t = {t_h}: {cause}", dt_min_h = crate::math::human(*.dt_min), t_h = crate::math::human(*.t))]
+    TimeStep {
+        /// The minimum time step (s).
+        dt_min: Real,
+        /// The time reached (s).
+        t: Real,
+        /// The last solve's failure.
+        cause: SolveError,
+    },
+    /// A signal (SIGINT, SIGTERM) asked the run to stop; the state reached is the last frame.
+    #[error("interrupted by {signal} at {what} {at_h}", at_h = crate::math::human(*.at))]
+    Interrupted {
+        /// The signal's name.
+        signal: &'static str,
+        /// "dial" or "t".
+        what: &'static str,
+        /// The dial or time reached.
+        at: Real,
+    },
+    /// Dynamics: the moisture boundary conditions could not be switched.
+    #[error("moisture at t = {t_h}: {source}", t_h = crate::math::human(*.t))]
+    MoistureSurface {
+        /// The time reached (s).
+        t: Real,
+        /// What went wrong.
+        source: crate::diffusion::SurfaceError,
+    },
+    /// Dynamics: the moisture diffusion solve failed.
+    #[error("moisture diffusion at t = {t_h}: {source}", t_h = crate::math::human(*.t))]
+    Diffusion {
+        /// The time reached (s).
+        t: Real,
+        /// What went wrong.
+        source: crate::diffusion::DiffusionError,
+    },
+    /// Dynamics: the moisture made a rest form invalid.
+    #[error("at t = {t_h}: {source}", t_h = crate::math::human(*.t))]
+    Growth {
+        /// The time reached (s).
+        t: Real,
+        /// What went wrong.
+        source: crate::rest::laws::GrowthError,
+    },
+}
+
+/// The signal that asked the run to stop (0: none). Set by [`catch_signals`]' handler and read
+/// by the drivers between steps.
+static STOP: std::sync::atomic::AtomicI32 = std::sync::atomic::AtomicI32::new(0);
+
+/// Makes SIGINT and SIGTERM stop a run cleanly: the drivers finish the step under way, write
+/// the state reached as the last frame, the log and `summary.json` (`reason` "interrupted …")
+/// and return. A second signal exits at once with 128 + its number.
+pub fn catch_signals() -> std::io::Result<()> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    for sig in [SIGINT, SIGTERM] {
+        // SAFETY: the handler only touches an atomic and calls `_exit`, both async-signal-safe.
+        unsafe {
+            signal_hook::low_level::register(sig, move || {
+                if STOP.swap(sig, std::sync::atomic::Ordering::SeqCst) != 0 {
+                    signal_hook::low_level::exit(128 + sig);
+                }
+            })?;
+        }
+    }
+    Ok(())
+}
+
+/// The signal number that interrupted the run, if any.
+pub fn interrupted() -> Option<i32> {
+    match STOP.load(std::sync::atomic::Ordering::SeqCst) {
+        0 => None,
+        s => Some(s),
+    }
+}
+
+/// The [`RunFailure`] of an interruption, if a signal came.
+pub(super) fn interruption(what: &'static str, at: Real) -> Option<RunFailure> {
+    interrupted().map(|sig| RunFailure::Interrupted {
+        signal: match sig {
+            signal_hook::consts::SIGINT => "SIGINT",
+            signal_hook::consts::SIGTERM => "SIGTERM",
+            _ => "a signal",
+        },
+        what,
+        at,
+    })
+}

@@ -1,0 +1,314 @@
+//! The solver state the drivers share ([`Solver`]): the scene, its pattern and factorisation,
+//! Newton's workspace, the summary and counters, and the frames it writes.
+
+use super::{config, DriverState, RunError};
+use crate::assembly::{Pattern, Want};
+use crate::math::{Real, Vec3};
+use crate::output::{LogRow, Summary, Writer};
+use crate::scene::Scene;
+use crate::settings::Mode;
+use crate::solve::newton::Workspace;
+use crate::solve::{
+    newton, LinearSolver, NewtonOptions, NewtonReport, Potential, SolveError, State,
+};
+use std::time::Instant;
+
+/// `r ← H⁻¹ r` with the last factorisation of `lin` and the low-rank parts of `pot` at `state`
+/// (Woodbury); `false` when there is no factor or the low-rank solve is singular.
+pub(super) fn apply_inverse(
+    lin: &mut LinearSolver,
+    pot: &Potential,
+    state: &State,
+    r: &mut [Real],
+) -> bool {
+    if !lin.is_factored() {
+        return false;
+    }
+    let lr = pot.low_rank(&state.x, &state.dofs);
+    let wb = crate::solve::low_rank::Woodbury::new(lin, &lr);
+    wb.solve_in_place(lin, r)
+}
+
+/// Multiplier updates allowed per solve (see [`Solver::solve`]).
+pub(super) const MAX_UPDATES: usize = 50;
+
+pub(super) struct Solver<'a> {
+    pub(super) scene: &'a Scene,
+    /// The current sparsity pattern (replaced when a term's elements change, see
+    /// [`Solver::refresh`]); potentials borrow a clone of the handle ([`Solver::pattern`]).
+    pub(super) pattern: std::sync::Arc<Pattern>,
+    /// Whether some term's elements change during the run.
+    pub(super) changing: bool,
+    /// The run's controls, from the validated settings.
+    pub(super) config: config::RunConfig,
+    pub(super) lin: LinearSolver,
+    pub(super) ws: Workspace,
+    pub(super) summary: Summary,
+    pub(super) start: Instant,
+    /// The summary's counters when the previous frame was written; log rows report the
+    /// differences.
+    pub(super) at_last_frame: Counters,
+    /// The driver's state as of the next frame (the drivers keep it current).
+    pub(super) driver: DriverState,
+}
+
+/// Counters that log rows report per frame.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Counters {
+    pub(super) newton: usize,
+    pub(super) steps: usize,
+    pub(super) shifted: usize,
+    pub(super) gauss_newton: usize,
+    pub(super) rejected: usize,
+}
+
+impl Counters {
+    pub(super) fn of(s: &Summary) -> Self {
+        Counters {
+            newton: s.newton_iterations,
+            steps: s.steps,
+            shifted: s.shifted_iterations,
+            gauss_newton: s.gauss_newton_iterations,
+            rejected: s.rejected_steps,
+        }
+    }
+}
+
+impl<'a> Solver<'a> {
+    pub(super) fn new(
+        scene: &'a Scene,
+        pattern: Pattern,
+        threads: usize,
+    ) -> Result<Self, RunError> {
+        let lin = LinearSolver::new(&pattern)?;
+        let ws = Workspace::new(&pattern);
+        let changing = scene.terms.iter().any(|t| {
+            let x = &scene.mesh.positions;
+            t.stencil_at(scene, x, &vec![0.0; scene.num_scalar_dofs()])
+                .is_some()
+        });
+        let config = config::RunConfig::new(scene);
+        let summary = Summary {
+            mode: match config.mode {
+                Mode::Static => "static",
+                Mode::Dynamic => "dynamic",
+                Mode::Explicit => "explicit",
+            }
+            .into(),
+            vertices: scene.num_vertices(),
+            faces: scene.num_faces(),
+            threads,
+            warnings: scene.warnings.clone(),
+            ..Default::default()
+        };
+        Ok(Solver {
+            scene,
+            pattern: std::sync::Arc::new(pattern),
+            changing,
+            config,
+            lin,
+            ws,
+            summary,
+            start: Instant::now(),
+            at_last_frame: Counters::default(),
+            driver: DriverState::default(),
+        })
+    }
+
+    /// The current pattern, for potentials to borrow.
+    pub(super) fn pattern(&self) -> std::sync::Arc<Pattern> {
+        self.pattern.clone()
+    }
+
+    /// Follows the terms whose elements change to the state `state`: a new pattern when their
+    /// elements there differ, a new symbolic factorisation only when the union of the stencils
+    /// changed. Returns whether the pattern was replaced (take a new [`Solver::pattern`]).
+    pub(super) fn refresh(&mut self, state: &State) -> Result<bool, RunError> {
+        if !self.changing {
+            return Ok(false);
+        }
+        let Some(p) = self.pattern.refreshed(self.scene, &state.x, &state.dofs) else {
+            return Ok(false);
+        };
+        self.summary.element_changes += 1;
+        if !p.same_union(&self.pattern) {
+            self.lin = LinearSolver::new(&p)?;
+            self.ws = Workspace::new(&p);
+            self.summary.pattern_rebuilds += 1;
+        }
+        self.pattern = std::sync::Arc::new(p);
+        Ok(true)
+    }
+
+    pub(super) fn potential<'p>(&self, pattern: &'p Pattern, dial: Real) -> Potential<'p>
+    where
+        'a: 'p,
+    {
+        self.potential_scaled(pattern, dial, 1.0)
+    }
+
+    pub(super) fn potential_scaled<'p>(
+        &self,
+        pattern: &'p Pattern,
+        dial: Real,
+        stretch_scale: Real,
+    ) -> Potential<'p>
+    where
+        'a: 'p,
+    {
+        Potential {
+            dial,
+            gravity: self.config.gravity,
+            stretch_scale,
+            ..Potential::new(self.scene, pattern)
+        }
+    }
+
+    pub(super) fn record(&mut self, rep: &NewtonReport) {
+        self.summary.newton_iterations += rep.iterations;
+        self.summary.shifted_iterations += rep.shifted_iterations;
+        self.summary.gauss_newton_iterations += rep.gauss_newton_iterations;
+        self.summary.indefinite_iterations += rep.indefinite_iterations;
+        self.summary.residual = rep.residual;
+        self.summary.timing.newton.add(&rep.timing);
+    }
+
+    /// Newton on `pot` from `state`, then the terms' multiplier updates (a prescribed volume's
+    /// pressure, [`crate::energy::term::Term::update`]), re-solving until no term asks for
+    /// another solve. The report sums the iterations of every solve; more than
+    /// [`MAX_UPDATES`] updates is a failure.
+    pub(super) fn solve(
+        &mut self,
+        pot: &Potential,
+        state: &mut State,
+        opts: NewtonOptions,
+    ) -> NewtonReport {
+        assert!(
+            std::ptr::eq(pot.pattern, &*self.pattern),
+            "a potential on a replaced pattern was solved"
+        );
+        let mut total = NewtonReport::default();
+        for _ in 0..MAX_UPDATES {
+            let rep = newton(pot, &mut self.lin, &mut self.ws, state, opts);
+            self.record(&rep);
+            total.absorb(&rep);
+            if !rep.converged {
+                return total;
+            }
+            let lin = &mut self.lin;
+            let mut sensitivity = |u: &[Real]| -> Option<Real> {
+                let mut y = u.to_vec();
+                apply_inverse(lin, pot, state, &mut y)
+                    .then(|| u.iter().zip(&y).map(|(a, b)| a * b).sum::<Real>())
+            };
+            if !self
+                .scene
+                .update(pot, &state.x, &state.dofs, &mut sensitivity)
+            {
+                return total;
+            }
+        }
+        total.converged = false;
+        total.failure = Some(SolveError::MultiplierNotConverged {
+            updates: MAX_UPDATES,
+        });
+        total
+    }
+
+    pub(super) fn frame(
+        &mut self,
+        writer: &mut Writer,
+        pot: &Potential,
+        state: &State,
+        v: &[Vec3],
+        time: Real,
+    ) -> Result<(), RunError> {
+        let (now, last) = (Counters::of(&self.summary), self.at_last_frame);
+        let row = LogRow {
+            frame: 0,
+            time,
+            dial: pot.dial,
+            energy: Default::default(),
+            observables: Vec::new(),
+            residual: self.summary.residual,
+            newton_iterations: now.newton - last.newton,
+            steps: now.steps - last.steps,
+            shifted_iterations: now.shifted - last.shifted,
+            gauss_newton_iterations: now.gauss_newton - last.gauss_newton,
+            rejected_steps: now.rejected - last.rejected,
+            wall_seconds: self.start.elapsed().as_secs_f64(),
+        };
+        self.at_last_frame = now;
+        let clock = Instant::now();
+        let mut driver = self.driver.clone();
+        driver.mode = self.summary.mode.clone();
+        driver.globals = state.dofs[self.scene.num_edge_dofs()..].to_vec();
+        for t in self.scene.terms.iter() {
+            let saved = t.saved_state();
+            if !saved.is_empty() {
+                driver.terms.insert(t.name().to_string(), saved);
+            }
+        }
+        let r = writer.frame(pot, state, v, row, Some(&driver));
+        self.summary.timing.output += clock.elapsed().as_secs_f64();
+        r?;
+        Ok(())
+    }
+
+    /// Lets the terms predict the equilibrium at dial `pot.dial` from the one at `from`
+    /// (see [`crate::energy::term::Term::predict`]) with the last factorisation.
+    pub(super) fn predict(&mut self, pot: &Potential, from: Real, state: &mut State) {
+        if !self.scene.terms.iter().any(|t| t.predicts()) {
+            return;
+        }
+        if !self.lin.is_factored() {
+            // The first step: the Hessian at the start (dial `from`).
+            let at = Potential { dial: from, ..*pot };
+            let mut values = vec![0.0; pot.pattern.nnz()];
+            let mut g = vec![0.0; pot.pattern.n];
+            at.eval(&state.x, &state.dofs, Want::Hessian, &mut g, &mut values);
+            let lr = at.low_rank(&state.x, &state.dofs);
+            let mut shifted = vec![0.0; values.len()];
+            if crate::solve::newton::exact_model(
+                &mut self.lin,
+                &at,
+                &values,
+                &mut shifted,
+                &lr,
+                1e-8,
+            )
+            .is_none()
+            {
+                return;
+            }
+        }
+        let lin = &mut self.lin;
+        let mut predicted = state.clone();
+        let at = &*state;
+        let mut solve = |r: &mut [Real]| apply_inverse(lin, pot, at, r);
+        for t in self.scene.terms.iter() {
+            t.predict(pot, from, &mut predicted.x, &predicted.dofs, &mut solve);
+        }
+        // Safeguard: a linear prediction from a nearly singular Hessian (an unstressed membrane
+        // has soft modes) can land far off; keep it only when it lowers the potential.
+        let e = |s: &State| pot.eval(&s.x, &s.dofs, Want::Energy, &mut [], &mut []);
+        let ep = e(&predicted);
+        if ep.is_finite() && ep < e(state) {
+            state.copy_from(&predicted);
+        }
+    }
+
+    /// Tests `H + δI ≻ 0` at `state` (see module doc).
+    pub(super) fn is_stable(&mut self, dial: Real, state: &State) -> bool {
+        let (x, phi) = (&state.x, &state.dofs);
+        let pattern = self.pattern();
+        let pot = self.potential(&pattern, dial);
+        let mut values = vec![0.0; pattern.nnz()];
+        let mut g = vec![0.0; pattern.n];
+        pot.eval(x, phi, Want::Hessian, &mut g, &mut values);
+        // One factorisation of H + 1e-9·mean|diag|·I, with the dense low-rank part through
+        // the inertia (an indefinite sparse part is fine when the whole is positive definite).
+        let lr = pot.low_rank(x, phi);
+        crate::solve::newton::is_positive_definite(&mut self.lin, &pot, &values, &lr, 1e-9)
+    }
+}
