@@ -1,16 +1,28 @@
 //! shellsim: a thin-shell simulator for shells whose rest shape changes.
 //!
 //! The binary (`shellsim SETTINGS MESH`) is a thin layer over this library; see the README and
-//! `docs/ARCHITECTURE.md` for the data flow. A scene can also be built and evaluated directly:
+//! `docs/ARCHITECTURE.md` for the data flow. The library's API is what the binary uses:
+//!
+//! * [`Settings`] ([`settings`], one validated section per file in [`config`]): a settings file,
+//!   with `--set` overrides;
+//! * [`Mesh`] ([`mesh`]): reading and writing meshes, generated sheets and closed surfaces;
+//! * [`Scene`] ([`scene`]): the body and its terms, built from the two;
+//! * [`run`] ([`integrate`]): the static, dynamic and explicit drivers, from the reference mesh
+//!   or a restart ([`InitialState`], read by [`restart`]);
+//! * [`Writer`] and [`Summary`] ([`output`]): frames, series, log and summary;
+//! * [`Potential`], [`Pattern`], [`State`], [`Want`]: the total energy of a scene, its gradient
+//!   and Hessian at a state, for users who drive Newton themselves;
+//! * [`cases`]: the analytic cases (programmed forms and exact shapes) and their error
+//!   measures; [`math`]: the scalar and small-matrix types.
+//!
+//! The other modules (the kernels, assembly, the solvers, the rest-form laws, the tools behind
+//! the subcommands) are public for the project's own tests and benches, hidden from this
+//! documentation and not part of the API.
 //!
 //! ```
-//! use shellsim::assembly::{Pattern, Want};
 //! use shellsim::cases::Case;
-//! use shellsim::math::Vec3;
 //! use shellsim::mesh::generate::{rectangle, Spacing};
-//! use shellsim::scene::Scene;
-//! use shellsim::settings::Settings;
-//! use shellsim::solve::Potential;
+//! use shellsim::{Pattern, Potential, Scene, Settings, Want};
 //!
 //! // A unit square programmed with the cylinder of seed 000's Table 1.
 //! let mut mesh = rectangle(-0.5, -0.5, 1.0, 1.0, 0.25, Spacing::default());
@@ -29,31 +41,54 @@
 //! ```
 #![warn(missing_docs)]
 
-pub mod assembly;
 pub mod cases;
-pub mod cli;
 pub mod config;
-pub mod diffusion;
-pub mod energy;
-pub mod expr;
-pub mod fields;
-pub mod fuzz;
-pub mod geometry;
 pub mod integrate;
 pub mod math;
 pub mod mesh;
-pub mod morphoshell;
 pub mod output;
-pub mod provenance;
-pub mod render;
-pub mod rest;
 pub mod restart;
-pub mod scales;
-/// The liquid-crystal director law, kept at its earlier path.
-pub use rest::lce;
 pub mod scene;
 pub mod settings;
+
+#[doc(hidden)]
+pub mod assembly;
+#[doc(hidden)]
+pub mod cli;
+#[doc(hidden)]
+pub mod diffusion;
+#[doc(hidden)]
+pub mod energy;
+#[doc(hidden)]
+pub mod fuzz;
+#[doc(hidden)]
+pub mod geometry;
+#[doc(hidden)]
+pub mod morphoshell;
+#[doc(hidden)]
+pub mod provenance;
+#[doc(hidden)]
+pub mod rest;
+#[doc(hidden)]
 pub mod solve;
-pub mod sweep;
+#[doc(hidden)]
 pub mod team;
-pub mod units;
+
+pub(crate) mod expr;
+pub(crate) mod fields;
+pub(crate) mod render;
+pub(crate) mod scales;
+pub(crate) mod sweep;
+pub(crate) mod units;
+
+/// The liquid-crystal director law, kept at its earlier path.
+#[doc(hidden)]
+pub use rest::lce;
+
+pub use assembly::{Pattern, Want};
+pub use integrate::{run, InitialState, Progress, Quiet, RunError};
+pub use mesh::Mesh;
+pub use output::{Summary, Writer};
+pub use scene::Scene;
+pub use settings::Settings;
+pub use solve::{Potential, State};

@@ -1103,7 +1103,7 @@ pub struct PressureLoad {
 }
 
 /// A number, or an expression of the reference coordinates x, y (m) as a string (see
-/// [`crate::expr`]), evaluated at each face's reference centroid.
+/// `src/expr.rs`), evaluated at each face's reference centroid.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Field {
@@ -1260,7 +1260,7 @@ pub struct Output {
     pub prefix: String,
     /// Also write MorphoShell's derived fields: angle deficits and their Gauss curvature per
     /// vertex, its strain measure and the principal Cauchy stresses per face
-    /// ([`crate::fields`]; default: `false`).
+    /// (`src/fields.rs`; default: `false`).
     pub morphoshell_fields: bool,
     /// `.vtu` frames: compression of every array, `"zlib"`, `"lz4"` or `"none"` (default:
     /// `"zlib"`).
@@ -1277,7 +1277,7 @@ pub struct Output {
     /// `["default"]`). The fields a restart reads (velocity in the dynamic modes, edge angles,
     /// term states) are always written.
     pub fields: Vec<String>,
-    /// PNG pictures beside frames ([`crate::render`]): `"none"`, `"all"` (beside every frame) or
+    /// PNG pictures beside frames (`src/render.rs`): `"none"`, `"all"` (beside every frame) or
     /// `"final"` (beside the last one) (default: `"none"`).
     pub snapshots: Snapshots,
     /// The field the snapshots are coloured by (default: `mean_curvature`).

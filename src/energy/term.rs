@@ -208,7 +208,7 @@ pub trait Term: Send + Sync {
 
     /// `∂W/∂a` of each face's stretching energy W (J) with respect to its barycentric first
     /// fundamental form, in the stored components `[a11, a12, a22]` (J/m²), for the frames'
-    /// Cauchy stress ([`crate::fields::cauchy_principal`]). Default: `None`, no membrane
+    /// Cauchy stress (`fields::cauchy_principal`). Default: `None`, no membrane
     /// energy.
     fn membrane_stress(
         &self,
