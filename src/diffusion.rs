@@ -53,8 +53,8 @@
 //!
 //! Units: lengths m, time s, moisture u dimensionless (fraction), D m²/s.
 
+use crate::linalg::{LinearError, LinearSolver};
 use crate::math::{Mat3, Real, Vec3};
-use crate::solve::{LinearError, LinearSolver};
 
 /// Diffusivities along the machine direction, across it (in the plane) and through the
 /// thickness (m²/s).

@@ -64,6 +64,8 @@ pub mod fuzz;
 #[doc(hidden)]
 pub mod geometry;
 #[doc(hidden)]
+pub mod linalg;
+#[doc(hidden)]
 pub mod morphoshell;
 #[doc(hidden)]
 pub mod provenance;

@@ -12,8 +12,9 @@ use std::path::{Path, PathBuf};
 
 /// The floor of every top-level module, lowest first.
 const FLOORS: &[(&str, u32)] = &[
-    // 1: scalars, small vectors, the thread team, units.
+    // 1: scalars, small vectors, sparse Cholesky, the thread team, units.
     ("math", 1),
+    ("linalg", 1),
     ("team", 1),
     ("units", 1),
     // 2: configuration; mesh and geometry; expressions of x, y.

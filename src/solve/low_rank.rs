@@ -17,8 +17,8 @@
 //! `C`; an indefinite `A` with one negative eigenvalue and one positive `c` (a gas's stiffness)
 //! gives a positive definite whole when `S < 0`.
 
-use super::linear::LinearSolver;
 use crate::energy::term::LowRank;
+use crate::linalg::LinearSolver;
 use crate::math::Real;
 
 /// The update vectors solved against the factor, and the capacitance matrix `S`.

@@ -5,13 +5,21 @@
 //! ([`low_rank`]).
 
 pub mod contact;
-pub mod linear;
+/// The sparse Cholesky solver, which lives on the lowest floor ([`crate::linalg`]).
+pub use crate::linalg as linear;
 pub mod low_rank;
 pub mod newton;
 pub mod potential;
 pub mod state;
 
-pub use linear::{LinearError, LinearSolver};
+pub use crate::linalg::{LinearError, LinearSolver};
 pub use newton::{newton, NewtonOptions, NewtonReport, SolveError};
 pub use potential::Potential;
 pub use state::State;
+
+impl LinearSolver {
+    /// Symbolic analysis of an assembled sparsity pattern, done once per pattern.
+    pub fn new(p: &crate::assembly::Pattern) -> Result<Self, LinearError> {
+        Self::from_csc(p.n, p.col_ptr.clone(), p.row_idx.clone())
+    }
+}

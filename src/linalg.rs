@@ -1,8 +1,9 @@
-//! Sparse symmetric solves with faer's Cholesky: LLᵀ for positive-definite matrices, and LDLᵀ
+//! Sparse symmetric solves with faer's Cholesky, on any lower-triangular CSC pattern (the
+//! assembled Hessian's, the moisture diffusion's): LLᵀ for positive-definite matrices, and LDLᵀ
 //! (no pivoting) with its inertia for the symmetric indefinite ones that a dense low-rank term
 //! makes positive definite (an inflated balloon past its pressure limit point: the sparse part
 //! has one negative eigenvalue, the gas's rank-one stiffness removes it; see
-//! [`super::low_rank`]).
+//! `solve::low_rank`).
 //!
 //! The symbolic factorisation (AMD ordering, elimination tree, supernodes) is computed once per
 //! sparsity pattern; every Newton iteration only refactorises numerically. Factorisation and
@@ -12,7 +13,6 @@
 //! congruence), read from the diagonal of the factor's storage (the first entry of each
 //! simplicial column, the diagonal of each supernode's block).
 
-use crate::assembly::Pattern;
 use crate::math::Real;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
@@ -65,11 +65,6 @@ pub struct LinearSolver {
 }
 
 impl LinearSolver {
-    /// Symbolic analysis of the pattern, done once.
-    pub fn new(p: &Pattern) -> Result<Self, LinearError> {
-        Self::from_csc(p.n, p.col_ptr.clone(), p.row_idx.clone())
-    }
-
     /// Symbolic analysis of any lower-triangular CSC pattern (sorted rows, diagonal first).
     pub fn from_csc(
         n: usize,
