@@ -149,7 +149,7 @@ impl Pattern {
     }
 
     /// The pattern of `scene` at the state `(x, phi)` when a term's elements there
-    /// ([`crate::energy::term::Term::stencil_at`]) differ from `self`'s; `None` when none do.
+    /// ([`crate::energy::term::ChangingElements`]) differ from `self`'s; `None` when none do.
     /// The caller keeps its symbolic factorisation when the new pattern's union
     /// ([`Pattern::same_union`]) is unchanged.
     pub fn refreshed(
@@ -164,7 +164,7 @@ impl Pattern {
             .iter()
             .zip(&self.maps)
             .map(|(t, map)| {
-                let st = t.stencil_at(scene, x, phi)?;
+                let st = t.changing()?.stencil_at(scene, x, phi);
                 changed |= st.nodes != map.nodes || st.slot_dofs.len() != map.slots;
                 Some(st)
             })

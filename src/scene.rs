@@ -299,13 +299,11 @@ impl Scene {
         let nv = self.num_vertices();
         let mut next = nv + self.num_edge_dofs();
         self.globals.clear();
-        for t in terms.iter_mut() {
-            let g = t.globals();
-            if !g.is_empty() {
-                t.bind_globals(next);
-                next += g.len();
-                self.globals.extend(g);
-            }
+        for g in terms.iter_mut().filter_map(|t| t.global_dofs()) {
+            let dofs = g.dofs();
+            g.bind(next);
+            next += dofs.len();
+            self.globals.extend(dofs);
         }
         if !self.globals.is_empty() {
             self.node_fixed.resize(nv + self.num_edge_dofs(), false);
@@ -395,7 +393,7 @@ impl Scene {
     }
 
     /// Lets every term update its multiplier after a converged solve; `true` when one did and
-    /// the solve must be repeated (see [`crate::energy::term::Term::update`]).
+    /// the solve must be repeated (see [`crate::energy::term::Multiplier`]).
     pub fn update(
         &self,
         pot: &crate::solve::Potential,
@@ -404,7 +402,7 @@ impl Scene {
         sensitivity: &mut dyn FnMut(&[Real]) -> Option<Real>,
     ) -> bool {
         let mut again = false;
-        for t in self.terms.iter() {
+        for t in self.terms.iter().filter_map(|t| t.updates()) {
             again |= t.update(pot, x, phi, sensitivity);
         }
         again

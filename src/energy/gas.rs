@@ -19,7 +19,7 @@
 //!   `E = −λ (V − V*) + ρ/2 (V − V*)²`; after each converged solve the multiplier takes
 //!   Newton's step on `V(λ) = V*`, `λ ← λ − (V − V*)/(dV/dλ)`, `dV/dλ = ∇Vᵀ H⁻¹ ∇V` from the
 //!   solve's factor, and the solve repeats until `|V − V*| ≤ 10⁻¹⁰ V*`
-//!   ([`crate::energy::term::Term::update`]). The penalty `ρ = 100 E h/(R V_ref)` (largest E h,
+//!   ([`crate::energy::term::Multiplier`]). The penalty `ρ = 100 E h/(R V_ref)` (largest E h,
 //!   `R` the radius of the sphere of volume V_ref) is 150 (1 − ν) times the stiffness
 //!   `dp/dV = 2 E h/(3 (1 − ν) R V)` of a spherical membrane's volume at rest: even the plain
 //!   update `λ ← λ − ρ (V − V*)` would converge by a factor of about that per update, and it
@@ -40,7 +40,7 @@
 //! `x[v0], x[v1], x[v2]`.
 
 use crate::assembly::{assemble_elements, ElementMap, Want};
-use crate::energy::term::{LowRank, Stencil, Term};
+use crate::energy::term::{LowRank, LowRankPart, Multiplier, Predictor, Stencil, Term};
 use crate::energy::HessianProjection;
 use crate::math::{Real, Vec3};
 use crate::mesh::MeshError;
@@ -248,16 +248,6 @@ impl Term for Gas {
         st.energy
     }
 
-    fn low_rank(&self, pot: &Potential, x: &[Vec3], _phi: &[Real], out: &mut Vec<LowRank>) {
-        let st = self.state(pot, x);
-        if st.stiffness != 0.0 {
-            out.push(LowRank {
-                c: st.stiffness,
-                u: Self::volume_gradient(pot, x),
-            });
-        }
-    }
-
     fn observables(&self, pot: &Potential, x: &[Vec3], _phi: &[Real]) -> Vec<(String, Real)> {
         let st = self.state(pot, x);
         vec![
@@ -271,10 +261,33 @@ impl Term for Gas {
         vec![("pressure".into(), vec![st.gauge; pot.scene.num_faces()])]
     }
 
-    fn predicts(&self) -> bool {
-        self.control != GasControl::None
+    fn updates(&self) -> Option<&dyn Multiplier> {
+        Some(self)
     }
 
+    /// Only a controlled gas predicts (amount, pressure or volume control).
+    fn predictor(&self) -> Option<&dyn Predictor> {
+        (self.control != GasControl::None).then_some(self)
+    }
+
+    fn low_rank(&self) -> Option<&dyn LowRankPart> {
+        Some(self)
+    }
+}
+
+impl LowRankPart for Gas {
+    fn low_rank(&self, pot: &Potential, x: &[Vec3], _phi: &[Real], out: &mut Vec<LowRank>) {
+        let st = self.state(pot, x);
+        if st.stiffness != 0.0 {
+            out.push(LowRank {
+                c: st.stiffness,
+                u: Self::volume_gradient(pot, x),
+            });
+        }
+    }
+}
+
+impl Predictor for Gas {
     /// Euler's predictor along the equilibrium path: the load's change moves the equilibrium by
     /// `dx = H⁻¹∇V · α`, with `α = Δn/V` (amount: the pressure's change at fixed volume), `Δp`
     /// (pressure) or `ΔV*/s`, `s = ∇Vᵀ H⁻¹ ∇V` (volume, whose multiplier moves by
@@ -319,7 +332,9 @@ impl Term for Gas {
             *p += Vec3::new(y[3 * i], y[3 * i + 1], y[3 * i + 2]) * alpha;
         }
     }
+}
 
+impl Multiplier for Gas {
     /// Volume control: while the volume is off by more than 10⁻¹⁰ V*, Newton's update of the
     /// multiplier, `λ ← λ − (V − V*)/s` with `s = ∇Vᵀ H⁻¹ ∇V = dV/dλ` at the equilibrium
     /// (H the whole Hessian, penalty included, so `0 < s < 1/ρ`); without a factor, the

@@ -7,7 +7,7 @@
 //! (μ, t the smallest shear modulus and thickness; N/m; gradient `k(z − z_u)₊ − k(z_l − z)₊`
 //! along z, Hessian `k` on zz while in contact). DOF order: `x[v]`.
 //!
-//! **Friction** (explicit mode, [`crate::energy::term::Term::explicit_step`]): Coulomb
+//! **Friction** (explicit mode, [`crate::energy::term::ExplicitHooks::explicit_step`]): Coulomb
 //! stick/slip on a vertex in contact, normal force `N = k d`, mass m. With `v*` the in-plane
 //! velocity the step would reach without friction (elastic and other forces, drag excluded), the
 //! vertex sticks when friction can stop it within the step, `|v*| ≤ Δt μ_f N / m` (its in-plane
@@ -31,7 +31,7 @@
 //! plane below the lower one by the penalty's give, `2F/(n k)` for n vertices, each pushed from
 //! both sides (clamped at the lower slide, the upper one would sit in an empty gap with no
 //! contact and the force unbalanced). The explicit driver's equilibrium test requires the
-//! balance `F_up = F` ([`crate::energy::term::Term::explicit_unbalanced`]); a pressed slide
+//! balance `F_up = F` ([`crate::energy::term::ExplicitHooks::explicit_unbalanced`]); a pressed slide
 //! that no free vertex touches while below the lower slide has passed the sheet, and the run
 //! stops with that reason.
 //!
@@ -164,7 +164,7 @@ impl VertexKernel for Slides {
         ]
     }
 
-    fn acts_on_explicit_steps(&self) -> bool {
+    fn explicit_hooks(&self) -> bool {
         true
     }
 

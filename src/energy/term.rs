@@ -120,29 +120,6 @@ pub trait Term: Send + Sync {
     /// The elements and their DOF nodes.
     fn stencil(&self, scene: &Scene) -> Stencil;
 
-    /// For a term whose elements change during a run (contact pairs), its elements at the
-    /// state `(x, phi)`, in an order that depends on nothing but that state (so that assembly
-    /// stays bitwise independent of the threads); `None` (default) for a term whose elements
-    /// are fixed by [`Term::stencil`]. The drivers ask before every implicit step (a static
-    /// continuation step, a time step); the sparsity pattern is rebuilt when some term's
-    /// elements changed, and the symbolic factorisation only when the union of the stencils
-    /// changed ([`crate::assembly::Pattern::refreshed`]). The explicit driver does not follow
-    /// changing elements: such a scene is refused there.
-    fn stencil_at(&self, _scene: &Scene, _x: &[Vec3], _phi: &[Real]) -> Option<Stencil> {
-        None
-    }
-
-    /// The global DOFs the term owns (default: none). The scene numbers them after the vertex
-    /// and edge nodes, in term order, and tells the term its first node with
-    /// [`Term::bind_globals`] before its stencil is asked for.
-    fn globals(&self) -> Vec<GlobalDof> {
-        Vec::new()
-    }
-
-    /// Gives the term the node id of its first global DOF (see [`Term::globals`]); its DOF in
-    /// [`crate::solve::State::dofs`] is `node − vertices`.
-    fn bind_globals(&mut self, _first_node: usize) {}
-
     /// Adds the term's energy (returned), gradient and Hessian (lower triangle, pattern order)
     /// at positions `x` and edge DOFs `phi` into `grad`/`values` as `want` says, skipping fixed
     /// nodes.
@@ -291,77 +268,119 @@ pub trait Term: Send + Sync {
         Vec::new()
     }
 
-    /// After a converged solve at `(x, phi)`: updates a multiplier the term carries (a
-    /// prescribed volume's pressure) and returns `true` when the solve must be repeated with
-    /// it (default: nothing to update). `sensitivity(u)` is `uᵀ H⁻¹ u` with the solve's last
+    /// A term whose elements change during a run declares it here (default: fixed elements).
+    fn changing(&self) -> Option<&dyn ChangingElements> {
+        None
+    }
+
+    /// A term that owns global DOFs declares them here (default: none).
+    fn global_dofs(&mut self) -> Option<&mut dyn GlobalDofs> {
+        None
+    }
+
+    /// A term that carries a multiplier updated after each converged solve (a prescribed
+    /// volume's pressure) declares it here (default: none).
+    fn updates(&self) -> Option<&dyn Multiplier> {
+        None
+    }
+
+    /// A term that knows how its load moves a static equilibrium declares its predictor here
+    /// (default: none).
+    fn predictor(&self) -> Option<&dyn Predictor> {
+        None
+    }
+
+    /// A term with a dense low-rank Hessian part declares it here (default: none).
+    fn low_rank(&self) -> Option<&dyn LowRankPart> {
+        None
+    }
+
+    /// A term that acts on the explicit driver's steps beyond its energy declares its hooks
+    /// here (default: none). The explicit driver fuses the update into the gradient's parallel
+    /// parts only when no term declares them.
+    fn explicit(&self) -> Option<&dyn ExplicitHooks> {
+        None
+    }
+}
+
+/// The capability of a term whose elements change during a run (contact pairs).
+pub trait ChangingElements {
+    /// Its elements at the state `(x, phi)`, in an order that depends on nothing but that
+    /// state (so that assembly stays bitwise independent of the threads). The static and
+    /// dynamic drivers ask before every step (a continuation step, a time step); the sparsity
+    /// pattern is rebuilt when some term's elements changed, and the symbolic factorisation
+    /// only when the union of the stencils changed
+    /// ([`crate::assembly::Pattern::refreshed`]). The explicit driver does not follow changing
+    /// elements: such a scene is refused there.
+    fn stencil_at(&self, scene: &Scene, x: &[Vec3], phi: &[Real]) -> Stencil;
+}
+
+/// The capability of a term that owns global DOFs (a force-controlled obstacle's offset).
+pub trait GlobalDofs {
+    /// The DOFs. The scene numbers them after the vertex and edge nodes, in term order, and
+    /// tells the term its first node with [`GlobalDofs::bind`] before its stencil is asked for.
+    fn dofs(&self) -> Vec<GlobalDof>;
+    /// Gives the term the node id of its first global DOF; its DOF in
+    /// [`crate::solve::State::dofs`] is `node − vertices`.
+    fn bind(&mut self, first_node: usize);
+}
+
+/// The capability of a term that carries a multiplier.
+pub trait Multiplier {
+    /// After a converged solve at `(x, phi)`: updates the multiplier and returns `true` when
+    /// the solve must be repeated with it. `sensitivity(u)` is `uᵀ H⁻¹ u` with the solve's last
     /// Hessian (sparse factor and low-rank parts; `None` when there is none), the derivative of
     /// the equilibrium's `u·x` with respect to a load along `u`.
     fn update(
         &self,
-        _pot: &Potential,
-        _x: &[Vec3],
-        _phi: &[Real],
-        _sensitivity: &mut dyn FnMut(&[Real]) -> Option<Real>,
-    ) -> bool {
-        false
-    }
+        pot: &Potential,
+        x: &[Vec3],
+        phi: &[Real],
+        sensitivity: &mut dyn FnMut(&[Real]) -> Option<Real>,
+    ) -> bool;
+}
 
-    /// Explicit dynamics, before the gradient at positions `x` of a step `dt` (s): a term with
-    /// a state of its own that follows the sheet (a moving slide) advances it to these
-    /// positions, so that the gradient sees the two consistent. Default: nothing.
+/// The capability of a term that predicts how its load moves a static equilibrium.
+pub trait Predictor {
+    /// Static continuation, before the solve at the new dial `pot.dial` from the equilibrium
+    /// `(x, phi)` at dial `from`: moves `x` (and the term's own multiplier) along the tangent
+    /// of the equilibrium path (Euler's predictor), with `solve(r)` applying the last
+    /// Hessian's inverse to `r` (`false` when there is none).
+    fn predict(
+        &self,
+        pot: &Potential,
+        from: Real,
+        x: &mut [Vec3],
+        phi: &[Real],
+        solve: &mut dyn FnMut(&mut [Real]) -> bool,
+    );
+}
+
+/// The capability of a term with a dense low-rank Hessian part.
+pub trait LowRankPart {
+    /// The part `Σ c u uᵀ` at `(x, phi)`, appended to `out`. Entries on fixed or pinned DOFs
+    /// must be zero.
+    fn low_rank(&self, pot: &Potential, x: &[Vec3], phi: &[Real], out: &mut Vec<LowRank>);
+}
+
+/// The capability of a term that acts on the explicit driver's steps.
+pub trait ExplicitHooks {
+    /// Before the gradient at positions `x` of a step `dt` (s): a term with a state of its own
+    /// that follows the sheet (a moving slide) advances it to these positions, so that the
+    /// gradient sees the two consistent. Default: nothing.
     fn explicit_begin(&self, _pot: &Potential, _x: &[Vec3], _dt: Real) {}
 
-    /// Explicit dynamics, after the gradient `g` at positions `x` with velocities `v` and before
-    /// the step `dt` (s): a term that acts on the step itself, beyond its energy, adjusts `g`
-    /// and `v` (stick/slip friction). Default: nothing.
-    fn explicit_step(
-        &self,
-        _pot: &Potential,
-        _x: &[Vec3],
-        _v: &mut [Vec3],
-        _g: &mut [Real],
-        _dt: Real,
-    ) {
-    }
+    /// After the gradient `g` at positions `x` with velocities `v` and before the step `dt`
+    /// (s): adjusts `g` and `v` beyond the term's energy (stick/slip friction).
+    fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real);
 
-    /// Explicit dynamics: the force (N) left unbalanced at positions `x` on a degree of
-    /// freedom the term moves itself (a force-controlled slide: the prescribed force minus the
-    /// sheet's push on it), which the equilibrium test requires to vanish like the sheet's own
-    /// forces; or why it never can (the slide has passed the sheet). Default: 0.
+    /// The force (N) left unbalanced at positions `x` on a degree of freedom the term moves
+    /// itself (a force-controlled slide: the prescribed force minus the sheet's push on it),
+    /// which the equilibrium test requires to vanish like the sheet's own forces; or why it
+    /// never can (the slide has passed the sheet). Default: 0.
     fn explicit_unbalanced(&self, _pot: &Potential, _x: &[Vec3]) -> Result<Real, String> {
         Ok(0.0)
     }
-
-    /// Whether the term overrides [`Term::explicit_step`] (default: no). A term that does must
-    /// say so here: the explicit driver fuses the update into the gradient's parallel parts
-    /// when no term acts on the step between the two.
-    fn acts_on_explicit_steps(&self) -> bool {
-        false
-    }
-
-    /// Whether the term implements [`Term::predict`] (default: no).
-    fn predicts(&self) -> bool {
-        false
-    }
-
-    /// Static continuation, before the solve at the new dial `pot.dial` from the equilibrium
-    /// `(x, phi)` at dial `from`: a term that knows how its load moves the equilibrium may move
-    /// `x` (and its own multiplier) along the tangent of the equilibrium path (Euler's predictor),
-    /// with `solve(r)` applying the last Hessian's inverse to `r` (`false` when there is none)
-    /// (default: nothing).
-    fn predict(
-        &self,
-        _pot: &Potential,
-        _from: Real,
-        _x: &mut [Vec3],
-        _phi: &[Real],
-        _solve: &mut dyn FnMut(&mut [Real]) -> bool,
-    ) {
-    }
-
-    /// The dense low-rank part of the Hessian at `x` (default: none). Entries on fixed or
-    /// pinned DOFs must be zero.
-    fn low_rank(&self, _pot: &Potential, _x: &[Vec3], _phi: &[Real], _out: &mut Vec<LowRank>) {}
 }
 
 /// A pure per-element kernel with `N` local DOFs over `S` stencil slots (compile-time sizes for
@@ -444,9 +463,14 @@ pub trait VertexKernel: Send + Sync {
     fn observables(&self, _pot: &Potential, _x: &[Vec3]) -> Vec<(String, Real)> {
         Vec::new()
     }
-    /// See [`Term::explicit_begin`] (default: nothing).
+    /// Whether the kernel acts on the explicit driver's steps: its term then declares
+    /// [`ExplicitHooks`] with the three methods below (default: no).
+    fn explicit_hooks(&self) -> bool {
+        false
+    }
+    /// See [`ExplicitHooks::explicit_begin`] (default: nothing).
     fn explicit_begin(&self, _pot: &Potential, _x: &[Vec3], _dt: Real) {}
-    /// See [`Term::explicit_step`] (default: nothing).
+    /// See [`ExplicitHooks::explicit_step`] (default: nothing).
     fn explicit_step(
         &self,
         _pot: &Potential,
@@ -456,10 +480,6 @@ pub trait VertexKernel: Send + Sync {
         _dt: Real,
     ) {
     }
-    /// See [`Term::acts_on_explicit_steps`] (default: no).
-    fn acts_on_explicit_steps(&self) -> bool {
-        false
-    }
     /// See [`Term::saved_state`] (default: none).
     fn saved_state(&self) -> Vec<Real> {
         Vec::new()
@@ -468,7 +488,7 @@ pub trait VertexKernel: Send + Sync {
     fn load_state(&self, _saved: &[Real]) -> Result<(), String> {
         Ok(())
     }
-    /// See [`Term::explicit_unbalanced`] (default: 0).
+    /// See [`ExplicitHooks::explicit_unbalanced`] (default: 0).
     fn explicit_unbalanced(&self, _pot: &Potential, _x: &[Vec3]) -> Result<Real, String> {
         Ok(0.0)
     }
@@ -490,23 +510,14 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
     fn name(&self) -> &'static str {
         self.name
     }
-    fn explicit_begin(&self, pot: &Potential, x: &[Vec3], dt: Real) {
-        self.kernel.explicit_begin(pot, x, dt);
-    }
-    fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
-        self.kernel.explicit_step(pot, x, v, g, dt);
-    }
-    fn acts_on_explicit_steps(&self) -> bool {
-        self.kernel.acts_on_explicit_steps()
+    fn explicit(&self) -> Option<&dyn ExplicitHooks> {
+        self.kernel.explicit_hooks().then_some(self)
     }
     fn saved_state(&self) -> Vec<Real> {
         self.kernel.saved_state()
     }
     fn load_state(&self, saved: &[Real]) -> Result<(), String> {
         self.kernel.load_state(saved)
-    }
-    fn explicit_unbalanced(&self, pot: &Potential, x: &[Vec3]) -> Result<Real, String> {
-        self.kernel.explicit_unbalanced(pot, x)
     }
     fn observables(&self, pot: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
         self.kernel.observables(pot, x)
@@ -574,6 +585,18 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
             values,
             &pot.pattern.col_ptr,
         )
+    }
+}
+
+impl<K: VertexKernel> ExplicitHooks for VertexTerm<K> {
+    fn explicit_begin(&self, pot: &Potential, x: &[Vec3], dt: Real) {
+        self.kernel.explicit_begin(pot, x, dt);
+    }
+    fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
+        self.kernel.explicit_step(pot, x, v, g, dt);
+    }
+    fn explicit_unbalanced(&self, pot: &Potential, x: &[Vec3]) -> Result<Real, String> {
+        self.kernel.explicit_unbalanced(pot, x)
     }
 }
 

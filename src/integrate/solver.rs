@@ -82,11 +82,7 @@ impl<'a> Solver<'a> {
     ) -> Result<Self, RunError> {
         let lin = LinearSolver::new(&pattern)?;
         let ws = Workspace::new(&pattern);
-        let changing = scene.terms.iter().any(|t| {
-            let x = &scene.mesh.positions;
-            t.stencil_at(scene, x, &vec![0.0; scene.num_scalar_dofs()])
-                .is_some()
-        });
+        let changing = scene.terms.iter().any(|t| t.changing().is_some());
         let config = config::RunConfig::new(scene);
         let summary = Summary {
             mode: match config.mode {
@@ -174,7 +170,7 @@ impl<'a> Solver<'a> {
     }
 
     /// Newton on `pot` from `state`, then the terms' multiplier updates (a prescribed volume's
-    /// pressure, [`crate::energy::term::Term::update`]), re-solving until no term asks for
+    /// pressure, [`crate::energy::term::Multiplier`]), re-solving until no term asks for
     /// another solve. The report sums the iterations of every solve; more than
     /// [`MAX_UPDATES`] updates is a failure.
     pub(super) fn solve(
@@ -256,9 +252,9 @@ impl<'a> Solver<'a> {
     }
 
     /// Lets the terms predict the equilibrium at dial `pot.dial` from the one at `from`
-    /// (see [`crate::energy::term::Term::predict`]) with the last factorisation.
+    /// (see [`crate::energy::term::Predictor`]) with the last factorisation.
     pub(super) fn predict(&mut self, pot: &Potential, from: Real, state: &mut State) {
-        if !self.scene.terms.iter().any(|t| t.predicts()) {
+        if !self.scene.terms.iter().any(|t| t.predictor().is_some()) {
             return;
         }
         if !self.lin.is_factored() {
@@ -286,8 +282,8 @@ impl<'a> Solver<'a> {
         let mut predicted = state.clone();
         let at = &*state;
         let mut solve = |r: &mut [Real]| apply_inverse(lin, pot, at, r);
-        for t in self.scene.terms.iter() {
-            t.predict(pot, from, &mut predicted.x, &predicted.dofs, &mut solve);
+        for p in self.scene.terms.iter().filter_map(|t| t.predictor()) {
+            p.predict(pot, from, &mut predicted.x, &predicted.dofs, &mut solve);
         }
         // Safeguard: a linear prediction from a nearly singular Hessian (an unstressed membrane
         // has soft modes) can land far off; keep it only when it lowers the potential.

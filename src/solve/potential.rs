@@ -283,7 +283,7 @@ impl<'a> Potential<'a> {
     /// pinned DOFs.
     pub fn low_rank(&self, x: &[Vec3], phi: &[Real]) -> Vec<LowRank> {
         let mut out = Vec::new();
-        for t in self.scene.terms.iter() {
+        for t in self.scene.terms.iter().filter_map(|t| t.low_rank()) {
             t.low_rank(self, x, phi, &mut out);
         }
         for lr in &mut out {

@@ -1,4 +1,4 @@
-//! A term whose elements change during a run (`Term::stencil_at`): a test term of short-range
+//! A term whose elements change during a run (the `ChangingElements` capability): a test term of short-range
 //! repulsion between the vertices of two sheets, `E = Σ k (r − d)³/3` over the pairs closer
 //! than `r`. A square falling onto a fixed one gathers pairs as it arrives: the drivers rebuild
 //! the pattern when the pairs change, the finite-difference check holds on the current pairs,
@@ -6,7 +6,7 @@
 //! and 2 threads.
 
 use shellsim::assembly::{assemble_elements, ElementMap, Pattern, Want};
-use shellsim::energy::term::{Stencil, Term};
+use shellsim::energy::term::{ChangingElements, Stencil, Term};
 use shellsim::energy::HessianProjection;
 use shellsim::math::{Mat3, Real, SMat, SVec, Vec3};
 use shellsim::mesh::generate::{rectangle, Spacing};
@@ -78,6 +78,12 @@ impl Repulsion {
     }
 }
 
+impl ChangingElements for Repulsion {
+    fn stencil_at(&self, _: &Scene, x: &[Vec3], _: &[Real]) -> Stencil {
+        self.pairs(x)
+    }
+}
+
 impl Term for Repulsion {
     fn name(&self) -> &'static str {
         "repulsion"
@@ -85,8 +91,8 @@ impl Term for Repulsion {
     fn stencil(&self, scene: &Scene) -> Stencil {
         self.pairs(&scene.mesh.positions)
     }
-    fn stencil_at(&self, _: &Scene, x: &[Vec3], _: &[Real]) -> Option<Stencil> {
-        Some(self.pairs(x))
+    fn changing(&self) -> Option<&dyn ChangingElements> {
+        Some(self)
     }
     fn eval(
         &self,

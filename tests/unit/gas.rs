@@ -10,7 +10,7 @@ use shellsim::assembly::{ElementMap, Pattern, Want};
 use shellsim::energy::membrane::neo_hookean::NeoHookeanFace;
 use shellsim::energy::membrane::prism::PrismFace;
 use shellsim::energy::membrane::MembraneLaw;
-use shellsim::energy::term::{LowRank, Stencil, Term, Terms};
+use shellsim::energy::term::{Stencil, Term, Terms};
 use shellsim::energy::HessianProjection;
 use shellsim::geometry::first_fundamental_form;
 use shellsim::math::{Mat3, Real, SVec, Sym2, Vec3};
@@ -160,7 +160,7 @@ fn gas_term_matches_finite_differences_for_every_control() {
         };
         let x = inflated(&sc, 1.15, 0.03, 4);
         // Volume control: a non-zero multiplier (one plain update).
-        term.update(&pot, &x, &[], &mut |_| None);
+        term.updates().unwrap().update(&pot, &x, &[], &mut |_| None);
         let eval = |x: &[Vec3], g: &mut Vec<Real>, h: &mut Vec<Real>, want: Want| {
             g.iter_mut().for_each(|v| *v = 0.0);
             h.iter_mut().for_each(|v| *v = 0.0);
@@ -170,7 +170,7 @@ fn gas_term_matches_finite_differences_for_every_control() {
         eval(&x, &mut g, &mut h, Want::Hessian);
         let mut full = dense(&p, &h);
         let mut lr = Vec::new();
-        term.low_rank(&pot, &x, &[], &mut lr);
+        term.low_rank().unwrap().low_rank(&pot, &x, &[], &mut lr);
         for part in &lr {
             let u = DVector::from_column_slice(&part.u);
             full += &u * u.transpose() * part.c;
@@ -318,7 +318,6 @@ impl Term for WithoutLowRank {
     ) -> Real {
         self.0[self.1].eval(pot, map, x, phi, want, projection, grad, values)
     }
-    fn low_rank(&self, _: &Potential, _: &[Vec3], _: &[Real], _: &mut Vec<LowRank>) {}
 }
 
 /// Residuals of Newton from `x0` after 0, 1, 2, … iterations (each run afresh, capped).

@@ -13,7 +13,7 @@ use shellsim::energy::membrane::{MembraneLaw, WithKoiterBending};
 use shellsim::energy::projection::jacobi_eigen;
 use shellsim::energy::registry;
 use shellsim::energy::shell::shell_element;
-use shellsim::energy::term::{LowRank, Stencil, Term};
+use shellsim::energy::term::{ExplicitHooks, LowRank, LowRankPart, Stencil, Term};
 use shellsim::energy::{HessianProjection, KoiterDensity};
 use shellsim::math::{Mat3, Real, SMat, SVec, Sym2, Vec2, Vec3};
 use shellsim::mesh::generate::{rectangle, Rng, Spacing};
@@ -727,6 +727,12 @@ impl Term for Tether {
         }
         0.5 * self.k * s * s
     }
+    fn low_rank(&self) -> Option<&dyn LowRankPart> {
+        Some(self)
+    }
+}
+
+impl LowRankPart for Tether {
     fn low_rank(&self, _: &Potential, x: &[Vec3], phi: &[Real], out: &mut Vec<LowRank>) {
         let mut u = self.w.clone();
         u.resize(3 * x.len() + phi.len(), 0.0);
@@ -848,12 +854,13 @@ fn low_rank_term_solves_like_the_dense_matrix() {
 }
 
 /// The scene's slides term.
-fn slides_term(sc: &Scene) -> &dyn Term {
+fn slides_term(sc: &Scene) -> &dyn ExplicitHooks {
     sc.terms
         .iter()
         .find(|t| t.name() == "slides")
         .expect("the slides term")
-        .as_ref()
+        .explicit()
+        .expect("the slides act on explicit steps")
 }
 
 /// Slide friction (explicit mode) on a strip pressed 0.01 into the lower slide, normal force

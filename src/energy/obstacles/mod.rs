@@ -343,7 +343,7 @@ impl VertexKernel for Obstacles {
         }
     }
 
-    fn acts_on_explicit_steps(&self) -> bool {
+    fn explicit_hooks(&self) -> bool {
         self.has_friction()
     }
 

@@ -24,7 +24,7 @@
 use super::{Body, Distance, Obstacles};
 use crate::assembly::{assemble_elements, ElementMap, Want};
 use crate::energy::projection::HessianProjection;
-use crate::energy::term::{GlobalDof, Stencil, Term};
+use crate::energy::term::{GlobalDof, GlobalDofs, Stencil, Term};
 use crate::math::{Mat3, Real, SMat, SVec, Vec3};
 use crate::mesh::topology::NONE;
 use crate::scene::Scene;
@@ -50,7 +50,7 @@ pub struct Pressed {
     pub sheet: Obstacles,
     /// Largest Newton step of the offset (m).
     pub max_step: Real,
-    /// Its global node (set by [`Term::bind_globals`]).
+    /// Its global node (set by [`GlobalDofs::bind`]).
     pub node: usize,
 }
 
@@ -128,12 +128,8 @@ impl Pressed {
     }
 }
 
-impl Term for Pressed {
-    fn name(&self) -> &'static str {
-        "pressed_obstacles"
-    }
-
-    fn globals(&self) -> Vec<GlobalDof> {
+impl GlobalDofs for Pressed {
+    fn dofs(&self) -> Vec<GlobalDof> {
         vec![GlobalDof {
             name: format!("obstacle{}_offset", self.index),
             length: 1.0,
@@ -142,8 +138,18 @@ impl Term for Pressed {
         }]
     }
 
-    fn bind_globals(&mut self, first_node: usize) {
+    fn bind(&mut self, first_node: usize) {
         self.node = first_node;
+    }
+}
+
+impl Term for Pressed {
+    fn name(&self) -> &'static str {
+        "pressed_obstacles"
+    }
+
+    fn global_dofs(&mut self) -> Option<&mut dyn GlobalDofs> {
+        Some(self)
     }
 
     /// One element per vertex that has an area (`[v, q]`), then the force's (`[·, q]`).

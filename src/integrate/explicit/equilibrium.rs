@@ -7,11 +7,11 @@ use crate::settings::{EquilibriumTest, Explicit};
 use crate::solve::Potential;
 
 /// The largest force (N) a term leaves unbalanced on a degree of freedom of its own
-/// ([`crate::energy::term::Term::explicit_unbalanced`]), or why one never balances.
+/// ([`crate::energy::term::ExplicitHooks::explicit_unbalanced`]), or why one never balances.
 pub(super) fn unbalanced(pot: &Potential, x: &[Vec3]) -> Result<Real, String> {
     let mut worst: Real = 0.0;
-    for term in pot.scene.terms.iter() {
-        worst = worst.max(term.explicit_unbalanced(pot, x)?);
+    for hooks in pot.scene.terms.iter().filter_map(|t| t.explicit()) {
+        worst = worst.max(hooks.explicit_unbalanced(pot, x)?);
     }
     Ok(worst)
 }

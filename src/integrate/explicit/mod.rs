@@ -56,7 +56,7 @@
 //! `"morphoshell"` reproduces MorphoShell's test: the largest node force (drag included) below
 //! `morphoshell_force_threshold` × μ t a_min and the largest speed below
 //! `morphoshell_speed_threshold` × √(μ/ρ). Both include the force a term leaves unbalanced on
-//! a degree of freedom it moves itself (a pressed slide, [`Term::explicit_unbalanced`]), so a
+//! a degree of freedom it moves itself (a pressed slide, [`ExplicitHooks::explicit_unbalanced`]), so a
 //! load the sheet does not carry is never reported as an equilibrium. Each frame's `residual`
 //! (`log.csv`) is the window test's force measure at the frame's state.
 //!
@@ -65,7 +65,7 @@
 //! `c Δt < 2`; and `gradient_descent_steps + max_long_times · T/Δt` at most
 //! [`crate::settings::MAX_STEPS`]. The time limit is checked every step.
 //!
-//! [`Term::explicit_unbalanced`]: crate::energy::term::Term::explicit_unbalanced
+//! [`ExplicitHooks::explicit_unbalanced`]: crate::energy::term::ExplicitHooks::explicit_unbalanced
 //!
 //! ## Failure
 //! A state that is not finite, or a kinetic energy above 100 × μ t A (strains of order ten
@@ -260,7 +260,7 @@ pub(super) fn run_explicit(
     let sc = s.scene;
     if s.changing {
         return Err(RunError::Unsupported(
-            "a term's elements change during the run (Term::stencil_at), which the explicit \
+            "a term's elements change during the run (a term declares ChangingElements), which the explicit \
              driver does not follow: use solver.mode = \"dynamic\""
                 .into(),
         ));
@@ -417,8 +417,8 @@ pub(super) fn run_explicit(
             };
             sc.prescribe(&mut state.x, dial);
             // Terms whose own state follows the sheet (a moving slide) catch up with it first.
-            for term in sc.terms.iter() {
-                term.explicit_begin(&pot, &state.x, dt);
+            for hooks in sc.terms.iter().filter_map(|t| t.explicit()) {
+                hooks.explicit_begin(&pot, &state.x, dt);
             }
             let c = if k.phase == Phase::Dial {
                 rate_dial
@@ -439,8 +439,8 @@ pub(super) fn run_explicit(
             // Terms that act on the step itself (slide friction), before the equilibrium test sees
             // the forces (a fused step has none).
             if !fused {
-                for term in sc.terms.iter() {
-                    term.explicit_step(&pot, &state.x, &mut v, &mut g, dt);
+                for hooks in sc.terms.iter().filter_map(|t| t.explicit()) {
+                    hooks.explicit_step(&pot, &state.x, &mut v, &mut g, dt);
                 }
             }
             // The equilibrium test, once per window (before the step, at the state the force

@@ -57,7 +57,7 @@ impl Disjoint {
 /// The explicit step, `g ← ∇Φ(x)` then [`advance`], fused when it can be.
 ///
 /// When the scene's only term goes through [`crate::assembly::assemble_elements`] and does
-/// not act on the step ([`crate::energy::term::Term::acts_on_explicit_steps`]), each vertex is
+/// not act on the step ([`crate::energy::term::Term::explicit`]), each vertex is
 /// advanced inside the gradient's parallel parts, by the part that owns it, right after that
 /// part has summed its force ([`crate::assembly::assemble_elements_owned`], through
 /// [`crate::solve::Potential::owned`]). The new positions go
@@ -87,7 +87,7 @@ impl Step {
         let fusable = fuse
             && sc.terms.len() == 1
             && pot.pattern.maps.len() == 1
-            && !sc.terms[0].acts_on_explicit_steps();
+            && sc.terms[0].explicit().is_none();
         let mut used = vec![!fusable; nv];
         if fusable {
             let map = &pot.pattern.maps[0];
