@@ -477,10 +477,8 @@ pub fn restart_fields(scene: &Scene) -> std::collections::BTreeSet<String> {
     if scene.has_edge_dofs() {
         r.insert("edge_angles".to_string());
     }
-    for t in scene.terms.iter() {
-        if let Some(f) = t.state_field() {
-            r.insert(f.to_string());
-        }
+    for t in scene.terms.iter().filter_map(|t| t.tracked()) {
+        r.insert(t.state_field().to_string());
     }
     r
 }
@@ -985,17 +983,14 @@ impl Writer {
             let ea = sc.topo.face_edges.iter().flat_map(|fe| fe.map(|e| phi[e]));
             ff.insert("edge_angles".into(), vec3(ea.collect()));
         }
-        for t in sc.terms.iter() {
-            if let Some(name) = t.state_field() {
-                let data = t.state(x, phi);
-                ff.insert(
-                    name.into(),
-                    Field {
-                        components: t.state_components(),
-                        data,
-                    },
-                );
-            }
+        for t in sc.terms.iter().filter_map(|t| t.tracked()) {
+            ff.insert(
+                t.state_field().into(),
+                Field {
+                    components: t.state_components(),
+                    data: t.state(x, phi),
+                },
+            );
         }
         // Slot fields in the input's corner order, like the faces.
         for name in sc.slot_fields() {

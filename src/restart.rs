@@ -2,7 +2,7 @@
 //!
 //! A frame holds the deformed positions, the per-vertex `velocity`, with an edge-DOF bending
 //! model the per-face `edge_angles`, and the state of terms that track one across steps (an end
-//! moment's `moment_turn`, [`crate::energy::term::Term::state_field`]). The reference geometry, rest forms and material come from
+//! moment's `moment_turn`, [`crate::energy::term::Tracked::state_field`]). The reference geometry, rest forms and material come from
 //! the mesh file and settings of the new run, so the frame must have the same vertices and faces
 //! as that mesh. The frame's time (dynamics) or dial (statics) is looked up in the `series.pvd`
 //! next to it; without one the run starts its clock at 0 and says so in a warning.
@@ -271,18 +271,16 @@ pub fn restart_from_frame(
         }
     }
     // Terms that track a state across steps (an end moment's turns) restart from theirs.
-    for t in scene.terms.iter() {
-        if let Some(field) = t.state_field() {
-            let data = frame.face_field(field, t.state_components())?;
-            match t.restore(
-                &frame.positions,
-                &phi,
-                data.as_ref().map(|f| f.data.as_slice()),
-            ) {
-                Ok(Some(w)) => warnings.push(format!("{name}: {w}")),
-                Ok(None) => {}
-                Err(e) => return Err(bad(e.to_string())),
-            }
+    for t in scene.terms.iter().filter_map(|t| t.tracked()) {
+        let data = frame.face_field(t.state_field(), t.state_components())?;
+        match t.restore(
+            &frame.positions,
+            &phi,
+            data.as_ref().map(|f| f.data.as_slice()),
+        ) {
+            Ok(Some(w)) => warnings.push(format!("{name}: {w}")),
+            Ok(None) => {}
+            Err(e) => return Err(bad(e.to_string())),
         }
     }
     Ok((

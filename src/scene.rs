@@ -252,8 +252,9 @@ impl Scene {
         names.extend(
             self.terms
                 .iter()
+                .filter_map(|t| t.tracked())
                 .filter(|t| t.state_components() == 3)
-                .filter_map(|t| t.state_field()),
+                .map(|t| t.state_field()),
         );
         names
     }
@@ -372,21 +373,21 @@ impl Scene {
     }
 
     /// Tells every term that `(x, phi)` is an accepted state (see
-    /// [`crate::energy::term::Term::accept`]).
+    /// [`crate::energy::term::Tracked::accept`]).
     pub fn accept(&self, x: &[Vec3], phi: &[Real]) {
-        for t in self.terms.iter() {
+        for t in self.terms.iter().filter_map(|t| t.tracked()) {
             t.accept(x, phi);
         }
     }
 
     /// Applies every term's projection after an accepted implicit step (see
-    /// [`crate::energy::term::Term::project`]).
+    /// [`crate::energy::term::Projection`]).
     pub fn project(
         &self,
         pot: &crate::solve::Potential,
         state: &mut crate::solve::State,
     ) -> Result<(), crate::energy::term::StateError> {
-        for t in self.terms.iter() {
+        for t in self.terms.iter().filter_map(|t| t.projection()) {
             t.project(pot, &mut state.x, &state.dofs)?;
         }
         Ok(())
@@ -409,9 +410,12 @@ impl Scene {
     }
 
     /// Whether every term admits `(x, phi)` as the next accepted state (see
-    /// [`crate::energy::term::Term::admissible`]).
+    /// [`crate::energy::term::Tracked::admissible`]).
     pub fn admissible(&self, x: &[Vec3], phi: &[Real]) -> bool {
-        self.terms.iter().all(|t| t.admissible(x, phi))
+        self.terms
+            .iter()
+            .filter_map(|t| t.tracked())
+            .all(|t| t.admissible(x, phi))
     }
 
     /// Moves the vertices on prescribed paths to `reference + dial × displacement`.

@@ -40,7 +40,7 @@
 //! `x[v0], x[v1], x[v2]`.
 
 use crate::assembly::{assemble_elements, ElementMap, Want};
-use crate::energy::term::{LowRank, LowRankPart, Multiplier, Predictor, Stencil, Term};
+use crate::energy::term::{LowRank, LowRankPart, Multiplier, Predictor, SavedState, Stencil, Term};
 use crate::energy::HessianProjection;
 use crate::math::{Real, Vec3};
 use crate::mesh::MeshError;
@@ -182,21 +182,8 @@ impl Term for Gas {
         "gas"
     }
 
-    /// Volume control: the multiplier λ (Pa), which warm-starts the next solve.
-    fn saved_state(&self) -> Vec<Real> {
-        vec![self.multiplier()]
-    }
-
-    fn load_state(&self, saved: &[Real]) -> Result<(), String> {
-        match saved {
-            [l] if l.is_finite() => {
-                *self.multiplier.lock().unwrap_or_else(|e| e.into_inner()) = *l;
-                Ok(())
-            }
-            _ => Err(format!(
-                "the gas's multiplier must be one finite number, got {saved:?}"
-            )),
-        }
+    fn saved(&self) -> Option<&dyn SavedState> {
+        Some(self)
     }
 
     fn stencil(&self, scene: &Scene) -> Stencil {
@@ -272,6 +259,25 @@ impl Term for Gas {
 
     fn low_rank(&self) -> Option<&dyn LowRankPart> {
         Some(self)
+    }
+}
+
+impl SavedState for Gas {
+    /// Volume control: the multiplier λ (Pa), which warm-starts the next solve.
+    fn saved_state(&self) -> Vec<Real> {
+        vec![self.multiplier()]
+    }
+
+    fn load_state(&self, saved: &[Real]) -> Result<(), String> {
+        match saved {
+            [l] if l.is_finite() => {
+                *self.multiplier.lock().unwrap_or_else(|e| e.into_inner()) = *l;
+                Ok(())
+            }
+            _ => Err(format!(
+                "the gas's multiplier must be one finite number, got {saved:?}"
+            )),
+        }
     }
 }
 

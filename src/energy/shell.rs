@@ -18,7 +18,7 @@ use super::bending::average::MidedgeAverage;
 use super::bending::BendingModel;
 use super::material::{DensityDerivs, FaceDensity};
 use super::membrane::Membrane;
-use super::term::{ElementKernel, Stencil};
+use super::term::{ElementKernel, Projection, StateError, Stencil, Tracked};
 use crate::geometry::{
     first_fundamental_form, first_fundamental_form_hessian_pattern, first_fundamental_form_jacobian,
 };
@@ -383,17 +383,35 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
         }))
     }
 
-    fn project(
-        &self,
-        pot: &Potential,
-        x: &mut [Vec3],
-        _phi: &[Real],
-    ) -> Result<Option<Real>, super::term::StateError> {
-        self.membrane.project(pot, x)
+    /// A membrane with a state of its own (the prism's position-based thickness).
+    fn tracked(&self) -> Option<&dyn Tracked> {
+        self.membrane.state_field().is_some().then_some(self)
     }
 
-    fn state_field(&self) -> Option<&'static str> {
-        self.membrane.state_field()
+    fn projection(&self) -> Option<&dyn Projection> {
+        self.membrane.projects().then_some(self)
+    }
+
+    /// The face energies once for both the totals and the densities.
+    fn report(
+        &self,
+        pot: &Potential,
+        _: &crate::assembly::ElementMap,
+        x: &[Vec3],
+        phi: &[Real],
+    ) -> (Vec<(&'static str, Real)>, Vec<(String, Vec<Real>)>) {
+        let fe = self.face_energies(pot, x, phi);
+        let mut f = densities(pot, &fe);
+        f.extend(self.membrane.face_fields(pot, x));
+        (totals(&fe), f)
+    }
+}
+
+impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Tracked
+    for Shell<M, B, N, S>
+{
+    fn state_field(&self) -> &'static str {
+        self.membrane.state_field().unwrap_or("membrane_state")
     }
 
     fn state_components(&self) -> usize {
@@ -409,22 +427,21 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
         _x: &[Vec3],
         _phi: &[Real],
         field: Option<&[Real]>,
-    ) -> Result<Option<String>, super::term::StateError> {
+    ) -> Result<Option<String>, StateError> {
         self.membrane.restore(field)
     }
+}
 
-    /// The face energies once for both the totals and the densities.
-    fn report(
+impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Projection
+    for Shell<M, B, N, S>
+{
+    fn project(
         &self,
         pot: &Potential,
-        _: &crate::assembly::ElementMap,
-        x: &[Vec3],
-        phi: &[Real],
-    ) -> (Vec<(&'static str, Real)>, Vec<(String, Vec<Real>)>) {
-        let fe = self.face_energies(pot, x, phi);
-        let mut f = densities(pot, &fe);
-        f.extend(self.membrane.face_fields(pot, x));
-        (totals(&fe), f)
+        x: &mut [Vec3],
+        _phi: &[Real],
+    ) -> Result<Option<Real>, StateError> {
+        self.membrane.project(pot, x)
     }
 }
 

@@ -273,6 +273,10 @@ impl VertexKernel for Slides {
         self.set_upper(next);
     }
 
+    fn saves_state(&self) -> bool {
+        true
+    }
+
     /// The upper slide's height (m) and velocity (m/s).
     fn saved_state(&self) -> Vec<Real> {
         vec![

@@ -196,76 +196,28 @@ pub trait Term: Send + Sync {
         None
     }
 
-    /// The name of the per-face field that carries the state this term tracks across steps
-    /// (default: none). Frames hold it as a 3-vector per face in the face's edge order (like
-    /// `edge_angles`), and a restart hands it back to [`Term::restore`].
-    fn state_field(&self) -> Option<&'static str> {
-        None
-    }
-
-    /// Values per face of [`Term::state_field`] (default: 3).
-    fn state_components(&self) -> usize {
-        3
-    }
-
-    /// A projection applied after each accepted implicit step (before the velocities are
-    /// taken from the positions), such as seed 002's position-based volume preservation; it may
-    /// move the positions and the term's own state. Returns the relative constraint error it
-    /// corrected, or `None` when the term has none (default); an error (an element turned inside
-    /// out) leaves its state as it was, and the driver cuts the step.
-    fn project(
-        &self,
-        _pot: &Potential,
-        _x: &mut [Vec3],
-        _phi: &[Real],
-    ) -> Result<Option<Real>, StateError> {
-        Ok(None)
-    }
-
-    /// The tracked state at `(x, phi)` for [`Term::state_field`]: [`Term::state_components`]
-    /// values per face.
-    fn state(&self, _x: &[Vec3], _phi: &[Real]) -> Vec<Real> {
-        Vec::new()
-    }
-
-    /// State the term carries across steps that no frame field holds (a gas's pressure
-    /// multiplier, a moving slide's height and speed), saved with every frame for an exact
-    /// restart (default: none).
-    fn saved_state(&self) -> Vec<Real> {
-        Vec::new()
-    }
-
-    /// Restores [`Term::saved_state`] on a restart; values of the wrong length are an error.
-    fn load_state(&self, _saved: &[Real]) -> Result<(), String> {
-        Ok(())
-    }
-
-    /// Restores the tracked state at the restart state `(x, phi)` from the frame's field
-    /// (`None` when the frame has none: the term then says in the returned warning what it
-    /// assumed). An invalid field is an error naming the face.
-    fn restore(
-        &self,
-        _x: &[Vec3],
-        _phi: &[Real],
-        _field: Option<&[Real]>,
-    ) -> Result<Option<String>, StateError> {
-        Ok(None)
-    }
-
-    /// Called by the drivers after every accepted step (static continuation step or time
-    /// step) at the accepted state, for terms that track it (default: nothing).
-    fn accept(&self, _x: &[Vec3], _phi: &[Real]) {}
-
-    /// Whether `(x, phi)` may become the next accepted state (default: yes); a term that tracks
-    /// a state across steps refuses a step too large for it, and the driver cuts the step.
-    fn admissible(&self, _x: &[Vec3], _phi: &[Real]) -> bool {
-        true
-    }
-
     /// Quantities to log per frame, by column name (default: none), e.g. a load's conjugate
     /// displacement for load–displacement curves.
     fn observables(&self, _pot: &Potential, _x: &[Vec3], _phi: &[Real]) -> Vec<(String, Real)> {
         Vec::new()
+    }
+
+    /// A term that tracks a per-face state across steps, carried by the frames, declares it
+    /// here (default: none).
+    fn tracked(&self) -> Option<&dyn Tracked> {
+        None
+    }
+
+    /// A term that carries a state no frame field holds declares it here, for the frames'
+    /// restart files (default: none).
+    fn saved(&self) -> Option<&dyn SavedState> {
+        None
+    }
+
+    /// A term that projects the state after each accepted implicit step declares it here
+    /// (default: none).
+    fn projection(&self) -> Option<&dyn Projection> {
+        None
     }
 
     /// A term whose elements change during a run declares it here (default: fixed elements).
@@ -301,6 +253,67 @@ pub trait Term: Send + Sync {
     fn explicit(&self) -> Option<&dyn ExplicitHooks> {
         None
     }
+}
+
+/// The capability of a term that tracks a per-face state across steps (the moment's angles,
+/// the prism's position-based thickness).
+pub trait Tracked {
+    /// The name of the per-face field that carries it. Frames hold it in the face's edge order
+    /// (like `edge_angles`) when it has 3 components per face, and a restart hands it back to
+    /// [`Tracked::restore`].
+    fn state_field(&self) -> &'static str;
+
+    /// Values per face (default: 3).
+    fn state_components(&self) -> usize {
+        3
+    }
+
+    /// The state at `(x, phi)`: [`Tracked::state_components`] values per face.
+    fn state(&self, x: &[Vec3], phi: &[Real]) -> Vec<Real>;
+
+    /// Restores the state at the restart state `(x, phi)` from the frame's field (`None` when
+    /// the frame has none: the term then says in the returned warning what it assumed). An
+    /// invalid field is an error naming the face.
+    fn restore(
+        &self,
+        x: &[Vec3],
+        phi: &[Real],
+        field: Option<&[Real]>,
+    ) -> Result<Option<String>, StateError>;
+
+    /// Called by the drivers after every accepted step (static continuation step or time
+    /// step) at the accepted state (default: nothing).
+    fn accept(&self, _x: &[Vec3], _phi: &[Real]) {}
+
+    /// Whether `(x, phi)` may become the next accepted state (default: yes); a step too large
+    /// for the tracked state is refused, and the driver cuts it.
+    fn admissible(&self, _x: &[Vec3], _phi: &[Real]) -> bool {
+        true
+    }
+}
+
+/// The capability of a term with a state no frame field holds (a gas's pressure multiplier, a
+/// moving slide's height and speed), saved beside every frame for an exact restart.
+pub trait SavedState {
+    /// The state.
+    fn saved_state(&self) -> Vec<Real>;
+    /// Restores it on a restart; values of the wrong length are an error.
+    fn load_state(&self, saved: &[Real]) -> Result<(), String>;
+}
+
+/// The capability of a term that projects the state after each accepted implicit step.
+pub trait Projection {
+    /// Applied before the velocities are taken from the positions, such as seed 002's
+    /// position-based volume preservation; it may move the positions and the term's own
+    /// state. Returns the relative constraint error it corrected (`None` when it had nothing
+    /// to correct); an error (an element turned inside out) leaves its state as it was, and
+    /// the driver cuts the step.
+    fn project(
+        &self,
+        pot: &Potential,
+        x: &mut [Vec3],
+        phi: &[Real],
+    ) -> Result<Option<Real>, StateError>;
 }
 
 /// The capability of a term whose elements change during a run (contact pairs).
@@ -480,11 +493,16 @@ pub trait VertexKernel: Send + Sync {
         _dt: Real,
     ) {
     }
-    /// See [`Term::saved_state`] (default: none).
+    /// Whether the kernel carries a state no frame field holds: its term then declares
+    /// [`SavedState`] with the two methods below (default: no).
+    fn saves_state(&self) -> bool {
+        false
+    }
+    /// See [`SavedState::saved_state`] (default: none).
     fn saved_state(&self) -> Vec<Real> {
         Vec::new()
     }
-    /// See [`Term::load_state`] (default: nothing to load).
+    /// See [`SavedState::load_state`] (default: nothing to load).
     fn load_state(&self, _saved: &[Real]) -> Result<(), String> {
         Ok(())
     }
@@ -513,11 +531,8 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
     fn explicit(&self) -> Option<&dyn ExplicitHooks> {
         self.kernel.explicit_hooks().then_some(self)
     }
-    fn saved_state(&self) -> Vec<Real> {
-        self.kernel.saved_state()
-    }
-    fn load_state(&self, saved: &[Real]) -> Result<(), String> {
-        self.kernel.load_state(saved)
+    fn saved(&self) -> Option<&dyn SavedState> {
+        self.kernel.saves_state().then_some(self)
     }
     fn observables(&self, pot: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
         self.kernel.observables(pot, x)
@@ -585,6 +600,15 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
             values,
             &pot.pattern.col_ptr,
         )
+    }
+}
+
+impl<K: VertexKernel> SavedState for VertexTerm<K> {
+    fn saved_state(&self) -> Vec<Real> {
+        self.kernel.saved_state()
+    }
+    fn load_state(&self, saved: &[Real]) -> Result<(), String> {
+        self.kernel.load_state(saved)
     }
 }
 

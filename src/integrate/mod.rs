@@ -204,8 +204,8 @@ pub fn run(
     let driver = driver.filter(|d| d.mode == s.summary.mode);
     if let Some(d) = &driver {
         for t in scene.terms.iter() {
-            if let Some(v) = d.terms.get(t.name()) {
-                t.load_state(v).map_err(RunError::Restart)?;
+            if let (Some(s), Some(v)) = (t.saved(), d.terms.get(t.name())) {
+                s.load_state(v).map_err(RunError::Restart)?;
             }
         }
     }

@@ -240,7 +240,9 @@ impl<'a> Solver<'a> {
         driver.mode = self.summary.mode.clone();
         driver.globals = state.dofs[self.scene.num_edge_dofs()..].to_vec();
         for t in self.scene.terms.iter() {
-            let saved = t.saved_state();
+            let Some(saved) = t.saved().map(|s| s.saved_state()) else {
+                continue;
+            };
             if !saved.is_empty() {
                 driver.terms.insert(t.name().to_string(), saved);
             }

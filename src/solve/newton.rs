@@ -127,7 +127,7 @@ pub enum SolveError {
         slope: Real,
     },
     /// A term refused the converged state as the next accepted one (see
-    /// [`crate::energy::term::Term::admissible`]).
+    /// [`crate::energy::term::Tracked::admissible`]).
     #[error("a term refused the step: {0}")]
     Refused(&'static str),
     /// A term's multiplier (a prescribed volume's pressure) did not settle.

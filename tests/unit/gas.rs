@@ -536,7 +536,9 @@ fn position_based_projection_restores_the_skin_volume() {
                 .1
         };
         let r0 = ratio(&x);
-        let c = shell.project(&pot, &mut x, &[]).unwrap().unwrap();
+        let projection = shell.projection().expect("the prism projects");
+        let tracked = shell.tracked().expect("the prism tracks its thickness");
+        let c = projection.project(&pot, &mut x, &[]).unwrap().unwrap();
         let r1 = ratio(&x);
         println!("{iterations} projections: ratio {r0} → {r1} (C/V₀ = {c:e})");
         assert!((c - (r0 - 1.0)).abs() < 1e-12);
@@ -557,10 +559,10 @@ fn position_based_projection_restores_the_skin_volume() {
             let mut y = x.clone();
             let f0 = sc.mesh.faces[0];
             y[f0[1]] = y[f0[0]];
-            let state = shell.state(&x, &[]);
-            let err = shell.project(&pot, &mut y, &[]).unwrap_err();
+            let state = tracked.state(&x, &[]);
+            let err = projection.project(&pot, &mut y, &[]).unwrap_err();
             assert!(err.to_string().contains("thickness not finite"), "{err}");
-            assert_eq!(shell.state(&x, &[]), state, "the state is left as it was");
+            assert_eq!(tracked.state(&x, &[]), state, "the state is left as it was");
         }
         // The frame's thickness field is the projected thickness: thinner than at rest.
         let fields = shell.face_fields(&pot, &x, &[]);

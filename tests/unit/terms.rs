@@ -292,7 +292,7 @@ fn end_moment_matches_finite_differences_past_a_half_turn() {
         let phi = vec![0.02; sc.num_edge_dofs()];
         // Accept in steps below π/2, as the solver would.
         for k in 1..=11 {
-            sc.terms[i].accept(
+            sc.terms[i].tracked().expect("the moment tracks").accept(
                 &rolled(&sc, 0.1 * k as Real * std::f64::consts::PI, 0.0),
                 &phi,
             );

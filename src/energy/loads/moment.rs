@@ -12,7 +12,7 @@
 //! with `n_V` the vector's direction projected normal to `t⁰` at the last accepted state,
 //! `o_V = −k × n_V`, `k = ±t⁰` the sense in which the angle counts positive (the face's outward
 //! direction tilting toward the side its normal points to), and `θ_V⁰` the angle accumulated up
-//! to that state ([`crate::energy::term::Term::accept`] updates them after every accepted step,
+//! to that state ([`crate::energy::term::Tracked::accept`] updates them after every accepted step,
 //! and a step that turns an edge by more than π/2 is cut). So each angle is single-valued within
 //! a solve and continues through full turns across steps: a strip can be rolled into a full
 //! circle. The face's turn is the mean `θ = (θ_A + θ_B)/2`.
@@ -47,7 +47,7 @@
 //! without edge DOFs). Units: m in N·m/m, E in J, gradient N and N·m.
 
 use super::select_vertices;
-use crate::energy::term::{ElementKernel, StateError, Stencil, Term};
+use crate::energy::term::{ElementKernel, StateError, Stencil, Term, Tracked};
 use crate::math::{skew, Mat3, Real, SMat, SVec, Vec3};
 use crate::mesh::topology::NONE;
 use crate::mesh::MeshError;
@@ -278,6 +278,23 @@ impl Term for MomentTerm {
             &pot.pattern.col_ptr,
         )
     }
+    fn observables(&self, _: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
+        let Ok(frames) = self.0.frames.lock() else {
+            return Vec::new();
+        };
+        let mut sum = 0.0;
+        for (e, f) in self.0.edges.iter().zip(frames.iter()) {
+            sum += Moment::turn(f, vectors(x, e)).0;
+        }
+        vec![("moment_rotation".into(), sum / self.0.edges.len() as Real)]
+    }
+
+    fn tracked(&self) -> Option<&dyn Tracked> {
+        Some(self)
+    }
+}
+
+impl Tracked for MomentTerm {
     fn accept(&self, x: &[Vec3], _: &[Real]) {
         if let Ok(mut frames) = self.0.frames.lock() {
             for (e, f) in self.0.edges.iter().zip(frames.iter_mut()) {
@@ -299,8 +316,8 @@ impl Term for MomentTerm {
             (ta - f.a.theta).abs() <= lim && (tb - f.b.theta).abs() <= lim
         })
     }
-    fn state_field(&self) -> Option<&'static str> {
-        Some("moment_turn")
+    fn state_field(&self) -> &'static str {
+        "moment_turn"
     }
     /// Each loaded edge's turn θ (rad) at its boundary face and edge slot; 0 elsewhere.
     fn state(&self, x: &[Vec3], _: &[Real]) -> Vec<Real> {
@@ -344,16 +361,6 @@ impl Term for MomentTerm {
             f.b = frame(&f.k, &b, theta);
         }
         Ok(None)
-    }
-    fn observables(&self, _: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
-        let Ok(frames) = self.0.frames.lock() else {
-            return Vec::new();
-        };
-        let mut sum = 0.0;
-        for (e, f) in self.0.edges.iter().zip(frames.iter()) {
-            sum += Moment::turn(f, vectors(x, e)).0;
-        }
-        vec![("moment_rotation".into(), sum / self.0.edges.len() as Real)]
     }
 }
 

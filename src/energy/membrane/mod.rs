@@ -41,8 +41,14 @@ pub trait Membrane: Send + Sync + 'static {
         Vec::new()
     }
 
-    /// A projection after each accepted implicit step that moves the positions (default: none;
-    /// see [`crate::energy::term::Term::project`]).
+    /// Whether the membrane projects the state after each accepted implicit step (default:
+    /// no); its shell term then declares [`crate::energy::term::Projection`] with
+    /// [`Membrane::project`].
+    fn projects(&self) -> bool {
+        false
+    }
+
+    /// The projection (see [`crate::energy::term::Projection`]; default: none).
     fn project(&self, _pot: &Potential, _x: &mut [Vec3]) -> Result<Option<Real>, StateError> {
         Ok(None)
     }

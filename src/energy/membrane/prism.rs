@@ -403,6 +403,10 @@ impl Membrane for Prism {
         vec![("skin_volume_ratio".into(), self.volume_ratio(pot, x))]
     }
 
+    fn projects(&self) -> bool {
+        self.mode == PrismThickness::Pbd
+    }
+
     fn project(
         &self,
         pot: &Potential,
