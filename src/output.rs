@@ -915,7 +915,7 @@ impl Writer {
         let mut term_energies = Vec::new();
         let mut term_fields = Vec::new();
         for (t, map) in sc.terms.iter().zip(&pot.pattern.maps) {
-            let (e, f) = t.report(pot, map, x, phi);
+            let (e, f) = crate::energy::term::report(t.as_ref(), pot, map, x, phi);
             term_energies.extend(e);
             term_fields.extend(f);
         }
@@ -1050,7 +1050,7 @@ impl Writer {
         row.observables = sc
             .terms
             .iter()
-            .flat_map(|t| t.observables(pot, x, phi))
+            .flat_map(|t| crate::energy::term::observables(t.as_ref(), pot, x, phi))
             .collect();
         let m = &mut self.frame_mesh;
         let keep = |n: &String| Self::writes(&self.selection, &self.restart_fields, n);
@@ -1337,7 +1337,12 @@ fn morphoshell_fields(m: &mut Mesh, pot: &Potential, x: &[Vec3], phi: &[Real], a
         .collect();
     m.face_fields
         .insert("strain_measure".into(), Field::scalar(strain));
-    let Some(ga) = sc.terms.iter().find_map(|t| t.membrane_stress(pot, x, phi)) else {
+    let Some(ga) = sc
+        .terms
+        .iter()
+        .filter_map(|t| t.reports())
+        .find_map(|r| r.membrane_stress(pot, x, phi))
+    else {
         return;
     };
     let nf = sc.num_faces();

@@ -40,7 +40,9 @@
 //! `x[v0], x[v1], x[v2]`.
 
 use crate::assembly::{assemble_elements, ElementMap, Want};
-use crate::energy::term::{LowRank, LowRankPart, Multiplier, Predictor, SavedState, Stencil, Term};
+use crate::energy::term::{
+    LowRank, LowRankPart, Multiplier, Predictor, Reports, SavedState, Stencil, Term,
+};
 use crate::energy::HessianProjection;
 use crate::math::{Real, Vec3};
 use crate::mesh::MeshError;
@@ -235,19 +237,6 @@ impl Term for Gas {
         st.energy
     }
 
-    fn observables(&self, pot: &Potential, x: &[Vec3], _phi: &[Real]) -> Vec<(String, Real)> {
-        let st = self.state(pot, x);
-        vec![
-            ("gas_pressure".into(), st.gauge),
-            ("gas_volume".into(), st.volume),
-        ]
-    }
-
-    fn face_fields(&self, pot: &Potential, x: &[Vec3], _phi: &[Real]) -> Vec<(String, Vec<Real>)> {
-        let st = self.state(pot, x);
-        vec![("pressure".into(), vec![st.gauge; pot.scene.num_faces()])]
-    }
-
     fn updates(&self) -> Option<&dyn Multiplier> {
         Some(self)
     }
@@ -259,6 +248,25 @@ impl Term for Gas {
 
     fn low_rank(&self) -> Option<&dyn LowRankPart> {
         Some(self)
+    }
+
+    fn reports(&self) -> Option<&dyn Reports> {
+        Some(self)
+    }
+}
+
+impl Reports for Gas {
+    fn observables(&self, pot: &Potential, x: &[Vec3], _phi: &[Real]) -> Vec<(String, Real)> {
+        let st = self.state(pot, x);
+        vec![
+            ("gas_pressure".into(), st.gauge),
+            ("gas_volume".into(), st.volume),
+        ]
+    }
+
+    fn face_fields(&self, pot: &Potential, x: &[Vec3], _phi: &[Real]) -> Vec<(String, Vec<Real>)> {
+        let st = self.state(pot, x);
+        vec![("pressure".into(), vec![st.gauge; pot.scene.num_faces()])]
     }
 }
 

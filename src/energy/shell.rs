@@ -18,7 +18,7 @@ use super::bending::average::MidedgeAverage;
 use super::bending::BendingModel;
 use super::material::{DensityDerivs, FaceDensity};
 use super::membrane::Membrane;
-use super::term::{ElementKernel, Projection, StateError, Stencil, Tracked};
+use super::term::{ElementKernel, Projection, Reports, StateError, Stencil, Tracked};
 use crate::geometry::{
     first_fundamental_form, first_fundamental_form_hessian_pattern, first_fundamental_form_jacobian,
 };
@@ -349,6 +349,23 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
         )
     }
 
+    /// A membrane with a state of its own (the prism's position-based thickness).
+    fn tracked(&self) -> Option<&dyn Tracked> {
+        self.membrane.state_field().is_some().then_some(self)
+    }
+
+    fn projection(&self) -> Option<&dyn Projection> {
+        self.membrane.projects().then_some(self)
+    }
+
+    fn reports(&self) -> Option<&dyn Reports> {
+        Some(self)
+    }
+}
+
+impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Reports
+    for Shell<M, B, N, S>
+{
     /// Stretching and bending, elastic parts only (Kelvin–Voigt damping is dissipation, not
     /// stored energy).
     fn energies(
@@ -357,8 +374,8 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
         _: &crate::assembly::ElementMap,
         x: &[Vec3],
         phi: &[Real],
-    ) -> Vec<(&'static str, Real)> {
-        totals(&self.face_energies(pot, x, phi))
+    ) -> Option<Vec<(&'static str, Real)>> {
+        Some(totals(&self.face_energies(pot, x, phi)))
     }
 
     /// `stretching_energy_density` and `bending_energy_density` (J/m² of rest area), and the
@@ -383,15 +400,6 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
         }))
     }
 
-    /// A membrane with a state of its own (the prism's position-based thickness).
-    fn tracked(&self) -> Option<&dyn Tracked> {
-        self.membrane.state_field().is_some().then_some(self)
-    }
-
-    fn projection(&self) -> Option<&dyn Projection> {
-        self.membrane.projects().then_some(self)
-    }
-
     /// The face energies once for both the totals and the densities.
     fn report(
         &self,
@@ -399,11 +407,11 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
         _: &crate::assembly::ElementMap,
         x: &[Vec3],
         phi: &[Real],
-    ) -> (Vec<(&'static str, Real)>, Vec<(String, Vec<Real>)>) {
+    ) -> (Option<Vec<(&'static str, Real)>>, Vec<(String, Vec<Real>)>) {
         let fe = self.face_energies(pot, x, phi);
         let mut f = densities(pot, &fe);
         f.extend(self.membrane.face_fields(pot, x));
-        (totals(&fe), f)
+        (Some(totals(&fe)), f)
     }
 }
 

@@ -136,70 +136,11 @@ pub trait Term: Send + Sync {
         values: &mut [Real],
     ) -> Real;
 
-    /// Energies to report, by name (default: the whole term under [`Term::name`]).
-    fn energies(
-        &self,
-        pot: &Potential,
-        map: &ElementMap,
-        x: &[Vec3],
-        phi: &[Real],
-    ) -> Vec<(&'static str, Real)> {
-        let e = self.eval(
-            pot,
-            map,
-            x,
-            phi,
-            Want::Energy,
-            HessianProjection::None,
-            &mut [],
-            &mut [],
-        );
-        vec![(self.name(), e)]
-    }
-
-    /// Everything a frame reports at once: [`Term::energies`] and [`Term::face_fields`]. A term
-    /// whose two share a computation overrides it to do that computation once.
-    #[allow(clippy::type_complexity)]
-    fn report(
-        &self,
-        pot: &Potential,
-        map: &ElementMap,
-        x: &[Vec3],
-        phi: &[Real],
-    ) -> (Vec<(&'static str, Real)>, Vec<(String, Vec<Real>)>) {
-        (
-            self.energies(pot, map, x, phi),
-            self.face_fields(pot, x, phi),
-        )
-    }
-
-    /// Per-face fields this term contributes to the frames (default: none).
-    fn face_fields(
-        &self,
-        _pot: &Potential,
-        _x: &[Vec3],
-        _phi: &[Real],
-    ) -> Vec<(String, Vec<Real>)> {
-        Vec::new()
-    }
-
-    /// `∂W/∂a` of each face's stretching energy W (J) with respect to its barycentric first
-    /// fundamental form, in the stored components `[a11, a12, a22]` (J/m²), for the frames'
-    /// Cauchy stress (`fields::cauchy_principal`). Default: `None`, no membrane
-    /// energy.
-    fn membrane_stress(
-        &self,
-        _pot: &Potential,
-        _x: &[Vec3],
-        _phi: &[Real],
-    ) -> Option<Vec<crate::math::Sym2>> {
+    /// A term that reports more than its energy under its name (several energies, face
+    /// fields, logged quantities, membrane stresses) declares it here (default: none; see
+    /// [`energies`]).
+    fn reports(&self) -> Option<&dyn Reports> {
         None
-    }
-
-    /// Quantities to log per frame, by column name (default: none), e.g. a load's conjugate
-    /// displacement for load–displacement curves.
-    fn observables(&self, _pot: &Potential, _x: &[Vec3], _phi: &[Real]) -> Vec<(String, Real)> {
-        Vec::new()
     }
 
     /// A term that tracks a per-face state across steps, carried by the frames, declares it
@@ -253,6 +194,124 @@ pub trait Term: Send + Sync {
     fn explicit(&self) -> Option<&dyn ExplicitHooks> {
         None
     }
+}
+
+/// The capability of a term that reports more than its energy under its name.
+pub trait Reports {
+    /// Energies to report, by name; `None` (default) reports the whole term under its name.
+    fn energies(
+        &self,
+        _pot: &Potential,
+        _map: &ElementMap,
+        _x: &[Vec3],
+        _phi: &[Real],
+    ) -> Option<Vec<(&'static str, Real)>> {
+        None
+    }
+
+    /// Everything a frame reports at once: [`Reports::energies`] and [`Reports::face_fields`].
+    /// A term whose two share a computation overrides it to do that computation once.
+    #[allow(clippy::type_complexity)]
+    fn report(
+        &self,
+        pot: &Potential,
+        map: &ElementMap,
+        x: &[Vec3],
+        phi: &[Real],
+    ) -> (Option<Vec<(&'static str, Real)>>, Vec<(String, Vec<Real>)>) {
+        (
+            self.energies(pot, map, x, phi),
+            self.face_fields(pot, x, phi),
+        )
+    }
+
+    /// Per-face fields this term contributes to the frames (default: none).
+    fn face_fields(
+        &self,
+        _pot: &Potential,
+        _x: &[Vec3],
+        _phi: &[Real],
+    ) -> Vec<(String, Vec<Real>)> {
+        Vec::new()
+    }
+
+    /// `∂W/∂a` of each face's stretching energy W (J) with respect to its barycentric first
+    /// fundamental form, in the stored components `[a11, a12, a22]` (J/m²), for the frames'
+    /// Cauchy stress (`fields::cauchy_principal`). Default: `None`, no membrane energy.
+    fn membrane_stress(
+        &self,
+        _pot: &Potential,
+        _x: &[Vec3],
+        _phi: &[Real],
+    ) -> Option<Vec<crate::math::Sym2>> {
+        None
+    }
+
+    /// Quantities to log per frame, by column name (default: none), e.g. a load's conjugate
+    /// displacement for load–displacement curves.
+    fn observables(&self, _pot: &Potential, _x: &[Vec3], _phi: &[Real]) -> Vec<(String, Real)> {
+        Vec::new()
+    }
+}
+
+/// The energies `t` reports at `(x, phi)`: its [`Reports::energies`], or its whole energy under
+/// its name.
+pub fn energies(
+    t: &dyn Term,
+    pot: &Potential,
+    map: &ElementMap,
+    x: &[Vec3],
+    phi: &[Real],
+) -> Vec<(&'static str, Real)> {
+    t.reports()
+        .and_then(|r| r.energies(pot, map, x, phi))
+        .unwrap_or_else(|| whole(t, pot, map, x, phi))
+}
+
+/// What a frame reports of `t` at `(x, phi)`: its energies ([`energies`]) and face fields.
+#[allow(clippy::type_complexity)]
+pub fn report(
+    t: &dyn Term,
+    pot: &Potential,
+    map: &ElementMap,
+    x: &[Vec3],
+    phi: &[Real],
+) -> (Vec<(&'static str, Real)>, Vec<(String, Vec<Real>)>) {
+    match t.reports() {
+        Some(r) => {
+            let (e, f) = r.report(pot, map, x, phi);
+            (e.unwrap_or_else(|| whole(t, pot, map, x, phi)), f)
+        }
+        None => (whole(t, pot, map, x, phi), Vec::new()),
+    }
+}
+
+/// The quantities `t` logs at `(x, phi)` ([`Reports::observables`]).
+pub fn observables(t: &dyn Term, pot: &Potential, x: &[Vec3], phi: &[Real]) -> Vec<(String, Real)> {
+    t.reports()
+        .map(|r| r.observables(pot, x, phi))
+        .unwrap_or_default()
+}
+
+/// The whole energy of `t` under its name.
+fn whole(
+    t: &dyn Term,
+    pot: &Potential,
+    map: &ElementMap,
+    x: &[Vec3],
+    phi: &[Real],
+) -> Vec<(&'static str, Real)> {
+    let e = t.eval(
+        pot,
+        map,
+        x,
+        phi,
+        Want::Energy,
+        HessianProjection::None,
+        &mut [],
+        &mut [],
+    );
+    vec![(t.name(), e)]
 }
 
 /// The capability of a term that tracks a per-face state across steps (the moment's angles,
@@ -472,7 +531,7 @@ impl<K: ElementKernel<N, S>, const N: usize, const S: usize> Term for ElementTer
 pub trait VertexKernel: Send + Sync {
     /// `None` when the vertex does not contribute.
     fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)>;
-    /// Quantities to log (see [`Term::observables`]; default: none).
+    /// Quantities to log (see [`Reports::observables`]; default: none).
     fn observables(&self, _pot: &Potential, _x: &[Vec3]) -> Vec<(String, Real)> {
         Vec::new()
     }
@@ -534,25 +593,8 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
     fn saved(&self) -> Option<&dyn SavedState> {
         self.kernel.saves_state().then_some(self)
     }
-    fn observables(&self, pot: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
-        self.kernel.observables(pot, x)
-    }
-    fn energies(
-        &self,
-        pot: &Potential,
-        _: &ElementMap,
-        x: &[Vec3],
-        _: &[Real],
-    ) -> Vec<(&'static str, Real)> {
-        if !self.report {
-            return Vec::new();
-        }
-        let e = x
-            .iter()
-            .enumerate()
-            .filter_map(|(v, xv)| self.kernel.eval(pot, v, xv).map(|r| r.0))
-            .sum();
-        vec![(self.name, e)]
+    fn reports(&self) -> Option<&dyn Reports> {
+        Some(self)
     }
     fn stencil(&self, scene: &Scene) -> Stencil {
         Stencil::vertices(&scene.mesh.positions)
@@ -600,6 +642,29 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
             values,
             &pot.pattern.col_ptr,
         )
+    }
+}
+
+impl<K: VertexKernel> Reports for VertexTerm<K> {
+    fn observables(&self, pot: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
+        self.kernel.observables(pot, x)
+    }
+    fn energies(
+        &self,
+        pot: &Potential,
+        _: &ElementMap,
+        x: &[Vec3],
+        _: &[Real],
+    ) -> Option<Vec<(&'static str, Real)>> {
+        if !self.report {
+            return Some(Vec::new());
+        }
+        let e = x
+            .iter()
+            .enumerate()
+            .filter_map(|(v, xv)| self.kernel.eval(pot, v, xv).map(|r| r.0))
+            .sum();
+        Some(vec![(self.name, e)])
     }
 }
 

@@ -306,11 +306,11 @@ impl<'a> Potential<'a> {
         }
     }
 
-    /// Energies by term name at `(x, phi)` (each term's [`crate::energy::term::Term::energies`]).
+    /// Energies by term name at `(x, phi)` (each term's [`crate::energy::term::energies`]).
     pub fn energies(&self, x: &[Vec3], phi: &[Real]) -> Vec<(&'static str, Real)> {
         let mut out = Vec::new();
         for (t, map) in self.scene.terms.iter().zip(&self.pattern.maps) {
-            out.extend(t.energies(self, map, x, phi));
+            out.extend(crate::energy::term::energies(t.as_ref(), self, map, x, phi));
         }
         out
     }

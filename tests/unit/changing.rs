@@ -6,7 +6,7 @@
 //! and 2 threads.
 
 use shellsim::assembly::{assemble_elements, ElementMap, Pattern, Want};
-use shellsim::energy::term::{ChangingElements, Stencil, Term};
+use shellsim::energy::term::{ChangingElements, Reports, Stencil, Term};
 use shellsim::energy::HessianProjection;
 use shellsim::math::{Mat3, Real, SMat, SVec, Vec3};
 use shellsim::mesh::generate::{rectangle, Spacing};
@@ -116,6 +116,13 @@ impl Term for Repulsion {
             &pot.pattern.col_ptr,
         )
     }
+
+    fn reports(&self) -> Option<&dyn Reports> {
+        Some(self)
+    }
+}
+
+impl Reports for Repulsion {
     /// The repulsion's vertical force on the upper sheet (N).
     fn observables(&self, _: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
         let st = self.pairs(x);

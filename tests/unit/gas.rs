@@ -528,8 +528,7 @@ fn position_based_projection_restores_the_skin_volume() {
         let before = x.clone();
         let shell = &sc.terms[0];
         let ratio = |x: &[Vec3]| {
-            shell
-                .observables(&pot, x, &[])
+            shellsim::energy::term::observables(shell.as_ref(), &pot, x, &[])
                 .into_iter()
                 .find(|o| o.0 == "skin_volume_ratio")
                 .unwrap()
@@ -565,7 +564,7 @@ fn position_based_projection_restores_the_skin_volume() {
             assert_eq!(tracked.state(&x, &[]), state, "the state is left as it was");
         }
         // The frame's thickness field is the projected thickness: thinner than at rest.
-        let fields = shell.face_fields(&pot, &x, &[]);
+        let fields = shell.reports().unwrap().face_fields(&pot, &x, &[]);
         let h = &fields.iter().find(|f| f.0 == "thickness").unwrap().1;
         assert!(h.iter().all(|&h| h > 0.0 && h < 0.01));
     }

@@ -307,7 +307,7 @@ fn end_moment_matches_finite_differences_past_a_half_turn() {
         // along y, so its normal's angle is κ(1 + x_k)/2 (x_k its third vertex), linear in κ.
         let turn = |t: Real| {
             let x = rolled(&sc, t * std::f64::consts::PI, 0.0);
-            let obs = sc.terms[i].observables(&pot, &x, &phi);
+            let obs = shellsim::energy::term::observables(sc.terms[i].as_ref(), &pot, &x, &phi);
             obs.iter().find(|(n, _)| n == "moment_rotation").unwrap().1
         };
         let (t11, t13) = (turn(1.1), turn(1.3));
@@ -588,7 +588,7 @@ fn a_force_controlled_obstacle_matches_finite_differences() {
     let i = (0..sc.terms.len())
         .find(|&i| sc.terms[i].name() == "pressed_obstacles")
         .unwrap();
-    let obs = sc.terms[i].observables(&pot, &x, &phi);
+    let obs = shellsim::energy::term::observables(sc.terms[i].as_ref(), &pot, &x, &phi);
     let gap = obs.iter().find(|(n, _)| n == "obstacle0_gap").unwrap().1;
     assert!(gap < -0.01, "no deep contact: gap {gap}");
     check_term(&sc, &p, &pot, &x, &phi, i);

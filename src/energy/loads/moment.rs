@@ -47,7 +47,7 @@
 //! without edge DOFs). Units: m in N·m/m, E in J, gradient N and N·m.
 
 use super::select_vertices;
-use crate::energy::term::{ElementKernel, StateError, Stencil, Term, Tracked};
+use crate::energy::term::{ElementKernel, Reports, StateError, Stencil, Term, Tracked};
 use crate::math::{skew, Mat3, Real, SMat, SVec, Vec3};
 use crate::mesh::topology::NONE;
 use crate::mesh::MeshError;
@@ -278,6 +278,17 @@ impl Term for MomentTerm {
             &pot.pattern.col_ptr,
         )
     }
+
+    fn tracked(&self) -> Option<&dyn Tracked> {
+        Some(self)
+    }
+
+    fn reports(&self) -> Option<&dyn Reports> {
+        Some(self)
+    }
+}
+
+impl Reports for MomentTerm {
     fn observables(&self, _: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
         let Ok(frames) = self.0.frames.lock() else {
             return Vec::new();
@@ -287,10 +298,6 @@ impl Term for MomentTerm {
             sum += Moment::turn(f, vectors(x, e)).0;
         }
         vec![("moment_rotation".into(), sum / self.0.edges.len() as Real)]
-    }
-
-    fn tracked(&self) -> Option<&dyn Tracked> {
-        Some(self)
     }
 }
 

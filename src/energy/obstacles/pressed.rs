@@ -24,7 +24,7 @@
 use super::{Body, Distance, Obstacles};
 use crate::assembly::{assemble_elements, ElementMap, Want};
 use crate::energy::projection::HessianProjection;
-use crate::energy::term::{GlobalDof, GlobalDofs, Stencil, Term};
+use crate::energy::term::{GlobalDof, GlobalDofs, Reports, Stencil, Term};
 use crate::math::{Mat3, Real, SMat, SVec, Vec3};
 use crate::mesh::topology::NONE;
 use crate::scene::Scene;
@@ -194,6 +194,12 @@ impl Term for Pressed {
         )
     }
 
+    fn reports(&self) -> Option<&dyn Reports> {
+        Some(self)
+    }
+}
+
+impl Reports for Pressed {
     /// The force on the sheet (N), the smallest gap (m) and the offset `q` (m).
     fn observables(&self, _pot: &Potential, x: &[Vec3], phi: &[Real]) -> Vec<(String, Real)> {
         let q = phi[self.node - x.len()];
