@@ -31,6 +31,7 @@ SCENES = {
     "bilayer_strip_explicit": ("final", "mean_curvature", "20,25", None),
     "cloth_drape_baraff_witkin": ("final", "max_stretch", "-70,10", "1,1.25"),
     "cloth_drape_koiter": ("final", "max_stretch", "-70,10", "1,1.25"),
+    "cloth_over_sphere_and_box": ("final", "mean_curvature", "-60,30", None),
     "balloon_sphere": ("final", "max_stretch", "iso", None),
     "balloon_teddy": ("final", "max_stretch", "front", None),
     "balloon_thickness": ("final", "max_stretch", "front", None),
