@@ -502,6 +502,7 @@ fn balloon(c: &mut Criterion) {
                     let mut st = State {
                         x: x.clone(),
                         dofs: Vec::new(),
+                        terms: sc.initial_states.clone(),
                     };
                     let opts = NewtonOptions {
                         max_iter: 3,
@@ -613,6 +614,7 @@ fn frame_write(c: &mut Criterion) {
     let state = shellsim::solve::State {
         x: curved(&sc),
         dofs: vec![0.0; p.n - 3 * sc.num_vertices()],
+        terms: sc.initial_states.clone(),
     };
     let v = vec![Vec3::new(1e-3, -2e-3, 5e-4); sc.num_vertices()];
     // One real frame, every field in double, read back: the mesh the variants write.

@@ -500,6 +500,7 @@ pub fn check_fields(
     let state = State {
         x: scene.mesh.positions.clone(),
         dofs: vec![0.0; pattern.n - 3 * scene.num_vertices()],
+        terms: scene.initial_states.clone(),
     };
     let v = vec![Vec3::zeros(); scene.num_vertices()];
     let mut w = Writer::detached(scene);
@@ -882,6 +883,10 @@ impl Writer {
 
     /// Energies of a state by term.
     pub fn energies(pot: &Potential, state: &State, v: &[Vec3]) -> Energies {
+        let pot = &Potential {
+            terms: &state.terms,
+            ..*pot
+        };
         Self::energies_of(pot, pot.energies(&state.x, &state.dofs), v)
     }
 
@@ -983,14 +988,16 @@ impl Writer {
             let ea = sc.topo.face_edges.iter().flat_map(|fe| fe.map(|e| phi[e]));
             ff.insert("edge_angles".into(), vec3(ea.collect()));
         }
-        for t in sc.terms.iter().filter_map(|t| t.tracked()) {
-            ff.insert(
-                t.state_field().into(),
-                Field {
-                    components: t.state_components(),
-                    data: t.state(x, phi),
-                },
-            );
+        for t in sc.terms.iter() {
+            if let Some(tr) = t.tracked() {
+                ff.insert(
+                    tr.state_field().into(),
+                    Field {
+                        components: tr.state_components(),
+                        data: tr.field(x, phi, pot.term_state(t.name())),
+                    },
+                );
+            }
         }
         // Slot fields in the input's corner order, like the faces.
         for name in sc.slot_fields() {
@@ -1040,6 +1047,10 @@ impl Writer {
             // A continued series: this is the frame it continues from.
             return Ok(());
         }
+        let pot = &Potential {
+            terms: &state.terms,
+            ..*pot
+        };
         let (x, phi) = (&state.x[..], &state.dofs[..]);
         let sc = pot.scene;
         let index = self.frames.len();

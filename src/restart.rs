@@ -270,13 +270,19 @@ pub fn restart_from_frame(
             )),
         }
     }
-    // Terms that track a state across steps (an end moment's turns) restart from theirs.
-    for t in scene.terms.iter().filter_map(|t| t.tracked()) {
-        let data = frame.face_field(t.state_field(), t.state_components())?;
-        match t.restore(
+    // Terms that track a state across steps (an end moment's turns) restart from their fields
+    // (the restart file beside the frame, when there is one, then gives the exact state).
+    let mut terms = scene.initial_states.clone();
+    for t in scene.terms.iter() {
+        let Some(tr) = t.tracked() else {
+            continue;
+        };
+        let data = frame.face_field(tr.state_field(), tr.state_components())?;
+        match tr.restore(
             &frame.positions,
             &phi,
             data.as_ref().map(|f| f.data.as_slice()),
+            terms.get_mut(t.name()),
         ) {
             Ok(Some(w)) => warnings.push(format!("{name}: {w}")),
             Ok(None) => {}
@@ -287,6 +293,7 @@ pub fn restart_from_frame(
         State {
             x: frame.positions,
             dofs: phi,
+            terms,
         },
         v,
         warnings,

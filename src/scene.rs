@@ -64,6 +64,8 @@ pub struct Scene {
     pub terms: crate::energy::term::Terms,
     /// The global DOFs the terms declared, in node order after the edge nodes.
     pub globals: Vec<crate::energy::term::GlobalDof>,
+    /// The stateful terms' states at the start of a run ([`crate::solve::State::terms`]).
+    pub initial_states: crate::energy::term::TermStates,
     /// Vertices on prescribed paths and their displacement at dial 1 (m); they are fixed.
     pub prescribed: Vec<(usize, Vec3)>,
 }
@@ -213,10 +215,13 @@ impl Scene {
             ground,
             terms: Default::default(),
             globals: Vec::new(),
+            initial_states: Default::default(),
             prescribed,
         };
         let mut terms = crate::energy::registry::terms(&scene)?;
         scene.bind_globals(&mut terms);
+        scene.initial_states =
+            crate::energy::term::TermStates::initial(&terms).map_err(|e| scene.mesh.invalid(e))?;
         scene.terms = crate::energy::term::Terms(std::sync::Arc::new(terms));
         Ok(scene)
     }
@@ -370,52 +375,6 @@ impl Scene {
             })
             .collect();
         (a, b)
-    }
-
-    /// Tells every term that `(x, phi)` is an accepted state (see
-    /// [`crate::energy::term::Tracked::accept`]).
-    pub fn accept(&self, x: &[Vec3], phi: &[Real]) {
-        for t in self.terms.iter().filter_map(|t| t.tracked()) {
-            t.accept(x, phi);
-        }
-    }
-
-    /// Applies every term's projection after an accepted implicit step (see
-    /// [`crate::energy::term::Projection`]).
-    pub fn project(
-        &self,
-        pot: &crate::solve::Potential,
-        state: &mut crate::solve::State,
-    ) -> Result<(), crate::energy::term::StateError> {
-        for t in self.terms.iter().filter_map(|t| t.projection()) {
-            t.project(pot, &mut state.x, &state.dofs)?;
-        }
-        Ok(())
-    }
-
-    /// Lets every term update its multiplier after a converged solve; `true` when one did and
-    /// the solve must be repeated (see [`crate::energy::term::Multiplier`]).
-    pub fn update(
-        &self,
-        pot: &crate::solve::Potential,
-        x: &[Vec3],
-        phi: &[Real],
-        sensitivity: &mut dyn FnMut(&[Real]) -> Option<Real>,
-    ) -> bool {
-        let mut again = false;
-        for t in self.terms.iter().filter_map(|t| t.updates()) {
-            again |= t.update(pot, x, phi, sensitivity);
-        }
-        again
-    }
-
-    /// Whether every term admits `(x, phi)` as the next accepted state (see
-    /// [`crate::energy::term::Tracked::admissible`]).
-    pub fn admissible(&self, x: &[Vec3], phi: &[Real]) -> bool {
-        self.terms
-            .iter()
-            .filter_map(|t| t.tracked())
-            .all(|t| t.admissible(x, phi))
     }
 
     /// Moves the vertices on prescribed paths to `reference + dial × displacement`.

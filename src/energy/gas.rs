@@ -41,7 +41,7 @@
 
 use crate::assembly::{assemble_elements, ElementMap, Want};
 use crate::energy::term::{
-    LowRank, LowRankPart, Multiplier, Predictor, Reports, SavedState, Stencil, Term,
+    LowRank, LowRankPart, Multiplier, Predictor, Reports, Stateful, Stencil, Term,
 };
 use crate::energy::HessianProjection;
 use crate::math::{Real, Vec3};
@@ -49,7 +49,6 @@ use crate::mesh::MeshError;
 use crate::scene::Scene;
 use crate::settings::{GasControl, GasProcess};
 use crate::solve::Potential;
-use std::sync::Mutex;
 
 /// The gas term.
 pub struct Gas {
@@ -65,8 +64,6 @@ pub struct Gas {
     target: Real,
     /// Volume control: penalty ρ (Pa/m³).
     rho: Real,
-    /// Volume control: the multiplier λ (gauge pressure, Pa).
-    multiplier: Mutex<Real>,
 }
 
 /// The gas's state at positions `x` and dial `s`.
@@ -99,8 +96,8 @@ impl Gas {
         self.v_ref + s * (self.target - self.v_ref)
     }
 
-    /// The state at volume `v` and dial `s`.
-    pub fn state_at(&self, v: Real, s: Real) -> GasState {
+    /// The state at volume `v`, dial `s` and, under volume control, multiplier `lambda` (Pa).
+    pub fn state_at(&self, v: Real, s: Real, lambda: Real) -> GasState {
         match self.control {
             GasControl::Amount => {
                 let n = self.amount(s);
@@ -132,7 +129,6 @@ impl Gas {
                 }
             }
             GasControl::Volume => {
-                let lambda = *self.multiplier.lock().unwrap_or_else(|e| e.into_inner());
                 let c = v - self.volume_target(s);
                 GasState {
                     volume: v,
@@ -152,12 +148,13 @@ impl Gas {
 
     /// The state at positions `x` under potential `pot`.
     pub fn state(&self, pot: &Potential, x: &[Vec3]) -> GasState {
-        self.state_at(Self::volume(pot.scene, x), pot.dial)
+        self.state_at(Self::volume(pot.scene, x), pot.dial, Self::multiplier(pot))
     }
 
-    /// Volume control: the current multiplier (gauge pressure, Pa).
-    pub fn multiplier(&self) -> Real {
-        *self.multiplier.lock().unwrap_or_else(|e| e.into_inner())
+    /// Volume control: the multiplier λ (gauge pressure, Pa) that `pot` is evaluated with (the
+    /// gas's [`Stateful`] state).
+    pub fn multiplier(pot: &Potential) -> Real {
+        pot.term_state("gas").first().copied().unwrap_or(0.0)
     }
 
     /// The penalty ρ of volume control (Pa/m³).
@@ -184,7 +181,7 @@ impl Term for Gas {
         "gas"
     }
 
-    fn saved(&self) -> Option<&dyn SavedState> {
+    fn stateful(&self) -> Option<&dyn Stateful> {
         Some(self)
     }
 
@@ -270,22 +267,11 @@ impl Reports for Gas {
     }
 }
 
-impl SavedState for Gas {
-    /// Volume control: the multiplier λ (Pa), which warm-starts the next solve.
-    fn saved_state(&self) -> Vec<Real> {
-        vec![self.multiplier()]
-    }
-
-    fn load_state(&self, saved: &[Real]) -> Result<(), String> {
-        match saved {
-            [l] if l.is_finite() => {
-                *self.multiplier.lock().unwrap_or_else(|e| e.into_inner()) = *l;
-                Ok(())
-            }
-            _ => Err(format!(
-                "the gas's multiplier must be one finite number, got {saved:?}"
-            )),
-        }
+impl Stateful for Gas {
+    /// The multiplier λ (Pa) of volume control, which warm-starts the next solve; 0 at the
+    /// start.
+    fn initial_state(&self) -> Vec<Real> {
+        vec![0.0]
     }
 }
 
@@ -312,6 +298,7 @@ impl Predictor for Gas {
         from: Real,
         x: &mut [Vec3],
         _phi: &[Real],
+        own: &mut [Real],
         solve: &mut dyn FnMut(&mut [Real]) -> bool,
     ) {
         let ds = pot.dial - from;
@@ -333,8 +320,7 @@ impl Predictor for Gas {
             GasControl::Pressure => ds * self.target,
             GasControl::Volume => {
                 let dv = self.volume_target(pot.dial) - self.volume_target(from);
-                let mut m = self.multiplier.lock().unwrap_or_else(|e| e.into_inner());
-                *m += dv * (1.0 / s - self.rho);
+                own[0] += dv * (1.0 / s - self.rho);
                 dv / s
             }
             GasControl::None => 0.0,
@@ -358,6 +344,7 @@ impl Multiplier for Gas {
         pot: &Potential,
         x: &[Vec3],
         _phi: &[Real],
+        own: &mut [Real],
         sensitivity: &mut dyn FnMut(&[Real]) -> Option<Real>,
     ) -> bool {
         if self.control != GasControl::Volume {
@@ -373,8 +360,7 @@ impl Multiplier for Gas {
         let s = sensitivity(&u)
             .filter(|s| s.is_finite() && *s > 0.0 && *s <= 1.0 / self.rho)
             .unwrap_or(1.0 / self.rho);
-        let mut m = self.multiplier.lock().unwrap_or_else(|e| e.into_inner());
-        *m -= c / s;
+        own[0] -= c / s;
         true
     }
 }
@@ -410,6 +396,5 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
         v_ref,
         target,
         rho,
-        multiplier: Mutex::new(0.0),
     })))
 }

@@ -18,7 +18,7 @@ use super::bending::average::MidedgeAverage;
 use super::bending::BendingModel;
 use super::material::{DensityDerivs, FaceDensity};
 use super::membrane::Membrane;
-use super::term::{ElementKernel, Projection, Reports, StateError, Stencil, Tracked};
+use super::term::{ElementKernel, Projection, Reports, StateError, Stateful, Stencil, Tracked};
 use crate::geometry::{
     first_fundamental_form, first_fundamental_form_hessian_pattern, first_fundamental_form_jacobian,
 };
@@ -206,6 +206,9 @@ pub fn shell_face_gauss_newton<D: FaceDensity>(
     shell_element::<D, MidedgeAverage, 18, 6, true>(&MidedgeAverage, &has, x, dens, grad, hess)
 }
 
+/// The name of the shell face term, and of its state when its membrane has one.
+pub const NAME: &str = "shell";
+
 /// The shell face term of a membrane material `M` and a bending model `B` with `N` local DOFs.
 pub struct Shell<M, B, const N: usize, const S: usize> {
     /// The membrane material.
@@ -317,7 +320,7 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
     for Shell<M, B, N, S>
 {
     fn name(&self) -> &'static str {
-        "shell"
+        NAME
     }
 
     fn stencil(&self, scene: &Scene) -> Stencil {
@@ -351,6 +354,10 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
 
     /// A membrane with a state of its own (the prism's position-based thickness).
     fn tracked(&self) -> Option<&dyn Tracked> {
+        self.membrane.state_field().is_some().then_some(self)
+    }
+
+    fn stateful(&self) -> Option<&dyn Stateful> {
         self.membrane.state_field().is_some().then_some(self)
     }
 
@@ -426,8 +433,8 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Tracked
         1
     }
 
-    fn state(&self, _x: &[Vec3], _phi: &[Real]) -> Vec<Real> {
-        self.membrane.state()
+    fn field(&self, _x: &[Vec3], _phi: &[Real], own: &[Real]) -> Vec<Real> {
+        own.to_vec()
     }
 
     fn restore(
@@ -435,8 +442,21 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Tracked
         _x: &[Vec3],
         _phi: &[Real],
         field: Option<&[Real]>,
+        own: &mut [Real],
     ) -> Result<Option<String>, StateError> {
-        self.membrane.restore(field)
+        self.membrane.restore(field, own)
+    }
+}
+
+impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Stateful
+    for Shell<M, B, N, S>
+{
+    fn initial_state(&self) -> Vec<Real> {
+        self.membrane.initial_state().unwrap_or_default()
+    }
+
+    fn check_state(&self, state: &[Real]) -> Result<(), String> {
+        self.membrane.check_state(state).map_err(|e| e.to_string())
     }
 }
 
@@ -448,8 +468,9 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Project
         pot: &Potential,
         x: &mut [Vec3],
         _phi: &[Real],
+        own: &mut [Real],
     ) -> Result<Option<Real>, StateError> {
-        self.membrane.project(pot, x)
+        self.membrane.project(pot, x, own)
     }
 }
 

@@ -44,9 +44,9 @@ use crate::mesh::MeshError;
 use crate::scene::Scene;
 use crate::settings::SlideControl;
 use crate::solve::Potential;
-use std::sync::atomic::{AtomicU64, Ordering};
 
-/// The slides' kernel and the upper slide's state.
+/// The slides' kernel. Its state ([`crate::energy::term::Stateful`], under the name `slides`)
+/// is the upper slide's height (m) and its velocity over the current step (m/s).
 pub struct Slides {
     /// Spring constant k (N/m).
     pub k: Real,
@@ -54,10 +54,6 @@ pub struct Slides {
     pub lower: Real,
     /// Upper slide's starting height (m).
     pub upper0: Real,
-    /// Upper slide height now (m), as f64 bits.
-    upper: AtomicU64,
-    /// Upper slide's velocity over the current step (m/s), as f64 bits.
-    upper_velocity: AtomicU64,
     /// Coulomb coefficient.
     pub friction: Real,
     /// Normal contact damping, a fraction of critical.
@@ -76,29 +72,31 @@ pub struct Slides {
     pub after_dial: bool,
 }
 
+/// The name of the slides' term and state.
+const NAME: &str = "slides";
+
 impl Slides {
-    /// The upper slide's height now (m).
-    pub fn upper(&self) -> Real {
-        Real::from_bits(self.upper.load(Ordering::Relaxed))
+    /// The upper slide's height (m) and velocity (m/s) that `pot` is evaluated with.
+    pub fn upper(pot: &Potential) -> (Real, Real) {
+        match pot.term_state(NAME) {
+            [z, v] => (*z, *v),
+            _ => (Real::NAN, 0.0),
+        }
     }
 
-    fn set_upper(&self, z: Real) {
-        self.upper.store(z.to_bits(), Ordering::Relaxed);
-    }
-
-    /// Penetrations beyond the upper and the lower slide (m, ≥ 0).
+    /// Penetrations beyond the upper slide at height `upper` and the lower slide (m, ≥ 0).
     #[inline]
-    fn depths(&self, z: Real) -> (Real, Real) {
-        ((z - self.upper()).max(0.0), (self.lower - z).max(0.0))
+    fn depths(&self, upper: Real, z: Real) -> (Real, Real) {
+        ((z - upper).max(0.0), (self.lower - z).max(0.0))
     }
 
-    /// Total forces (N) the sheet exerts on the upper slide (upward) and on the lower one
-    /// (downward), at positions `x`.
-    pub fn forces(&self, x: &[Vec3], fixed: &[bool]) -> (Real, Real) {
+    /// Total forces (N) the sheet at positions `x` exerts on the upper slide at height `upper`
+    /// (upward) and on the lower one (downward).
+    pub fn forces(&self, upper: Real, x: &[Vec3], fixed: &[bool]) -> (Real, Real) {
         let (mut up, mut down) = (0.0, 0.0);
         for (v, p) in x.iter().enumerate() {
             if !fixed[v] {
-                let (du, dl) = self.depths(p.z);
+                let (du, dl) = self.depths(upper, p.z);
                 up += self.k * du;
                 down += self.k * dl;
             }
@@ -139,8 +137,8 @@ impl Slides {
 
 impl VertexKernel for Slides {
     #[inline]
-    fn eval(&self, _: &Potential, _: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
-        let (du, dl) = self.depths(x.z);
+    fn eval(&self, pot: &Potential, _: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
+        let (du, dl) = self.depths(Self::upper(pot).0, x.z);
         if du == 0.0 && dl == 0.0 {
             return None;
         }
@@ -154,11 +152,12 @@ impl VertexKernel for Slides {
     }
 
     fn observables(&self, pot: &Potential, x: &[Vec3]) -> Vec<(String, Real)> {
-        let (up, down) = self.forces(x, &pot.scene.fixed);
+        let upper = Self::upper(pot).0;
+        let (up, down) = self.forces(upper, x, &pot.scene.fixed);
         vec![
-            ("slide_upper_z".into(), self.upper()),
+            ("slide_upper_z".into(), upper),
             ("slide_lower_z".into(), self.lower),
-            ("slide_gap".into(), self.upper() - self.lower),
+            ("slide_gap".into(), upper - self.lower),
             ("slide_upper_force".into(), up),
             ("slide_lower_force".into(), down),
         ]
@@ -175,14 +174,15 @@ impl VertexKernel for Slides {
         if self.control != SlideControl::Force || (self.after_dial && pot.dial < 1.0) {
             return Ok(0.0);
         }
-        let (up, _) = self.forces(x, &pot.scene.fixed);
-        if up == 0.0 && self.force > 0.0 && self.upper() < self.lower {
+        let upper = Self::upper(pot).0;
+        let (up, _) = self.forces(upper, x, &pot.scene.fixed);
+        if up == 0.0 && self.force > 0.0 && upper < self.lower {
             return Err(format!(
                 "slides: the force-controlled upper slide (slides.force = {} N) has passed every \
                  free vertex of the sheet and the lower slide (upper z = {} m, lower z = {} \
                  m): nothing carries its force",
                 crate::math::human(self.force),
-                crate::math::human(self.upper()),
+                crate::math::human(upper),
                 crate::math::human(self.lower)
             ));
         }
@@ -194,11 +194,12 @@ impl VertexKernel for Slides {
             return;
         }
         let fixed = &pot.scene.fixed;
+        let (upper, upper_velocity) = Self::upper(pot);
         for (i, p) in x.iter().enumerate() {
             if fixed[i] {
                 continue;
             }
-            let (du, dl) = self.depths(p.z);
+            let (du, dl) = self.depths(upper, p.z);
             let normal = self.k * (du + dl);
             if normal == 0.0 {
                 continue;
@@ -208,11 +209,7 @@ impl VertexKernel for Slides {
                 // The dashpot c = ζ 2√(km) on the normal velocity relative to the slide that
                 // the step reaches, taken implicitly, w' = w*/(1 + Δt c/m): stable for any ζ.
                 let c = self.contact_damping * 2.0 * (self.k * m).sqrt();
-                let slide = if du > 0.0 {
-                    Real::from_bits(self.upper_velocity.load(Ordering::Relaxed))
-                } else {
-                    0.0
-                };
+                let slide = if du > 0.0 { upper_velocity } else { 0.0 };
                 let w = (v[i].z - slide - dt * g[3 * i + 2] / m) / (1.0 + dt * c / m);
                 g[3 * i + 2] += c * w;
             }
@@ -240,14 +237,13 @@ impl VertexKernel for Slides {
     /// The upper slide's motion over the step, from the positions the gradient is taken at (no
     /// lag between the slide and the sheet: a slide moved from the previous positions drives a
     /// slow limit cycle through the contact).
-    fn explicit_begin(&self, pot: &Potential, x: &[Vec3], dt: Real) {
-        let fixed = &pot.scene.fixed;
-        if self.after_dial && pot.dial < 1.0 {
-            self.upper_velocity
-                .store(0.0f64.to_bits(), Ordering::Relaxed);
+    fn explicit_begin(&self, scene: &Scene, dial: Real, x: &[Vec3], dt: Real, own: &mut [Real]) {
+        let fixed = &scene.fixed;
+        if self.after_dial && dial < 1.0 {
+            own[1] = 0.0;
             return;
         }
-        let z = self.upper();
+        let z = own[0];
         let next = match self.control {
             SlideControl::Speed => {
                 let bottom = self.upper0 - self.travel * self.speed.signum();
@@ -268,34 +264,13 @@ impl VertexKernel for Slides {
             SlideControl::Speed => next.max(self.lower + 1e-12 * (1.0 + self.lower.abs())),
             SlideControl::Force => next,
         };
-        self.upper_velocity
-            .store(((next - z) / dt).to_bits(), Ordering::Relaxed);
-        self.set_upper(next);
+        own[1] = (next - z) / dt;
+        own[0] = next;
     }
 
-    fn saves_state(&self) -> bool {
-        true
-    }
-
-    /// The upper slide's height (m) and velocity (m/s).
-    fn saved_state(&self) -> Vec<Real> {
-        vec![
-            self.upper(),
-            Real::from_bits(self.upper_velocity.load(Ordering::Relaxed)),
-        ]
-    }
-
-    fn load_state(&self, saved: &[Real]) -> Result<(), String> {
-        match saved {
-            [z, v] if z.is_finite() && v.is_finite() => {
-                self.set_upper(*z);
-                self.upper_velocity.store(v.to_bits(), Ordering::Relaxed);
-                Ok(())
-            }
-            _ => Err(format!(
-                "the slides' state must be a finite height and velocity, got {saved:?}"
-            )),
-        }
+    /// The upper slide's height (m) and velocity (m/s): its starting height, at rest.
+    fn initial_state(&self) -> Option<Vec<Real>> {
+        Some(vec![self.upper0, 0.0])
     }
 }
 
@@ -337,14 +312,12 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn super::term::Term>>, MeshErr
     });
     let k = s.stiffness_prefactor * sc.mu * sc.t;
     Ok(Some(Box::new(VertexTerm {
-        name: "slides",
+        name: NAME,
         report: true,
         kernel: Slides {
             k,
             lower,
             upper0: upper,
-            upper: AtomicU64::new(upper.to_bits()),
-            upper_velocity: AtomicU64::new(0.0f64.to_bits()),
             friction: s.friction,
             contact_damping: s.contact_damping.unwrap_or(1.0),
             control: s.control,

@@ -149,9 +149,10 @@ pub trait Term: Send + Sync {
         None
     }
 
-    /// A term that carries a state no frame field holds declares it here, for the frames'
-    /// restart files (default: none).
-    fn saved(&self) -> Option<&dyn SavedState> {
+    /// A term with a state of its own that changes during a run (a multiplier, a moving
+    /// slide, a per-face thickness, per-edge frames) declares it here (default: none). The
+    /// state itself lives in the driver's [`crate::solve::State`], not in the term.
+    fn stateful(&self) -> Option<&dyn Stateful> {
         None
     }
 
@@ -185,6 +186,13 @@ pub trait Term: Send + Sync {
 
     /// A term with a dense low-rank Hessian part declares it here (default: none).
     fn low_rank(&self) -> Option<&dyn LowRankPart> {
+        None
+    }
+
+    /// A term whose friction takes its normal forces at a lagged iterate (the dynamic
+    /// driver's friction lag) declares it here, so that the lag can tell when they settled
+    /// (default: none).
+    fn lagged(&self) -> Option<&dyn LaggedNormals> {
         None
     }
 
@@ -314,12 +322,103 @@ fn whole(
     vec![(t.name(), e)]
 }
 
+/// The capability of a term with a state of its own.
+///
+/// The state is a vector of reals that the term reads through [`Potential::term_state`] under
+/// its [`Term::name`] (unique among the stateful terms of a scene) and that only the drivers
+/// change, through the term's [`Tracked`], [`Projection`], [`Multiplier`], [`Predictor`] and
+/// [`ExplicitHooks`] capabilities, which receive it as `own`. It lives in
+/// [`crate::solve::State::terms`] beside the positions: a trial step that is cut leaves it as
+/// it was, clones of a scene share none of it, and every frame's restart file carries it under
+/// the term's name.
+pub trait Stateful {
+    /// The state at the start of a run.
+    fn initial_state(&self) -> Vec<Real>;
+
+    /// Checks a state read from a restart file (default: the initial state's length and finite
+    /// values), or says what is wrong with it.
+    fn check_state(&self, state: &[Real]) -> Result<(), String> {
+        let n = self.initial_state().len();
+        if state.len() != n || !state.iter().all(|v| v.is_finite()) {
+            return Err(format!("expected {n} finite values, got {state:?}"));
+        }
+        Ok(())
+    }
+}
+
+/// Every stateful term's state, under its term's name, in term order (see [`Stateful`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TermStates(Vec<(&'static str, Vec<Real>)>);
+
+impl TermStates {
+    /// The initial states of `terms` (those that declare [`Term::stateful`]). Two stateful
+    /// terms with one name are an error naming it.
+    pub fn initial(terms: &[Box<dyn Term>]) -> Result<TermStates, String> {
+        let mut all: Vec<(&'static str, Vec<Real>)> = Vec::new();
+        for t in terms {
+            if let Some(s) = t.stateful() {
+                if all.iter().any(|(n, _)| *n == t.name()) {
+                    return Err(format!("two stateful terms are named '{}'", t.name()));
+                }
+                all.push((t.name(), s.initial_state()));
+            }
+        }
+        Ok(TermStates(all))
+    }
+
+    /// The state of the term named `name` (empty when it has none).
+    #[inline]
+    pub fn get(&self, name: &str) -> &[Real] {
+        self.0
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map_or(&[], |(_, v)| &v[..])
+    }
+
+    /// The state of the term named `name`, to change (empty when it has none).
+    pub fn get_mut(&mut self, name: &str) -> &mut [Real] {
+        match self.0.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, v)) => &mut v[..],
+            None => &mut [],
+        }
+    }
+
+    /// Replaces the state of the term named `name` (nothing when it has none).
+    pub fn set(&mut self, name: &str, values: Vec<Real>) {
+        if let Some((_, v)) = self.0.iter_mut().find(|(n, _)| *n == name) {
+            *v = values;
+        }
+    }
+
+    /// Every (name, state), in term order.
+    pub fn iter(&self) -> impl Iterator<Item = (&'static str, &[Real])> {
+        self.0.iter().map(|(n, v)| (*n, &v[..]))
+    }
+
+    /// Copies `other` (the same terms) into `self` without allocating.
+    pub fn copy_from(&mut self, other: &TermStates) {
+        if self.0.len() == other.0.len()
+            && self
+                .0
+                .iter()
+                .zip(&other.0)
+                .all(|(a, b)| a.1.len() == b.1.len())
+        {
+            for (a, b) in self.0.iter_mut().zip(&other.0) {
+                a.1.copy_from_slice(&b.1);
+            }
+        } else {
+            self.clone_from(other);
+        }
+    }
+}
+
 /// The capability of a term that tracks a per-face state across steps (the moment's angles,
-/// the prism's position-based thickness).
+/// the prism's position-based thickness). Its state is the term's [`Stateful`] state `own`.
 pub trait Tracked {
-    /// The name of the per-face field that carries it. Frames hold it in the face's edge order
-    /// (like `edge_angles`) when it has 3 components per face, and a restart hands it back to
-    /// [`Tracked::restore`].
+    /// The name of the per-face field that shows it. Frames hold it in the face's edge order
+    /// (like `edge_angles`) when it has 3 components per face, and a restart from a frame
+    /// without its restart file hands it back to [`Tracked::restore`].
     fn state_field(&self) -> &'static str;
 
     /// Values per face (default: 3).
@@ -327,37 +426,30 @@ pub trait Tracked {
         3
     }
 
-    /// The state at `(x, phi)`: [`Tracked::state_components`] values per face.
-    fn state(&self, x: &[Vec3], phi: &[Real]) -> Vec<Real>;
+    /// The field at `(x, phi)` with the state `own`: [`Tracked::state_components`] values per
+    /// face.
+    fn field(&self, x: &[Vec3], phi: &[Real], own: &[Real]) -> Vec<Real>;
 
-    /// Restores the state at the restart state `(x, phi)` from the frame's field (`None` when
-    /// the frame has none: the term then says in the returned warning what it assumed). An
-    /// invalid field is an error naming the face.
+    /// Rebuilds the state `own` at the restart state `(x, phi)` from a frame's field (`None`
+    /// when the frame has none: the term then says in the returned warning what it assumed).
+    /// An invalid field is an error naming the face.
     fn restore(
         &self,
         x: &[Vec3],
         phi: &[Real],
         field: Option<&[Real]>,
+        own: &mut [Real],
     ) -> Result<Option<String>, StateError>;
 
     /// Called by the drivers after every accepted step (static continuation step or time
     /// step) at the accepted state (default: nothing).
-    fn accept(&self, _x: &[Vec3], _phi: &[Real]) {}
+    fn accept(&self, _x: &[Vec3], _phi: &[Real], _own: &mut [Real]) {}
 
-    /// Whether `(x, phi)` may become the next accepted state (default: yes); a step too large
-    /// for the tracked state is refused, and the driver cuts it.
-    fn admissible(&self, _x: &[Vec3], _phi: &[Real]) -> bool {
+    /// Whether `(x, phi)` may become the next accepted state from the state `own` (default:
+    /// yes); a step too large for the tracked state is refused, and the driver cuts it.
+    fn admissible(&self, _x: &[Vec3], _phi: &[Real], _own: &[Real]) -> bool {
         true
     }
-}
-
-/// The capability of a term with a state no frame field holds (a gas's pressure multiplier, a
-/// moving slide's height and speed), saved beside every frame for an exact restart.
-pub trait SavedState {
-    /// The state.
-    fn saved_state(&self) -> Vec<Real>;
-    /// Restores it on a restart; values of the wrong length are an error.
-    fn load_state(&self, saved: &[Real]) -> Result<(), String>;
 }
 
 /// The capability of a term that projects the state after each accepted implicit step.
@@ -367,11 +459,13 @@ pub trait Projection {
     /// state. Returns the relative constraint error it corrected (`None` when it had nothing
     /// to correct); an error (an element turned inside out) leaves its state as it was, and
     /// the driver cuts the step.
+    /// `own` is the term's state; `pot` holds it as it was before the step's projections.
     fn project(
         &self,
         pot: &Potential,
         x: &mut [Vec3],
         phi: &[Real],
+        own: &mut [Real],
     ) -> Result<Option<Real>, StateError>;
 }
 
@@ -402,12 +496,14 @@ pub trait Multiplier {
     /// After a converged solve at `(x, phi)`: updates the multiplier and returns `true` when
     /// the solve must be repeated with it. `sensitivity(u)` is `uᵀ H⁻¹ u` with the solve's last
     /// Hessian (sparse factor and low-rank parts; `None` when there is none), the derivative of
-    /// the equilibrium's `u·x` with respect to a load along `u`.
+    /// the equilibrium's `u·x` with respect to a load along `u`. `own` is the term's state
+    /// (the multiplier); `pot` holds it as it was for the solve.
     fn update(
         &self,
         pot: &Potential,
         x: &[Vec3],
         phi: &[Real],
+        own: &mut [Real],
         sensitivity: &mut dyn FnMut(&[Real]) -> Option<Real>,
     ) -> bool;
 }
@@ -417,13 +513,14 @@ pub trait Predictor {
     /// Static continuation, before the solve at the new dial `pot.dial` from the equilibrium
     /// `(x, phi)` at dial `from`: moves `x` (and the term's own multiplier) along the tangent
     /// of the equilibrium path (Euler's predictor), with `solve(r)` applying the last
-    /// Hessian's inverse to `r` (`false` when there is none).
+    /// Hessian's inverse to `r` (`false` when there is none). `own` is the term's state.
     fn predict(
         &self,
         pot: &Potential,
         from: Real,
         x: &mut [Vec3],
         phi: &[Real],
+        own: &mut [Real],
         solve: &mut dyn FnMut(&mut [Real]) -> bool,
     );
 }
@@ -435,12 +532,28 @@ pub trait LowRankPart {
     fn low_rank(&self, pot: &Potential, x: &[Vec3], phi: &[Real], out: &mut Vec<LowRank>);
 }
 
+/// The capability of a term whose friction uses normal forces taken at the friction lag's
+/// iterate ([`crate::solve::potential::Friction::x_lag`]).
+pub trait LaggedNormals {
+    /// The largest normal force (N) at the iterate `trial` at dial `dial`, and the largest
+    /// change of a normal force from the lagged iterate `lag` at dial `dial_lag` to it.
+    fn lag_change(&self, trial: &[Vec3], dial: Real, lag: &[Vec3], dial_lag: Real) -> (Real, Real);
+}
+
 /// The capability of a term that acts on the explicit driver's steps.
 pub trait ExplicitHooks {
-    /// Before the gradient at positions `x` of a step `dt` (s): a term with a state of its own
-    /// that follows the sheet (a moving slide) advances it to these positions, so that the
-    /// gradient sees the two consistent. Default: nothing.
-    fn explicit_begin(&self, _pot: &Potential, _x: &[Vec3], _dt: Real) {}
+    /// Before the gradient at positions `x` of a step `dt` (s) at dial `dial`: a term with a
+    /// state of its own that follows the sheet (a moving slide) advances its state `own` to
+    /// these positions, so that the gradient sees the two consistent. Default: nothing.
+    fn explicit_begin(
+        &self,
+        _scene: &Scene,
+        _dial: Real,
+        _x: &[Vec3],
+        _dt: Real,
+        _own: &mut [Real],
+    ) {
+    }
 
     /// After the gradient `g` at positions `x` with velocities `v` and before the step `dt`
     /// (s): adjusts `g` and `v` beyond the term's energy (stick/slip friction).
@@ -541,7 +654,15 @@ pub trait VertexKernel: Send + Sync {
         false
     }
     /// See [`ExplicitHooks::explicit_begin`] (default: nothing).
-    fn explicit_begin(&self, _pot: &Potential, _x: &[Vec3], _dt: Real) {}
+    fn explicit_begin(
+        &self,
+        _scene: &Scene,
+        _dial: Real,
+        _x: &[Vec3],
+        _dt: Real,
+        _own: &mut [Real],
+    ) {
+    }
     /// See [`ExplicitHooks::explicit_step`] (default: nothing).
     fn explicit_step(
         &self,
@@ -552,18 +673,25 @@ pub trait VertexKernel: Send + Sync {
         _dt: Real,
     ) {
     }
-    /// Whether the kernel carries a state no frame field holds: its term then declares
-    /// [`SavedState`] with the two methods below (default: no).
-    fn saves_state(&self) -> bool {
+    /// The kernel's own state at the start of a run, if it has one: its term then declares
+    /// [`Stateful`] (default: none).
+    fn initial_state(&self) -> Option<Vec<Real>> {
+        None
+    }
+    /// Whether the kernel's friction uses lagged normal forces: its term then declares
+    /// [`LaggedNormals`] with [`VertexKernel::lag_change`] (default: no).
+    fn lags_normals(&self) -> bool {
         false
     }
-    /// See [`SavedState::saved_state`] (default: none).
-    fn saved_state(&self) -> Vec<Real> {
-        Vec::new()
-    }
-    /// See [`SavedState::load_state`] (default: nothing to load).
-    fn load_state(&self, _saved: &[Real]) -> Result<(), String> {
-        Ok(())
+    /// See [`LaggedNormals::lag_change`] (default: no force, no change).
+    fn lag_change(
+        &self,
+        _trial: &[Vec3],
+        _dial: Real,
+        _lag: &[Vec3],
+        _dial_lag: Real,
+    ) -> (Real, Real) {
+        (0.0, 0.0)
     }
     /// See [`ExplicitHooks::explicit_unbalanced`] (default: 0).
     fn explicit_unbalanced(&self, _pot: &Potential, _x: &[Vec3]) -> Result<Real, String> {
@@ -590,8 +718,11 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
     fn explicit(&self) -> Option<&dyn ExplicitHooks> {
         self.kernel.explicit_hooks().then_some(self)
     }
-    fn saved(&self) -> Option<&dyn SavedState> {
-        self.kernel.saves_state().then_some(self)
+    fn stateful(&self) -> Option<&dyn Stateful> {
+        self.kernel.initial_state().is_some().then_some(self)
+    }
+    fn lagged(&self) -> Option<&dyn LaggedNormals> {
+        self.kernel.lags_normals().then_some(self)
     }
     fn reports(&self) -> Option<&dyn Reports> {
         Some(self)
@@ -668,18 +799,21 @@ impl<K: VertexKernel> Reports for VertexTerm<K> {
     }
 }
 
-impl<K: VertexKernel> SavedState for VertexTerm<K> {
-    fn saved_state(&self) -> Vec<Real> {
-        self.kernel.saved_state()
+impl<K: VertexKernel> LaggedNormals for VertexTerm<K> {
+    fn lag_change(&self, trial: &[Vec3], dial: Real, lag: &[Vec3], dial_lag: Real) -> (Real, Real) {
+        self.kernel.lag_change(trial, dial, lag, dial_lag)
     }
-    fn load_state(&self, saved: &[Real]) -> Result<(), String> {
-        self.kernel.load_state(saved)
+}
+
+impl<K: VertexKernel> Stateful for VertexTerm<K> {
+    fn initial_state(&self) -> Vec<Real> {
+        self.kernel.initial_state().unwrap_or_default()
     }
 }
 
 impl<K: VertexKernel> ExplicitHooks for VertexTerm<K> {
-    fn explicit_begin(&self, pot: &Potential, x: &[Vec3], dt: Real) {
-        self.kernel.explicit_begin(pot, x, dt);
+    fn explicit_begin(&self, scene: &Scene, dial: Real, x: &[Vec3], dt: Real, own: &mut [Real]) {
+        self.kernel.explicit_begin(scene, dial, x, dt, own);
     }
     fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
         self.kernel.explicit_step(pot, x, v, g, dt);

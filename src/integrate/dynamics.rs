@@ -288,7 +288,7 @@ pub(super) fn run_dynamic(
         let projected = {
             let pat = s.pattern();
             let pot = accepted(s.potential(&pat, dial), moisture.as_ref(), &trial_targets);
-            sc.project(&pot, &mut trial)
+            super::hooks::project(&pot, &mut trial)
         };
         if let Err(e) = projected {
             s.summary.rejected_steps += 1;
@@ -314,7 +314,7 @@ pub(super) fn run_dynamic(
             (last.1, last.2) = (dial_now, h);
         }
         state.copy_from(&trial);
-        sc.accept(&state.x, &state.dofs);
+        super::hooks::accept(sc, &mut state);
         if let Some(m) = &mut moisture {
             m.u.copy_from_slice(&m.trial);
             std::mem::swap(&mut targets, &mut trial_targets);
@@ -350,7 +350,10 @@ pub(super) fn run_dynamic(
         let mut released = false;
         if tm.stop_at_equilibrium || holding {
             let pat = s.pattern();
-            let pot = accepted(s.potential(&pat, dial), moisture.as_ref(), &targets);
+            let pot = Potential {
+                terms: &state.terms,
+                ..accepted(s.potential(&pat, dial), moisture.as_ref(), &targets)
+            };
             let mut g = vec![0.0; pat.n];
             pot.eval(&state.x, &state.dofs, Want::Gradient, &mut g, &mut []);
             let r = pot.residual(&g);

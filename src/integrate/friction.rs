@@ -6,7 +6,6 @@
 //! per step. The ground's `λ` is kept per vertex; an obstacle's normal force and normal are taken
 //! at the lagged iterate's positions and dial, which the lag keeps. See [`crate::solve::contact`] for the friction potential.
 
-use crate::energy::obstacles::Obstacles;
 use crate::math::{Real, Vec3};
 use crate::scene::Scene;
 use crate::solve::potential::Friction;
@@ -17,13 +16,11 @@ pub const FRICTION_LAG_TOL: Real = 1e-3;
 pub const FRICTION_LAG_MAX: usize = 6;
 
 /// The lagged normal forces of a scene with friction: the ground's per vertex, and the
-/// positions and dial of the friction iterate that the obstacles' normal forces and normals are
-/// taken at.
+/// positions and dial of the friction iterate that the frictional terms (the obstacles,
+/// [`crate::energy::term::LaggedNormals`]) take their normal forces and normals at.
 pub struct FrictionLag {
     /// Normal contact force per vertex against a frictional ground (N), lagged; empty without.
     lambda: Vec<Real>,
-    /// The frictional obstacles (for their normal forces), if any.
-    obstacles: Option<Obstacles>,
     /// Positions of the lagged iterate (m).
     x_lag: Vec<Vec3>,
     /// Dial of the lagged iterate.
@@ -43,18 +40,14 @@ impl FrictionLag {
     /// or obstacle.
     pub fn new(scene: &Scene, x: &[Vec3], dial: Real, slip_speed: Real) -> Option<FrictionLag> {
         let ground = scene.ground.as_ref().filter(|g| g.friction > 0.0);
-        let obstacles = crate::energy::obstacles::build(scene)
-            .ok()
-            .flatten()
-            .filter(Obstacles::has_friction);
-        if ground.is_none() && obstacles.is_none() {
+        let lagged = scene.terms.iter().any(|t| t.lagged().is_some());
+        if ground.is_none() && !lagged {
             return None;
         }
         let lambda = ground.map_or_else(Vec::new, |g| g.normal_forces(x));
         Some(FrictionLag {
             solved: (lambda.clone(), x.to_vec(), dial),
             lambda,
-            obstacles,
             x_lag: x.to_vec(),
             dial_lag: dial,
             slip_speed,
@@ -112,15 +105,11 @@ impl FrictionLag {
                 .fold(diff, |m, (a, b)| m.max((a - b).abs()));
             self.lambda = new;
         }
-        if let Some(o) = &self.obstacles {
-            for (v, (xt, xl)) in trial.iter().zip(&self.x_lag).enumerate() {
-                for k in (0..o.list.len()).filter(|&k| o.list[k].friction > 0.0) {
-                    let new = o.normal_force(k, v, xt, dial);
-                    let old = o.normal_force(k, v, xl, self.dial_lag);
-                    scale = scale.max(new);
-                    diff = diff.max((new - old).abs());
-                }
-            }
+        // The terms whose friction lags its normal forces (the frictional obstacles).
+        for t in scene.terms.iter().filter_map(|t| t.lagged()) {
+            let (s, d) = t.lag_change(trial, dial, &self.x_lag, self.dial_lag);
+            scale = scale.max(s);
+            diff = diff.max(d);
         }
         self.x_lag.copy_from_slice(trial);
         self.dial_lag = dial;

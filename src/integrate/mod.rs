@@ -26,6 +26,7 @@ mod dynamics;
 pub mod explicit;
 mod failure;
 pub mod friction;
+pub(crate) mod hooks;
 pub(crate) mod moisture;
 mod resume;
 mod solver;
@@ -204,8 +205,10 @@ pub fn run(
     let driver = driver.filter(|d| d.mode == s.summary.mode);
     if let Some(d) = &driver {
         for t in scene.terms.iter() {
-            if let (Some(s), Some(v)) = (t.saved(), d.terms.get(t.name())) {
-                s.load_state(v).map_err(RunError::Restart)?;
+            if let (Some(s), Some(v)) = (t.stateful(), d.terms.get(t.name())) {
+                s.check_state(v)
+                    .map_err(|e| RunError::Restart(format!("the {}'s state: {e}", t.name())))?;
+                state.terms.set(t.name(), v.clone());
             }
         }
     }

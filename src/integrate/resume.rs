@@ -33,8 +33,8 @@ pub struct DriverState {
     pub moisture: Option<Vec<Real>>,
     /// See `moisture`.
     pub diffusion_substep: Option<Real>,
-    /// Terms' states that no frame field carries (a gas's pressure multiplier, a moving slide),
-    /// by term name.
+    /// The stateful terms' states ([`crate::solve::State::terms`]: a gas's pressure
+    /// multiplier, a moving slide, a moment's frames, the prism's thickness), by term name.
     pub terms: std::collections::BTreeMap<String, Vec<Real>>,
     /// The explicit driver's own numbers: `phase` (0 dialling, 1 waiting), `next_frame` (s),
     /// `steps` (since its start, which align the equilibrium windows), `gradient_descent_left`,

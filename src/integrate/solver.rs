@@ -143,6 +143,22 @@ impl<'a> Solver<'a> {
         self.potential_scaled(pattern, dial, 1.0)
     }
 
+    /// The potential at `dial` with `state`'s term states.
+    pub(super) fn potential_at<'p>(
+        &self,
+        pattern: &'p Pattern,
+        dial: Real,
+        state: &'p State,
+    ) -> Potential<'p>
+    where
+        'a: 'p,
+    {
+        Potential {
+            terms: &state.terms,
+            ..self.potential(pattern, dial)
+        }
+    }
+
     pub(super) fn potential_scaled<'p>(
         &self,
         pattern: &'p Pattern,
@@ -171,8 +187,9 @@ impl<'a> Solver<'a> {
 
     /// Newton on `pot` from `state`, then the terms' multiplier updates (a prescribed volume's
     /// pressure, [`crate::energy::term::Multiplier`]), re-solving until no term asks for
-    /// another solve. The report sums the iterations of every solve; more than
-    /// [`MAX_UPDATES`] updates is a failure.
+    /// another solve. Each solve is evaluated with the term states `state` holds when it
+    /// starts (`pot.terms` is replaced). The report sums the iterations of every solve; more
+    /// than [`MAX_UPDATES`] updates is a failure.
     pub(super) fn solve(
         &mut self,
         pot: &Potential,
@@ -185,22 +202,28 @@ impl<'a> Solver<'a> {
         );
         let mut total = NewtonReport::default();
         for _ in 0..MAX_UPDATES {
+            let terms = state.terms.clone();
+            let pot = &Potential {
+                terms: &terms,
+                ..*pot
+            };
             let rep = newton(pot, &mut self.lin, &mut self.ws, state, opts);
             self.record(&rep);
             total.absorb(&rep);
             if !rep.converged {
                 return total;
             }
+            if !self.scene.terms.iter().any(|t| t.updates().is_some()) {
+                return total;
+            }
             let lin = &mut self.lin;
+            let at = state.clone();
             let mut sensitivity = |u: &[Real]| -> Option<Real> {
                 let mut y = u.to_vec();
-                apply_inverse(lin, pot, state, &mut y)
+                apply_inverse(lin, pot, &at, &mut y)
                     .then(|| u.iter().zip(&y).map(|(a, b)| a * b).sum::<Real>())
             };
-            if !self
-                .scene
-                .update(pot, &state.x, &state.dofs, &mut sensitivity)
-            {
+            if !super::hooks::update(pot, state, &mut sensitivity) {
                 return total;
             }
         }
@@ -239,15 +262,16 @@ impl<'a> Solver<'a> {
         let mut driver = self.driver.clone();
         driver.mode = self.summary.mode.clone();
         driver.globals = state.dofs[self.scene.num_edge_dofs()..].to_vec();
-        for t in self.scene.terms.iter() {
-            let Some(saved) = t.saved().map(|s| s.saved_state()) else {
-                continue;
-            };
-            if !saved.is_empty() {
-                driver.terms.insert(t.name().to_string(), saved);
+        for (name, own) in state.terms.iter() {
+            if !own.is_empty() {
+                driver.terms.insert(name.to_string(), own.to_vec());
             }
         }
-        let r = writer.frame(pot, state, v, row, Some(&driver));
+        let pot = Potential {
+            terms: &state.terms,
+            ..*pot
+        };
+        let r = writer.frame(&pot, state, v, row, Some(&driver));
         self.summary.timing.output += clock.elapsed().as_secs_f64();
         r?;
         Ok(())
@@ -261,7 +285,11 @@ impl<'a> Solver<'a> {
         }
         if !self.lin.is_factored() {
             // The first step: the Hessian at the start (dial `from`).
-            let at = Potential { dial: from, ..*pot };
+            let at = Potential {
+                dial: from,
+                terms: &state.terms,
+                ..*pot
+            };
             let mut values = vec![0.0; pot.pattern.nnz()];
             let mut g = vec![0.0; pot.pattern.n];
             at.eval(&state.x, &state.dofs, Want::Hessian, &mut g, &mut values);
@@ -283,13 +311,34 @@ impl<'a> Solver<'a> {
         let lin = &mut self.lin;
         let mut predicted = state.clone();
         let at = &*state;
-        let mut solve = |r: &mut [Real]| apply_inverse(lin, pot, at, r);
-        for p in self.scene.terms.iter().filter_map(|t| t.predictor()) {
-            p.predict(pot, from, &mut predicted.x, &predicted.dofs, &mut solve);
+        let pot_at = Potential {
+            terms: &at.terms,
+            ..*pot
+        };
+        let mut solve = |r: &mut [Real]| apply_inverse(lin, &pot_at, at, r);
+        for t in self.scene.terms.iter() {
+            if let Some(p) = t.predictor() {
+                let own = predicted.terms.get_mut(t.name());
+                p.predict(
+                    &pot_at,
+                    from,
+                    &mut predicted.x,
+                    &predicted.dofs,
+                    own,
+                    &mut solve,
+                );
+            }
         }
         // Safeguard: a linear prediction from a nearly singular Hessian (an unstressed membrane
-        // has soft modes) can land far off; keep it only when it lowers the potential.
-        let e = |s: &State| pot.eval(&s.x, &s.dofs, Want::Energy, &mut [], &mut []);
+        // has soft modes) can land far off; keep it (positions and term states) only when it
+        // lowers the potential.
+        let e = |s: &State| {
+            Potential {
+                terms: &s.terms,
+                ..*pot
+            }
+            .eval(&s.x, &s.dofs, Want::Energy, &mut [], &mut [])
+        };
         let ep = e(&predicted);
         if ep.is_finite() && ep < e(state) {
             state.copy_from(&predicted);
@@ -300,7 +349,7 @@ impl<'a> Solver<'a> {
     pub(super) fn is_stable(&mut self, dial: Real, state: &State) -> bool {
         let (x, phi) = (&state.x, &state.dofs);
         let pattern = self.pattern();
-        let pot = self.potential(&pattern, dial);
+        let pot = self.potential_at(&pattern, dial, state);
         let mut values = vec![0.0; pattern.nnz()];
         let mut g = vec![0.0; pattern.n];
         pot.eval(x, phi, Want::Hessian, &mut g, &mut values);

@@ -83,7 +83,7 @@ pub(super) fn run_static(
         let rep = s.solve(&pot, &mut trial, NewtonOptions { tol: t, ..opts });
         // A term tracking a state across steps (a moment's angle) may refuse a step too large
         // for it; the step is then cut like a failed solve.
-        let admissible = rep.converged && s.scene.admissible(&trial.x, &trial.dofs);
+        let admissible = rep.converged && super::hooks::admissible(s.scene, &trial);
         let rep = if rep.converged && !admissible {
             NewtonReport {
                 converged: false,
@@ -99,7 +99,7 @@ pub(super) fn run_static(
         if rep.converged {
             let taken = target - dial;
             state.copy_from(&trial);
-            s.scene.accept(&state.x, &state.dofs);
+            super::hooks::accept(s.scene, &mut state);
             let grow = rep.iterations <= 5;
             if dial < 1.0 {
                 dial = target;

@@ -198,6 +198,7 @@ impl Workspace {
             trial: State {
                 x: vec![Vec3::zeros(); pattern.num_vertices],
                 dofs: vec![0.0; pattern.num_scalar_dofs],
+                terms: Default::default(),
             },
             indefinite: false,
         }

@@ -13,7 +13,7 @@
 
 use crate::assembly::{Pattern, Want};
 use crate::energy::material::sv_matrix;
-use crate::energy::term::LowRank;
+use crate::energy::term::{LowRank, TermStates};
 use crate::energy::{HessianProjection, KoiterDensity};
 use crate::math::{Real, Sym2, Vec3};
 use crate::scene::Scene;
@@ -95,6 +95,9 @@ pub struct Potential<'a> {
     /// gradient hands each part's node sums to it instead of writing the gradient vector
     /// ([`crate::assembly::assemble_elements_owned`]). `None` everywhere else.
     pub owned: Option<&'a crate::assembly::OwnedNodes<'a>>,
+    /// The stateful terms' states the potential is evaluated with ([`crate::solve::State::terms`]): the
+    /// scene's initial states unless a driver sets its own.
+    pub terms: &'a TermStates,
 }
 
 impl<'a> Potential<'a> {
@@ -114,7 +117,14 @@ impl<'a> Potential<'a> {
             friction: None,
             frozen: None,
             owned: None,
+            terms: &scene.initial_states,
         }
+    }
+
+    /// The state of the stateful term named `name` ([`crate::energy::term::Stateful`]).
+    #[inline]
+    pub fn term_state(&self, name: &str) -> &'a [Real] {
+        self.terms.get(name)
     }
 
     /// The rest forms `(ā, b̄)` of face `f` at this potential's dial (or override).

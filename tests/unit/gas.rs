@@ -154,13 +154,21 @@ fn gas_term_matches_finite_differences_for_every_control() {
         let i = gas_index(&sc);
         let term = &sc.terms[i];
         let map: &ElementMap = &p.maps[i];
-        let pot = Potential {
+        let x = inflated(&sc, 1.15, 0.03, 4);
+        // Volume control: a non-zero multiplier (one plain update).
+        let mut states = sc.initial_states.clone();
+        let at_start = Potential {
             dial: 0.7,
             ..Potential::new(&sc, &p)
         };
-        let x = inflated(&sc, 1.15, 0.03, 4);
-        // Volume control: a non-zero multiplier (one plain update).
-        term.updates().unwrap().update(&pot, &x, &[], &mut |_| None);
+        term.updates()
+            .unwrap()
+            .update(&at_start, &x, &[], states.get_mut("gas"), &mut |_| None);
+        let pot = Potential {
+            dial: 0.7,
+            terms: &states,
+            ..Potential::new(&sc, &p)
+        };
         let eval = |x: &[Vec3], g: &mut Vec<Real>, h: &mut Vec<Real>, want: Want| {
             g.iter_mut().for_each(|v| *v = 0.0);
             h.iter_mut().for_each(|v| *v = 0.0);
@@ -331,6 +339,7 @@ fn residuals(sc: &Scene, x0: &[Vec3], projection: HessianProjection, n: usize) -
             let mut st = State {
                 x: x0.to_vec(),
                 dofs: Vec::new(),
+                terms: sc.initial_states.clone(),
             };
             let opts = NewtonOptions {
                 tol: 1e-300,
@@ -356,6 +365,7 @@ fn newton_is_quadratic_with_the_rank_one_part() {
     let mut st = State {
         x: inflated(&sc, 1.2, 0.0, 1),
         dofs: Vec::new(),
+        terms: sc.initial_states.clone(),
     };
     let rep = newton(&pot, &mut lin, &mut ws, &mut st, NewtonOptions::default());
     assert!(rep.converged, "{rep:?}");
@@ -527,18 +537,28 @@ fn position_based_projection_restores_the_skin_volume() {
         }
         let before = x.clone();
         let shell = &sc.terms[0];
-        let ratio = |x: &[Vec3]| {
-            shellsim::energy::term::observables(shell.as_ref(), &pot, x, &[])
+        let ratio = |pot: &Potential, x: &[Vec3]| {
+            shellsim::energy::term::observables(shell.as_ref(), pot, x, &[])
                 .into_iter()
                 .find(|o| o.0 == "skin_volume_ratio")
                 .unwrap()
                 .1
         };
-        let r0 = ratio(&x);
+        let r0 = ratio(&pot, &x);
         let projection = shell.projection().expect("the prism projects");
         let tracked = shell.tracked().expect("the prism tracks its thickness");
-        let c = projection.project(&pot, &mut x, &[]).unwrap().unwrap();
-        let r1 = ratio(&x);
+        let mut own = sc.initial_states.get("shell").to_vec();
+        let c = projection
+            .project(&pot, &mut x, &[], &mut own)
+            .unwrap()
+            .unwrap();
+        let mut states = sc.initial_states.clone();
+        states.set("shell", own.clone());
+        let pot = Potential {
+            terms: &states,
+            ..pot
+        };
+        let r1 = ratio(&pot, &x);
         println!("{iterations} projections: ratio {r0} → {r1} (C/V₀ = {c:e})");
         assert!((c - (r0 - 1.0)).abs() < 1e-12);
         if iterations == 1 {
@@ -558,14 +578,54 @@ fn position_based_projection_restores_the_skin_volume() {
             let mut y = x.clone();
             let f0 = sc.mesh.faces[0];
             y[f0[1]] = y[f0[0]];
-            let state = tracked.state(&x, &[]);
-            let err = projection.project(&pot, &mut y, &[]).unwrap_err();
+            let state = tracked.field(&x, &[], &own);
+            let err = projection.project(&pot, &mut y, &[], &mut own).unwrap_err();
             assert!(err.to_string().contains("thickness not finite"), "{err}");
-            assert_eq!(tracked.state(&x, &[]), state, "the state is left as it was");
+            assert_eq!(
+                tracked.field(&x, &[], &own),
+                state,
+                "the state is left as it was"
+            );
         }
         // The frame's thickness field is the projected thickness: thinner than at rest.
         let fields = shell.reports().unwrap().face_fields(&pot, &x, &[]);
         let h = &fields.iter().find(|f| f.0 == "thickness").unwrap().1;
         assert!(h.iter().all(|&h| h > 0.0 && h < 0.01));
     }
+}
+
+/// The gas's multiplier lives in the run's state, not in the scene: one scene run twice, and
+/// its clone, take the same steps and end on the same positions bitwise, and the scene's
+/// initial multiplier stays 0. (With the multiplier kept in the term, the second run started
+/// from the first one's final pressure and took other iterations.)
+#[test]
+fn a_volume_controlled_run_leaves_the_scene_as_it_was() {
+    let sc = balloon(
+        2,
+        "[gas]\ncontrol = \"volume\"\nvolume = 6.0\n[solver]\nmode = \"static\"\n",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let mut runs = Vec::new();
+    let copy = sc.clone();
+    for (k, run_on) in [&sc, &copy, &sc].into_iter().enumerate() {
+        let out = dir.path().join(format!("run{k}"));
+        let mut writer = shellsim::output::Writer::new(&out, run_on, false).unwrap();
+        let summary = shellsim::integrate::run(
+            run_on,
+            &mut writer,
+            &mut shellsim::integrate::Quiet,
+            1,
+            None,
+        )
+        .unwrap();
+        assert!(summary.converged, "{}", summary.reason);
+        let last = out.join(&summary.final_frame);
+        let frame = shellsim::mesh::io::read_mesh(&last).unwrap();
+        runs.push((summary.newton_iterations, summary.steps, frame.positions));
+    }
+    assert_eq!(sc.initial_states.get("gas"), &[0.0][..]);
+    assert_eq!(runs[0], runs[1], "the clone's run differs");
+    assert_eq!(runs[0], runs[2], "the scene's second run differs");
+    let volume = shellsim::energy::gas::Gas::volume(&sc, &runs[0].2);
+    assert!((volume / 6.0 - 1.0).abs() < 1e-8, "volume {volume}");
 }

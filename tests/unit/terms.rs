@@ -291,15 +291,18 @@ fn end_moment_matches_finite_differences_past_a_half_turn() {
             .expect("a moment term");
         let phi = vec![0.02; sc.num_edge_dofs()];
         // Accept in steps below π/2, as the solver would.
+        let mut states = sc.initial_states.clone();
         for k in 1..=11 {
             sc.terms[i].tracked().expect("the moment tracks").accept(
                 &rolled(&sc, 0.1 * k as Real * std::f64::consts::PI, 0.0),
                 &phi,
+                states.get_mut("moment"),
             );
         }
         let x = rolled(&sc, 1.3 * std::f64::consts::PI, 0.01);
         let pot = Potential {
             dial: 0.8,
+            terms: &states,
             ..Potential::new(&sc, &p)
         };
         check_term(&sc, &p, &pot, &x, &phi, i);
@@ -827,6 +830,7 @@ fn low_rank_term_solves_like_the_dense_matrix() {
     let mut state = shellsim::solve::State {
         x: x.clone(),
         dofs: Vec::new(),
+        terms: Default::default(),
     };
     let mut ws = shellsim::solve::newton::Workspace::new(&p);
     let rep = shellsim::solve::newton(
@@ -968,7 +972,12 @@ fn slide_contact_damping_is_an_implicit_dashpot_relative_to_the_slide() {
         .enumerate()
         .map(|(i, q)| Vec3::new(q.x, q.y, z(i)))
         .collect();
-    slides.explicit_begin(&pot, &x, dt);
+    let mut states = sc.initial_states.clone();
+    slides.explicit_begin(&sc, pot.dial, &x, dt, states.get_mut("slides"));
+    let pot = Potential {
+        terms: &states,
+        ..pot
+    };
     let mut v: Vec<Vec3> = (0..n).map(|i| Vec3::new(0.0, 0.0, vz(i))).collect();
     // The penalty's own gradient along z, and an in-plane force that must stay untouched.
     let g0: Vec<Real> = (0..n)

@@ -47,13 +47,12 @@
 //! without edge DOFs). Units: m in N·m/m, E in J, gradient N and N·m.
 
 use super::select_vertices;
-use crate::energy::term::{ElementKernel, Reports, StateError, Stencil, Term, Tracked};
+use crate::energy::term::{ElementKernel, Reports, StateError, Stateful, Stencil, Term, Tracked};
 use crate::math::{skew, Mat3, Real, SMat, SVec, Vec3};
 use crate::mesh::topology::NONE;
 use crate::mesh::MeshError;
 use crate::scene::Scene;
 use crate::solve::Potential;
-use std::sync::Mutex;
 
 /// One loaded boundary edge.
 #[derive(Clone, Copy, Debug)]
@@ -88,11 +87,46 @@ struct Frames {
     b: Frame,
 }
 
-/// The moment kernel with its per-edge frames.
+/// Reals per edge in the term's state: `k`, then `n` and `θ` of `A`, then of `B`.
+const PER_EDGE: usize = 11;
+
+impl Frames {
+    /// Edge `e`'s frames in the state `s` (`None` when `s` is too short).
+    fn read(s: &[Real], e: usize) -> Option<Frames> {
+        let v = s.get(PER_EDGE * e..PER_EDGE * (e + 1))?;
+        let vec = |i: usize| Vec3::new(v[i], v[i + 1], v[i + 2]);
+        Some(Frames {
+            k: vec(0),
+            a: Frame {
+                n: vec(3),
+                theta: v[6],
+            },
+            b: Frame {
+                n: vec(7),
+                theta: v[10],
+            },
+        })
+    }
+
+    /// Writes these frames as edge `e`'s in the state `s`.
+    fn write(&self, s: &mut [Real], e: usize) {
+        let v = &mut s[PER_EDGE * e..PER_EDGE * (e + 1)];
+        v[0..3].copy_from_slice(self.k.as_slice());
+        v[3..6].copy_from_slice(self.a.n.as_slice());
+        v[6] = self.a.theta;
+        v[7..10].copy_from_slice(self.b.n.as_slice());
+        v[10] = self.b.theta;
+    }
+}
+
+/// The moment kernel. Its state ([`crate::energy::term::Stateful`], under the name `moment`)
+/// is every loaded edge's frames at the last accepted state, 11 reals per edge (`k`, then `n`
+/// and `θ` of `A` and of `B`).
 pub struct Moment {
     edges: Vec<Edge>,
     num_faces: usize,
-    frames: Mutex<Vec<Frames>>,
+    /// The frames at the reference, flattened: the initial state.
+    initial: Vec<Real>,
 }
 
 /// The face's area normal `A` and in-face edge normal `B = A × e` at positions `x`.
@@ -149,7 +183,7 @@ impl ElementKernel<10, 4> for Moment {
         hess: Option<&mut SMat<10, 10>>,
     ) -> Real {
         let edge = &self.edges[e];
-        let Some(f) = self.frames.lock().ok().map(|fr| fr[e]) else {
+        let Some(f) = Frames::read(pot.term_state(NAME), e) else {
             return Real::NAN;
         };
         let xs = [x[nodes[0]], x[nodes[1]], x[nodes[2]]];
@@ -224,9 +258,12 @@ impl ElementKernel<10, 4> for Moment {
 /// The moment term: accumulates each edge's angle after every accepted step.
 pub struct MomentTerm(Moment);
 
+/// The name of the moment's term and state.
+const NAME: &str = "moment";
+
 impl Term for MomentTerm {
     fn name(&self) -> &'static str {
-        "moment"
+        NAME
     }
     fn stencil(&self, scene: &Scene) -> Stencil {
         let p = &scene.mesh.positions;
@@ -283,42 +320,76 @@ impl Term for MomentTerm {
         Some(self)
     }
 
+    fn stateful(&self) -> Option<&dyn Stateful> {
+        Some(self)
+    }
+
     fn reports(&self) -> Option<&dyn Reports> {
         Some(self)
     }
 }
 
+impl Stateful for MomentTerm {
+    fn initial_state(&self) -> Vec<Real> {
+        self.0.initial.clone()
+    }
+
+    /// The initial state's length, finite values and unit vectors.
+    fn check_state(&self, state: &[Real]) -> Result<(), String> {
+        if state.len() != self.0.initial.len() || !state.iter().all(|v| v.is_finite()) {
+            return Err(format!(
+                "expected {} finite values ({PER_EDGE} per loaded edge), got {}",
+                self.0.initial.len(),
+                state.len()
+            ));
+        }
+        for e in 0..self.0.edges.len() {
+            let Some(f) = Frames::read(state, e) else {
+                continue;
+            };
+            for v in [f.k, f.a.n, f.b.n] {
+                if (v.norm() - 1.0).abs() > 1e-9 {
+                    return Err(format!("loaded edge {e}: its frames are not unit vectors"));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
 impl Reports for MomentTerm {
-    fn observables(&self, _: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
-        let Ok(frames) = self.0.frames.lock() else {
-            return Vec::new();
-        };
+    fn observables(&self, pot: &Potential, x: &[Vec3], _: &[Real]) -> Vec<(String, Real)> {
+        let own = pot.term_state(NAME);
         let mut sum = 0.0;
-        for (e, f) in self.0.edges.iter().zip(frames.iter()) {
-            sum += Moment::turn(f, vectors(x, e)).0;
+        for (i, e) in self.0.edges.iter().enumerate() {
+            if let Some(f) = Frames::read(own, i) {
+                sum += Moment::turn(&f, vectors(x, e)).0;
+            }
         }
         vec![("moment_rotation".into(), sum / self.0.edges.len() as Real)]
     }
 }
 
 impl Tracked for MomentTerm {
-    fn accept(&self, x: &[Vec3], _: &[Real]) {
-        if let Ok(mut frames) = self.0.frames.lock() {
-            for (e, f) in self.0.edges.iter().zip(frames.iter_mut()) {
-                let (a, b) = vectors(x, e);
-                let (_, ta, tb) = Moment::turn(f, (a, b));
-                f.a = frame(&f.k, &a, ta);
-                f.b = frame(&f.k, &b, tb);
-            }
+    fn accept(&self, x: &[Vec3], _: &[Real], own: &mut [Real]) {
+        for (i, e) in self.0.edges.iter().enumerate() {
+            let Some(mut f) = Frames::read(own, i) else {
+                continue;
+            };
+            let (a, b) = vectors(x, e);
+            let (_, ta, tb) = Moment::turn(&f, (a, b));
+            f.a = frame(&f.k, &a, ta);
+            f.b = frame(&f.k, &b, tb);
+            f.write(own, i);
         }
     }
     /// Each edge's angles may change by at most π/2 per step, well inside the atan2 branch.
-    fn admissible(&self, x: &[Vec3], _: &[Real]) -> bool {
-        let Ok(frames) = self.0.frames.lock() else {
-            return false;
-        };
-        self.0.edges.iter().zip(frames.iter()).all(|(e, f)| {
-            let (_, ta, tb) = Moment::turn(f, vectors(x, e));
+    fn admissible(&self, x: &[Vec3], _: &[Real], own: &[Real]) -> bool {
+        self.0.edges.iter().enumerate().all(|(i, e)| {
+            let Some(f) = Frames::read(own, i) else {
+                return false;
+            };
+            let (_, ta, tb) = Moment::turn(&f, vectors(x, e));
             let lim = std::f64::consts::FRAC_PI_2;
             (ta - f.a.theta).abs() <= lim && (tb - f.b.theta).abs() <= lim
         })
@@ -327,11 +398,11 @@ impl Tracked for MomentTerm {
         "moment_turn"
     }
     /// Each loaded edge's turn θ (rad) at its boundary face and edge slot; 0 elsewhere.
-    fn state(&self, x: &[Vec3], _: &[Real]) -> Vec<Real> {
+    fn field(&self, x: &[Vec3], _: &[Real], own: &[Real]) -> Vec<Real> {
         let mut out = vec![0.0; 3 * self.0.num_faces];
-        if let Ok(frames) = self.0.frames.lock() {
-            for (e, f) in self.0.edges.iter().zip(frames.iter()) {
-                out[3 * e.face + e.slot] = Moment::turn(f, vectors(x, e)).0;
+        for (i, e) in self.0.edges.iter().enumerate() {
+            if let Some(f) = Frames::read(own, i) {
+                out[3 * e.face + e.slot] = Moment::turn(&f, vectors(x, e)).0;
             }
         }
         out
@@ -343,19 +414,17 @@ impl Tracked for MomentTerm {
         x: &[Vec3],
         phi: &[Real],
         field: Option<&[Real]>,
+        own: &mut [Real],
     ) -> Result<Option<String>, StateError> {
         let Some(field) = field else {
-            self.accept(x, phi);
+            self.accept(x, phi, own);
             return Ok(Some(
                 "no 'moment_turn' field: the end moment's turns are counted from the reference \
                  mesh within ±π"
                     .into(),
             ));
         };
-        let Ok(mut frames) = self.0.frames.lock() else {
-            return Ok(None);
-        };
-        for (e, f) in self.0.edges.iter().zip(frames.iter_mut()) {
+        for (i, e) in self.0.edges.iter().enumerate() {
             let theta = field.get(3 * e.face + e.slot).copied().unwrap_or(Real::NAN);
             if !theta.is_finite() {
                 return Err(StateError {
@@ -363,9 +432,13 @@ impl Tracked for MomentTerm {
                     reason: format!("field 'moment_turn' is not finite at edge {}", e.slot),
                 });
             }
+            let Some(mut f) = Frames::read(own, i) else {
+                continue;
+            };
             let (a, b) = vectors(x, e);
             f.a = frame(&f.k, &a, theta);
             f.b = frame(&f.k, &b, theta);
+            f.write(own, i);
         }
         Ok(None)
     }
@@ -435,9 +508,13 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
             )));
         }
     }
+    let mut initial = vec![0.0; PER_EDGE * frames.len()];
+    for (e, f) in frames.iter().enumerate() {
+        f.write(&mut initial, e);
+    }
     Ok(Some(Box::new(MomentTerm(Moment {
         edges,
         num_faces: mesh.faces.len(),
-        frames: Mutex::new(frames),
+        initial,
     }))))
 }

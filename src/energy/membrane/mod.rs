@@ -48,23 +48,41 @@ pub trait Membrane: Send + Sync + 'static {
         false
     }
 
-    /// The projection (see [`crate::energy::term::Projection`]; default: none).
-    fn project(&self, _pot: &Potential, _x: &mut [Vec3]) -> Result<Option<Real>, StateError> {
+    /// The projection of the state `own` (see [`crate::energy::term::Projection`]; default:
+    /// none).
+    fn project(
+        &self,
+        _pot: &Potential,
+        _x: &mut [Vec3],
+        _own: &mut [Real],
+    ) -> Result<Option<Real>, StateError> {
         Ok(None)
     }
 
-    /// The per-face state a restart needs, one value per face (default: none).
+    /// The name of the per-face field that shows the membrane's state, one value per face
+    /// (default: none, a stateless membrane).
     fn state_field(&self) -> Option<&'static str> {
         None
     }
 
-    /// That state.
-    fn state(&self) -> Vec<Real> {
-        Vec::new()
+    /// The state at the start of a run, one value per face, when the membrane has one: its
+    /// shell term then declares [`crate::energy::term::Stateful`] and
+    /// [`crate::energy::term::Tracked`] (default: none).
+    fn initial_state(&self) -> Option<Vec<Real>> {
+        None
     }
 
-    /// Restores that state from a restart frame's field (`None` when absent).
-    fn restore(&self, _field: Option<&[Real]>) -> Result<Option<String>, StateError> {
+    /// Checks a state read from a restart (default: anything goes).
+    fn check_state(&self, _state: &[Real]) -> Result<(), StateError> {
+        Ok(())
+    }
+
+    /// Restores the state `own` from a restart frame's field (`None` when absent).
+    fn restore(
+        &self,
+        _field: Option<&[Real]>,
+        _own: &mut [Real],
+    ) -> Result<Option<String>, StateError> {
         Ok(None)
     }
 }

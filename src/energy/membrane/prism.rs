@@ -41,7 +41,6 @@ use super::{bending_wells, psd3, psd_ga, Membrane, MembraneLaw, WithKoiterBendin
 use crate::math::{sym_det, sym_to_mat, Mat3, Real, SVec, Sym2, Vec3};
 use crate::settings::{PrismLaw, PrismThickness};
 use crate::solve::Potential;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The 3D St Venant–Kirchhoff or neo-Hookean prism membrane of one face.
 #[derive(Clone, Copy, Debug)]
@@ -167,7 +166,8 @@ impl MembraneLaw for PrismFace {
     }
 }
 
-/// The prism membrane material, with the per-face thickness state of the `"pbd"` mode.
+/// The prism membrane material. In the `"pbd"` mode its shell term carries the current
+/// thickness of each face (m) as its state ([`crate::energy::term::Stateful`]).
 pub struct Prism {
     /// The density law.
     pub law: PrismLaw,
@@ -177,9 +177,8 @@ pub struct Prism {
     pub iterations: usize,
     /// Poisson's ratio ν.
     pub poisson: Real,
-    /// `"pbd"`: the current thickness of each face (m, `f64` bits; written only between
-    /// solves, read per face without locking).
-    thickness: Vec<AtomicU64>,
+    /// The rest thickness of each face (m): the `"pbd"` mode's initial state.
+    rest_thickness: Vec<Real>,
 }
 
 impl Prism {
@@ -191,18 +190,17 @@ impl Prism {
             mode: p.thickness,
             iterations: p.pbd_iterations,
             poisson: scene.settings.material.poisson,
-            thickness: scene
-                .thickness
-                .iter()
-                .map(|h| AtomicU64::new(h.to_bits()))
-                .collect(),
+            rest_thickness: scene.thickness.clone(),
         }
     }
 
-    /// The current thickness of face `f` in the `"pbd"` mode (m).
+    /// The current thickness of face `f` in the `"pbd"` mode (m) that `pot` is evaluated with.
     #[inline]
-    fn h(&self, f: usize) -> Real {
-        Real::from_bits(self.thickness[f].load(Ordering::Relaxed))
+    fn h(pot: &Potential, f: usize) -> Real {
+        pot.term_state(crate::energy::shell::NAME)
+            .get(f)
+            .copied()
+            .unwrap_or(Real::NAN)
     }
 
     /// The current thickness of every face at positions `x` (m): `h̄ Ā/A` (incompressible) or
@@ -211,7 +209,7 @@ impl Prism {
         let sc = pot.scene;
         (0..sc.num_faces())
             .map(|f| match self.mode {
-                PrismThickness::Pbd => self.h(f),
+                PrismThickness::Pbd => Self::h(pot, f),
                 PrismThickness::Incompressible => {
                     let (abar, _) = pot.rest_forms(f);
                     let t = sc.mesh.faces[f];
@@ -245,13 +243,15 @@ impl Prism {
     /// `w = 1/m'` from the masses of Eq. 19 (1/6 of a prism's mass to each of its three vertices,
     /// 1/2 to its virtual vertex; fixed vertices do not move), `n` the number of points. Then
     /// `h` is read back as the height of `x₄` over its moved face. `iterations` projections
-    /// (1 in the seed). Moves `x` and the thickness state; returns `C/V_b⁰` before the first
-    /// projection. A thickness that comes out non-positive or non-finite (the prism turned
-    /// inside out: `det F ≤ 0`) is an error naming the face, and the state is left as it was.
+    /// (1 in the seed). Moves `x` and the thickness state `own` (from the state `pot` holds);
+    /// returns `C/V_b⁰` before the first projection. A thickness that comes out non-positive or
+    /// non-finite (the prism turned inside out: `det F ≤ 0`) is an error naming the face, and
+    /// the state is left as it was.
     pub fn project(
         &self,
         pot: &Potential,
         x: &mut [Vec3],
+        own: &mut [Real],
     ) -> Result<Real, crate::energy::term::StateError> {
         let sc = pot.scene;
         let faces = &sc.mesh.faces;
@@ -281,7 +281,7 @@ impl Prism {
             .collect();
         let n_points = (nv + nf) as Real;
         let w_sum: Real = w.iter().sum();
-        let mut h: Vec<Real> = (0..nf).map(|f| self.h(f)).collect();
+        let mut h: Vec<Real> = (0..nf).map(|f| Self::h(pot, f)).collect();
         let mut first = 0.0;
         for it in 0..self.iterations.max(1) {
             // Virtual vertices at the current thickness.
@@ -339,14 +339,22 @@ impl Prism {
                 ),
             });
         }
-        for (a, v) in self.thickness.iter().zip(&h) {
-            a.store(v.to_bits(), Ordering::Relaxed);
-        }
+        own.copy_from_slice(&h);
         Ok(first)
     }
 
-    /// Sets the thickness state (a restart), checking each value is positive and finite.
-    pub fn set_thickness(&self, h: &[Real]) -> Result<(), crate::energy::term::StateError> {
+    /// Checks a thickness state (a restart): one positive finite value per face.
+    pub fn check_thickness(&self, h: &[Real]) -> Result<(), crate::energy::term::StateError> {
+        if h.len() != self.rest_thickness.len() {
+            return Err(crate::energy::term::StateError {
+                face: h.len().min(self.rest_thickness.len()),
+                reason: format!(
+                    "the thickness state has {} values for {} faces",
+                    h.len(),
+                    self.rest_thickness.len()
+                ),
+            });
+        }
         for (f, &v) in h.iter().enumerate() {
             if !(v.is_finite() && v > 0.0) {
                 return Err(crate::energy::term::StateError {
@@ -357,9 +365,6 @@ impl Prism {
                     ),
                 });
             }
-        }
-        for (a, &v) in self.thickness.iter().zip(h) {
-            a.store(v.to_bits(), Ordering::Relaxed);
         }
         Ok(())
     }
@@ -375,7 +380,7 @@ impl Membrane for Prism {
         let c = match self.mode {
             PrismThickness::Incompressible => None,
             PrismThickness::Pbd => {
-                let r = self.h(f) / h0;
+                let r = Self::h(pot, f) / h0;
                 Some(r * r)
             }
         };
@@ -411,9 +416,10 @@ impl Membrane for Prism {
         &self,
         pot: &Potential,
         x: &mut [Vec3],
+        own: &mut [Real],
     ) -> Result<Option<Real>, crate::energy::term::StateError> {
         match self.mode {
-            PrismThickness::Pbd => Prism::project(self, pot, x).map(Some),
+            PrismThickness::Pbd => Prism::project(self, pot, x, own).map(Some),
             PrismThickness::Incompressible => Ok(None),
         }
     }
@@ -422,16 +428,26 @@ impl Membrane for Prism {
         (self.mode == PrismThickness::Pbd).then_some("thickness")
     }
 
-    fn state(&self) -> Vec<Real> {
-        (0..self.thickness.len()).map(|f| self.h(f)).collect()
+    /// `"pbd"`: the rest thickness of each face (m).
+    fn initial_state(&self) -> Option<Vec<Real>> {
+        (self.mode == PrismThickness::Pbd).then(|| self.rest_thickness.clone())
+    }
+
+    fn check_state(&self, state: &[Real]) -> Result<(), crate::energy::term::StateError> {
+        self.check_thickness(state)
     }
 
     fn restore(
         &self,
         field: Option<&[Real]>,
+        own: &mut [Real],
     ) -> Result<Option<String>, crate::energy::term::StateError> {
         match field {
-            Some(h) => self.set_thickness(h).map(|_| None),
+            Some(h) => {
+                self.check_thickness(h)?;
+                own.copy_from_slice(h);
+                Ok(None)
+            }
             None => Ok(Some(
                 "the frame has no 'thickness': the position-based thickness restarts at the rest \
                  thickness"

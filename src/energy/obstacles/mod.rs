@@ -262,6 +262,26 @@ impl VertexKernel for ObstacleFriction {
         out
     }
 
+    fn lags_normals(&self) -> bool {
+        true
+    }
+
+    /// Over every vertex and frictional obstacle, the largest normal force at `trial` and the
+    /// largest change from the lagged iterate.
+    fn lag_change(&self, trial: &[Vec3], dial: Real, lag: &[Vec3], dial_lag: Real) -> (Real, Real) {
+        let o = &self.0;
+        let (mut scale, mut diff) = (0.0 as Real, 0.0 as Real);
+        for (v, (xt, xl)) in trial.iter().zip(lag).enumerate() {
+            for k in (0..o.list.len()).filter(|&k| o.list[k].friction > 0.0) {
+                let new = o.normal_force(k, v, xt, dial);
+                let old = o.normal_force(k, v, xl, dial_lag);
+                scale = scale.max(new);
+                diff = diff.max((new - old).abs());
+            }
+        }
+        (scale, diff)
+    }
+
     /// Per frictional obstacle `i`, the friction force it exerted on the sheet over the last
     /// step (`obstacle{i}_friction_x/y/z`, N; 0 where the frame's potential carries no step,
     /// the first frame), so that the normal and friction forces together balance the loads.

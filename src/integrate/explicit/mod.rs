@@ -295,7 +295,7 @@ pub(super) fn run_explicit(
 
     // The mesh's stability limit, measured at the start (gradient only).
     let omega2 = {
-        let pot = s.potential(&pat, 0.0);
+        let pot = s.potential_at(&pat, 0.0, &state);
         max_frequency_squared(&pot, &state.x, 60)
     };
     let stable_prefactor = (omega2 > 0.0).then(|| 2.0 / (omega2.sqrt() * sca.dt_unit));
@@ -371,7 +371,7 @@ pub(super) fn run_explicit(
         // target's energy in the starting shape (a compatible target relaxes to Φ ≈ 0, where a
         // test relative to Φ alone would ask for round-off).
         energy_floor: {
-            let pot = s.potential(&pat, 1.0);
+            let pot = s.potential_at(&pat, 1.0, &state);
             1e-6 * gradient(&pot, &state.x, &mut g).abs()
         },
         window: Window {
@@ -386,7 +386,7 @@ pub(super) fn run_explicit(
     s.summary.holds_reached = k.holds_reached;
     report.holds_reached = k.holds_reached;
     {
-        let pot = s.potential(&pat, k.dial);
+        let pot = s.potential_at(&pat, k.dial, &state);
         s.summary.residual = residual_at(&pot, &state.x, &mut scratch);
         s.driver = k.saved();
         s.frame(writer, &pot, &state, &v, k.t)?;
@@ -397,7 +397,7 @@ pub(super) fn run_explicit(
     // The steps' gradients run on a team of spinning threads: a step is too short for rayon's
     // sleeping workers to be woken twice per step (`crate::team`).
     let team = crate::team::Team::new(rayon::current_num_threads());
-    let mut step = Step::new(&s.potential(&pat, k.dial), true);
+    let mut step = Step::new(&s.potential_at(&pat, k.dial, &state), true);
     let stop = team.activate(|| -> Result<Stop, RunError> {
         Ok(loop {
             if let Some(f) = super::interruption("t", k.t) {
@@ -408,18 +408,22 @@ pub(super) fn run_explicit(
                 let pot = s.potential(&pat, dial);
                 frozen = Some((dial, (0..sc.num_faces()).map(|f| pot.density(f)).collect()));
             }
+            sc.prescribe(&mut state.x, dial);
+            // Terms whose own state follows the sheet (a moving slide) catch up with it first.
+            for t in sc.terms.iter() {
+                if let Some(hooks) = t.explicit() {
+                    let own = state.terms.get_mut(t.name());
+                    hooks.explicit_begin(sc, dial, &state.x, dt, own);
+                }
+            }
             let pot = Potential {
                 frozen: frozen
                     .as_ref()
                     .filter(|(d, _)| *d == dial)
                     .map(|(_, v)| &v[..]),
+                terms: &state.terms,
                 ..s.potential(&pat, dial)
             };
-            sc.prescribe(&mut state.x, dial);
-            // Terms whose own state follows the sheet (a moving slide) catch up with it first.
-            for hooks in sc.terms.iter().filter_map(|t| t.explicit()) {
-                hooks.explicit_begin(&pot, &state.x, dt);
-            }
             let c = if k.phase == Phase::Dial {
                 rate_dial
             } else {
@@ -486,7 +490,7 @@ pub(super) fn run_explicit(
                     report.holds_reached = k.holds_reached;
                     s.summary.holds_reached = k.holds_reached;
                     k.phase = Phase::Dial;
-                    let pot = s.potential(&pat, k.dial);
+                    let pot = s.potential_at(&pat, k.dial, &state);
                     s.summary.residual = residual_at(&pot, &state.x, &mut scratch);
                     k.next_frame = k.t + frame_interval;
                     s.driver = k.saved();
@@ -519,7 +523,7 @@ pub(super) fn run_explicit(
             }
             k.advance_dial(dt, dial_time, &holds);
             if k.t >= k.next_frame {
-                let pot = s.potential(&pat, k.dial);
+                let pot = s.potential_at(&pat, k.dial, &state);
                 let healthy = state.x.iter().all(|p| p.iter().all(|c| c.is_finite()));
                 if !healthy {
                     let why = unstable(
@@ -586,7 +590,7 @@ fn finish(
     max_long_times: Real,
     scratch: &mut [Real],
 ) -> Result<(), RunError> {
-    let pot = s.potential(pat, k.dial);
+    let pot = s.potential_at(pat, k.dial, state);
     s.summary.residual = residual_at(&pot, &state.x, scratch);
     s.summary.time = Some(k.t);
     s.summary.dial = k.dial;
