@@ -27,6 +27,10 @@ pub struct Scene {
     pub lame: Vec<Lame2d>,
     /// Multiplier on stretching (1 Koiter, 4 MorphoShell).
     pub stretch_factor: Real,
+    /// Whether the sheet has a bending energy (`material.bending` is not `"none"`).
+    pub has_bending: bool,
+    /// The bending stiffening factor γ (`material.bend_stiffening`), if any.
+    pub bend_stiffening: Option<Real>,
     /// Lumped mass per vertex: Σ ρ h A / 3 over incident faces, reference areas (kg).
     pub mass: Vec<Real>,
     /// True for fixed vertices.
@@ -193,6 +197,8 @@ impl Scene {
             .fold(0.0, Real::max);
         let mut scene = Scene {
             stretch_factor: m.stretch_convention.factor(),
+            has_bending: m.bending != crate::settings::BendingModel::None,
+            bend_stiffening: m.bend_stiffening,
             force_scale: eh * mean_edge,
             mean_edge,
             mesh,

@@ -176,6 +176,53 @@ fn unit(key: &str, v: [Real; 3]) -> Result<[Real; 3], Invalid> {
 }
 
 impl ObstacleSettings {
+    /// Validates obstacle `i` (`[[obstacles]]`, its keys `obstacles[i].…`) in a run of mode
+    /// `mode`: its shape, its control, and what each mode allows (force control needs an
+    /// implicit driver and, in dynamics, a mass; friction needs time to slip over, and the
+    /// explicit stick/slip acts against fixed obstacles only).
+    pub fn validate(&self, i: usize, mode: super::solver::Mode) -> Result<(), Invalid> {
+        use super::solver::Mode;
+        self.shape(i)?;
+        let control = self.control(i)?;
+        let invalid =
+            |key: &str, reason: &str| Err(Invalid::new(&format!("obstacles[{i}].{key}"), reason));
+        if let Control::Pressed { mass, .. } = control {
+            if mode == Mode::Explicit {
+                return invalid(
+                    "force",
+                    "force control needs solver.mode = \"static\" or \"dynamic\" (the \
+                     explicit driver moves vertices only; [slides] offer a pressed plane \
+                     there)",
+                );
+            }
+            if mode == Mode::Dynamic && mass.is_none() {
+                return invalid(
+                    "mass",
+                    "is required by a force-controlled obstacle in dynamic mode (kg, its \
+                     inertia)",
+                );
+            }
+        }
+        if self.friction > 0.0 && mode == Mode::Static {
+            return invalid(
+                "friction",
+                "friction needs solver.mode = \"dynamic\" or \"explicit\": a static solve \
+                 has no slip over a time for friction to resist",
+            );
+        }
+        if self.friction > 0.0
+            && mode == Mode::Explicit
+            && self.displacement.iter().any(|&c| c != 0.0)
+        {
+            return invalid(
+                "friction",
+                "friction on a moving obstacle needs solver.mode = \"dynamic\" (explicit \
+                 stick/slip acts against fixed obstacles only)",
+            );
+        }
+        Ok(())
+    }
+
     /// The validated motion of obstacle `i`: `force` (a non-zero direction, finite) excludes a
     /// non-zero `displacement` and `friction`; `mass` is positive and only with a force.
     pub fn control(&self, i: usize) -> Result<Control, Invalid> {

@@ -158,17 +158,13 @@ impl<'a> Potential<'a> {
         let (ws, wb) = KoiterDensity::weights(&abar, self.thickness(f), sc.stretch_factor);
         let ws = ws * self.stretch_scale;
         // A pure membrane has no bending energy (b ≡ 0, whatever b̄ the mesh's shape gives).
-        let wb = if sc.settings.material.bending == crate::settings::BendingModel::None {
-            0.0
-        } else {
-            wb
-        };
+        let wb = if sc.has_bending { wb } else { 0.0 };
         let mut d = KoiterDensity {
             c: sv_matrix(&abar, sc.lame[f]),
             stretch: [(ws, abar), (0.0, Sym2::zeros())],
             bend: [(wb, bbar), (0.0, Sym2::zeros())],
             stiffen: crate::energy::stiffening::coefficient(
-                sc.settings.material.bend_stiffening,
+                sc.bend_stiffening,
                 0.5 * crate::math::sym_det(&abar).max(0.0).sqrt(),
                 sc.lame[f].beta,
                 self.thickness(f),

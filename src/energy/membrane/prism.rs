@@ -179,6 +179,8 @@ pub struct Prism {
     pub poisson: Real,
     /// The rest thickness of each face (m): the `"pbd"` mode's initial state.
     rest_thickness: Vec<Real>,
+    /// Mass density ρ (kg/m³), for the projection's weights.
+    density: Real,
 }
 
 impl Prism {
@@ -191,6 +193,7 @@ impl Prism {
             iterations: p.pbd_iterations,
             poisson: scene.settings.material.poisson,
             rest_thickness: scene.thickness.clone(),
+            density: scene.settings.material.density,
         }
     }
 
@@ -257,7 +260,7 @@ impl Prism {
         let faces = &sc.mesh.faces;
         let nf = faces.len();
         let nv = x.len();
-        let rho = sc.settings.material.density;
+        let rho = self.density;
         let rest_vol: Vec<Real> = (0..nf)
             .map(|f| 0.5 * sym_det(&pot.rest_forms(f).0).max(0.0).sqrt() * pot.thickness(f))
             .collect();
