@@ -56,6 +56,8 @@ pub mod assembly;
 #[doc(hidden)]
 pub mod cli;
 #[doc(hidden)]
+pub mod contact;
+#[doc(hidden)]
 pub mod diffusion;
 #[doc(hidden)]
 pub mod energy;

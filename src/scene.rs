@@ -63,7 +63,7 @@ pub struct Scene {
     /// [`crate::solve::Potential::thickness`]).
     pub grown_thickness: Vec<Real>,
     /// The ground plane (`contact.enabled`), else `None`.
-    pub ground: Option<crate::solve::contact::Ground>,
+    pub ground: Option<crate::contact::Ground>,
     /// The energy terms the settings enable, in assembly order ([`crate::energy::registry`]).
     pub terms: crate::energy::term::Terms,
     /// The global DOFs the terms declared, in node order after the edge nodes.
@@ -853,7 +853,7 @@ impl ContactAreas {
 }
 
 /// The ground of `[contact]` with the per-vertex areas and half thicknesses it needs (see
-/// [`crate::solve::contact`] and [`ContactAreas`]); `"auto"` stiffness is the area-weighted
+/// [`crate::contact`] and [`ContactAreas`]); `"auto"` stiffness is the area-weighted
 /// mean of E/h, `"auto"` smoothing is the area-weighted mean h over 100. A vertex that starts
 /// deeper inside than the smoothing is an error naming it.
 fn build_ground(
@@ -861,14 +861,14 @@ fn build_ground(
     c: &crate::settings::Contact,
     thickness: &[Real],
     young: &[Real],
-) -> Result<crate::solve::contact::Ground, MeshError> {
+) -> Result<crate::contact::Ground, MeshError> {
     let ContactAreas {
         area,
         half_thickness,
         e_over_h,
         h_mean,
     } = ContactAreas::of(mesh, thickness, young);
-    let g = crate::solve::contact::Ground {
+    let g = crate::contact::Ground {
         point: Vec3::from(c.point),
         normal: Vec3::from(c.normal).normalize(),
         stiffness: c.stiffness.or(e_over_h),

@@ -17,12 +17,13 @@ const FLOORS: &[(&str, u32)] = &[
     ("linalg", 1),
     ("team", 1),
     ("units", 1),
-    // 2: configuration; mesh and geometry; expressions of x, y.
+    // 2: configuration; mesh and geometry; contact laws; expressions of x, y.
     ("config", 2),
     ("settings", 2),
     ("expr", 2),
     ("mesh", 2),
     ("geometry", 2),
+    ("contact", 2),
     ("fields", 2),
     // 3: rest forms, their laws and the fields that drive them.
     ("rest", 3),

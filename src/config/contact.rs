@@ -6,7 +6,7 @@ use crate::math::Real;
 use serde::{Deserialize, Serialize};
 
 /// `[contact]`: a rigid ground plane the sheet rests on and lifts off from, with Coulomb
-/// friction, inside the Newton solve (see [`crate::solve::contact`]).
+/// friction, inside the Newton solve (see [`crate::contact`]).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Contact {

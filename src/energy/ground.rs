@@ -1,4 +1,4 @@
-//! The ground plane and its friction, two vertex terms over [`crate::solve::contact::Ground`]
+//! The ground plane and its friction, two vertex terms over [`crate::contact::Ground`]
 //! (formulas, units and smoothing there): the C² normal penalty `k A_v ψ(p)`, and the lagged,
 //! smoothed Coulomb friction `μ λ f₀(‖slip‖)` (dynamics only, while the potential carries a
 //! [`crate::solve::potential::Friction`]). DOF order: `x[v]`.

@@ -4,7 +4,7 @@
 //! [`FRICTION_LAG_TOL`] of its largest entry or [`FRICTION_LAG_MAX`] solves were made (the last
 //! one is accepted). `λ` carries over to the next step, so a resting contact needs one solve
 //! per step. The ground's `λ` is kept per vertex; an obstacle's normal force and normal are taken
-//! at the lagged iterate's positions and dial, which the lag keeps. See [`crate::solve::contact`] for the friction potential.
+//! at the lagged iterate's positions and dial, which the lag keeps. See [`crate::contact`] for the friction potential.
 
 use crate::math::{Real, Vec3};
 use crate::scene::Scene;

@@ -4,7 +4,6 @@
 //! it uses ([`linear`]), with dense low-rank Hessian parts through the Woodbury identity
 //! ([`low_rank`]).
 
-pub mod contact;
 /// The sparse Cholesky solver, which lives on the lowest floor ([`crate::linalg`]).
 pub use crate::linalg as linear;
 pub mod low_rank;

@@ -1,7 +1,7 @@
 //! Rigid obstacles (`[[obstacles]]`): spheres, capsules, infinite cylinders, planes and boxes,
 //! fixed or moved with the dial, that the sheet's surfaces rest on or are pressed by. One file
 //! per shape gives its signed distance `d(x)` with `∇d` and `∇²d` ([`Distance`]); this term
-//! turns them into the ground's smoothed one-sided penalty ([`crate::solve::contact`]).
+//! turns them into the ground's smoothed one-sided penalty ([`crate::contact`]).
 //!
 //! **Energy.** Vertex `v`'s gap to obstacle `o` is `g = d_o(x_v − s u_o) − h_v/2`, with `u_o`
 //! the obstacle's `displacement`, `s` the dial (clamped to [0, 1]) and `h_v` the mean thickness
@@ -11,7 +11,7 @@
 //! `E = Σ_o Σ_v k_o A_v ψ(p)`,
 //! `∂E/∂x_v = −k_o A_v ψ′(p) ∇d`, `∂²E/∂x_v² = k_o A_v (ψ″(p) ∇d∇dᵀ − ψ′(p) ∇²d)`,
 //!
-//! `ψ` the C² penalty of [`crate::solve::contact::penalty`] with smoothing δ, `A_v` the vertex's
+//! `ψ` the C² penalty of [`crate::contact::penalty`] with smoothing δ, `A_v` the vertex's
 //! reference area, `k_o` the stiffness (Pa/m). Defaults as for the ground: `k = E/h` and
 //! `δ = h/100`, area-weighted over the sheet; in explicit mode `k` is at most `ρ h / Δt²`, the
 //! stiffest spring the explicit step Δt resolves (ω Δt = 1, ω² = k/(ρh)). The curvature part `−ψ′∇²d` is negative
@@ -39,10 +39,10 @@ pub mod sphere;
 
 use super::term::{Term, VertexKernel, VertexTerm};
 use crate::config::obstacle::{Control, Shape};
+use crate::contact::{friction_potential, penalty};
 use crate::math::{Mat3, Real, Vec3};
 use crate::mesh::MeshError;
 use crate::scene::Scene;
-use crate::solve::contact::{friction_potential, penalty};
 use crate::solve::Potential;
 
 /// A shape's signed distance (m, negative inside), its gradient and its Hessian (1/m) at `x`.
@@ -210,7 +210,7 @@ impl Obstacles {
 }
 
 /// The obstacles' lagged, smoothed Coulomb friction in dynamic mode, the ground's law
-/// ([`crate::solve::contact::friction_potential`]) against each frictional obstacle `o`:
+/// ([`crate::contact::friction_potential`]) against each frictional obstacle `o`:
 ///
 /// `D_v = Σ_o μ_o λ_o f₀(‖T_o (x_v − x⁰_v − u_o Δs)‖)`,
 ///
