@@ -60,6 +60,8 @@ pub mod contact;
 #[doc(hidden)]
 pub mod diffusion;
 #[doc(hidden)]
+pub mod elements;
+#[doc(hidden)]
 pub mod energy;
 #[doc(hidden)]
 pub mod fuzz;

@@ -25,8 +25,9 @@ const FLOORS: &[(&str, u32)] = &[
     ("geometry", 2),
     ("contact", 2),
     ("fields", 2),
-    // 3: rest forms, their laws and the fields that drive them.
+    // 3: rest forms, their laws and the fields that drive them; the element loops.
     ("rest", 3),
+    ("elements", 3),
     ("diffusion", 3),
     // 4: the body and its scales.
     ("scene", 4),

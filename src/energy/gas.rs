@@ -39,7 +39,7 @@
 //! Units: V in m³, pressures in Pa, E in J, gradient N, Hessian N/m. DOF order per face (9):
 //! `x[v0], x[v1], x[v2]`.
 
-use crate::assembly::{assemble_elements, ElementMap, Want};
+use crate::elements::{assemble_elements, ElementMap, Want};
 use crate::energy::term::{
     LowRank, LowRankPart, Multiplier, Predictor, Reports, Stateful, Stencil, Term,
 };

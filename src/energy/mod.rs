@@ -30,7 +30,7 @@ pub mod loads;
 pub mod material;
 pub mod membrane;
 pub mod obstacles;
-pub mod projection;
+pub use crate::elements::projection;
 pub mod registry;
 pub mod shell;
 pub mod slides;

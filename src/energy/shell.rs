@@ -330,16 +330,16 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
     fn eval(
         &self,
         pot: &Potential,
-        map: &crate::assembly::ElementMap,
+        map: &crate::elements::ElementMap,
         x: &[Vec3],
         phi: &[Real],
-        want: crate::assembly::Want,
+        want: crate::elements::Want,
         projection: super::HessianProjection,
         grad: &mut [Real],
         values: &mut [Real],
     ) -> Real {
         let gn = projection == super::HessianProjection::GaussNewton;
-        crate::assembly::assemble_elements_owned::<N, S, _>(
+        crate::elements::assemble_elements_owned::<N, S, _>(
             map,
             |e, nodes, g, h| ElementKernel::<N, S>::eval(self, pot, e, nodes, x, phi, gn, g, h),
             &pot.scene.node_fixed,
@@ -378,7 +378,7 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Reports
     fn energies(
         &self,
         pot: &Potential,
-        _: &crate::assembly::ElementMap,
+        _: &crate::elements::ElementMap,
         x: &[Vec3],
         phi: &[Real],
     ) -> Option<Vec<(&'static str, Real)>> {
@@ -411,7 +411,7 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Reports
     fn report(
         &self,
         pot: &Potential,
-        _: &crate::assembly::ElementMap,
+        _: &crate::elements::ElementMap,
         x: &[Vec3],
         phi: &[Real],
     ) -> (Option<Vec<(&'static str, Real)>>, Vec<(String, Vec<Real>)>) {

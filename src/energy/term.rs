@@ -16,64 +16,12 @@
 //!
 //! Dispatch is once per term: a term's element loop is monomorphic.
 
-use crate::assembly::{assemble_elements, assemble_elements_owned, ElementMap, Want};
+pub use crate::elements::Stencil;
+use crate::elements::{assemble_elements, assemble_elements_owned, ElementMap, Want};
 use crate::energy::HessianProjection;
 use crate::math::{Mat3, Real, SMat, SVec, Vec3};
 use crate::scene::Scene;
 use crate::solve::Potential;
-
-/// The stencil of an element term: every element's DOF nodes in slot order (`NONE` where a slot
-/// is absent), the number of DOFs of each slot, and one point per element that orders elements
-/// into spatially coherent blocks.
-#[derive(Clone, Debug)]
-pub struct Stencil {
-    /// DOFs per slot (3 for a vertex node, 1 for an edge node).
-    pub slot_dofs: Vec<usize>,
-    /// Node ids, `elements × slots`.
-    pub nodes: Vec<usize>,
-    /// One point per element (its centroid) for the Morton ordering.
-    pub anchors: Vec<Vec3>,
-}
-
-impl Stencil {
-    /// Number of slots per element.
-    pub fn slots(&self) -> usize {
-        self.slot_dofs.len()
-    }
-    /// Number of elements.
-    pub fn len(&self) -> usize {
-        self.anchors.len()
-    }
-    /// Whether there are no elements.
-    pub fn is_empty(&self) -> bool {
-        self.anchors.is_empty()
-    }
-    /// The three-slot stencil of faces `faces` of `mesh` (their vertices; anchors at their
-    /// reference centroids).
-    pub fn faces(mesh: &crate::mesh::Mesh, faces: impl Iterator<Item = usize>) -> Stencil {
-        let p = &mesh.positions;
-        let (mut nodes, mut anchors) = (Vec::new(), Vec::new());
-        for f in faces {
-            let t = mesh.faces[f];
-            nodes.extend_from_slice(&t);
-            anchors.push((p[t[0]] + p[t[1]] + p[t[2]]) / 3.0);
-        }
-        Stencil {
-            slot_dofs: vec![3; 3],
-            nodes,
-            anchors,
-        }
-    }
-
-    /// The one-slot stencil of every vertex (vertex terms).
-    pub fn vertices(x: &[Vec3]) -> Stencil {
-        Stencil {
-            slot_dofs: vec![3],
-            nodes: (0..x.len()).collect(),
-            anchors: x.to_vec(),
-        }
-    }
-}
 
 /// A dense low-rank Hessian part `c u uᵀ` over all DOFs.
 #[derive(Clone, Debug)]

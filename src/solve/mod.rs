@@ -1,6 +1,5 @@
-//! Nonlinear solves: the incremental potential of a step ([`potential`]) with its ground contact
-//! ([`contact`]), Newton's method with a
-//! backtracking line search and a growing diagonal shift ([`mod@newton`]), and the sparse Cholesky
+//! Nonlinear solves: the incremental potential of a step ([`potential`]; the contact laws it
+//! carries are [`crate::contact`]'s), Newton's method with a backtracking line search and a growing diagonal shift ([`mod@newton`]), and the sparse Cholesky
 //! it uses ([`linear`]), with dense low-rank Hessian parts through the Woodbury identity
 //! ([`low_rank`]).
 

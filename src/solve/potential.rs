@@ -43,7 +43,7 @@ pub struct Damping<'a> {
 }
 
 /// Friction over one step (dynamics with a frictional ground or obstacle; see
-/// [`super::contact`]).
+/// [`crate::contact`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Friction<'a> {
     /// Positions at the start of the step (m).

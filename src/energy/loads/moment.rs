@@ -293,15 +293,15 @@ impl Term for MomentTerm {
     fn eval(
         &self,
         pot: &Potential,
-        map: &crate::assembly::ElementMap,
+        map: &crate::elements::ElementMap,
         x: &[Vec3],
         phi: &[Real],
-        want: crate::assembly::Want,
+        want: crate::elements::Want,
         projection: crate::energy::HessianProjection,
         grad: &mut [Real],
         values: &mut [Real],
     ) -> Real {
-        crate::assembly::assemble_elements::<10, 4, _>(
+        crate::elements::assemble_elements::<10, 4, _>(
             map,
             |e, nodes, g, h| {
                 let gn = projection == crate::energy::HessianProjection::GaussNewton;

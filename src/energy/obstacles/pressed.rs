@@ -22,7 +22,7 @@
 //! `q` only (its vertex slot is absent).
 
 use super::{Body, Distance, Obstacles};
-use crate::assembly::{assemble_elements, ElementMap, Want};
+use crate::elements::{assemble_elements, ElementMap, Want};
 use crate::energy::projection::HessianProjection;
 use crate::energy::term::{GlobalDof, GlobalDofs, Reports, Stencil, Term};
 use crate::math::{Mat3, Real, SMat, SVec, Vec3};
