@@ -8,8 +8,9 @@
 //! * [`Mesh`] ([`mesh`]): reading and writing meshes, generated sheets and closed surfaces;
 //! * [`Scene`] ([`scene`]): the body and its terms, built from the two;
 //! * [`run`] ([`integrate`]): the static, dynamic and explicit drivers, from the reference mesh
-//!   or a restart ([`InitialState`], read by [`restart`]);
-//! * [`Writer`] and [`Summary`] ([`output`]): frames, series, log and summary;
+//!   or a restart ([`InitialState`], read by [`restart`]), writing into a [`Sink`];
+//! * [`Writer`] and [`Summary`] ([`output`]): the sink that writes frames, series, log and
+//!   summary;
 //! * [`Potential`], [`Pattern`], [`State`], [`Want`]: the total energy of a scene, its gradient
 //!   and Hessian at a state, for users who drive Newton themselves;
 //! * [`cases`]: the analytic cases (programmed forms and exact shapes) and their error
@@ -92,7 +93,7 @@ pub(crate) mod units;
 pub use rest::lce;
 
 pub use assembly::{Pattern, Want};
-pub use integrate::{run, InitialState, Progress, Quiet, RunError};
+pub use integrate::{run, InitialState, Progress, Quiet, RunError, Sink};
 pub use mesh::Mesh;
 pub use output::{Summary, Writer};
 pub use scene::Scene;

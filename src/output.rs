@@ -15,6 +15,9 @@
 //! vertex: `displacement`, `velocity`, `constraint_indicators`, and `node_tags` when present.
 
 use crate::geometry::curvatures;
+pub use crate::integrate::report::{
+    summary_json, Energies, ExplicitReport, LogRow, OutputError, Summary, Timing,
+};
 use crate::math::{Mat2, Real, Sym2, Vec3};
 use crate::mesh::io::{write_atomic, Format};
 use crate::mesh::{Field, Mesh};
@@ -23,350 +26,6 @@ use crate::scene::Scene;
 use crate::solve::{Potential, State};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
-
-/// Errors while writing output.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum OutputError {
-    /// A file or folder could not be written.
-    #[error("{path}: {reason}")]
-    Io {
-        /// The path.
-        path: String,
-        /// Why.
-        reason: String,
-    },
-    /// The folder holds the output of an earlier run.
-    #[error(
-        "{path} holds the output of an earlier run ({what}); pass --overwrite to replace it, or \
-         choose another --out"
-    )]
-    Used {
-        /// The folder.
-        path: String,
-        /// What is there.
-        what: String,
-    },
-    /// Another run writes into the folder.
-    #[error(
-        "{path}: another shellsim run (process {pid}) is writing into this folder; wait for it \
-         or choose another --out (remove {path}/.shellsim.lock if that process is not shellsim)"
-    )]
-    Locked {
-        /// The folder.
-        path: String,
-        /// The process holding the lock.
-        pid: u32,
-    },
-    /// A frame contained NaN or infinity; it was not written.
-    #[error(
-        "frame {index} at t = {} would hold a non-finite value in '{field}; not written",
-        crate::math::human(*.time)
-    )]
-    NonFinite {
-        /// Frame index.
-        index: usize,
-        /// Time.
-        time: Real,
-        /// The field.
-        field: String,
-    },
-}
-
-/// Energies of a state by term (J): `total`, then each reported term under its own name (in
-/// the scene's term order), then `kinetic` (½ Σ m |v|²).
-#[derive(Clone, Debug, Default)]
-pub struct Energies {
-    /// Sum of the terms and the kinetic energy.
-    pub total: Real,
-    /// The terms' energies by name.
-    pub terms: Vec<(&'static str, Real)>,
-    /// Kinetic energy ½ Σ m |v|².
-    pub kinetic: Real,
-}
-
-impl Energies {
-    /// The energy reported under `name` (`"total"`, a term's name, `"kinetic"`).
-    pub fn get(&self, name: &str) -> Option<Real> {
-        match name {
-            "total" => Some(self.total),
-            "kinetic" => Some(self.kinetic),
-            _ => self.terms.iter().find(|t| t.0 == name).map(|t| t.1),
-        }
-    }
-
-    /// `(name, value)` pairs in column order.
-    pub fn columns(&self) -> Vec<(&str, Real)> {
-        let mut c = vec![("total", self.total)];
-        c.extend(self.terms.iter().copied());
-        c.push(("kinetic", self.kinetic));
-        c
-    }
-}
-
-impl Serialize for Energies {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        use serde::ser::SerializeMap;
-        // A run stopped by a non-finite state may hold non-finite energies: they are left
-        // out, never written as `null`.
-        let cols: Vec<_> = self
-            .columns()
-            .into_iter()
-            .filter(|(_, v)| v.is_finite())
-            .collect();
-        let mut m = s.serialize_map(Some(cols.len()))?;
-        for (k, v) in cols {
-            m.serialize_entry(k, &v)?;
-        }
-        m.end()
-    }
-}
-
-/// One row of the per-frame log.
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct LogRow {
-    /// Frame index.
-    pub frame: usize,
-    /// Simulated time (s); in static mode the dial factor, and `log.csv` has no time column.
-    pub time: Real,
-    /// Dial factor of the rest forms.
-    pub dial: Real,
-    /// Energies.
-    #[serde(flatten)]
-    pub energy: Energies,
-    /// Quantities the terms log (load–displacement measures), by column name.
-    #[serde(skip)]
-    pub observables: Vec<(String, Real)>,
-    /// Relative residual ‖∇Φ‖∞/F of the last solve.
-    pub residual: Real,
-    /// Newton iterations since the previous frame.
-    pub newton_iterations: usize,
-    /// Steps (time steps or continuation steps) since the previous frame.
-    pub steps: usize,
-    /// Newton iterations since the previous frame that needed a diagonal shift.
-    pub shifted_iterations: usize,
-    /// Newton iterations since the previous frame that fell back to the Gauss–Newton Hessian.
-    pub gauss_newton_iterations: usize,
-    /// Steps rejected (and cut) since the previous frame.
-    pub rejected_steps: usize,
-    /// Wall time since the start (s).
-    pub wall_seconds: Real,
-}
-
-fn not_finite(v: &Real) -> bool {
-    !v.is_finite()
-}
-
-fn is_zero(n: &usize) -> bool {
-    *n == 0
-}
-
-/// The run summary written to `summary.json`.
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct Summary {
-    /// Whether the run reached its goal (static: a stable equilibrium at dial 1; dynamic: the end
-    /// time, or equilibrium when asked to stop there).
-    pub converged: bool,
-    /// Why it stopped, when not converged.
-    pub reason: String,
-    /// `"static"` or `"dynamic"`.
-    pub mode: String,
-    /// Last frame, relative to the output folder.
-    pub final_frame: String,
-    /// Frames written.
-    pub frames: usize,
-    /// Wall time (s).
-    pub wall_seconds: Real,
-    /// Accepted steps (time steps or continuation steps).
-    pub steps: usize,
-    /// Rejected steps (cut after a failed Newton solve).
-    pub rejected_steps: usize,
-    /// Total Newton iterations.
-    pub newton_iterations: usize,
-    /// Newton iterations that needed a diagonal shift.
-    pub shifted_iterations: usize,
-    /// Newton iterations that fell back to the Gauss–Newton Hessian.
-    pub gauss_newton_iterations: usize,
-    /// Newton iterations whose sparse Hessian part was indefinite and made positive definite
-    /// by a dense low-rank part (an enclosed gas past a pressure limit point).
-    pub indefinite_iterations: usize,
-    /// Saddle points detected and escaped by perturbation.
-    pub saddle_escapes: usize,
-    /// Steps before which a term's elements changed (a new sparsity pattern); left out when 0.
-    #[serde(skip_serializing_if = "is_zero")]
-    pub element_changes: usize,
-    /// Of those, the ones that changed the union of the stencils (a new symbolic
-    /// factorisation); left out when 0.
-    #[serde(skip_serializing_if = "is_zero")]
-    pub pattern_rebuilds: usize,
-    /// Vertices.
-    pub vertices: usize,
-    /// Faces.
-    pub faces: usize,
-    /// Worker threads.
-    pub threads: usize,
-    /// Final simulated time (s); absent in static runs, whose progress is the dial.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub time: Option<Real>,
-    /// Final dial factor.
-    pub dial: Real,
-    /// Hold points of `dial.holds` at which the run reached equilibrium.
-    pub holds_reached: usize,
-    /// Final relative residual (left out when it is not finite).
-    #[serde(skip_serializing_if = "not_finite")]
-    pub residual: Real,
-    /// Final energies.
-    pub energy: Energies,
-    /// Wall time spent in the moisture diffusion and the rest forms it sets (s; 0 without
-    /// `[moisture]`): the coupled step's cost over the mechanics alone is
-    /// `wall / (wall − moisture_seconds)`.
-    pub moisture_seconds: Real,
-    /// Accepted and rejected error-controlled diffusion sub-steps, and the numeric
-    /// factorisations they needed (0 without `[moisture]`).
-    pub diffusion_substeps: usize,
-    /// See `diffusion_substeps`.
-    pub diffusion_rejected: usize,
-    /// See `diffusion_substeps`.
-    pub diffusion_factorisations: usize,
-    /// Conjugate-gradient iterations of the diffusion solves, and the solves done by the
-    /// sparse Cholesky instead (strong lateral coupling).
-    pub diffusion_cg_iterations: usize,
-    /// See `diffusion_cg_iterations`.
-    pub diffusion_direct_solves: usize,
-    /// Warnings raised while loading.
-    pub warnings: Vec<String>,
-    /// Where the wall time went (s).
-    pub timing: Timing,
-    /// Explicit mode: its time step, time scales and cost.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub explicit: Option<ExplicitReport>,
-}
-
-impl Summary {
-    /// Refuses a summary that would hold a non-finite number (serialised as `null`): the run
-    /// is marked unconverged (exit 1) with an internal error naming the values, which
-    /// [`Writer::summary`] leaves out. Returns whether it did.
-    pub fn refuse_non_finite(&mut self) -> bool {
-        let (_, paths) = summary_json(self);
-        if paths.is_empty() {
-            return false;
-        }
-        self.converged = false;
-        let was = std::mem::take(&mut self.reason);
-        self.reason = format!(
-            "internal error: summary.json would hold a non-finite number at {} (left out){}",
-            paths.join(", "),
-            if was.is_empty() {
-                String::new()
-            } else {
-                format!("; the run stopped: {was}")
-            }
-        );
-        true
-    }
-}
-
-/// `summary` as JSON with every `null` (a non-finite number) left out, and the dotted paths
-/// of the values left out.
-pub fn summary_json(summary: &Summary) -> (String, Vec<String>) {
-    fn prune(v: &mut serde_json::Value, at: &str, out: &mut Vec<String>) {
-        let key = |k: &str| {
-            if at.is_empty() {
-                k.to_string()
-            } else {
-                format!("{at}.{k}")
-            }
-        };
-        match v {
-            serde_json::Value::Object(m) => {
-                m.retain(|k, x| {
-                    let null = x.is_null();
-                    if null {
-                        out.push(key(k));
-                    }
-                    !null
-                });
-                for (k, x) in m.iter_mut() {
-                    prune(x, &key(k), out);
-                }
-            }
-            serde_json::Value::Array(a) => {
-                a.retain(|x| {
-                    let null = x.is_null();
-                    if null {
-                        out.push(format!("{at}[]"));
-                    }
-                    !null
-                });
-                for (i, x) in a.iter_mut().enumerate() {
-                    prune(x, &format!("{at}[{i}]"), out);
-                }
-            }
-            _ => {}
-        }
-    }
-    let mut paths = Vec::new();
-    let text = match serde_json::to_value(summary) {
-        Ok(mut v) => {
-            prune(&mut v, "", &mut paths);
-            match paths.is_empty() {
-                // The fields in their declared order.
-                true => serde_json::to_string_pretty(summary),
-                false => serde_json::to_string_pretty(&v),
-            }
-            .unwrap_or_default()
-        }
-        // Serialising plain data cannot fail; were it to, the file says so instead of a value.
-        Err(e) => {
-            paths.push(format!("(the whole summary: {e})"));
-            String::from("{}")
-        }
-    };
-    (text, paths)
-}
-
-/// Where a run's wall time went (s): Newton's parts (explicit mode: the force evaluations under
-/// `assembly`), the moisture diffusion, writing frames, and the rest (setup, predictors,
-/// bookkeeping).
-#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
-pub struct Timing {
-    /// Assembly, factorisation, solve and line search, summed over the Newton solves.
-    #[serde(flatten)]
-    pub newton: crate::solve::newton::NewtonTiming,
-    /// Moisture diffusion and the rest forms it sets.
-    pub diffusion: Real,
-    /// Building and writing frames, the series and the log.
-    pub output: Real,
-    /// The wall time not in the above.
-    pub other: Real,
-}
-
-/// What an explicit run reports in `summary.json` ([`crate::integrate`]'s explicit driver).
-#[derive(Clone, Debug, Default, serde::Serialize)]
-pub struct ExplicitReport {
-    /// The time step Δt (s).
-    pub time_step: Real,
-    /// The mesh's measured stability limit of `explicit.time_step_prefactor` (left out when
-    /// the stiffness at the start has no positive eigenvalue).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub stable_prefactor: Option<Real>,
-    /// The long time T (s).
-    pub long_time: Real,
-    /// The drag rate c while dialling (1/s).
-    pub damping_rate_dial: Real,
-    /// The drag rate c while waiting (1/s).
-    pub damping_rate_wait: Real,
-    /// The sample length L (reference perimeter, m).
-    pub sample_length: Real,
-    /// The smallest reference altitude a_min (m).
-    pub min_altitude: Real,
-    /// `"window"` or `"morphoshell"`.
-    pub equilibrium_test: String,
-    /// Wall time per face and step (µs), the whole loop included.
-    pub microseconds_per_face_step: Real,
-    /// Hold points at which equilibrium was reached.
-    pub holds_reached: usize,
-}
 
 /// Writes frames, the series, the log and the summary into one folder.
 pub struct Writer {
@@ -881,28 +540,9 @@ impl Writer {
         self.frames.last().map(|f| f.1.clone()).unwrap_or_default()
     }
 
-    /// Energies of a state by term.
+    /// Energies of a state by term ([`crate::integrate::report::energies`]).
     pub fn energies(pot: &Potential, state: &State, v: &[Vec3]) -> Energies {
-        let pot = &Potential {
-            terms: &state.terms,
-            ..*pot
-        };
-        Self::energies_of(pot, pot.energies(&state.x, &state.dofs), v)
-    }
-
-    /// The energies record of the terms' energies and the kinetic energy at velocities `v`.
-    fn energies_of(pot: &Potential, terms: Vec<(&'static str, Real)>, v: &[Vec3]) -> Energies {
-        let kinetic: Real = v
-            .iter()
-            .zip(pot.mass)
-            .map(|(v, m)| 0.5 * m * v.norm_squared())
-            .sum();
-        let total = terms.iter().map(|t| t.1).sum::<Real>() + kinetic;
-        Energies {
-            total,
-            terms,
-            kinetic,
-        }
+        crate::integrate::report::energies(pot, state, v)
     }
 
     /// Builds every field of a frame at `x`, `phi`, `v` into `frame_mesh`; returns the terms'
@@ -1057,7 +697,7 @@ impl Writer {
         row.frame = index;
         self.built_is_written = false;
         let term_energies = self.fill(pot, x, phi, v);
-        row.energy = Self::energies_of(pot, term_energies, v);
+        row.energy = crate::integrate::report::energies_of(pot, term_energies, v);
         row.observables = sc
             .terms
             .iter()
@@ -1386,4 +1026,35 @@ fn morphoshell_fields(m: &mut Mesh, pot: &Potential, x: &[Vec3], phi: &[Real], a
     };
     ff.insert("cauchy_stress_eigvec_1".into(), vec3(u1));
     ff.insert("cauchy_stress_eigvec_2".into(), vec3(u2));
+}
+
+impl crate::integrate::Sink for Writer {
+    fn frame(
+        &mut self,
+        pot: &Potential,
+        state: &State,
+        v: &[Vec3],
+        row: LogRow,
+        driver: Option<&crate::integrate::DriverState>,
+    ) -> Result<(), OutputError> {
+        Writer::frame(self, pot, state, v, row, driver)
+    }
+    fn set_face_field(&mut self, name: &str, data: Vec<Real>) {
+        Writer::set_face_field(self, name, data)
+    }
+    fn num_faces(&self) -> usize {
+        Writer::num_faces(self)
+    }
+    fn num_frames(&self) -> usize {
+        Writer::num_frames(self)
+    }
+    fn last_frame(&self) -> String {
+        Writer::last_frame(self)
+    }
+    fn release_reserve(&mut self) {
+        Writer::release_reserve(self)
+    }
+    fn summary(&self, summary: &Summary) -> Result<(), OutputError> {
+        Writer::summary(self, summary)
+    }
 }

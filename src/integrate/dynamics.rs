@@ -4,17 +4,17 @@
 
 use super::friction::FrictionLag;
 use super::moisture::{accepted, Moisture};
+use super::Sink;
 use super::{OutputClock, Progress, RunError, RunFailure, Solver, StepControl};
 use crate::assembly::Want;
 use crate::math::{Real, Sym2, Vec3};
-use crate::output::Writer;
 use crate::solve::potential::{Damping, Inertia};
 use crate::solve::{Potential, State};
 use std::time::Instant;
 
 pub(super) fn run_dynamic(
     s: &mut Solver,
-    writer: &mut Writer,
+    writer: &mut dyn Sink,
     progress: &mut dyn Progress,
     mut state: State,
     from: super::Resume,
@@ -357,7 +357,7 @@ pub(super) fn run_dynamic(
             let mut g = vec![0.0; pat.n];
             pot.eval(&state.x, &state.dofs, Want::Gradient, &mut g, &mut []);
             let r = pot.residual(&g);
-            let en = Writer::energies(&pot, &state, &v);
+            let en = super::report::energies(&pot, &state, &v);
             let calm = r <= tol
                 && en.kinetic
                     <= tm.equilibrium_kinetic
@@ -400,7 +400,7 @@ pub(super) fn run_dynamic(
     s.summary.reason = failure.map(|f| f.to_string()).unwrap_or_default();
     let pat = s.pattern();
     let pot = accepted(s.potential(&pat, dial_now), moisture.as_ref(), &targets);
-    s.summary.energy = Writer::energies(&pot, &state, &v);
+    s.summary.energy = super::report::energies(&pot, &state, &v);
     if s.summary.reason.is_empty() {
         return Ok(());
     }

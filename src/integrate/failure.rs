@@ -1,8 +1,8 @@
 //! What stops a run: the errors that end it ([`RunError`]), the failures a driver reports
 //! ([`RunFailure`]), and the signals that interrupt it.
 
+use super::report::OutputError;
 use crate::math::Real;
-use crate::output::OutputError;
 use crate::solve::linear::LinearError;
 use crate::solve::SolveError;
 

@@ -18,8 +18,9 @@
 //! (`config.rs`), what stops a run (`failure.rs`) and the symmetry breaking of a planar start
 //! (`symmetry.rs`: every free vertex moved along its normal by `symmetry_breaking × mean edge ×
 //! u`, `u` uniform in [−1, 1) from a SplitMix64 stream seeded by `solver.seed`, deterministic).
-//! Every driver calls Newton on a [`Potential`](crate::solve::Potential) and writes frames
-//! through an [`output::Writer`](crate::output::Writer).
+//! Every driver calls Newton on a [`Potential`](crate::solve::Potential) and hands its frames
+//! and summary to a [`Sink`] (`report.rs`: the records a run fills, the energies, and the sink
+//! that [`crate::output::Writer`] implements).
 
 pub mod config;
 mod dynamics;
@@ -28,6 +29,7 @@ mod failure;
 pub mod friction;
 pub(crate) mod hooks;
 pub(crate) mod moisture;
+pub mod report;
 mod resume;
 mod solver;
 mod statics;
@@ -43,10 +45,10 @@ use solver::Solver;
 
 use crate::assembly::Pattern;
 use crate::math::Real;
-use crate::output::{OutputError, Summary, Writer};
 use crate::scene::Scene;
 use crate::settings::Mode;
 use crate::solve::State;
+pub use report::{OutputError, Sink, Summary};
 
 /// Receives progress updates (a terminal progress bar, or nothing).
 pub trait Progress {
@@ -190,7 +192,7 @@ impl OutputClock {
 /// frames, the log and the summary.
 pub fn run(
     scene: &Scene,
-    writer: &mut Writer,
+    writer: &mut dyn Sink,
     progress: &mut dyn Progress,
     threads: usize,
     initial: Option<InitialState>,

@@ -2,8 +2,8 @@
 //! masses it sets each step, and the ground exchange switched by contact.
 
 use super::RunError;
+use super::Sink;
 use crate::math::{Real, Sym2, Vec3};
-use crate::output::Writer;
 use crate::scene::Scene;
 use crate::solve::Potential;
 
@@ -275,7 +275,7 @@ impl Moisture {
     }
 
     /// Hands the surface moisture of the accepted state to the writer for the next frame.
-    pub(super) fn publish(&self, writer: &mut Writer) {
+    pub(super) fn publish(&self, writer: &mut dyn Sink) {
         let nf = writer.num_faces();
         let (mut top, mut bottom) = (Vec::with_capacity(nf), Vec::with_capacity(nf));
         for f in 0..nf {

@@ -1,10 +1,11 @@
 //! The solver state the drivers share ([`Solver`]): the scene, its pattern and factorisation,
 //! Newton's workspace, the summary and counters, and the frames it writes.
 
+use super::report::{LogRow, Summary};
+use super::Sink;
 use super::{config, DriverState, RunError};
 use crate::assembly::{Pattern, Want};
 use crate::math::{Real, Vec3};
-use crate::output::{LogRow, Summary, Writer};
 use crate::scene::Scene;
 use crate::settings::Mode;
 use crate::solve::newton::Workspace;
@@ -236,7 +237,7 @@ impl<'a> Solver<'a> {
 
     pub(super) fn frame(
         &mut self,
-        writer: &mut Writer,
+        writer: &mut dyn Sink,
         pot: &Potential,
         state: &State,
         v: &[Vec3],

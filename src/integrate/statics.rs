@@ -1,14 +1,14 @@
 //! The static driver: adaptive continuation of the dial (rest forms and loads), then of the
 //! stretching weight (membrane continuation), with the stability check and saddle escapes.
 
+use super::Sink;
 use super::{perturb, Progress, RunError, RunFailure, Solver, StepControl};
 use crate::math::{Real, Vec3};
-use crate::output::Writer;
 use crate::solve::{NewtonOptions, NewtonReport, State};
 
 pub(super) fn run_static(
     s: &mut Solver,
-    writer: &mut Writer,
+    writer: &mut dyn Sink,
     progress: &mut dyn Progress,
     mut state: State,
     restart: Option<Real>,
@@ -203,7 +203,7 @@ pub(super) fn run_static(
     s.summary.reason = failure.map(|f| f.to_string()).unwrap_or_default();
     let pat = s.pattern();
     let pot = s.potential(&pat, dial);
-    s.summary.energy = Writer::energies(&pot, &state, &zeros);
+    s.summary.energy = super::report::energies(&pot, &state, &zeros);
     s.driver = super::DriverState::at_dial(dial, &steps);
     // The series' time of a static frame is its dial (a failed run's last frame included).
     s.frame(writer, &pot, &state, &zeros, dial)?;

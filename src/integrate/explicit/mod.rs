@@ -73,8 +73,9 @@
 //! unstable state is never written.
 
 use super::{Progress, RunError, Solver};
+use crate::integrate::report::ExplicitReport;
+use crate::integrate::Sink;
 use crate::math::{human, Real, Vec3};
-use crate::output::{ExplicitReport, Writer};
 use crate::settings::EquilibriumTest;
 use crate::solve::{Potential, State};
 
@@ -246,7 +247,7 @@ fn unstable(what: &str, t: Real, prefactor: Real, limit: Option<Option<Real>>) -
 
 pub(super) fn run_explicit(
     s: &mut Solver,
-    writer: &mut Writer,
+    writer: &mut dyn Sink,
     progress: &mut dyn Progress,
     mut state: State,
     from: super::Resume,
@@ -580,7 +581,7 @@ pub(super) fn run_explicit(
 #[allow(clippy::too_many_arguments)]
 fn finish(
     s: &mut Solver,
-    writer: &mut Writer,
+    writer: &mut dyn Sink,
     pat: &crate::assembly::Pattern,
     stop: Stop,
     k: &Clock,
@@ -599,7 +600,7 @@ fn finish(
     match stop {
         Stop::Converged => {
             s.summary.converged = true;
-            s.summary.energy = Writer::energies(&pot, state, v);
+            s.summary.energy = crate::integrate::report::energies(&pot, state, v);
             s.frame(writer, &pot, state, v, k.t)?;
         }
         Stop::Unstable(reason) => {
@@ -621,7 +622,7 @@ fn finish(
                     t_h = human(k.t)
                 ),
             };
-            s.summary.energy = Writer::energies(&pot, state, v);
+            s.summary.energy = crate::integrate::report::energies(&pot, state, v);
             s.frame(writer, &pot, state, v, k.t)?;
         }
     }
