@@ -314,12 +314,13 @@ impl TermStates {
         Ok(TermStates(all))
     }
 
-    /// The state of the term named `name` (empty when it has none).
+    /// The state of the term named `name` (empty when it has none). Kernels ask per element
+    /// with their own `&'static str`, so the names are compared by address first.
     #[inline]
     pub fn get(&self, name: &str) -> &[Real] {
         self.0
             .iter()
-            .find(|(n, _)| *n == name)
+            .find(|(n, _)| std::ptr::eq(*n, name) || *n == name)
             .map_or(&[], |(_, v)| &v[..])
     }
 
@@ -592,6 +593,18 @@ impl<K: ElementKernel<N, S>, const N: usize, const S: usize> Term for ElementTer
 pub trait VertexKernel: Send + Sync {
     /// `None` when the vertex does not contribute.
     fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)>;
+    /// [`VertexKernel::eval`] with the kernel's own state `own` ([`Stateful`]), which its term
+    /// fetches once per evaluation instead of once per vertex (default: `eval`).
+    #[inline(always)]
+    fn eval_with(
+        &self,
+        pot: &Potential,
+        _own: &[Real],
+        v: usize,
+        x: &Vec3,
+    ) -> Option<(Real, Vec3, Mat3)> {
+        self.eval(pot, v, x)
+    }
     /// Quantities to log (see [`Reports::observables`]; default: none).
     fn observables(&self, _pot: &Potential, _x: &[Vec3]) -> Vec<(String, Real)> {
         Vec::new()
@@ -690,6 +703,7 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
         values: &mut [Real],
     ) -> Real {
         let fixed = &pot.scene.fixed;
+        let own = pot.term_state(self.name);
         assemble_elements::<3, 1, _>(
             map,
             |v, _, g, h| {
@@ -702,10 +716,11 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
                     }
                     return 0.0;
                 }
-                let (e, gv, hv) =
-                    self.kernel
-                        .eval(pot, v, &x[v])
-                        .unwrap_or((0.0, Vec3::zeros(), Mat3::zeros()));
+                let (e, gv, hv) = self.kernel.eval_with(pot, own, v, &x[v]).unwrap_or((
+                    0.0,
+                    Vec3::zeros(),
+                    Mat3::zeros(),
+                ));
                 if let Some(g) = g {
                     g.copy_from(&gv);
                 }
