@@ -86,6 +86,46 @@ impl MaterialModel {
     ];
 }
 
+/// The membrane material with the constants its model reads: `material.model` and its own keys
+/// as one value, so that no material's constants are read under another model.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MembraneMaterial {
+    /// St Venant–Kirchhoff / Koiter.
+    Koiter,
+    /// Incompressible neo-Hookean.
+    NeoHookean,
+    /// Incompressible Mooney–Rivlin, `W = c1 (I₁ − 3) + c2 (I₂ − 3)` (Pa).
+    MooneyRivlin {
+        /// `c1` (Pa).
+        c1: Real,
+        /// `c2` (Pa).
+        c2: Real,
+    },
+    /// Incompressible Gent rubber.
+    Gent {
+        /// The limiting extensibility `J_m` (dimensionless).
+        jm: Real,
+    },
+    /// Strain-limiting Baraff–Witkin cloth, `[material.baraff_witkin]`.
+    BaraffWitkin(BaraffWitkinSettings),
+    /// Seed 002's prism element, `[material.prism]`.
+    Prism(PrismSettings),
+}
+
+impl MembraneMaterial {
+    /// Its `material.model`.
+    pub fn model(&self) -> MaterialModel {
+        match self {
+            MembraneMaterial::Koiter => MaterialModel::Koiter,
+            MembraneMaterial::NeoHookean => MaterialModel::NeoHookean,
+            MembraneMaterial::MooneyRivlin { .. } => MaterialModel::MooneyRivlin,
+            MembraneMaterial::Gent { .. } => MaterialModel::Gent,
+            MembraneMaterial::BaraffWitkin(_) => MaterialModel::BaraffWitkin,
+            MembraneMaterial::Prism(_) => MaterialModel::Prism,
+        }
+    }
+}
+
 /// The 3D strain energy of the prism element.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -109,7 +149,7 @@ pub enum PrismThickness {
 }
 
 /// `[material.prism]`: seed 002's three-prism membrane.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PrismSettings {
     /// `"stvk"` or `"neo_hookean"` (default: `"stvk"`, the seed's).
@@ -133,7 +173,7 @@ impl Default for PrismSettings {
 }
 
 /// `[material.baraff_witkin]`.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct BaraffWitkinSettings {
     /// Stretch stiffness λ (Pa, default: `E/2`).
@@ -210,6 +250,23 @@ impl Default for Material {
 }
 
 impl Material {
+    /// The membrane material `model` names, with the constants it reads.
+    pub fn membrane(&self) -> MembraneMaterial {
+        match self.model {
+            MaterialModel::Koiter => MembraneMaterial::Koiter,
+            MaterialModel::NeoHookean => MembraneMaterial::NeoHookean,
+            MaterialModel::MooneyRivlin => MembraneMaterial::MooneyRivlin {
+                c1: self.c1,
+                c2: self.c2,
+            },
+            MaterialModel::Gent => MembraneMaterial::Gent { jm: self.gent.jm() },
+            MaterialModel::BaraffWitkin => {
+                MembraneMaterial::BaraffWitkin(self.baraff_witkin.clone())
+            }
+            MaterialModel::Prism => MembraneMaterial::Prism(self.prism.clone()),
+        }
+    }
+
     /// Validates `[material]`: moduli, density, thickness, Poisson's ratio, the membrane model and its constants.
     /// `mode` is the run's mode (`solver.mode`): the position-based prism needs dynamics.
     pub fn validate(&self, mode: Mode) -> Result<(), Invalid> {
@@ -351,5 +408,45 @@ impl Material {
             );
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every model gives its own variant, which names the model back, with the constants that
+    /// model reads and no other.
+    #[test]
+    fn each_model_carries_its_own_constants() {
+        for model in MaterialModel::ALL {
+            let m = Material {
+                model,
+                ..Material::default()
+            };
+            assert_eq!(m.membrane().model(), model);
+        }
+        let mr = Material {
+            model: MaterialModel::MooneyRivlin,
+            c1: 3e5,
+            c2: 1e5,
+            ..Material::default()
+        };
+        assert_eq!(
+            mr.membrane(),
+            MembraneMaterial::MooneyRivlin { c1: 3e5, c2: 1e5 }
+        );
+        let gent = Material {
+            model: MaterialModel::Gent,
+            gent: crate::config::gent::GentSettings { jm: Some(0.5) },
+            ..Material::default()
+        };
+        assert_eq!(gent.membrane(), MembraneMaterial::Gent { jm: 0.5 });
+        // The Mooney–Rivlin constants are not part of another model's material.
+        let koiter = Material {
+            c1: 3e5,
+            ..Material::default()
+        };
+        assert_eq!(koiter.membrane(), MembraneMaterial::Koiter);
     }
 }

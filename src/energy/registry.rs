@@ -2,7 +2,8 @@
 //! summation order, so results are reproducible): the shell faces first, then the vertex terms
 //! (ground, friction, inertia, gravity), then the loads. Only what the scene enables is built.
 //!
-//! Adding a membrane material is one file plus one entry in [`MATERIALS`]; a bending model, one
+//! Adding a membrane material is one file, one entry in [`MATERIALS`] and its variant of
+//! [`MembraneMaterial`] with its constants (its config section); a bending model, one
 //! file plus one arm in `with_bending` and one line in [`BENDINGS`];
 //! adding a load or obstacle is one file plus one line in [`terms`].
 
@@ -15,6 +16,7 @@ use super::membrane::{
 };
 use super::shell::Shell;
 use super::term::{Term, VertexTerm};
+use crate::config::material::MembraneMaterial;
 use crate::mesh::MeshError;
 use crate::scene::Scene;
 use crate::settings::{BendingModel, MaterialModel, Mode};
@@ -49,59 +51,72 @@ fn with_bending<M: Membrane>(scene: &Scene, m: M) -> Box<dyn Term> {
 }
 
 /// A registered membrane material: its settings value, the `[material]` lines a small test
-/// scene uses for it, and the shell term it builds with the scene's bending model.
+/// scene uses for it, and the shell term it builds, with the scene's bending model, from its
+/// own variant of [`MembraneMaterial`] (the constants its model reads).
 pub struct MaterialEntry {
     /// `material.model`.
     pub model: MaterialModel,
     /// `[material]` lines for a test scene (its constants; the finite-difference, thread-count
     /// and restart tests iterate over [`MATERIALS`] with these).
     pub example: &'static str,
-    /// The shell term.
-    pub build: fn(&Scene) -> Result<Box<dyn Term>, MeshError>,
+    /// The shell term; `None` for another model's variant (never asked: [`shell_term`] picks
+    /// the entry by the model).
+    pub build: BuildShell,
 }
+
+/// A material's shell-term builder (see [`MaterialEntry::build`]).
+pub type BuildShell = fn(&Scene, &MembraneMaterial) -> Option<Result<Box<dyn Term>, MeshError>>;
 
 /// Every membrane material, one entry each.
 pub const MATERIALS: &[MaterialEntry] = &[
     MaterialEntry {
         model: MaterialModel::Koiter,
         example: "model = \"koiter\"",
-        build: |s| Ok(with_bending(s, Koiter)),
+        build: |s, m| matches!(m, MembraneMaterial::Koiter).then(|| Ok(with_bending(s, Koiter))),
     },
     MaterialEntry {
         model: MaterialModel::NeoHookean,
         example: "model = \"neo_hookean\"",
-        build: |s| Ok(with_bending(s, NeoHookean)),
+        build: |s, m| {
+            matches!(m, MembraneMaterial::NeoHookean).then(|| Ok(with_bending(s, NeoHookean)))
+        },
     },
     MaterialEntry {
         model: MaterialModel::MooneyRivlin,
         example: "model = \"mooney_rivlin\"\nc1 = 3e5\nc2 = 1e5",
-        build: |s| {
-            let m = &s.settings.material;
-            Ok(with_bending(s, MooneyRivlin { c1: m.c1, c2: m.c2 }))
+        build: |s, m| match *m {
+            MembraneMaterial::MooneyRivlin { c1, c2 } => {
+                Some(Ok(with_bending(s, MooneyRivlin { c1, c2 })))
+            }
+            _ => None,
         },
     },
     MaterialEntry {
         model: MaterialModel::Gent,
         // A small J_m, so that the lock shapes the energy at the small strains of test scenes.
         example: "model = \"gent\"\npoisson = 0.5\ngent = { jm = 0.5 }",
-        build: |s| {
-            Ok(with_bending(
-                s,
-                Gent {
-                    jm: s.settings.material.gent.jm(),
-                },
-            ))
+        build: |s, m| match *m {
+            MembraneMaterial::Gent { jm } => Some(Ok(with_bending(s, Gent { jm }))),
+            _ => None,
         },
     },
     MaterialEntry {
         model: MaterialModel::BaraffWitkin,
         example: "model = \"baraff_witkin\"\nbaraff_witkin = { direction = [1, 1, 0] }",
-        build: |s| Ok(with_bending(s, baraff_witkin::from_scene(s)?)),
+        build: |s, m| match m {
+            MembraneMaterial::BaraffWitkin(bw) => {
+                Some(baraff_witkin::from_scene(s, bw).map(|b| with_bending(s, b)))
+            }
+            _ => None,
+        },
     },
     MaterialEntry {
         model: MaterialModel::Prism,
         example: "model = \"prism\"\npoisson = 0.45",
-        build: |s| Ok(with_bending(s, Prism::new(s))),
+        build: |s, m| match m {
+            MembraneMaterial::Prism(p) => Some(Ok(with_bending(s, Prism::new(s, p)))),
+            _ => None,
+        },
     },
 ];
 
@@ -119,11 +134,17 @@ pub const BENDINGS: &[(BendingModel, &str)] = &[
 
 /// The shell face term: the membrane material × the bending model, from [`MATERIALS`].
 pub fn shell_term(scene: &Scene) -> Result<Box<dyn Term>, MeshError> {
-    let model = scene.settings.material.model;
-    match MATERIALS.iter().find(|e| e.model == model) {
-        Some(e) => (e.build)(scene),
-        None => unreachable!("material {model:?} has no registry entry (a test checks this)"),
-    }
+    let m = scene.settings.material.membrane();
+    MATERIALS
+        .iter()
+        .find(|e| e.model == m.model())
+        .and_then(|e| (e.build)(scene, &m))
+        .unwrap_or_else(|| {
+            Err(scene.mesh.invalid(format!(
+                "material {:?} has no registry entry (a test checks this)",
+                m.model()
+            )))
+        })
 }
 
 /// Every term the scene enables, in assembly order.

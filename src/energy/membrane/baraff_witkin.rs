@@ -173,10 +173,12 @@ impl Membrane for BaraffWitkin {
 /// reference Cartesian) when present, else `material.baraff_witkin.direction`, each projected on
 /// its rest face; constants from `material.baraff_witkin` or from each face's E and ν.
 /// A zero or non-finite direction, or one normal to a face, is an error naming the face.
-pub fn from_scene(scene: &crate::scene::Scene) -> Result<BaraffWitkin, crate::mesh::MeshError> {
+pub fn from_scene(
+    scene: &crate::scene::Scene,
+    bw: &crate::config::material::BaraffWitkinSettings,
+) -> Result<BaraffWitkin, crate::mesh::MeshError> {
     use crate::math::Vec3;
     let mesh = &scene.mesh;
-    let bw = &scene.settings.material.baraff_witkin;
     let field = mesh.face_field("warp_direction", 3)?;
     let mut directions = Vec::with_capacity(mesh.faces.len());
     for f in 0..mesh.faces.len() {

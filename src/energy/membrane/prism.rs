@@ -184,9 +184,9 @@ pub struct Prism {
 }
 
 impl Prism {
-    /// The material of a scene: the current thickness starts at the rest thickness.
-    pub fn new(scene: &crate::scene::Scene) -> Self {
-        let p = &scene.settings.material.prism;
+    /// The material of a scene with the constants `p` (`[material.prism]`): the current
+    /// thickness starts at the rest thickness.
+    pub fn new(scene: &crate::scene::Scene, p: &crate::config::material::PrismSettings) -> Self {
         Prism {
             law: p.law,
             mode: p.thickness,
