@@ -540,11 +540,6 @@ impl Writer {
         self.frames.last().map(|f| f.1.clone()).unwrap_or_default()
     }
 
-    /// Energies of a state by term ([`crate::integrate::report::energies`]).
-    pub fn energies(pot: &Potential, state: &State, v: &[Vec3]) -> Energies {
-        crate::integrate::report::energies(pot, state, v)
-    }
-
     /// Builds every field of a frame at `x`, `phi`, `v` into `frame_mesh`; returns the terms'
     /// energies.
     fn fill(

@@ -10,7 +10,7 @@ pub struct Gravity;
 
 impl VertexKernel for Gravity {
     #[inline]
-    fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
+    fn eval(&self, pot: &Potential, _: &[Real], v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
         let g = pot.gravity;
         if g == Vec3::zeros() {
             return None;

@@ -20,7 +20,7 @@ fn mat(h: [[Real; 3]; 3]) -> Mat3 {
 
 impl VertexKernel for GroundContact {
     #[inline]
-    fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
+    fn eval(&self, pot: &Potential, _: &[Real], v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
         let (e, g, h) = pot.scene.ground.as_ref()?.normal_term(v, x)?;
         Some((e, g, mat(h)))
     }
@@ -28,7 +28,7 @@ impl VertexKernel for GroundContact {
 
 impl VertexKernel for GroundFriction {
     #[inline]
-    fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
+    fn eval(&self, pot: &Potential, _: &[Real], v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
         let ground = pot.scene.ground.as_ref()?;
         let fr = pot.friction.as_ref()?;
         let lambda = fr.normal_force[v];

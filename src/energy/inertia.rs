@@ -12,7 +12,7 @@ pub struct InertiaTerm;
 
 impl VertexKernel for InertiaTerm {
     #[inline]
-    fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
+    fn eval(&self, pot: &Potential, _: &[Real], v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
         let inr = pot.inertia.as_ref()?;
         let k = inr.inv_dt2 * pot.mass[v];
         let dx = x - inr.xhat[v];

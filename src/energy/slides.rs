@@ -136,20 +136,9 @@ impl Slides {
 }
 
 impl VertexKernel for Slides {
-    #[inline]
-    fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
-        self.eval_with(pot, pot.term_state(NAME), v, x)
-    }
-
     /// The penalties of both slides, the upper one at its height `own[0]`.
     #[inline]
-    fn eval_with(
-        &self,
-        _: &Potential,
-        own: &[Real],
-        _: usize,
-        x: &Vec3,
-    ) -> Option<(Real, Vec3, Mat3)> {
+    fn eval(&self, _: &Potential, own: &[Real], _: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
         let upper = own.first().copied().unwrap_or(Real::NAN);
         let (du, dl) = self.depths(upper, x.z);
         if du == 0.0 && dl == 0.0 {

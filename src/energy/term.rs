@@ -591,20 +591,10 @@ impl<K: ElementKernel<N, S>, const N: usize, const S: usize> Term for ElementTer
 
 /// A per-vertex kernel: energy, gradient (N) and Hessian (N/m) of one vertex at `x`.
 pub trait VertexKernel: Send + Sync {
-    /// `None` when the vertex does not contribute.
-    fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)>;
-    /// [`VertexKernel::eval`] with the kernel's own state `own` ([`Stateful`]), which its term
-    /// fetches once per evaluation instead of once per vertex (default: `eval`).
-    #[inline(always)]
-    fn eval_with(
-        &self,
-        pot: &Potential,
-        _own: &[Real],
-        v: usize,
-        x: &Vec3,
-    ) -> Option<(Real, Vec3, Mat3)> {
-        self.eval(pot, v, x)
-    }
+    /// `None` when the vertex does not contribute. `own` is the kernel's own state
+    /// ([`VertexKernel::initial_state`], fetched once per evaluation; empty without one).
+    fn eval(&self, pot: &Potential, own: &[Real], v: usize, x: &Vec3)
+        -> Option<(Real, Vec3, Mat3)>;
     /// Quantities to log (see [`Reports::observables`]; default: none).
     fn observables(&self, _pot: &Potential, _x: &[Vec3]) -> Vec<(String, Real)> {
         Vec::new()
@@ -716,7 +706,7 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
                     }
                     return 0.0;
                 }
-                let (e, gv, hv) = self.kernel.eval_with(pot, own, v, &x[v]).unwrap_or((
+                let (e, gv, hv) = self.kernel.eval(pot, own, v, &x[v]).unwrap_or((
                     0.0,
                     Vec3::zeros(),
                     Mat3::zeros(),
@@ -753,10 +743,11 @@ impl<K: VertexKernel> Reports for VertexTerm<K> {
         if !self.report {
             return Some(Vec::new());
         }
+        let own = pot.term_state(self.name);
         let e = x
             .iter()
             .enumerate()
-            .filter_map(|(v, xv)| self.kernel.eval(pot, v, xv).map(|r| r.0))
+            .filter_map(|(v, xv)| self.kernel.eval(pot, own, v, xv).map(|r| r.0))
             .sum();
         Some(vec![(self.name, e)])
     }

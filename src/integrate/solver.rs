@@ -268,11 +268,8 @@ impl<'a> Solver<'a> {
                 driver.terms.insert(name.to_string(), own.to_vec());
             }
         }
-        let pot = Potential {
-            terms: &state.terms,
-            ..*pot
-        };
-        let r = writer.frame(&pot, state, v, row, Some(&driver));
+        // The sink evaluates the frame with `state`'s own term states.
+        let r = writer.frame(pot, state, v, row, Some(&driver));
         self.summary.timing.output += clock.elapsed().as_secs_f64();
         r?;
         Ok(())

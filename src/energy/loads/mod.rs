@@ -26,7 +26,7 @@ pub struct NodalForces {
 
 impl VertexKernel for NodalForces {
     #[inline]
-    fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
+    fn eval(&self, pot: &Potential, _: &[Real], v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
         let f = self.force[v] * pot.dial;
         if f == Vec3::zeros() {
             return None;

@@ -246,7 +246,7 @@ impl ObstacleFriction {
 
 impl VertexKernel for ObstacleFriction {
     #[inline]
-    fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
+    fn eval(&self, pot: &Potential, _: &[Real], v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
         let fr = pot.friction.as_ref()?;
         let mut out: Option<(Real, Vec3, Mat3)> = None;
         for o in self.0.list.iter().filter(|o| o.friction > 0.0) {
@@ -312,7 +312,7 @@ impl VertexKernel for ObstacleFriction {
 
 impl VertexKernel for Obstacles {
     #[inline]
-    fn eval(&self, pot: &Potential, v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
+    fn eval(&self, pot: &Potential, _: &[Real], v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
         let mut out: Option<(Real, Vec3, Mat3)> = None;
         for o in self.list.iter().filter(|o| o.pressed.is_none()) {
             let (p, n, hd) = self.contact(o, v, x, pot.dial);
