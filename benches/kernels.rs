@@ -6,12 +6,13 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use shellsim::assembly::{Pattern, Want};
+use shellsim::energy::Potential;
 use shellsim::energy::{material::sv_matrix, shell_face, KoiterDensity, Lame2d};
 use shellsim::math::{SMat, SVec, Sym2, Vec3};
 use shellsim::mesh::generate::{rectangle, Rng, Spacing};
-use shellsim::scene::Scene;
+use shellsim::model::Scene;
 use shellsim::settings::Settings;
-use shellsim::solve::{LinearSolver, Potential};
+use shellsim::solve::LinearSolver;
 use std::hint::black_box;
 
 #[path = "common/scene.rs"]
@@ -181,7 +182,7 @@ fn assembly(c: &mut Criterion) {
     let x = curved(&sc);
     let mut g = c.benchmark_group("assembly_100k");
     g.sample_size(10);
-    g.throughput(Throughput::Elements(sc.num_faces() as u64));
+    g.throughput(Throughput::Elements(sc.body.num_faces() as u64));
     for threads in [1usize, 2] {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -204,7 +205,7 @@ fn assembly(c: &mut Criterion) {
                 let pot = potential(&sc, &p);
                 b.iter(|| {
                     pool.install(|| {
-                        (0..sc.num_faces())
+                        (0..sc.body.num_faces())
                             .into_par_iter()
                             .map(|f| {
                                 let st = p.faces().element(f);
@@ -239,7 +240,7 @@ fn assembly(c: &mut Criterion) {
     }
     // The same Hessian assembly with edge DOFs (the default bending model).
     let sc = scene_with(1.0 / 224.0, "midedge_sin");
-    let phi = vec![0.0; sc.num_edge_dofs()];
+    let phi = vec![0.0; sc.body.num_edge_dofs()];
     bench_hessian(&mut g, "midedge_sin_hessian", &sc, &x, &phi);
     // A membrane-only (no bending) Baraff–Witkin sheet of the same size.
     let sc = scene_with_material(1.0 / 224.0, "none", "baraff_witkin");
@@ -255,12 +256,12 @@ fn newton_iteration(c: &mut Criterion) {
             let sc = scene_with(edge, model);
             let p = Pattern::for_scene(&sc);
             let x = curved(&sc);
-            let phi = vec![0.0; sc.num_edge_dofs()];
+            let phi = vec![0.0; sc.body.num_edge_dofs()];
             let mut lin = LinearSolver::new(&p).unwrap();
             let pot = potential(&sc, &p);
             let mut gr = vec![0.0; p.n];
             let mut h = vec![0.0; p.nnz()];
-            let nf = sc.num_faces();
+            let nf = sc.body.num_faces();
             g.bench_function(BenchmarkId::new(format!("{model}/total"), nf), |b| {
                 b.iter(|| {
                     pot.eval(&x, &phi, Want::Hessian, &mut gr, &mut h);
@@ -296,7 +297,7 @@ fn moisture_step(c: &mut Criterion) {
     let mut g = c.benchmark_group("moisture_step");
     g.sample_size(20);
     let sc = scene(1.0 / 50.0);
-    let nf = sc.num_faces();
+    let nf = sc.body.num_faces();
     let dirs = vec![Vec3::new(1.0, 0.0, 0.0); nf];
     let d = Diffusivity {
         along: 1e-9,
@@ -304,9 +305,9 @@ fn moisture_step(c: &mut Criterion) {
         through: 1e-9,
     };
     let mut diff = Diffusion::new(
-        &sc.mesh.positions,
-        &sc.mesh.faces,
-        &sc.thickness,
+        &sc.body.mesh.positions,
+        &sc.body.mesh.faces,
+        &sc.body.thickness,
         &dirs,
         d,
         Layering {
@@ -333,9 +334,9 @@ fn moisture_step(c: &mut Criterion) {
                 .map(|f| {
                     let (mt, mb) = diff.surface_moisture(&u, f);
                     let r = shellsim::rest::laws::linear_swelling::linear_swelling(
-                        &sc.rest.abar0[f],
-                        &sc.rest.bbar0[f],
-                        sc.thickness[f],
+                        &sc.body.rest.abar0[f],
+                        &sc.body.rest.bbar0[f],
+                        sc.body.thickness[f],
                         mt,
                         mb,
                         0.01,
@@ -411,7 +412,7 @@ fn coupled_step(c: &mut Criterion) {
 /// part (the gas's `∇V` and its Sherman–Morrison preparation: one extra solve), one Newton
 /// iteration, and one frame (an implicit step of at most 3 Newton iterations).
 fn balloon(c: &mut Criterion) {
-    use shellsim::solve::potential::Inertia;
+    use shellsim::energy::potential::Inertia;
     use shellsim::solve::{newton, NewtonOptions, State};
     let mesh = shellsim::mesh::surfaces::closed_shape("teddy", 0.05, 0.0026).unwrap();
     let settings = Settings::from_str_with(
@@ -424,7 +425,7 @@ fn balloon(c: &mut Criterion) {
     .unwrap();
     let sc = Scene::build(mesh, settings).unwrap();
     let p = Pattern::for_scene(&sc);
-    let x: Vec<Vec3> = sc.mesh.positions.iter().map(|q| q * 1.2).collect();
+    let x: Vec<Vec3> = sc.body.mesh.positions.iter().map(|q| q * 1.2).collect();
     let xhat = x.clone();
     let pot = Potential {
         dial: 0.5,
@@ -435,7 +436,7 @@ fn balloon(c: &mut Criterion) {
         }),
         ..Potential::new(&sc, &p)
     };
-    let nf = sc.num_faces();
+    let nf = sc.body.num_faces();
     let mut g = c.benchmark_group("balloon_teddy");
     g.sample_size(10);
     g.bench_function("prism_kernel_per_face", |b| {
@@ -455,7 +456,7 @@ fn balloon(c: &mut Criterion) {
     let mut lin = LinearSolver::new(&p).unwrap();
     println!(
         "balloon: {} vertices, {nf} faces, {} DOFs, factor non-zeros {}",
-        sc.num_vertices(),
+        sc.body.num_vertices(),
         p.n,
         lin.factor_nnz()
     );
@@ -562,10 +563,10 @@ fn explicit_step(c: &mut Criterion) {
         .unwrap();
         let sc = Scene::build(mesh, settings).unwrap();
         let p = Pattern::for_scene(&sc);
-        let nf = sc.num_faces();
+        let nf = sc.body.num_faces();
         let mut g = c.benchmark_group(format!("explicit_step_{nf}"));
         g.throughput(Throughput::Elements(nf as u64));
-        let inv_m: Vec<f64> = sc.mass.iter().map(|m| 1.0 / m).collect();
+        let inv_m: Vec<f64> = sc.body.mass.iter().map(|m| 1.0 / m).collect();
         let x0 = curved(&sc);
         let frozen: Vec<KoiterDensity> = {
             let pot = Potential::new(&sc, &p);
@@ -613,16 +614,16 @@ fn frame_write(c: &mut Criterion) {
     let pot = Potential::new(&sc, &p);
     let state = shellsim::solve::State {
         x: curved(&sc),
-        dofs: vec![0.0; p.n - 3 * sc.num_vertices()],
+        dofs: vec![0.0; p.n - 3 * sc.body.num_vertices()],
         terms: sc.initial_states.clone(),
     };
-    let v = vec![Vec3::new(1e-3, -2e-3, 5e-4); sc.num_vertices()];
+    let v = vec![Vec3::new(1e-3, -2e-3, 5e-4); sc.body.num_vertices()];
     // One real frame, every field in double, read back: the mesh the variants write.
     let dir = tempfile::tempdir().unwrap();
     let mut s2 = sc.settings.clone();
     s2.output.precision = shellsim::settings::Precision::Double;
     s2.output.fields = vec!["all".into()];
-    let sc2 = Scene::build(sc.mesh.clone(), s2).unwrap();
+    let sc2 = Scene::build(sc.body.mesh.clone(), s2).unwrap();
     let mut w = shellsim::output::Writer::new(dir.path(), &sc2, true).unwrap();
     let pot2 = Potential::new(&sc2, &p);
     w.frame(&pot2, &state, &v, Default::default(), None::<&()>)

@@ -6,7 +6,7 @@
 //!
 //!     cargo run --release --example assembly_work -- BENDING EDGE REPEATS
 use shellsim::assembly::{Pattern, Want};
-use shellsim::solve::Potential;
+use shellsim::energy::Potential;
 
 #[path = "../benches/common/scene.rs"]
 mod scene;
@@ -23,7 +23,7 @@ fn main() {
     let sc = scene_with_material(edge, model, "koiter");
     let p = Pattern::for_scene(&sc);
     let x = curved(&sc);
-    let phi = vec![0.01; sc.num_edge_dofs()];
+    let phi = vec![0.01; sc.body.num_edge_dofs()];
     let pot = Potential::new(&sc, &p);
     let (mut g, mut h) = (vec![0.0; p.n], vec![0.0; p.nnz()]);
     let pool = rayon::ThreadPoolBuilder::new()
@@ -40,7 +40,7 @@ fn main() {
     let per = start.elapsed().as_secs_f64() / repeats.max(1) as f64;
     println!(
         "{} faces, {model}: energy {e:.6e}, h[0] {:.6e}, {:.1} ms per assembly",
-        sc.num_faces(),
+        sc.body.num_faces(),
         h[0],
         1e3 * per
     );

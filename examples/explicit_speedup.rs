@@ -13,11 +13,11 @@
 //!
 //! `cargo run --release --example explicit_speedup [EDGE ...]`
 use shellsim::assembly::Pattern;
+use shellsim::energy::potential::Potential;
 use shellsim::integrate::explicit::Step;
 use shellsim::math::Vec3;
 use shellsim::mesh::generate::{annulus, Spacing};
-use shellsim::scene::Scene;
-use shellsim::solve::potential::Potential;
+use shellsim::model::Scene;
 use shellsim::team::Team;
 use std::time::Instant;
 
@@ -91,9 +91,10 @@ fn main() {
         )
         .expect("settings");
         let sc = Scene::build(mesh, settings).expect("scene");
-        let nf = sc.num_faces();
-        let inv_m: Vec<f64> = sc.mass.iter().map(|m| 1.0 / m).collect();
+        let nf = sc.body.num_faces();
+        let inv_m: Vec<f64> = sc.body.mass.iter().map(|m| 1.0 / m).collect();
         let x0: Vec<Vec3> = sc
+            .body
             .mesh
             .positions
             .iter()

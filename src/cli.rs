@@ -13,8 +13,8 @@ use crate::mesh::generate::{
 };
 use crate::mesh::io::{read_mesh, write_mesh, Format};
 use crate::mesh::Topology;
+use crate::model::Scene;
 use crate::output::Writer;
-use crate::scene::Scene;
 use crate::settings::Settings;
 use anyhow::{anyhow, bail, Result};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -581,7 +581,7 @@ pub(crate) fn import_text(
             let draft = crate::morphoshell::to_toml(&m, name, Some(0.0))?;
             let settings = Settings::from_str_with(&draft, name, &[])?;
             let scene = Scene::build(read_mesh(mp)?, settings)?;
-            let sc = crate::scales::Scales::of(&scene);
+            let sc = crate::scales::Scales::of(&scene.body);
             let t_bend = 2.0 * std::f64::consts::PI / sc.omega_long;
             Some(m.get("slide_speed_prefactor") * sc.length / t_bend)
         }
@@ -662,11 +662,11 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
     let initial = match &restart {
         Some(p) => {
             let (mut st, w) = crate::restart::read_restart(p, &scene)?;
-            scene.warnings.extend(w);
+            scene.body.warnings.extend(w);
             if scene.settings.dial.from == crate::settings::DialFrom::Start {
                 // Dial from the starting state's forms, from dial 0 (MorphoShell's dialling
                 // from an ansatz).
-                scene.dial_from_state(&st.state.x, &st.state.dofs);
+                scene.body.dial_from_state(&st.state.x, &st.state.dofs);
                 st.time = 0.0;
                 st.dial = Some(0.0);
                 st.driver = None;
@@ -675,7 +675,7 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
         }
         None => None,
     };
-    for w in &scene.warnings {
+    for w in &scene.body.warnings {
         eprintln!("warning: {w}");
     }
     let cores = std::thread::available_parallelism()
@@ -713,8 +713,8 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
         overrides: cli.set.clone(),
         resolved_settings: crate::output::RESOLVED_SETTINGS.into(),
         mesh: file(&mesh_path)?,
-        vertices: scene.num_vertices(),
-        faces: scene.num_faces(),
+        vertices: scene.body.num_vertices(),
+        faces: scene.body.num_faces(),
         restart: restart.as_deref().map(file).transpose()?,
         threads,
         host: crate::provenance::host(),
@@ -745,8 +745,8 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
             "shellsim: {mode} run of {} on {} ({} vertices, {} faces, {threads} thread{}){} into {}",
             settings_path.display(),
             mesh_path.display(),
-            scene.num_vertices(),
-            scene.num_faces(),
+            scene.body.num_vertices(),
+            scene.body.num_faces(),
             if threads == 1 { "" } else { "s" },
             match &restart {
                 Some(p) => format!(" from {}", p.display()),

@@ -14,7 +14,7 @@
 use crate::mesh::generate::Rng;
 use crate::mesh::io::mesh_from_bytes;
 use crate::mesh::{Mesh, Topology};
-use crate::scene::Scene;
+use crate::model::Scene;
 use crate::settings::Settings;
 
 /// An input path under test.

@@ -26,6 +26,7 @@
 //! The seed's displayed matrix (`½[(n_i − n_j)·(v_i − v_j) ...]`) has the opposite sign and a
 //! factor 1/4 relative to its own offset definition; shellsim uses the derivation above.
 
+use crate::config::shell::AngleVariant;
 use crate::math::{skew, Mat2, Mat3, Real, SMat, SVec, Sym2, Vec3};
 
 /// First fundamental form `[e1·e1, e1·e2, e2·e2]` of a triangle (m²).
@@ -423,4 +424,71 @@ pub fn cone_volume(
         }
     }
     w6 * x0.dot(&x1.cross(&x2))
+}
+
+impl AngleVariant {
+    /// `(g, g', g'')` at `t`.
+    #[inline(always)]
+    pub fn eval(self, t: Real) -> (Real, Real, Real) {
+        match self {
+            AngleVariant::Sin => {
+                let (s, c) = t.sin_cos();
+                (s, c, -s)
+            }
+            AngleVariant::Tan => {
+                let tn = t.tan();
+                let sec2 = 1.0 + tn * tn;
+                (tn, sec2, 2.0 * tn * sec2)
+            }
+        }
+    }
+}
+
+/// `ℓ_i²` as a linear form in `a = [a11, a12, a22]` for the edge opposite vertex `i`.
+const EDGE_LENGTH2: [[Real; 3]; 3] = [[1.0, -2.0, 1.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]];
+
+/// Height `h_i = √(det a / ℓ_i²)` of vertex `i` over its opposite edge (m), with its gradient
+/// and Hessian with respect to `a`.
+#[inline]
+pub fn height_from_a(a: &Sym2, i: usize) -> (Real, SVec<3>, Mat3) {
+    let l = SVec::<3>::from(EDGE_LENGTH2[i]);
+    let det = a[0] * a[2] - a[1] * a[1];
+    let len2 = l.dot(a);
+    let u = det / len2;
+    let h = u.max(0.0).sqrt();
+    let gd = SVec::<3>::new(a[2], -2.0 * a[1], a[0]);
+    let hd = Mat3::new(0.0, 0.0, 1.0, 0.0, -2.0, 0.0, 1.0, 0.0, 0.0);
+    let gu = gd / len2 - l * (det / (len2 * len2));
+    let hu = hd / len2 - (gd * l.transpose() + l * gd.transpose()) / (len2 * len2)
+        + l * l.transpose() * (2.0 * det / (len2 * len2 * len2));
+    let gh = gu / (2.0 * h);
+    let hh = hu / (2.0 * h) - gu * gu.transpose() / (4.0 * h * h * h);
+    (h, gh, hh)
+}
+
+/// Second fundamental form of one face (value only), 6 stencil positions as in the module doc.
+pub fn midedge_angle_b(
+    x: &[Vec3; 6],
+    has: [bool; 3],
+    phi: &[Real; 3],
+    sigma: [Real; 3],
+    variant: AngleVariant,
+) -> Sym2 {
+    let xf = [x[0], x[1], x[2]];
+    let a = first_fundamental_form(&xf);
+    let nf = UnitNormal::new(&xf);
+    let mut q = SVec::<3>::zeros();
+    for i in 0..3 {
+        let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+        let qt = if has[i] {
+            let ng = UnitNormal::new(&[x[3 + i], xf[k], xf[j]]).n;
+            (xf[j] - xf[i]).dot(&ng) / (nf.n + ng).norm()
+        } else {
+            0.0
+        };
+        let h = height_from_a(&a, i).0;
+        let w = (h * h - qt * qt).max(0.0).sqrt();
+        q[i] = h * variant.eval(qt.atan2(w) + sigma[i] * phi[i]).0;
+    }
+    b_from_q(&q)
 }

@@ -6,7 +6,8 @@
 //! * [`Settings`] ([`settings`], one validated section per file in [`config`]): a settings file,
 //!   with `--set` overrides;
 //! * [`Mesh`] ([`mesh`]): reading and writing meshes, generated sheets and closed surfaces;
-//! * [`Scene`] ([`scene`]): the body and its terms, built from the two;
+//! * [`Scene`] ([`model`]): the body ([`body`]: mesh, rest forms, materials, masses, supports)
+//!   and the energy terms the settings enable, built in that order;
 //! * [`run`] ([`integrate`]): the static, dynamic and explicit drivers, from the reference mesh
 //!   or a restart ([`InitialState`], read by [`restart`]), writing into a [`Sink`];
 //! * [`Writer`] and [`Summary`] ([`output`]): the sink that writes frames, series, log and
@@ -37,19 +38,20 @@
 //! let mut grad = vec![0.0; pattern.n];
 //! // Edge DOFs (the default bending model has one per edge) start at 0.
 //! let phi = vec![0.0; scene.num_scalar_dofs()];
-//! let e = pot.eval(&scene.mesh.positions, &phi, Want::Gradient, &mut grad, &mut []);
+//! let e = pot.eval(&scene.body.mesh.positions, &phi, Want::Gradient, &mut grad, &mut []);
 //! assert!(e > 0.0 && grad.iter().any(|g| g.abs() > 0.0));
 //! ```
 #![warn(missing_docs)]
 
+pub mod body;
 pub mod cases;
 pub mod config;
 pub mod integrate;
 pub mod math;
 pub mod mesh;
+pub mod model;
 pub mod output;
 pub mod restart;
-pub mod scene;
 pub mod settings;
 
 #[doc(hidden)]
@@ -93,9 +95,10 @@ pub(crate) mod units;
 pub use rest::lce;
 
 pub use assembly::{Pattern, Want};
+pub use energy::Potential;
 pub use integrate::{run, InitialState, Progress, Quiet, RunError, Sink};
 pub use mesh::Mesh;
+pub use model::Scene;
 pub use output::{Summary, Writer};
-pub use scene::Scene;
 pub use settings::Settings;
-pub use solve::{Potential, State};
+pub use solve::State;

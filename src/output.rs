@@ -14,6 +14,7 @@
 //! each edge's value appears in both its faces, and a restart reads it back). Per
 //! vertex: `displacement`, `velocity`, `constraint_indicators`, and `node_tags` when present.
 
+use crate::energy::Potential;
 use crate::geometry::curvatures;
 pub use crate::integrate::report::{
     summary_json, Energies, ExplicitReport, LogRow, OutputError, Summary, Timing,
@@ -21,9 +22,9 @@ pub use crate::integrate::report::{
 use crate::math::{Mat2, Real, Sym2, Vec3};
 use crate::mesh::io::{write_atomic, Format};
 use crate::mesh::{Field, Mesh};
+use crate::model::Scene;
 use crate::rest::{push_forward, reference_frame};
-use crate::scene::Scene;
-use crate::solve::{Potential, State};
+use crate::solve::State;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -133,7 +134,7 @@ pub fn restart_fields(scene: &Scene) -> std::collections::BTreeSet<String> {
     if scene.settings.solver.mode != crate::settings::Mode::Static {
         r.insert("velocity".to_string());
     }
-    if scene.has_edge_dofs() {
+    if scene.body.has_edge_dofs() {
         r.insert("edge_angles".to_string());
     }
     for t in scene.terms.iter().filter_map(|t| t.tracked()) {
@@ -157,11 +158,11 @@ pub fn check_fields(
     let pattern = crate::assembly::Pattern::for_scene(scene);
     let pot = Potential::new(scene, &pattern);
     let state = State {
-        x: scene.mesh.positions.clone(),
-        dofs: vec![0.0; pattern.n - 3 * scene.num_vertices()],
+        x: scene.body.mesh.positions.clone(),
+        dofs: vec![0.0; pattern.n - 3 * scene.body.num_vertices()],
         terms: scene.initial_states.clone(),
     };
-    let v = vec![Vec3::zeros(); scene.num_vertices()];
+    let v = vec![Vec3::zeros(); scene.body.num_vertices()];
     let mut w = Writer::detached(scene);
     w.fill(&pot, &state.x, &state.dofs, &v);
     let mut names: Vec<String> = w
@@ -313,7 +314,7 @@ fn ioerr(path: &Path, e: impl ToString) -> OutputError {
 /// coordinates (see module doc): on a curved reference, each face's frame starts at its first
 /// edge in the input's corner order.
 fn output_frames(scene: &Scene) -> Vec<Mat2> {
-    let mesh = &scene.mesh;
+    let mesh = &scene.body.mesh;
     let flat = mesh.is_flat_xy();
     (0..mesh.faces.len())
         .map(|f| {
@@ -322,7 +323,7 @@ fn output_frames(scene: &Scene) -> Vec<Mat2> {
             } else {
                 let [p0, p1, p2] = mesh.face_positions(f);
                 let (e1, e2) = (p1 - p0, p2 - p0);
-                let [i0, i1, _] = scene.input_face(f);
+                let [i0, i1, _] = scene.body.input_face(f);
                 let t1 = (mesh.positions[i1] - mesh.positions[i0]).normalize();
                 let n = e1.cross(&e2).normalize();
                 let t2 = n.cross(&t1);
@@ -476,11 +477,11 @@ impl Writer {
 
     /// A writer that builds frames' fields but writes nothing (no folder, no lock).
     fn detached(scene: &Scene) -> Self {
-        let mesh = &scene.mesh;
+        let mesh = &scene.body.mesh;
         // Frames keep the input's corner order.
         let mut frame_mesh = Mesh {
             positions: mesh.positions.clone(),
-            faces: scene.input_faces(),
+            faces: scene.body.input_faces(),
             ..Default::default()
         };
         if let Some(t) = mesh.face_fields.get("tri_tags") {
@@ -549,12 +550,12 @@ impl Writer {
         phi: &[Real],
         v: &[Vec3],
     ) -> Vec<(&'static str, Real)> {
-        let sc = pot.scene;
+        let sc = pot.body;
         let nf = sc.num_faces();
         let (a, b) = sc.forms(x, phi);
         let mut term_energies = Vec::new();
         let mut term_fields = Vec::new();
-        for (t, map) in sc.terms.iter().zip(&pot.pattern.maps) {
+        for (t, map) in pot.terms.iter().zip(&pot.pattern.maps) {
             let (e, f) = crate::energy::term::report(t.as_ref(), pot, map, x, phi);
             term_energies.extend(e);
             term_fields.extend(f);
@@ -623,7 +624,7 @@ impl Writer {
             let ea = sc.topo.face_edges.iter().flat_map(|fe| fe.map(|e| phi[e]));
             ff.insert("edge_angles".into(), vec3(ea.collect()));
         }
-        for t in sc.terms.iter() {
+        for t in pot.terms.iter() {
             if let Some(tr) = t.tracked() {
                 ff.insert(
                     tr.state_field().into(),
@@ -635,7 +636,7 @@ impl Writer {
             }
         }
         // Slot fields in the input's corner order, like the faces.
-        for name in sc.slot_fields() {
+        for name in crate::energy::term::slot_fields(pot.terms) {
             if let Some(f) = ff.get_mut(name).filter(|f| f.components == 3) {
                 sc.reorder_slots(&mut f.data, true);
             }
@@ -646,7 +647,7 @@ impl Writer {
                 Field::scalar(sc.patches.iter().map(|p| p.condition).collect()),
             );
         }
-        if sc.settings.output.morphoshell_fields {
+        if self.selection.morphoshell_fields {
             morphoshell_fields(m, pot, x, phi, &a);
         }
         let vf = &mut m.vertex_fields;
@@ -683,17 +684,16 @@ impl Writer {
             return Ok(());
         }
         let pot = &Potential {
-            terms: &state.terms,
+            states: &state.terms,
             ..*pot
         };
         let (x, phi) = (&state.x[..], &state.dofs[..]);
-        let sc = pot.scene;
         let index = self.frames.len();
         row.frame = index;
         self.built_is_written = false;
         let term_energies = self.fill(pot, x, phi, v);
         row.energy = crate::integrate::report::energies_of(pot, term_energies, v);
-        row.observables = sc
+        row.observables = pot
             .terms
             .iter()
             .flat_map(|t| crate::energy::term::observables(t.as_ref(), pot, x, phi))
@@ -969,7 +969,7 @@ impl Writer {
 /// them) and `cauchy_stress_eigvec_1/2` (unit 3-vectors) per face. Without a membrane term the
 /// stress fields are left out.
 fn morphoshell_fields(m: &mut Mesh, pot: &Potential, x: &[Vec3], phi: &[Real], a: &[Sym2]) {
-    let sc = pot.scene;
+    let sc = pot.body;
     let (deficit, curvature) =
         crate::fields::angle_deficits(x, &sc.mesh.faces, &sc.topo.boundary_vertex);
     m.vertex_fields
@@ -983,7 +983,7 @@ fn morphoshell_fields(m: &mut Mesh, pot: &Potential, x: &[Vec3], phi: &[Real], a
         .collect();
     m.face_fields
         .insert("strain_measure".into(), Field::scalar(strain));
-    let Some(ga) = sc
+    let Some(ga) = pot
         .terms
         .iter()
         .filter_map(|t| t.reports())

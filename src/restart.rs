@@ -11,7 +11,7 @@ use crate::integrate::InitialState;
 use crate::math::{Real, Vec3};
 use crate::mesh::io::read_mesh;
 use crate::mesh::MeshError;
-use crate::scene::Scene;
+use crate::model::Scene;
 use crate::solve::State;
 use std::path::Path;
 
@@ -22,10 +22,10 @@ const EDGE_ANGLE_TOLERANCE: Real = 1e-9;
 /// Reads a restart state for `scene` from `path`. Returns the state and any warnings.
 pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<String>), MeshError> {
     let name = path.display().to_string();
-    if let Some((dial, positions)) = read_ansatz(path, scene.num_vertices())? {
+    if let Some((dial, positions)) = read_ansatz(path, scene.body.num_vertices())? {
         let frame = crate::mesh::Mesh {
             positions,
-            faces: scene.input_faces(),
+            faces: scene.body.input_faces(),
             ..Default::default()
         };
         let (state, v, warnings) = restart_from_frame(frame, &name, scene)?;
@@ -63,7 +63,7 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
     let mut state = state;
     if !scene.globals.is_empty() {
         // The global DOFs (a force-controlled obstacle's offset) are in the state file only.
-        let ne = scene.num_edge_dofs();
+        let ne = scene.body.num_edge_dofs();
         match &driver {
             Some(d) if d.globals.len() == scene.globals.len() => {
                 if let Some(k) = d.globals.iter().position(|q| !q.is_finite()) {
@@ -177,22 +177,23 @@ pub fn restart_from_frame(
     let mut warnings = Vec::new();
     let mut frame = frame;
     // Frames keep the input's corner order; the scene may start slivers at another corner.
-    if frame.positions.len() != scene.num_vertices() || frame.faces != scene.input_faces() {
+    if frame.positions.len() != scene.body.num_vertices() || frame.faces != scene.body.input_faces()
+    {
         return Err(bad(format!(
             "restart frame has {} vertices and {} faces, the mesh {} has {} and {} (or the faces \
              differ): a restart needs the frame of a run on the same mesh",
             frame.positions.len(),
             frame.faces.len(),
-            scene.mesh.name(),
-            scene.num_vertices(),
-            scene.num_faces()
+            scene.body.mesh.name(),
+            scene.body.num_vertices(),
+            scene.body.num_faces()
         )));
     }
-    frame.faces = scene.mesh.faces.clone();
+    frame.faces = scene.body.mesh.faces.clone();
     for name in scene.slot_fields() {
         if let Some(f) = frame.face_fields.get_mut(name) {
-            if f.components == 3 && f.data.len() == 3 * scene.num_faces() {
-                scene.reorder_slots(&mut f.data, false);
+            if f.components == 3 && f.data.len() == 3 * scene.body.num_faces() {
+                scene.body.reorder_slots(&mut f.data, false);
             }
         }
     }
@@ -237,11 +238,11 @@ pub fn restart_from_frame(
         None => None,
     };
     let mut phi = vec![0.0; scene.num_scalar_dofs()];
-    if scene.has_edge_dofs() {
+    if scene.body.has_edge_dofs() {
         match frame.face_field("edge_angles", 3)? {
             Some(f) => {
                 let mut seen = vec![false; phi.len()];
-                for (fi, fe) in scene.topo.face_edges.iter().enumerate() {
+                for (fi, fe) in scene.body.topo.face_edges.iter().enumerate() {
                     for (i, &e) in fe.iter().enumerate() {
                         let val = f.get(fi)[i];
                         if !val.is_finite() {
@@ -256,7 +257,7 @@ pub fn restart_from_frame(
                             return Err(bad(format!(
                                 "field 'edge_angles': the two faces of edge {:?} disagree ({} \
                                  at face {fi} vs {})",
-                                scene.topo.edges[e],
+                                scene.body.topo.edges[e],
                                 crate::math::human(val),
                                 crate::math::human(phi[e])
                             )));

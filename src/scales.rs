@@ -10,8 +10,8 @@
 //!
 //! Units: s, rad/s, m, Pa, kg/m³, N·m.
 
+use crate::body::Body;
 use crate::math::Real;
-use crate::scene::Scene;
 use std::f64::consts::PI;
 
 /// The time and force scales of a scene's explicit dynamics (module doc).
@@ -38,22 +38,21 @@ pub struct Scales {
 }
 
 impl Scales {
-    /// The scales of `scene`.
-    pub fn of(scene: &Scene) -> Scales {
-        let m = &scene.settings.material;
-        let rho = m.density;
-        let mu = scene
+    /// The scales of `body`.
+    pub fn of(body: &Body) -> Scales {
+        let rho = body.density;
+        let mu = body
             .lame
             .iter()
             .map(|l| l.beta)
             .fold(Real::INFINITY, Real::min);
-        let t = scene
+        let t = body
             .thickness
             .iter()
             .copied()
             .fold(Real::INFINITY, Real::min);
-        let flexural = mu * t * t * t / (6.0 * (1.0 - m.poisson));
-        let mesh = &scene.mesh;
+        let flexural = mu * t * t * t / (6.0 * (1.0 - body.poisson));
+        let mesh = &body.mesh;
         let mut a_min = Real::INFINITY;
         for f in 0..mesh.faces.len() {
             let [p0, p1, p2] = mesh.face_positions(f);
@@ -62,7 +61,7 @@ impl Scales {
                 a_min = a_min.min(twice_area / (b - a).norm());
             }
         }
-        let topo = &scene.topo;
+        let topo = &body.topo;
         let perimeter: Real = topo
             .edges
             .iter()

@@ -30,10 +30,11 @@ const FLOORS: &[(&str, u32)] = &[
     ("elements", 3),
     ("diffusion", 3),
     // 4: the body and its scales.
-    ("scene", 4),
+    ("body", 4),
     ("scales", 4),
     // 5: energy terms and their registry.
     ("energy", 5),
+    ("model", 5),
     // 6: assembly.
     ("assembly", 6),
     // 7: physics-free solvers.

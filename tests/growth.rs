@@ -153,9 +153,9 @@ fn volumetric_growth_of_curved_shells_is_a_scaled_copy() {
 #[test]
 fn the_scaled_copy_is_the_rest_state_of_volumetric_growth_only() {
     use shellsim::assembly::{Pattern, Want};
-    use shellsim::scene::Scene;
+    use shellsim::energy::Potential;
+    use shellsim::model::Scene;
     use shellsim::settings::Settings;
-    use shellsim::solve::Potential;
     let dir = tempfile::tempdir().unwrap();
     let mesh = curved(dir.path(), "cap");
     let h = 0.05;
@@ -173,8 +173,8 @@ fn the_scaled_copy_is_the_rest_state_of_volumetric_growth_only() {
                 dial: 1.0,
                 ..Potential::new(&scene, &pattern)
             };
-            let x: Vec<Vec3> = scene.mesh.positions.iter().map(|p| p * 0.9).collect();
-            let phi = vec![0.0; scene.num_edge_dofs()];
+            let x: Vec<Vec3> = scene.body.mesh.positions.iter().map(|p| p * 0.9).collect();
+            let phi = vec![0.0; scene.body.num_edge_dofs()];
             let mut g = vec![0.0; pattern.n];
             let e = pot.eval(&x, &phi, Want::Gradient, &mut g, &mut []);
             let gmax = g.iter().fold(0.0 as Real, |m, v| m.max(v.abs()));

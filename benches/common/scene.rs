@@ -5,7 +5,7 @@
 use shellsim::cases::Case;
 use shellsim::math::Vec3;
 use shellsim::mesh::generate::{rectangle, Spacing};
-use shellsim::scene::Scene;
+use shellsim::model::Scene;
 use shellsim::settings::Settings;
 
 /// The unit square with target edge `edge`, interior vertices jittered by 0.2 edge (seed 1),
@@ -38,7 +38,8 @@ pub fn scene_with_material(edge: f64, model: &str, material: &str) -> Scene {
 
 /// The square lifted onto the unit sphere, `z = √(1 − x² − y²)`.
 pub fn curved(sc: &Scene) -> Vec<Vec3> {
-    sc.mesh
+    sc.body
+        .mesh
         .positions
         .iter()
         .map(|p| Vec3::new(p.x, p.y, (1.0 - p.x * p.x - p.y * p.y).sqrt()))

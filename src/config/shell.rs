@@ -23,6 +23,16 @@ pub enum StretchConvention {
     Morphoshell,
 }
 
+impl StretchConvention {
+    /// Multiplier on the stretching term.
+    pub fn factor(self) -> crate::math::Real {
+        match self {
+            StretchConvention::Koiter => 1.0,
+            StretchConvention::Morphoshell => 4.0,
+        }
+    }
+}
+
 /// How to treat negative eigenvalues of an element Hessian.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]

@@ -21,6 +21,7 @@
 //! of threads. Energies are stored per element and summed in fixed blocks along the elements'
 //! Morton curve ([`ElementMap::sum_energies`]).
 
+pub mod pattern;
 pub mod projection;
 
 use crate::math::{Real, SMat, SVec, Vec3};
@@ -140,7 +141,7 @@ struct Parts {
 }
 
 /// Work fused into the parts of an element term's gradient ([`assemble_elements_owned`],
-/// from [`crate::solve::Potential::owned`]): called once
+/// from [`crate::energy::Potential::owned`]): called once
 /// per part, on the thread that runs it, right after the part has summed the gradient of the
 /// nodes it owns, with those node ids, their sums (3 entries per vertex node, 1 per edge node,
 /// in the nodes' order; N for vertices, N·m for edge DOFs; fixed nodes included and not
@@ -415,7 +416,7 @@ where
 }
 
 /// [`assemble_elements`], with the explicit driver's fused step: given `owned` (from
-/// [`crate::solve::Potential::owned`]) and asked for a gradient, each part of the gradient's
+/// [`crate::energy::Potential::owned`]) and asked for a gradient, each part of the gradient's
 /// partition hands the sums of the nodes it owns to the hook, on the thread that summed them,
 /// instead of adding them into `grad`, which is left alone ([`OwnedNodes`]). Element terms
 /// pass their potential's hook here.

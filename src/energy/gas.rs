@@ -39,16 +39,16 @@
 //! Units: V in m³, pressures in Pa, E in J, gradient N, Hessian N/m. DOF order per face (9):
 //! `x[v0], x[v1], x[v2]`.
 
+use crate::body::Body;
 use crate::elements::{assemble_elements, ElementMap, Want};
 use crate::energy::term::{
     LowRank, LowRankPart, Multiplier, Predictor, Reports, Stateful, Stencil, Term,
 };
 use crate::energy::HessianProjection;
+use crate::energy::Potential;
 use crate::math::{Real, Vec3};
 use crate::mesh::MeshError;
-use crate::scene::Scene;
 use crate::settings::{GasControl, GasProcess};
-use crate::solve::Potential;
 
 /// The gas term.
 pub struct Gas {
@@ -81,8 +81,8 @@ pub struct GasState {
 
 impl Gas {
     /// The enclosed volume at `x` (m³), summed in face order.
-    pub fn volume(scene: &Scene, x: &[Vec3]) -> Real {
-        crate::mesh::closed::enclosed_volume(x, &scene.mesh.faces)
+    pub fn volume(body: &Body, x: &[Vec3]) -> Real {
+        crate::mesh::closed::enclosed_volume(x, &body.mesh.faces)
     }
 
     /// The amount at dial `s` (amount control, J).
@@ -148,7 +148,7 @@ impl Gas {
 
     /// The state at positions `x` under potential `pot`.
     pub fn state(&self, pot: &Potential, x: &[Vec3]) -> GasState {
-        self.state_at(Self::volume(pot.scene, x), pot.dial, Self::multiplier(pot))
+        self.state_at(Self::volume(pot.body, x), pot.dial, Self::multiplier(pot))
     }
 
     /// Volume control: the multiplier λ (gauge pressure, Pa) that `pot` is evaluated with (the
@@ -166,7 +166,7 @@ impl Gas {
     /// pinned DOFs).
     fn volume_gradient(pot: &Potential, x: &[Vec3]) -> Vec<Real> {
         let mut g = vec![Vec3::zeros(); x.len()];
-        crate::mesh::closed::add_enclosed_volume_gradient(x, &pot.scene.mesh.faces, &mut g);
+        crate::mesh::closed::add_enclosed_volume_gradient(x, &pot.body.mesh.faces, &mut g);
         let mut u = vec![0.0; pot.pattern.n];
         for (v, gv) in g.iter().enumerate() {
             u[3 * v..3 * v + 3].copy_from_slice(gv.as_slice());
@@ -185,8 +185,8 @@ impl Term for Gas {
         Some(self)
     }
 
-    fn stencil(&self, scene: &Scene) -> Stencil {
-        Stencil::faces(&scene.mesh, 0..scene.num_faces())
+    fn stencil(&self, body: &Body) -> Stencil {
+        Stencil::faces(&body.mesh, 0..body.num_faces())
     }
 
     fn eval(
@@ -208,7 +208,7 @@ impl Term for Gas {
         // never projected face by face.
         let w = -st.gauge;
         let keep_h = projection != HessianProjection::GaussNewton;
-        let faces = &pot.scene.mesh.faces;
+        let faces = &pot.body.mesh.faces;
         assemble_elements::<9, 3, _>(
             map,
             |f, _, g, h| {
@@ -224,7 +224,7 @@ impl Term for Gas {
                 crate::geometry::cone_volume(&xs, w, g, h);
                 0.0
             },
-            &pot.scene.node_fixed,
+            pot.node_fixed,
             HessianProjection::None,
             want,
             grad,
@@ -263,7 +263,7 @@ impl Reports for Gas {
 
     fn face_fields(&self, pot: &Potential, x: &[Vec3], _phi: &[Real]) -> Vec<(String, Vec<Real>)> {
         let st = self.state(pot, x);
-        vec![("pressure".into(), vec![st.gauge; pot.scene.num_faces()])]
+        vec![("pressure".into(), vec![st.gauge; pot.body.num_faces()])]
     }
 }
 
@@ -314,7 +314,7 @@ impl Predictor for Gas {
         if !(s.is_finite() && s > 0.0) {
             return;
         }
-        let v = Self::volume(pot.scene, x);
+        let v = Self::volume(pot.body, x);
         let alpha = match self.control {
             GasControl::Amount => (self.amount(pot.dial) - self.amount(from)) / v,
             GasControl::Pressure => ds * self.target,
@@ -350,7 +350,7 @@ impl Multiplier for Gas {
         if self.control != GasControl::Volume {
             return false;
         }
-        let v = Self::volume(pot.scene, x);
+        let v = Self::volume(pot.body, x);
         let target = self.volume_target(pot.dial);
         let c = v - target;
         if c.abs() <= 1e-10 * target.abs() {
@@ -368,22 +368,21 @@ impl Multiplier for Gas {
 /// The gas term of a scene (`None` unless `gas.control` is set). The mesh must be a closed,
 /// consistently oriented 2-manifold with outward normals (errors name the first open edge, or
 /// the fix for an inward mesh), and volume control must ask for a positive volume.
-pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
-    let g = &scene.settings.gas;
+pub fn term(body: &Body, g: &crate::config::gas::Gas) -> Result<Option<Box<dyn Term>>, MeshError> {
     if g.control == GasControl::None {
         return Ok(None);
     }
-    let v_ref = crate::mesh::closed::check_closed_outward(&scene.mesh, &scene.topo)?;
+    let v_ref = crate::mesh::closed::check_closed_outward(&body.mesh, &body.topo)?;
     let target = match g.control {
         GasControl::Amount => g.amount,
         GasControl::Pressure => g.pressure,
         _ => g.volume,
     };
     // Penalty of volume control: 100 E h / (R V_ref) (module doc).
-    let eh = scene
+    let eh = body
         .young
         .iter()
-        .zip(&scene.thickness)
+        .zip(&body.thickness)
         .map(|(e, h)| e * h)
         .fold(0.0, Real::max);
     let radius = (3.0 * v_ref / (4.0 * std::f64::consts::PI)).cbrt();

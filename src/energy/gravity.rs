@@ -2,8 +2,8 @@
 //! and acceleration `g` (m/s²). Gradient `−m_v g` (N), no Hessian. DOF order: `x[v]`.
 
 use super::term::VertexKernel;
+use crate::energy::Potential;
 use crate::math::{Mat3, Real, Vec3};
-use crate::solve::Potential;
 
 /// The gravity kernel.
 pub struct Gravity;

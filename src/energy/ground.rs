@@ -1,11 +1,11 @@
 //! The ground plane and its friction, two vertex terms over [`crate::contact::Ground`]
 //! (formulas, units and smoothing there): the C² normal penalty `k A_v ψ(p)`, and the lagged,
 //! smoothed Coulomb friction `μ λ f₀(‖slip‖)` (dynamics only, while the potential carries a
-//! [`crate::solve::potential::Friction`]). DOF order: `x[v]`.
+//! [`crate::energy::potential::Friction`]). DOF order: `x[v]`.
 
 use super::term::VertexKernel;
+use crate::energy::Potential;
 use crate::math::{Mat3, Real, Vec3};
-use crate::solve::Potential;
 
 /// The normal contact kernel.
 pub struct GroundContact;
@@ -21,7 +21,7 @@ fn mat(h: [[Real; 3]; 3]) -> Mat3 {
 impl VertexKernel for GroundContact {
     #[inline]
     fn eval(&self, pot: &Potential, _: &[Real], v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
-        let (e, g, h) = pot.scene.ground.as_ref()?.normal_term(v, x)?;
+        let (e, g, h) = pot.body.ground.as_ref()?.normal_term(v, x)?;
         Some((e, g, mat(h)))
     }
 }
@@ -29,7 +29,7 @@ impl VertexKernel for GroundContact {
 impl VertexKernel for GroundFriction {
     #[inline]
     fn eval(&self, pot: &Potential, _: &[Real], v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
-        let ground = pot.scene.ground.as_ref()?;
+        let ground = pot.body.ground.as_ref()?;
         let fr = pot.friction.as_ref()?;
         let lambda = fr.normal_force[v];
         if lambda <= 0.0 || ground.friction <= 0.0 {

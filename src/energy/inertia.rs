@@ -1,11 +1,11 @@
 //! Inertia of an implicit-Euler step (seed 000 §3), a vertex term:
 //! `E = Σ_v m_v/(2Δt²) |x_v − x̂_v|²` with `x̂ = x_n + Δt v_n`; its minimiser with the other terms
 //! satisfies `M(v_{n+1} − v_n)/Δt = F(x_{n+1})`. Units: J; gradient N; Hessian `m/Δt²` I (N/m).
-//! Contributes only while the potential has an [`crate::solve::potential::Inertia`].
+//! Contributes only while the potential has an [`crate::energy::potential::Inertia`].
 
 use super::term::VertexKernel;
+use crate::energy::Potential;
 use crate::math::{Mat3, Real, Vec3};
-use crate::solve::Potential;
 
 /// The inertia kernel.
 pub struct InertiaTerm;

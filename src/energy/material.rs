@@ -11,36 +11,8 @@
 
 use crate::math::{sym_det, Mat3, Real, Sym2};
 
-/// Plane-stress (2D) Lamé parameters (Pa).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Lame2d {
-    /// `α = Eν/(1−ν²)` (Pa).
-    pub alpha: Real,
-    /// `β = E/(2(1+ν))`, the shear modulus (Pa).
-    pub beta: Real,
-}
-
-impl Lame2d {
-    /// From Young's modulus `E` (Pa) and Poisson's ratio `ν` (dimensionless, −1 < ν ≤ ½).
-    pub fn from_young_poisson(young: Real, poisson: Real) -> Self {
-        Lame2d {
-            alpha: young * poisson / (1.0 - poisson * poisson),
-            beta: young / (2.0 * (1.0 + poisson)),
-        }
-    }
-}
-
+pub use crate::body::Lame2d;
 pub use crate::config::shell::StretchConvention;
-
-impl StretchConvention {
-    /// Multiplier on the stretching term.
-    pub fn factor(self) -> Real {
-        match self {
-            StretchConvention::Koiter => 1.0,
-            StretchConvention::Morphoshell => 4.0,
-        }
-    }
-}
 
 /// The St Venant–Kirchhoff quadratic form in `[m11, m12, m22]` coordinates:
 /// `‖ā⁻¹M‖²_SV = α/2 tr²(ā⁻¹M) + β tr((ā⁻¹M)²) = mᵀ C m`, with

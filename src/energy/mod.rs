@@ -30,6 +30,7 @@ pub mod loads;
 pub mod material;
 pub mod membrane;
 pub mod obstacles;
+pub mod potential;
 pub use crate::elements::projection;
 pub mod registry;
 pub mod shell;
@@ -39,5 +40,6 @@ pub mod term;
 
 pub use bending::{midedge_angle, patch};
 pub use material::{FaceDensity, KoiterDensity, Lame2d, StretchConvention};
+pub use potential::Potential;
 pub use projection::HessianProjection;
 pub use shell::{shell_face, shell_face_gauss_newton};

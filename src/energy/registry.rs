@@ -16,14 +16,14 @@ use super::membrane::{
 };
 use super::shell::Shell;
 use super::term::{Term, VertexTerm};
+use crate::body::Body;
 use crate::config::material::MembraneMaterial;
 use crate::mesh::MeshError;
-use crate::scene::Scene;
-use crate::settings::{BendingModel, MaterialModel, Mode};
+use crate::settings::{BendingModel, Material, MaterialModel, Mode, Settings};
 
 /// The shell term of membrane `m` with the scene's bending model.
-fn with_bending<M: Membrane>(scene: &Scene, m: M) -> Box<dyn Term> {
-    match scene.settings.material.bending {
+fn with_bending<M: Membrane>(body: &Body, m: M) -> Box<dyn Term> {
+    match body.bending {
         BendingModel::MidedgeAverage => Box::new(Shell {
             membrane: m,
             bending: MidedgeAverage,
@@ -35,10 +35,7 @@ fn with_bending<M: Membrane>(scene: &Scene, m: M) -> Box<dyn Term> {
         BendingModel::MidedgeSin | BendingModel::MidedgeTan => Box::new(Shell {
             membrane: m,
             bending: MidedgeAngle(
-                scene
-                    .settings
-                    .material
-                    .bending
+                body.bending
                     .angle_variant()
                     .unwrap_or(crate::energy::midedge_angle::AngleVariant::Sin),
             ),
@@ -65,7 +62,7 @@ pub struct MaterialEntry {
 }
 
 /// A material's shell-term builder (see [`MaterialEntry::build`]).
-pub type BuildShell = fn(&Scene, &MembraneMaterial) -> Option<Result<Box<dyn Term>, MeshError>>;
+pub type BuildShell = fn(&Body, &MembraneMaterial) -> Option<Result<Box<dyn Term>, MeshError>>;
 
 /// Every membrane material, one entry each.
 pub const MATERIALS: &[MaterialEntry] = &[
@@ -133,26 +130,26 @@ pub const BENDINGS: &[(BendingModel, &str)] = &[
 ];
 
 /// The shell face term: the membrane material × the bending model, from [`MATERIALS`].
-pub fn shell_term(scene: &Scene) -> Result<Box<dyn Term>, MeshError> {
-    let m = scene.settings.material.membrane();
+pub fn shell_term(body: &Body, material: &Material) -> Result<Box<dyn Term>, MeshError> {
+    let m = material.membrane();
     MATERIALS
         .iter()
         .find(|e| e.model == m.model())
-        .and_then(|e| (e.build)(scene, &m))
+        .and_then(|e| (e.build)(body, &m))
         .unwrap_or_else(|| {
-            Err(scene.mesh.invalid(format!(
+            Err(body.mesh.invalid(format!(
                 "material {:?} has no registry entry (a test checks this)",
                 m.model()
             )))
         })
 }
 
-/// Every term the scene enables, in assembly order.
-pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
-    let s = &scene.settings;
+/// Every term the validated `settings` enable on `body`, in assembly order. Each builder reads
+/// its own section.
+pub fn terms(body: &Body, s: &Settings) -> Result<Vec<Box<dyn Term>>, MeshError> {
     let dynamic = s.solver.mode == Mode::Dynamic;
-    let mut t = vec![shell_term(scene)?];
-    if scene.ground.is_some() {
+    let mut t = vec![shell_term(body, &s.material)?];
+    if body.ground.is_some() {
         t.push(Box::new(VertexTerm {
             name: "contact",
             report: true,
@@ -180,17 +177,18 @@ pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
             kernel: super::gravity::Gravity,
         }));
     }
-    for load in [
-        super::loads::point::term,
-        super::loads::traction::term,
-        super::loads::pressure::term,
-        super::loads::moment::term,
-        super::gas::term,
-        super::slides::term,
-    ] {
-        t.extend(load(scene)?);
-    }
-    t.extend(super::obstacles::terms(scene)?);
+    t.extend(super::loads::point::term(body, &s.loads.point)?);
+    t.extend(super::loads::traction::term(body, &s.loads.traction)?);
+    t.extend(super::loads::pressure::term(body, &s.loads.pressure)?);
+    t.extend(super::loads::moment::term(body, &s.loads.moment)?);
+    t.extend(super::gas::term(body, &s.gas)?);
+    t.extend(super::slides::term(body, &s.slides, &s.explicit)?);
+    t.extend(super::obstacles::terms(
+        body,
+        &s.obstacles,
+        s.solver.mode,
+        &s.explicit,
+    )?);
     Ok(t)
 }
 

@@ -19,13 +19,13 @@ use super::bending::BendingModel;
 use super::material::{DensityDerivs, FaceDensity};
 use super::membrane::Membrane;
 use super::term::{ElementKernel, Projection, Reports, StateError, Stateful, Stencil, Tracked};
+use crate::body::Body;
+use crate::energy::Potential;
 use crate::geometry::{
     first_fundamental_form, first_fundamental_form_hessian_pattern, first_fundamental_form_jacobian,
 };
 use crate::math::{Real, SMat, SVec, Sym2, Vec3};
 use crate::mesh::topology::NONE;
-use crate::scene::Scene;
-use crate::solve::Potential;
 
 /// Fundamental forms of one face under the mid-edge average (for output and the damping term's
 /// previous state).
@@ -242,7 +242,7 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Element
         hess: Option<&mut SMat<N, N>>,
     ) -> Real {
         let xs = gather(nodes, x);
-        let face = self.bending.face(pot.scene, f, nodes, phi);
+        let face = self.bending.face(pot.body, f, nodes, phi);
         let dens = self.membrane.density(pot, f);
         if gauss_newton {
             shell_element::<_, B, N, S, true>(&self.bending, &face, &xs, &dens, grad, hess)
@@ -254,16 +254,16 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Element
 
 impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Shell<M, B, N, S> {
     /// The stencil `[v0, v1, v2, p0, p1, p2, e0, e1, e2]` truncated to the model's slots.
-    pub fn stencil(scene: &Scene, _: &Self) -> Stencil {
+    pub fn stencil(body: &Body, _: &Self) -> Stencil {
         let slots = S;
-        let extra = scene.stencil_extra();
-        let nv = scene.num_vertices();
-        let mut nodes = Vec::with_capacity(slots * scene.num_faces());
-        let mut anchors = Vec::with_capacity(scene.num_faces());
-        for (f, face) in scene.mesh.faces.iter().enumerate() {
+        let extra = body.stencil_extra();
+        let nv = body.num_vertices();
+        let mut nodes = Vec::with_capacity(slots * body.num_faces());
+        let mut anchors = Vec::with_capacity(body.num_faces());
+        for (f, face) in body.mesh.faces.iter().enumerate() {
             let o = extra[f];
             let e = if slots > 6 {
-                scene.topo.face_edges[f].map(|e| nv + e)
+                body.topo.face_edges[f].map(|e| nv + e)
             } else {
                 [NONE; 3]
             };
@@ -271,7 +271,7 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Shell<M
                 face[0], face[1], face[2], o[0], o[1], o[2], e[0], e[1], e[2],
             ];
             nodes.extend_from_slice(&all[..slots]);
-            let p = &scene.mesh.positions;
+            let p = &body.mesh.positions;
             anchors.push((p[face[0]] + p[face[1]] + p[face[2]]) / 3.0);
         }
         let slot_dofs = (0..slots).map(|s| if s < 6 { 3 } else { 1 }).collect();
@@ -292,12 +292,12 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Shell<M
     ) -> Vec<T> {
         use rayon::prelude::*;
         let pattern = pot.pattern.faces();
-        (0..pot.scene.num_faces())
+        (0..pot.body.num_faces())
             .into_par_iter()
             .map(|f| {
                 let nodes = pattern.element(f);
                 let xs = gather(nodes, x);
-                let face = self.bending.face(pot.scene, f, nodes, phi);
+                let face = self.bending.face(pot.body, f, nodes, phi);
                 let dens = self.membrane.density(pot, f);
                 let a = first_fundamental_form(&[xs[0], xs[1], xs[2]]);
                 let b = if N > 9 {
@@ -323,8 +323,8 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
         NAME
     }
 
-    fn stencil(&self, scene: &Scene) -> Stencil {
-        Self::stencil(scene, self)
+    fn stencil(&self, body: &Body) -> Stencil {
+        Self::stencil(body, self)
     }
 
     fn eval(
@@ -342,7 +342,7 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
         crate::elements::assemble_elements_owned::<N, S, _>(
             map,
             |e, nodes, g, h| ElementKernel::<N, S>::eval(self, pot, e, nodes, x, phi, gn, g, h),
-            &pot.scene.node_fixed,
+            pot.node_fixed,
             projection,
             want,
             grad,

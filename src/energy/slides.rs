@@ -39,11 +39,11 @@
 //! of the frame (never accumulated across steps).
 
 use super::term::{VertexKernel, VertexTerm};
+use crate::body::Body;
+use crate::energy::Potential;
 use crate::math::{Mat3, Real, Vec3};
 use crate::mesh::MeshError;
-use crate::scene::Scene;
 use crate::settings::SlideControl;
-use crate::solve::Potential;
 
 /// The slides' kernel. Its state ([`crate::energy::term::Stateful`], under the name `slides`)
 /// is the upper slide's height (m) and its velocity over the current step (m/s).
@@ -155,7 +155,7 @@ impl VertexKernel for Slides {
 
     fn observables(&self, pot: &Potential, x: &[Vec3]) -> Vec<(String, Real)> {
         let upper = Self::upper(pot).0;
-        let (up, down) = self.forces(upper, x, &pot.scene.fixed);
+        let (up, down) = self.forces(upper, x, &pot.body.fixed);
         vec![
             ("slide_upper_z".into(), upper),
             ("slide_lower_z".into(), self.lower),
@@ -177,7 +177,7 @@ impl VertexKernel for Slides {
             return Ok(0.0);
         }
         let upper = Self::upper(pot).0;
-        let (up, _) = self.forces(upper, x, &pot.scene.fixed);
+        let (up, _) = self.forces(upper, x, &pot.body.fixed);
         if up == 0.0 && self.force > 0.0 && upper < self.lower {
             return Err(format!(
                 "slides: the force-controlled upper slide (slides.force = {} N) has passed every \
@@ -195,7 +195,7 @@ impl VertexKernel for Slides {
         if self.friction == 0.0 && self.contact_damping == 0.0 {
             return;
         }
-        let fixed = &pot.scene.fixed;
+        let fixed = &pot.body.fixed;
         let (upper, upper_velocity) = Self::upper(pot);
         for (i, p) in x.iter().enumerate() {
             if fixed[i] {
@@ -206,7 +206,7 @@ impl VertexKernel for Slides {
             if normal == 0.0 {
                 continue;
             }
-            let m = pot.scene.mass[i];
+            let m = pot.body.mass[i];
             if self.contact_damping > 0.0 {
                 // The dashpot c = ζ 2√(km) on the normal velocity relative to the slide that
                 // the step reaches, taken implicitly, w' = w*/(1 + Δt c/m): stable for any ζ.
@@ -239,8 +239,8 @@ impl VertexKernel for Slides {
     /// The upper slide's motion over the step, from the positions the gradient is taken at (no
     /// lag between the slide and the sheet: a slide moved from the previous positions drives a
     /// slow limit cycle through the contact).
-    fn explicit_begin(&self, scene: &Scene, dial: Real, x: &[Vec3], dt: Real, own: &mut [Real]) {
-        let fixed = &scene.fixed;
+    fn explicit_begin(&self, body: &Body, dial: Real, x: &[Vec3], dt: Real, own: &mut [Real]) {
+        let fixed = &body.fixed;
         if self.after_dial && dial < 1.0 {
             own[1] = 0.0;
             return;
@@ -278,12 +278,15 @@ impl VertexKernel for Slides {
 
 /// The slides' term when `[slides]` is enabled. A vertex starting beyond a slide is an error
 /// naming it.
-pub fn term(scene: &Scene) -> Result<Option<Box<dyn super::term::Term>>, MeshError> {
-    let s = &scene.settings.slides;
+pub fn term(
+    body: &Body,
+    s: &crate::config::slides::Slides,
+    explicit: &crate::config::explicit::Explicit,
+) -> Result<Option<Box<dyn super::term::Term>>, MeshError> {
     if !s.enabled {
         return Ok(None);
     }
-    let mesh = &scene.mesh;
+    let mesh = &body.mesh;
     let (zmin, zmax) = mesh
         .positions
         .iter()
@@ -306,10 +309,10 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn super::term::Term>>, MeshErr
             )));
         }
     }
-    let sc = crate::scales::Scales::of(scene);
+    let sc = crate::scales::Scales::of(body);
     let drag = s.drag.unwrap_or_else(|| {
-        let mass: Real = scene.mass.iter().sum();
-        let rate = scene.settings.explicit.damping_prefactor_wait.max(1.0) * 2.0 * sc.omega_long;
+        let mass: Real = body.mass.iter().sum();
+        let rate = explicit.damping_prefactor_wait.max(1.0) * 2.0 * sc.omega_long;
         mass * rate
     });
     let k = s.stiffness_prefactor * sc.mu * sc.t;

@@ -16,12 +16,12 @@
 //!
 //! Dispatch is once per term: a term's element loop is monomorphic.
 
+use crate::body::Body;
 pub use crate::elements::Stencil;
 use crate::elements::{assemble_elements, assemble_elements_owned, ElementMap, Want};
 use crate::energy::HessianProjection;
+use crate::energy::Potential;
 use crate::math::{Mat3, Real, SMat, SVec, Vec3};
-use crate::scene::Scene;
-use crate::solve::Potential;
 
 /// A dense low-rank Hessian part `c u uᵀ` over all DOFs.
 #[derive(Clone, Debug)]
@@ -66,7 +66,7 @@ pub trait Term: Send + Sync {
     fn name(&self) -> &'static str;
 
     /// The elements and their DOF nodes.
-    fn stencil(&self, scene: &Scene) -> Stencil;
+    fn stencil(&self, body: &Body) -> Stencil;
 
     /// Adds the term's energy (returned), gradient and Hessian (lower triangle, pattern order)
     /// at positions `x` and edge DOFs `phi` into `grad`/`values` as `want` says, skipping fixed
@@ -427,7 +427,7 @@ pub trait ChangingElements {
     /// only when the union of the stencils changed
     /// ([`crate::assembly::Pattern::refreshed`]). The explicit driver does not follow changing
     /// elements: such a scene is refused there.
-    fn stencil_at(&self, scene: &Scene, x: &[Vec3], phi: &[Real]) -> Stencil;
+    fn stencil_at(&self, body: &Body, x: &[Vec3], phi: &[Real]) -> Stencil;
 }
 
 /// The capability of a term that owns global DOFs (a force-controlled obstacle's offset).
@@ -482,7 +482,7 @@ pub trait LowRankPart {
 }
 
 /// The capability of a term whose friction uses normal forces taken at the friction lag's
-/// iterate ([`crate::solve::potential::Friction::x_lag`]).
+/// iterate ([`crate::energy::potential::Friction::x_lag`]).
 pub trait LaggedNormals {
     /// The largest normal force (N) at the iterate `trial` at dial `dial`, and the largest
     /// change of a normal force from the lagged iterate `lag` at dial `dial_lag` to it.
@@ -494,14 +494,7 @@ pub trait ExplicitHooks {
     /// Before the gradient at positions `x` of a step `dt` (s) at dial `dial`: a term with a
     /// state of its own that follows the sheet (a moving slide) advances its state `own` to
     /// these positions, so that the gradient sees the two consistent. Default: nothing.
-    fn explicit_begin(
-        &self,
-        _scene: &Scene,
-        _dial: Real,
-        _x: &[Vec3],
-        _dt: Real,
-        _own: &mut [Real],
-    ) {
+    fn explicit_begin(&self, _body: &Body, _dial: Real, _x: &[Vec3], _dt: Real, _own: &mut [Real]) {
     }
 
     /// After the gradient `g` at positions `x` with velocities `v` and before the step `dt`
@@ -549,15 +542,15 @@ pub struct ElementTerm<K, const N: usize, const S: usize> {
     /// The kernel.
     pub kernel: K,
     /// The stencil builder.
-    pub stencil: fn(&Scene, &K) -> Stencil,
+    pub stencil: fn(&Body, &K) -> Stencil,
 }
 
 impl<K: ElementKernel<N, S>, const N: usize, const S: usize> Term for ElementTerm<K, N, S> {
     fn name(&self) -> &'static str {
         self.name
     }
-    fn stencil(&self, scene: &Scene) -> Stencil {
-        (self.stencil)(scene, &self.kernel)
+    fn stencil(&self, body: &Body) -> Stencil {
+        (self.stencil)(body, &self.kernel)
     }
     fn eval(
         &self,
@@ -574,7 +567,7 @@ impl<K: ElementKernel<N, S>, const N: usize, const S: usize> Term for ElementTer
         assemble_elements_owned::<N, S, _>(
             map,
             |e, nodes, g, h| self.kernel.eval(pot, e, nodes, x, phi, gn, g, h),
-            &pot.scene.node_fixed,
+            pot.node_fixed,
             if K::PROJECTABLE {
                 projection
             } else {
@@ -605,14 +598,7 @@ pub trait VertexKernel: Send + Sync {
         false
     }
     /// See [`ExplicitHooks::explicit_begin`] (default: nothing).
-    fn explicit_begin(
-        &self,
-        _scene: &Scene,
-        _dial: Real,
-        _x: &[Vec3],
-        _dt: Real,
-        _own: &mut [Real],
-    ) {
+    fn explicit_begin(&self, _body: &Body, _dial: Real, _x: &[Vec3], _dt: Real, _own: &mut [Real]) {
     }
     /// See [`ExplicitHooks::explicit_step`] (default: nothing).
     fn explicit_step(
@@ -678,8 +664,8 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
     fn reports(&self) -> Option<&dyn Reports> {
         Some(self)
     }
-    fn stencil(&self, scene: &Scene) -> Stencil {
-        Stencil::vertices(&scene.mesh.positions)
+    fn stencil(&self, body: &Body) -> Stencil {
+        Stencil::vertices(&body.mesh.positions)
     }
     fn eval(
         &self,
@@ -692,7 +678,7 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
         grad: &mut [Real],
         values: &mut [Real],
     ) -> Real {
-        let fixed = &pot.scene.fixed;
+        let fixed = &pot.body.fixed;
         let own = pot.term_state(self.name);
         assemble_elements::<3, 1, _>(
             map,
@@ -719,7 +705,7 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
                 }
                 e
             },
-            &pot.scene.node_fixed,
+            pot.node_fixed,
             projection,
             want,
             grad,
@@ -766,8 +752,8 @@ impl<K: VertexKernel> Stateful for VertexTerm<K> {
 }
 
 impl<K: VertexKernel> ExplicitHooks for VertexTerm<K> {
-    fn explicit_begin(&self, scene: &Scene, dial: Real, x: &[Vec3], dt: Real, own: &mut [Real]) {
-        self.kernel.explicit_begin(scene, dial, x, dt, own);
+    fn explicit_begin(&self, body: &Body, dial: Real, x: &[Vec3], dt: Real, own: &mut [Real]) {
+        self.kernel.explicit_begin(body, dial, x, dt, own);
     }
     fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
         self.kernel.explicit_step(pot, x, v, g, dt);
@@ -808,4 +794,19 @@ impl Terms {
             None => Err(t),
         }
     }
+}
+
+/// The per-face fields with one value per corner slot (the edge opposite each corner):
+/// `edge_angles` and the terms' 3-component state fields. Frames write them in the input's
+/// corner order.
+pub fn slot_fields(terms: &[Box<dyn Term>]) -> Vec<&'static str> {
+    let mut names = vec!["edge_angles"];
+    names.extend(
+        terms
+            .iter()
+            .filter_map(|t| t.tracked())
+            .filter(|t| t.state_components() == 3)
+            .map(|t| t.state_field()),
+    );
+    names
 }

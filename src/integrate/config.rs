@@ -2,7 +2,7 @@
 //! drivers, Newton and the friction lag read these values, never the settings.
 
 use crate::math::{Real, Vec3};
-use crate::scene::Scene;
+use crate::model::Scene;
 use crate::settings::{Mode, Softening, Time};
 use crate::solve::NewtonOptions;
 
@@ -68,17 +68,18 @@ impl RunConfig {
         let s = &scene.settings;
         let st = &s.solver;
         let h_min = scene
+            .body
             .thickness
             .iter()
             .copied()
             .fold(Real::INFINITY, Real::min);
         let loaded = s.loads.any_external()
-            || !scene.prescribed.is_empty()
+            || !scene.body.prescribed.is_empty()
             || !s.obstacles.is_empty()
             || s.gas.control != crate::settings::GasControl::None;
         let softening = match st.membrane_continuation {
             Softening::Auto(_) if loaded => 1.0,
-            m => m.factor(scene.mesh.bbox_diagonal(), h_min),
+            m => m.factor(scene.body.mesh.bbox_diagonal(), h_min),
         };
         RunConfig {
             mode: st.mode,

@@ -7,9 +7,10 @@ use super::moisture::{accepted, Moisture};
 use super::Sink;
 use super::{OutputClock, Progress, RunError, RunFailure, Solver, StepControl};
 use crate::assembly::Want;
+use crate::energy::potential::{Damping, Inertia};
+use crate::energy::Potential;
 use crate::math::{Real, Sym2, Vec3};
-use crate::solve::potential::{Damping, Inertia};
-use crate::solve::{Potential, State};
+use crate::solve::State;
 use std::time::Instant;
 
 pub(super) fn run_dynamic(
@@ -74,7 +75,7 @@ pub(super) fn run_dynamic(
     let mut v = v0.unwrap_or_else(|| vec![Vec3::zeros(); n]);
     let mut xhat = state.x.clone();
     // The global DOFs (after the edge DOFs) have inertia too: their velocities and prediction.
-    let ne = sc.num_edge_dofs();
+    let ne = sc.body.num_edge_dofs();
     let mut w = vec![0.0; sc.globals.len()];
     if let Some(d) = driver
         .as_ref()
@@ -86,7 +87,7 @@ pub(super) fn run_dynamic(
     let mut trial = state.clone();
     let damping = tm.damping > 0.0;
     let (mut a_prev, mut b_prev) = if damping {
-        sc.forms(&state.x, &state.dofs)
+        sc.body.forms(&state.x, &state.dofs)
     } else {
         (Vec::new(), Vec::new())
     };
@@ -168,13 +169,13 @@ pub(super) fn run_dynamic(
         }
         // Vertices on prescribed paths are fixed: their inertia is not assembled, so the
         // prediction can carry their prescribed position into every trial.
-        sc.prescribe(&mut xhat, dial);
+        sc.body.prescribe(&mut xhat, dial);
         if obstacles {
             // Newton starts from the last state, not the prediction: the prediction of a sheet
             // falling onto an obstacle lies deep inside it, where the penalty's curvature and
             // the friction's lagged normals make the first iterations wander.
             trial.x.copy_from_slice(&state.x);
-            sc.prescribe(&mut trial.x, dial);
+            sc.body.prescribe(&mut trial.x, dial);
         } else {
             trial.x.copy_from_slice(&xhat);
         }
@@ -235,10 +236,12 @@ pub(super) fn run_dynamic(
                     break;
                 }
             }
-            m.trial_mass = m.masses_of(sc, &m.trial);
+            m.trial_mass = m.masses_of(&sc.body, &m.trial);
             s.summary.moisture_seconds += moisture_clock.elapsed().as_secs_f64();
         }
-        let trial_mass = moisture.as_ref().map_or(&sc.mass[..], |m| m.mass(sc, true));
+        let trial_mass = moisture
+            .as_ref()
+            .map_or(&sc.body.mass[..], |m| m.mass(&sc.body, true));
         // Friction lags the normal force: solve with λ, update λ from the solution, and re-solve
         // until it agrees.
         if let Some(l) = &mut lag {
@@ -327,7 +330,7 @@ pub(super) fn run_dynamic(
             holding = true;
         }
         if damping {
-            let (a, b) = sc.forms(&state.x, &state.dofs);
+            let (a, b) = sc.body.forms(&state.x, &state.dofs);
             a_prev = a;
             b_prev = b;
         }
@@ -351,7 +354,7 @@ pub(super) fn run_dynamic(
         if tm.stop_at_equilibrium || holding {
             let pat = s.pattern();
             let pot = Potential {
-                terms: &state.terms,
+                states: &state.terms,
                 ..accepted(s.potential(&pat, dial), moisture.as_ref(), &targets)
             };
             let mut g = vec![0.0; pat.n];

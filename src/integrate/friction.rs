@@ -6,9 +6,9 @@
 //! per step. The ground's `λ` is kept per vertex; an obstacle's normal force and normal are taken
 //! at the lagged iterate's positions and dial, which the lag keeps. See [`crate::contact`] for the friction potential.
 
+use crate::energy::potential::Friction;
 use crate::math::{Real, Vec3};
-use crate::scene::Scene;
-use crate::solve::potential::Friction;
+use crate::model::Scene;
 
 /// `λ` has converged when it changes by at most this fraction of its largest entry ...
 pub const FRICTION_LAG_TOL: Real = 1e-3;
@@ -39,7 +39,7 @@ impl FrictionLag {
     /// friction's slip speed (`contact.slip_speed`, m/s), or `None` without a frictional ground
     /// or obstacle.
     pub fn new(scene: &Scene, x: &[Vec3], dial: Real, slip_speed: Real) -> Option<FrictionLag> {
-        let ground = scene.ground.as_ref().filter(|g| g.friction > 0.0);
+        let ground = scene.body.ground.as_ref().filter(|g| g.friction > 0.0);
         let lagged = scene.terms.iter().any(|t| t.lagged().is_some());
         if ground.is_none() && !lagged {
             return None;
@@ -96,7 +96,12 @@ impl FrictionLag {
         self.solved.1.copy_from_slice(&self.x_lag);
         self.solved.2 = self.dial_lag;
         let (mut scale, mut diff) = (0.0 as Real, 0.0 as Real);
-        if let Some(g) = scene.ground.as_ref().filter(|_| !self.lambda.is_empty()) {
+        if let Some(g) = scene
+            .body
+            .ground
+            .as_ref()
+            .filter(|_| !self.lambda.is_empty())
+        {
             let new = g.normal_forces(trial);
             scale = new.iter().fold(scale, |m, v| m.max(*v));
             diff = new

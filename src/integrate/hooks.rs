@@ -2,9 +2,10 @@
 //! each hands a term its own state from the driver's [`State`], so that a step that is cut
 //! leaves every term's state as it was before the step.
 
+use crate::energy::Potential;
 use crate::math::Real;
-use crate::scene::Scene;
-use crate::solve::{Potential, State};
+use crate::model::Scene;
+use crate::solve::State;
 
 /// Tells every tracking term that `state` is accepted (see
 /// [`crate::energy::term::Tracked::accept`]).
@@ -31,10 +32,10 @@ pub fn admissible(scene: &Scene, trial: &State) -> bool {
 pub fn project(pot: &Potential, state: &mut State) -> Result<(), crate::energy::term::StateError> {
     let before = state.terms.clone();
     let pot = Potential {
-        terms: &before,
+        states: &before,
         ..*pot
     };
-    for t in pot.scene.terms.iter() {
+    for t in pot.terms.iter() {
         if let Some(p) = t.projection() {
             p.project(
                 &pot,
@@ -56,7 +57,7 @@ pub fn update(
     sensitivity: &mut dyn FnMut(&[Real]) -> Option<Real>,
 ) -> bool {
     let mut again = false;
-    for t in pot.scene.terms.iter() {
+    for t in pot.terms.iter() {
         if let Some(m) = t.updates() {
             let own = state.terms.get_mut(t.name());
             again |= m.update(pot, &state.x, &state.dofs, own, sensitivity);

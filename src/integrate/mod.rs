@@ -18,7 +18,7 @@
 //! (`config.rs`), what stops a run (`failure.rs`) and the symmetry breaking of a planar start
 //! (`symmetry.rs`: every free vertex moved along its normal by `symmetry_breaking × mean edge ×
 //! u`, `u` uniform in [−1, 1) from a SplitMix64 stream seeded by `solver.seed`, deterministic).
-//! Every driver calls Newton on a [`Potential`](crate::solve::Potential) and hands its frames
+//! Every driver calls Newton on a [`Potential`](crate::energy::Potential) and hands its frames
 //! and summary to a [`Sink`] (`report.rs`: the records a run fills, the energies, and the sink
 //! that [`crate::output::Writer`] implements).
 
@@ -45,7 +45,7 @@ use solver::Solver;
 
 use crate::assembly::Pattern;
 use crate::math::Real;
-use crate::scene::Scene;
+use crate::model::Scene;
 use crate::settings::Mode;
 use crate::solve::State;
 pub use report::{OutputError, Sink, Summary};
@@ -217,7 +217,12 @@ pub fn run(
     let sb = s.config.symmetry_breaking;
     // A restart with its driver's state continues the state it is given, planar or not.
     if sb > 0.0 && driver.is_none() && is_planar(scene, &state.x) {
-        perturb(scene, &mut state.x, sb * scene.mean_edge, s.config.seed);
+        perturb(
+            scene,
+            &mut state.x,
+            sb * scene.body.mean_edge,
+            s.config.seed,
+        );
     }
     let ran = match s.config.mode {
         Mode::Static => statics::run_static(&mut s, writer, progress, state, dial.or(start)),
@@ -282,7 +287,7 @@ pub fn run(
 /// bounds, [`explicit::check`]); the error names the mesh file.
 pub fn check_scene(scene: &Scene) -> Result<(), crate::mesh::MeshError> {
     if scene.settings.solver.mode == crate::settings::Mode::Explicit {
-        explicit::check(scene).map_err(|r| scene.mesh.invalid(r))?;
+        explicit::check(scene).map_err(|r| scene.body.mesh.invalid(r))?;
     }
     Ok(())
 }

@@ -3,9 +3,10 @@
 
 use super::RunError;
 use super::Sink;
+use crate::body::Body;
+use crate::energy::Potential;
 use crate::math::{Real, Sym2, Vec3};
-use crate::scene::Scene;
-use crate::solve::Potential;
+use crate::model::Scene;
 
 /// The per-face fields moisture adds to frames: the content at the top and the bottom face.
 pub const FRAME_FIELDS: [&str; 2] = ["moisture_top", "moisture_bottom"];
@@ -43,11 +44,11 @@ impl Moisture {
         if !mo.enabled {
             return Ok(None);
         }
-        let dirs: Vec<Vec3> = sc.growth.direction.iter().map(|d| d.1).collect();
+        let dirs: Vec<Vec3> = sc.body.growth.direction.iter().map(|d| d.1).collect();
         let mut diffusion = Diffusion::new(
-            &sc.mesh.positions,
-            &sc.mesh.faces,
-            &sc.thickness,
+            &sc.body.mesh.positions,
+            &sc.body.mesh.faces,
+            &sc.body.thickness,
             &dirs,
             Diffusivity {
                 along: mo.diffusivity_along,
@@ -60,9 +61,9 @@ impl Moisture {
             },
         )?;
         // Sides sealed on purpose (tape): the ground exchange leaves them sealed.
-        let mut taped = vec![[false; 2]; sc.num_faces()];
+        let mut taped = vec![[false; 2]; sc.body.num_faces()];
         // Sides covered by tape (`tape = true`): a non-swelling layer for the growth law.
-        let mut tape = vec![[false; 2]; sc.num_faces()];
+        let mut tape = vec![[false; 2]; sc.body.num_faces()];
         for b in &mo.boundary {
             let side = match b.side {
                 SurfaceSide::Top => Side::Top,
@@ -77,7 +78,7 @@ impl Moisture {
                     ambient: b.ambient,
                 },
             };
-            let faces = crate::scene::region_faces(&sc.mesh, b)?;
+            let faces = crate::body::region_faces(&sc.body.mesh, b)?;
             for f in faces {
                 diffusion.set_surface(f, side, bc)?;
                 if bc == SurfaceBc::Sealed {
@@ -89,7 +90,7 @@ impl Moisture {
             }
         }
         let u = vec![mo.initial; diffusion.num_nodes()];
-        let nf = sc.num_faces();
+        let nf = sc.body.num_faces();
         let base = (0..nf)
             .map(|f| {
                 [
@@ -98,7 +99,7 @@ impl Moisture {
                 ]
             })
             .collect();
-        let h_mean = sc.thickness.iter().sum::<Real>() / nf.max(1) as Real;
+        let h_mean = sc.body.thickness.iter().sum::<Real>() / nf.max(1) as Real;
         let ground = mo
             .ground
             .as_ref()
@@ -117,7 +118,7 @@ impl Moisture {
             water_density: mo.water_density,
             touching: vec![[false; 2]; nf],
         };
-        m.mass = m.masses_of(sc, &m.u);
+        m.mass = m.masses_of(&sc.body, &m.u);
         m.trial_mass = m.mass.clone();
         Ok(Some(m))
     }
@@ -156,15 +157,15 @@ impl Moisture {
         x: &[Vec3],
     ) -> Result<(), crate::diffusion::SurfaceError> {
         use crate::diffusion::{Side, SurfaceBc};
-        let (Some((k, value, distance)), Some(g)) = (self.ground, &sc.ground) else {
+        let (Some((k, value, distance)), Some(g)) = (self.ground, &sc.body.ground) else {
             return Ok(());
         };
-        for (f, face) in sc.mesh.faces.iter().enumerate() {
+        for (f, face) in sc.body.mesh.faces.iter().enumerate() {
             let [p0, p1, p2] = face.map(|v| x[v]);
             let n = (p1 - p0).cross(&(p2 - p0)).normalize();
             let c = (p0 + p1 + p2) / 3.0;
             let facing = n.dot(&g.normal);
-            let gap = g.normal.dot(&(c - g.point)) - 0.5 * sc.thickness[f] * facing.abs();
+            let gap = g.normal.dot(&(c - g.point)) - 0.5 * sc.body.thickness[f] * facing.abs();
             let near = gap <= distance && facing.abs() >= 0.5;
             // The top (+n) faces the ground when n points into it.
             let touch = [near && facing < 0.0, near && facing > 0.0];
@@ -204,7 +205,7 @@ impl Moisture {
         }
         self.u.copy_from_slice(u);
         self.trial.copy_from_slice(u);
-        self.mass = self.masses_of(sc, &self.u);
+        self.mass = self.masses_of(&sc.body, &self.u);
         if let Some(h) = d.diffusion_substep {
             self.diffusion.resume_substep(h);
         }
@@ -213,7 +214,7 @@ impl Moisture {
 
     /// Lumped vertex masses with face densities ρ_shell + (m⁺ + m⁻)/2 · ρ_water (seed 000 §3,
     /// "Mass Matrix"); empty when the water density is 0 (the scene's masses apply).
-    pub(super) fn masses_of(&self, sc: &Scene, u: &[Real]) -> Vec<Real> {
+    pub(super) fn masses_of(&self, sc: &Body, u: &[Real]) -> Vec<Real> {
         let rho_w = self.water_density;
         if rho_w == 0.0 {
             return Vec::new();
@@ -232,7 +233,7 @@ impl Moisture {
 
     /// The masses at the accepted state (`trial = false`) or the trial one (the scene's without
     /// water density).
-    pub(super) fn mass<'s>(&'s self, sc: &'s Scene, trial: bool) -> &'s [Real] {
+    pub(super) fn mass<'s>(&'s self, sc: &'s Body, trial: bool) -> &'s [Real] {
         let m = if trial { &self.trial_mass } else { &self.mass };
         if m.is_empty() {
             &sc.mass
@@ -250,7 +251,7 @@ impl Moisture {
         sc: &Scene,
         u: &[Real],
     ) -> Result<Vec<(Sym2, Sym2)>, crate::rest::laws::GrowthError> {
-        (0..sc.num_faces())
+        (0..sc.body.num_faces())
             .map(|f| {
                 let (mut top, mut bottom) = self.diffusion.surface_moisture(u, f);
                 if self.tape[f][0] {
@@ -260,13 +261,13 @@ impl Moisture {
                     bottom = 0.0;
                 }
                 let m = (top, bottom);
-                let reference = (sc.rest.abar0[f], sc.rest.bbar0[f]);
+                let reference = (sc.body.rest.abar0[f], sc.body.rest.bbar0[f]);
                 crate::rest::laws::growth_face(
                     &sc.settings.growth,
-                    &sc.growth,
+                    &sc.body.growth,
                     f,
                     reference,
-                    sc.thickness[f],
+                    sc.body.thickness[f],
                     m,
                 )
                 .map(|g| (g.abar, g.bbar))
@@ -299,7 +300,7 @@ pub(super) fn accepted<'a>(
     match moisture {
         Some(m) => Potential {
             rest_override: Some(targets),
-            mass: m.mass(base.scene, false),
+            mass: m.mass(base.body, false),
             ..base
         },
         None => base,

@@ -3,8 +3,9 @@
 //! The drivers fill these records and hand them to their [`crate::integrate::Sink`]; the
 //! output module writes them.
 
+use crate::energy::Potential;
 use crate::math::{Real, Vec3};
-use crate::solve::{Potential, State};
+use crate::solve::State;
 use serde::Serialize;
 
 /// Errors while writing output.
@@ -295,7 +296,7 @@ pub struct ExplicitReport {
 /// Energies of a state by term.
 pub fn energies(pot: &Potential, state: &State, v: &[Vec3]) -> Energies {
     let pot = &Potential {
-        terms: &state.terms,
+        states: &state.terms,
         ..*pot
     };
     energies_of(pot, pot.energies(&state.x, &state.dofs), v)

@@ -5,13 +5,12 @@ use super::report::{LogRow, Summary};
 use super::Sink;
 use super::{config, DriverState, RunError};
 use crate::assembly::{Pattern, Want};
+use crate::energy::Potential;
 use crate::math::{Real, Vec3};
-use crate::scene::Scene;
+use crate::model::Scene;
 use crate::settings::Mode;
 use crate::solve::newton::Workspace;
-use crate::solve::{
-    newton, LinearSolver, NewtonOptions, NewtonReport, Potential, SolveError, State,
-};
+use crate::solve::{newton, LinearSolver, NewtonOptions, NewtonReport, SolveError, State};
 use std::time::Instant;
 
 /// `r ← H⁻¹ r` with the last factorisation of `lin` and the low-rank parts of `pot` at `state`
@@ -92,10 +91,10 @@ impl<'a> Solver<'a> {
                 Mode::Explicit => "explicit",
             }
             .into(),
-            vertices: scene.num_vertices(),
-            faces: scene.num_faces(),
+            vertices: scene.body.num_vertices(),
+            faces: scene.body.num_faces(),
             threads,
-            warnings: scene.warnings.clone(),
+            warnings: scene.body.warnings.clone(),
             ..Default::default()
         };
         Ok(Solver {
@@ -155,7 +154,7 @@ impl<'a> Solver<'a> {
         'a: 'p,
     {
         Potential {
-            terms: &state.terms,
+            states: &state.terms,
             ..self.potential(pattern, dial)
         }
     }
@@ -205,7 +204,7 @@ impl<'a> Solver<'a> {
         for _ in 0..MAX_UPDATES {
             let terms = state.terms.clone();
             let pot = &Potential {
-                terms: &terms,
+                states: &terms,
                 ..*pot
             };
             let rep = newton(pot, &mut self.lin, &mut self.ws, state, opts);
@@ -262,7 +261,7 @@ impl<'a> Solver<'a> {
         let clock = Instant::now();
         let mut driver = self.driver.clone();
         driver.mode = self.summary.mode.clone();
-        driver.globals = state.dofs[self.scene.num_edge_dofs()..].to_vec();
+        driver.globals = state.dofs[self.scene.body.num_edge_dofs()..].to_vec();
         for (name, own) in state.terms.iter() {
             if !own.is_empty() {
                 driver.terms.insert(name.to_string(), own.to_vec());
@@ -285,7 +284,7 @@ impl<'a> Solver<'a> {
             // The first step: the Hessian at the start (dial `from`).
             let at = Potential {
                 dial: from,
-                terms: &state.terms,
+                states: &state.terms,
                 ..*pot
             };
             let mut values = vec![0.0; pot.pattern.nnz()];
@@ -310,7 +309,7 @@ impl<'a> Solver<'a> {
         let mut predicted = state.clone();
         let at = &*state;
         let pot_at = Potential {
-            terms: &at.terms,
+            states: &at.terms,
             ..*pot
         };
         let mut solve = |r: &mut [Real]| apply_inverse(lin, &pot_at, at, r);
@@ -332,7 +331,7 @@ impl<'a> Solver<'a> {
         // lowers the potential.
         let e = |s: &State| {
             Potential {
-                terms: &s.terms,
+                states: &s.terms,
                 ..*pot
             }
             .eval(&s.x, &s.dofs, Want::Energy, &mut [], &mut [])

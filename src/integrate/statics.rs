@@ -73,7 +73,7 @@ pub(super) fn run_static(
             tol
         };
         trial.copy_from(&state);
-        s.scene.prescribe(&mut trial.x, target);
+        s.scene.body.prescribe(&mut trial.x, target);
         s.refresh(&trial)?;
         let pat = s.pattern();
         let pot = s.potential_scaled(&pat, target, target_scale);
@@ -138,7 +138,10 @@ pub(super) fn run_static(
                     Some(p) => RunFailure::PressureLimit {
                         pressure: p * dial,
                         dial,
-                        volume: crate::mesh::closed::enclosed_volume(&state.x, &s.scene.mesh.faces),
+                        volume: crate::mesh::closed::enclosed_volume(
+                            &state.x,
+                            &s.scene.body.mesh.faces,
+                        ),
                         cause: rep.failure_or_unknown(),
                     },
                     None => RunFailure::ContinuationStep {
@@ -173,7 +176,7 @@ pub(super) fn run_static(
                 break;
             }
             escapes += 1;
-            let amp = sb.max(1e-3) * s.scene.mean_edge * 10f64.powi(escapes as i32);
+            let amp = sb.max(1e-3) * s.scene.body.mean_edge * 10f64.powi(escapes as i32);
             perturb(
                 s.scene,
                 &mut state.x,

@@ -3,12 +3,12 @@
 
 use crate::math::{Real, Vec3};
 use crate::mesh::generate::Rng;
-use crate::scene::Scene;
+use crate::model::Scene;
 
 /// Area-weighted vertex normals.
 pub fn vertex_normals(scene: &Scene, x: &[Vec3]) -> Vec<Vec3> {
     let mut n = vec![Vec3::zeros(); x.len()];
-    for f in &scene.mesh.faces {
+    for f in &scene.body.mesh.faces {
         let c = (x[f[1]] - x[f[0]]).cross(&(x[f[2]] - x[f[0]]));
         for &v in f {
             n[v] += c;
@@ -26,7 +26,7 @@ pub fn vertex_normals(scene: &Scene, x: &[Vec3]) -> Vec<Vec3> {
 /// True when all face normals are parallel (the sheet is planar).
 pub fn is_planar(scene: &Scene, x: &[Vec3]) -> bool {
     let mut n0: Option<Vec3> = None;
-    for f in &scene.mesh.faces {
+    for f in &scene.body.mesh.faces {
         let c = (x[f[1]] - x[f[0]]).cross(&(x[f[2]] - x[f[0]])).normalize();
         match n0 {
             None => n0 = Some(c),
@@ -46,7 +46,7 @@ pub fn perturb(scene: &Scene, x: &mut [Vec3], amp: Real, seed: u64) {
     let mut rng = Rng::new(seed);
     for (v, p) in x.iter_mut().enumerate() {
         let u = rng.symmetric();
-        if !scene.fixed[v] {
+        if !scene.body.fixed[v] {
             *p += normals[v] * (amp * u);
         }
     }

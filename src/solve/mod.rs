@@ -1,5 +1,4 @@
-//! Nonlinear solves: the incremental potential of a step ([`potential`]; the contact laws it
-//! carries are [`crate::contact`]'s), Newton's method with a backtracking line search and a growing diagonal shift ([`mod@newton`]), and the sparse Cholesky
+//! Nonlinear solves of a step's incremental potential ([`crate::energy::potential`]): Newton's method with a backtracking line search and a growing diagonal shift ([`mod@newton`]), and the sparse Cholesky
 //! it uses ([`linear`]), with dense low-rank Hessian parts through the Woodbury identity
 //! ([`low_rank`]).
 
@@ -7,12 +6,10 @@
 pub use crate::linalg as linear;
 pub mod low_rank;
 pub mod newton;
-pub mod potential;
 pub mod state;
 
 pub use crate::linalg::{LinearError, LinearSolver};
 pub use newton::{newton, NewtonOptions, NewtonReport, SolveError};
-pub use potential::Potential;
 pub use state::State;
 
 impl LinearSolver {

@@ -12,10 +12,10 @@
 //! energies are treated as a failed trial point, never accepted.
 
 use super::linear::LinearSolver;
-use super::potential::Potential;
 use super::state::State;
 use crate::assembly::Want;
 use crate::energy::HessianProjection;
+use crate::energy::Potential;
 use crate::math::{Real, Vec3};
 use std::time::Instant;
 

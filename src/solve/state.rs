@@ -2,11 +2,11 @@
 //! kind the terms declared, in node order after the vertices (today the edge DOFs of the
 //! angle-based bending models, [`crate::energy::midedge_angle`]), plus the stateful terms' own
 //! states. Newton, the drivers, restarts and frames carry one `State`; kernels see it as the
-//! two views `x` and `dofs`, and their own state through [`crate::solve::Potential::terms`].
+//! two views `x` and `dofs`, and their own state through [`crate::energy::Potential::terms`].
 
 use crate::energy::term::TermStates;
 use crate::math::{Real, Vec3};
-use crate::scene::Scene;
+use crate::model::Scene;
 
 /// Positions, scalar node DOFs and the terms' own states.
 #[derive(Clone, Debug, PartialEq)]
@@ -24,7 +24,7 @@ impl State {
     /// The reference state of `scene`: its mesh positions, every scalar DOF 0.
     pub fn reference(scene: &Scene) -> State {
         State {
-            x: scene.mesh.positions.clone(),
+            x: scene.body.mesh.positions.clone(),
             dofs: vec![0.0; scene.num_scalar_dofs()],
             terms: scene.initial_states.clone(),
         }

@@ -3,11 +3,11 @@
 
 use shellsim::assembly::{Pattern, Want};
 use shellsim::cases::Case;
+use shellsim::energy::Potential;
 use shellsim::math::Vec3;
 use shellsim::mesh::generate::{rectangle, Rng, Spacing};
-use shellsim::scene::Scene;
+use shellsim::model::Scene;
 use shellsim::settings::Settings;
-use shellsim::solve::Potential;
 
 fn scene(settings: &str, program: Option<Case>) -> Scene {
     scene_with_edge(settings, program, 0.125)
@@ -40,7 +40,7 @@ fn pattern(sc: &Scene) -> Pattern {
 /// Random edge DOFs of amplitude 0.05 rad (empty without them).
 fn angles(sc: &Scene) -> Vec<f64> {
     let mut rng = Rng::new(9);
-    (0..sc.num_edge_dofs())
+    (0..sc.body.num_edge_dofs())
         .map(|_| 0.05 * rng.symmetric())
         .collect()
 }
@@ -55,7 +55,8 @@ const MODELS: [&str; 4] = [
 
 fn bumpy(sc: &Scene) -> Vec<Vec3> {
     let mut rng = Rng::new(1);
-    sc.mesh
+    sc.body
+        .mesh
         .positions
         .iter()
         .map(|p| {
@@ -71,8 +72,14 @@ fn rest_state_has_zero_energy_and_gradient() {
     let p = pattern(&sc);
     let pot = Potential::new(&sc, &p);
     let mut g = vec![0.0; p.n];
-    let phi = vec![0.0; sc.num_edge_dofs()];
-    let e = pot.eval(&sc.mesh.positions, &phi, Want::Gradient, &mut g, &mut []);
+    let phi = vec![0.0; sc.body.num_edge_dofs()];
+    let e = pot.eval(
+        &sc.body.mesh.positions,
+        &phi,
+        Want::Gradient,
+        &mut g,
+        &mut [],
+    );
     assert!(e.abs() < 1e-20, "E = {e}");
     assert!(g.iter().all(|v: &f64| v.abs() < 1e-12), "gradient not zero");
 }
@@ -103,6 +110,7 @@ fn every_registered_material_and_bending_model_is_thread_independent() {
             let p = pattern(&sc);
             // Small bumps: inside every material's domain (Gent's lock included).
             let x: Vec<Vec3> = sc
+                .body
                 .mesh
                 .positions
                 .iter()
@@ -271,16 +279,16 @@ fn assembled_derivatives(model: &str) {
     let x = bumpy(&sc);
     let phi = angles(&sc);
     let xhat: Vec<Vec3> = x.iter().map(|v| v * 1.01).collect();
-    let a_prev = vec![shellsim::math::Sym2::new(0.01, 0.001, 0.012); sc.num_faces()];
-    let b_prev = vec![shellsim::math::Sym2::new(0.001, 0.0, -0.001); sc.num_faces()];
+    let a_prev = vec![shellsim::math::Sym2::new(0.01, 0.001, 0.012); sc.body.num_faces()];
+    let b_prev = vec![shellsim::math::Sym2::new(0.001, 0.0, -0.001); sc.body.num_faces()];
     let pot = Potential {
         dial: 0.6,
-        inertia: Some(shellsim::solve::potential::Inertia {
+        inertia: Some(shellsim::energy::potential::Inertia {
             inv_dt2: 1e4,
             xhat: &xhat,
             dofs_hat: &[],
         }),
-        damping: Some(shellsim::solve::potential::Damping {
+        damping: Some(shellsim::energy::potential::Damping {
             eta_over_dt: 0.5,
             a_prev: &a_prev,
             b_prev: &b_prev,
@@ -324,7 +332,7 @@ fn ground_contact_and_friction_match_finite_differences() {
          [constraints]\nfix_boxes = [{ min = [-1, -1, -1], max = [-0.45, 1, 1] }]\n",
         Some(Case::Hyperboloid),
     );
-    let g = sc.ground.as_ref().unwrap();
+    let g = sc.body.ground.as_ref().unwrap();
     assert_eq!((g.stiffness, g.smoothing, g.friction), (1e7, 0.01, 0.4));
     let p = pattern(&sc);
     let x = bumpy(&sc);
@@ -339,7 +347,7 @@ fn ground_contact_and_friction_match_finite_differences() {
         .collect();
     let lambda: Vec<f64> = (0..x.len()).map(|v| 1.0 + (v % 5) as f64).collect();
     let pot = Potential {
-        friction: Some(shellsim::solve::potential::Friction {
+        friction: Some(shellsim::energy::potential::Friction {
             x_prev: &x_prev,
             dial_prev: 1.0,
             normal_force: &lambda,
@@ -363,7 +371,7 @@ fn ground_contact_and_friction_match_finite_differences() {
 fn colouring_separates_stencils() {
     let sc = scene_with_edge("", None, 0.02);
     let p = pattern(&sc);
-    let mut seen = vec![usize::MAX; sc.num_vertices() + sc.num_edge_dofs()];
+    let mut seen = vec![usize::MAX; sc.body.num_vertices() + sc.body.num_edge_dofs()];
     let mut total = 0;
     for (c, blocks) in p.colours().iter().enumerate() {
         for (b, block) in blocks.iter().enumerate() {
@@ -390,7 +398,7 @@ fn colouring_separates_stencils() {
             }
         }
     }
-    assert_eq!(total, sc.num_faces());
+    assert_eq!(total, sc.body.num_faces());
     assert!(p.colours().iter().map(|c| c.len()).sum::<usize>() >= 16);
     assert!(p.num_colours() < 16, "{} colours", p.num_colours());
 }
@@ -425,8 +433,14 @@ fn curved_reference_is_at_rest_for_every_midedge_model() {
             ..Potential::new(&sc, &p)
         };
         let mut g = vec![0.0; p.n];
-        let phi = vec![0.0; sc.num_edge_dofs()];
-        let e = pot.eval(&sc.mesh.positions, &phi, Want::Gradient, &mut g, &mut []);
+        let phi = vec![0.0; sc.body.num_edge_dofs()];
+        let e = pot.eval(
+            &sc.body.mesh.positions,
+            &phi,
+            Want::Gradient,
+            &mut g,
+            &mut [],
+        );
         assert!(e.abs() < 1e-20, "{model}: E = {e}");
         assert!(
             g.iter().all(|v: &f64| v.abs() < 1e-12),
@@ -453,17 +467,17 @@ fn fused_explicit_step_gives_the_unfused_bits() {
         m.positions.push(Vec3::new(2.0, 2.0, 0.0));
         Scene::build(m, Settings::from_str_with(&settings, "test", &[]).unwrap()).unwrap()
     };
-    assert!(!free.pinned_dofs.is_empty());
+    assert!(!free.body.pinned_dofs.is_empty());
     assert!(clamped.node_fixed.iter().any(|&f| f));
     for sc in [&free, &clamped] {
         let p = pattern(sc);
         let pot = Potential::new(sc, &p);
-        let inv_m: Vec<f64> = (0..sc.num_vertices())
+        let inv_m: Vec<f64> = (0..sc.body.num_vertices())
             .map(|v| {
                 if sc.node_fixed[v] {
                     0.0
                 } else {
-                    1.0 / sc.mass[v].max(1e-12)
+                    1.0 / sc.body.mass[v].max(1e-12)
                 }
             })
             .collect();

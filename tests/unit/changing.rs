@@ -6,14 +6,15 @@
 //! and 2 threads.
 
 use shellsim::assembly::{assemble_elements, ElementMap, Pattern, Want};
+use shellsim::body::Body;
 use shellsim::energy::term::{ChangingElements, Reports, Stencil, Term};
 use shellsim::energy::HessianProjection;
+use shellsim::energy::Potential;
 use shellsim::math::{Mat3, Real, SMat, SVec, Vec3};
 use shellsim::mesh::generate::{rectangle, Spacing};
 use shellsim::mesh::Mesh;
-use shellsim::scene::Scene;
+use shellsim::model::Scene;
 use shellsim::settings::Settings;
-use shellsim::solve::Potential;
 
 /// Repulsion between vertices of different sheets (`sheet[v]`) closer than `r` (m), stiffness
 /// `k` (N/m²). DOF order per element: `x_i`, then `x_j`.
@@ -79,7 +80,7 @@ impl Repulsion {
 }
 
 impl ChangingElements for Repulsion {
-    fn stencil_at(&self, _: &Scene, x: &[Vec3], _: &[Real]) -> Stencil {
+    fn stencil_at(&self, _: &Body, x: &[Vec3], _: &[Real]) -> Stencil {
         self.pairs(x)
     }
 }
@@ -88,8 +89,8 @@ impl Term for Repulsion {
     fn name(&self) -> &'static str {
         "repulsion"
     }
-    fn stencil(&self, scene: &Scene) -> Stencil {
-        self.pairs(&scene.mesh.positions)
+    fn stencil(&self, body: &Body) -> Stencil {
+        self.pairs(&body.mesh.positions)
     }
     fn changing(&self) -> Option<&dyn ChangingElements> {
         Some(self)
@@ -108,7 +109,7 @@ impl Term for Repulsion {
         assemble_elements::<6, 2, _>(
             map,
             |_, nodes, g, h| self.element(nodes, x, g, h),
-            &pot.scene.node_fixed,
+            pot.node_fixed,
             projection,
             want,
             grad,
@@ -184,6 +185,7 @@ fn the_pattern_follows_changing_elements() {
     let i = sc.terms.len() - 1;
     assert_eq!(p.maps[i].len(), 0);
     let x: Vec<Vec3> = sc
+        .body
         .mesh
         .positions
         .iter()

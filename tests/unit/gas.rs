@@ -7,18 +7,20 @@
 
 use nalgebra::{DMatrix, DVector};
 use shellsim::assembly::{ElementMap, Pattern, Want};
+use shellsim::body::Body;
 use shellsim::energy::membrane::neo_hookean::NeoHookeanFace;
 use shellsim::energy::membrane::prism::PrismFace;
 use shellsim::energy::membrane::MembraneLaw;
 use shellsim::energy::term::{Stencil, Term, Terms};
 use shellsim::energy::HessianProjection;
+use shellsim::energy::Potential;
 use shellsim::geometry::first_fundamental_form;
 use shellsim::math::{Mat3, Real, SVec, Sym2, Vec3};
 use shellsim::mesh::generate::{icosphere, Rng};
-use shellsim::scene::Scene;
+use shellsim::model::Scene;
 use shellsim::settings::{PrismLaw, Settings};
 use shellsim::solve::low_rank::Woodbury;
-use shellsim::solve::{newton, LinearSolver, NewtonOptions, Potential, State};
+use shellsim::solve::{newton, LinearSolver, NewtonOptions, State};
 
 /// A balloon scene: an icosphere of radius 1 with `n` subdivisions, membrane only (static: 6
 /// position DOFs pinned against rigid motions).
@@ -38,7 +40,8 @@ fn balloon(n: usize, extra: &str) -> Scene {
 /// Positions scaled by `lambda` about the origin plus a random offset of `noise`.
 fn inflated(sc: &Scene, lambda: Real, noise: Real, seed: u64) -> Vec<Vec3> {
     let mut rng = Rng::new(seed);
-    sc.mesh
+    sc.body
+        .mesh
         .positions
         .iter()
         .map(|p| p * lambda + Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * noise)
@@ -166,7 +169,7 @@ fn gas_term_matches_finite_differences_for_every_control() {
             .update(&at_start, &x, &[], states.get_mut("gas"), &mut |_| None);
         let pot = Potential {
             dial: 0.7,
-            terms: &states,
+            states: &states,
             ..Potential::new(&sc, &p)
         };
         let eval = |x: &[Vec3], g: &mut Vec<Real>, h: &mut Vec<Real>, want: Want| {
@@ -233,8 +236,8 @@ fn volume_is_invariant_under_rigid_motions() {
     let rot = nalgebra::Rotation3::from_euler_angles(0.3, -1.1, 2.0);
     let t = Vec3::new(3.0, -7.0, 11.0);
     let y: Vec<Vec3> = x.iter().map(|p| rot * p + t).collect();
-    let v = shellsim::mesh::closed::enclosed_volume(&x, &sc.mesh.faces);
-    let w = shellsim::mesh::closed::enclosed_volume(&y, &sc.mesh.faces);
+    let v = shellsim::mesh::closed::enclosed_volume(&x, &sc.body.mesh.faces);
+    let w = shellsim::mesh::closed::enclosed_volume(&y, &sc.body.mesh.faces);
     assert!(((v - w) / v).abs() < 1e-12, "{v} vs {w}");
     let p = Pattern::for_scene(&sc);
     let pot = Potential::new(&sc, &p);
@@ -243,7 +246,7 @@ fn volume_is_invariant_under_rigid_motions() {
     let ey = pot.eval(&y, &[], Want::Gradient, &mut gy, &mut []);
     assert!(((ex - ey) / ex).abs() < 1e-12, "{ex} vs {ey}");
     let gmax = gx.iter().fold(0.0 as Real, |m, v| m.max(v.abs()));
-    for v in 0..sc.num_vertices() {
+    for v in 0..sc.body.num_vertices() {
         let a = rot * Vec3::new(gx[3 * v], gx[3 * v + 1], gx[3 * v + 2]);
         let b = Vec3::new(gy[3 * v], gy[3 * v + 1], gy[3 * v + 2]);
         assert!((a - b).amax() < 1e-10 * gmax);
@@ -310,8 +313,8 @@ impl Term for WithoutLowRank {
     fn name(&self) -> &'static str {
         self.0[self.1].name()
     }
-    fn stencil(&self, scene: &Scene) -> Stencil {
-        self.0[self.1].stencil(scene)
+    fn stencil(&self, body: &Body) -> Stencil {
+        self.0[self.1].stencil(body)
     }
     fn eval(
         &self,
@@ -379,9 +382,10 @@ fn newton_is_quadratic_with_the_rank_one_part() {
     let mut without = sc.clone();
     let gi = gas_index(&sc);
     let fresh = Terms(std::sync::Arc::new(
-        shellsim::energy::registry::terms(&sc).unwrap(),
+        shellsim::energy::registry::terms(&sc.body, &sc.settings).unwrap(),
     ));
-    let mut list: Vec<Box<dyn Term>> = shellsim::energy::registry::terms(&sc).unwrap();
+    let mut list: Vec<Box<dyn Term>> =
+        shellsim::energy::registry::terms(&sc.body, &sc.settings).unwrap();
     list[gi] = Box::new(WithoutLowRank(fresh, gi));
     without.terms = Terms(std::sync::Arc::new(list));
     let no_rank_one = residuals(&without, &x0, HessianProjection::None, 5);
@@ -531,7 +535,7 @@ fn position_based_projection_restores_the_skin_volume() {
         let pot = Potential::new(&sc, &p);
         let mut x = inflated(&sc, 1.0, 0.0, 1);
         for (v, q) in x.iter_mut().enumerate() {
-            if !sc.fixed[v] {
+            if !sc.body.fixed[v] {
                 *q *= 1.1;
             }
         }
@@ -555,7 +559,7 @@ fn position_based_projection_restores_the_skin_volume() {
         let mut states = sc.initial_states.clone();
         states.set("shell", own.clone());
         let pot = Potential {
-            terms: &states,
+            states: &states,
             ..pot
         };
         let r1 = ratio(&pot, &x);
@@ -567,8 +571,8 @@ fn position_based_projection_restores_the_skin_volume() {
         } else {
             assert!((r1 - 1.0).abs() < 1e-6, "{r1}");
         }
-        for v in 0..sc.num_vertices() {
-            if sc.fixed[v] {
+        for v in 0..sc.body.num_vertices() {
+            if sc.body.fixed[v] {
                 assert_eq!(x[v], before[v]);
             }
         }
@@ -576,7 +580,7 @@ fn position_based_projection_restores_the_skin_volume() {
         // number), naming a face, and leaves the thickness state as it was.
         if iterations == 1 {
             let mut y = x.clone();
-            let f0 = sc.mesh.faces[0];
+            let f0 = sc.body.mesh.faces[0];
             y[f0[1]] = y[f0[0]];
             let state = tracked.field(&x, &[], &own);
             let err = projection.project(&pot, &mut y, &[], &mut own).unwrap_err();
@@ -626,6 +630,6 @@ fn a_volume_controlled_run_leaves_the_scene_as_it_was() {
     assert_eq!(sc.initial_states.get("gas"), &[0.0][..]);
     assert_eq!(runs[0], runs[1], "the clone's run differs");
     assert_eq!(runs[0], runs[2], "the scene's second run differs");
-    let volume = shellsim::energy::gas::Gas::volume(&sc, &runs[0].2);
+    let volume = shellsim::energy::gas::Gas::volume(&sc.body, &runs[0].2);
     assert!((volume / 6.0 - 1.0).abs() < 1e-8, "volume {volume}");
 }

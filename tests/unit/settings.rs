@@ -49,7 +49,7 @@ fn override_syntax_errors() {
 fn expressions_of_x_y_give_the_per_face_forms() {
     use shellsim::cases::Case;
     use shellsim::mesh::generate::{rectangle, Spacing};
-    use shellsim::scene::Scene;
+    use shellsim::model::Scene;
     let mesh = || rectangle(-0.5, -0.5, 1.0, 1.0, 0.125, Spacing::default());
     let mut programmed = mesh();
     Case::Hyperboloid.program(&mut programmed);
@@ -61,19 +61,19 @@ fn expressions_of_x_y_give_the_per_face_forms() {
     let text = "[rest]\ntarget = \"uniform\"\nabar = [\"1 + x^2\", \"-x*y\", \"1 + y^2\"]\n\
                 bbar = [\"-1/sqrt(1 + x^2 + y^2)\", 0, \"1/sqrt(1 + x^2 + y^2)\"]\n";
     let by_expr = Scene::build(mesh(), Settings::from_str_with(text, "t", &[]).unwrap()).unwrap();
-    for f in 0..by_expr.num_faces() {
-        assert!((by_expr.rest.abar1[f] - by_fields.rest.abar1[f]).norm() < 1e-14);
-        assert!((by_expr.rest.bbar1[f] - by_fields.rest.bbar1[f]).norm() < 1e-14);
+    for f in 0..by_expr.body.num_faces() {
+        assert!((by_expr.body.rest.abar1[f] - by_fields.body.rest.abar1[f]).norm() < 1e-14);
+        assert!((by_expr.body.rest.bbar1[f] - by_fields.body.rest.bbar1[f]).norm() < 1e-14);
     }
     // Isotropic growth with s(x, y): ā = e^{2s} a⁰ at each centroid.
     let text = "[growth]\nlaw = \"isotropic\"\ns = \"-log(1 + (x^2 + y^2)/4)\"\n";
     let sc = Scene::build(mesh(), Settings::from_str_with(text, "t", &[]).unwrap()).unwrap();
-    for f in 0..sc.num_faces() {
-        let [p0, p1, p2] = sc.mesh.face_positions(f);
+    for f in 0..sc.body.num_faces() {
+        let [p0, p1, p2] = sc.body.mesh.face_positions(f);
         let c = (p0 + p1 + p2) / 3.0;
         let eta = 1.0 / (1.0 + 0.25 * (c.x * c.x + c.y * c.y));
-        let want = sc.rest.abar0[f] * (eta * eta);
-        assert!((sc.rest.abar1[f] - want).norm() < 1e-13 * want.norm());
+        let want = sc.body.rest.abar0[f] * (eta * eta);
+        assert!((sc.body.rest.abar1[f] - want).norm() < 1e-13 * want.norm());
     }
     // Bad expressions name the key; values that are not finite or not positive definite name
     // the face.

@@ -4,23 +4,24 @@
 //! the low-rank global-term interface against a dense solve.
 
 use shellsim::assembly::{ElementMap, Pattern, Want};
+use shellsim::body::Body;
 use shellsim::energy::bending::none::NoBending;
 use shellsim::energy::membrane::baraff_witkin::BaraffWitkinFace;
 use shellsim::energy::membrane::gent::GentFace;
 use shellsim::energy::membrane::mooney_rivlin::MooneyRivlinFace;
 use shellsim::energy::membrane::neo_hookean::NeoHookeanFace;
 use shellsim::energy::membrane::{MembraneLaw, WithKoiterBending};
+use shellsim::energy::potential::{Damping, Inertia};
 use shellsim::energy::projection::jacobi_eigen;
 use shellsim::energy::registry;
 use shellsim::energy::shell::shell_element;
 use shellsim::energy::term::{ExplicitHooks, LowRank, LowRankPart, Stencil, Term};
+use shellsim::energy::Potential;
 use shellsim::energy::{HessianProjection, KoiterDensity};
 use shellsim::math::{Mat3, Real, SMat, SVec, Sym2, Vec2, Vec3};
 use shellsim::mesh::generate::{rectangle, Rng, Spacing};
-use shellsim::scene::Scene;
+use shellsim::model::Scene;
 use shellsim::settings::Settings;
-use shellsim::solve::potential::{Damping, Inertia};
-use shellsim::solve::Potential;
 
 fn strip_scene(settings: &str) -> Scene {
     let m = rectangle(
@@ -41,7 +42,8 @@ fn strip_scene(settings: &str) -> Scene {
 /// A stretched, sheared and bent configuration: some faces beyond s = 1, some below.
 fn deformed(sc: &Scene) -> Vec<Vec3> {
     let mut rng = Rng::new(5);
-    sc.mesh
+    sc.body
+        .mesh
         .positions
         .iter()
         .map(|p| {
@@ -70,12 +72,12 @@ pub fn fd_check(
     hess_scale: impl Fn(Real, Real) -> Real,
     eval: impl Fn(&[Vec3], &[Real], Want, &mut [Real], &mut [Real]) -> Real,
 ) {
-    let nx = 3 * sc.num_vertices();
+    let nx = 3 * sc.body.num_vertices();
     let node_of = |k: usize| {
         if k < nx {
             k / 3
         } else {
-            sc.num_vertices() + (k - nx)
+            sc.body.num_vertices() + (k - nx)
         }
     };
     let (mut g, mut h) = (vec![0.0; p.n], vec![0.0; p.nnz()]);
@@ -185,12 +187,14 @@ fn every_registered_term_matches_finite_differences() {
             let p = Pattern::for_scene(&sc);
             let x = deformed(&sc);
             let mut rng = Rng::new(2);
-            let phi: Vec<Real> = (0..sc.num_edge_dofs())
+            let phi: Vec<Real> = (0..sc.body.num_edge_dofs())
                 .map(|_| 0.05 * rng.symmetric())
                 .collect();
-            let (a_prev, b_prev) = sc.forms(&sc.mesh.positions, &vec![0.0; phi.len()]);
+            let (a_prev, b_prev) = sc
+                .body
+                .forms(&sc.body.mesh.positions, &vec![0.0; phi.len()]);
             let xhat: Vec<Vec3> = x.iter().map(|p| p * 0.99).collect();
-            let normal: Vec<Real> = (0..sc.num_vertices())
+            let normal: Vec<Real> = (0..sc.body.num_vertices())
                 .map(|v| 0.1 + 0.01 * v as Real)
                 .collect();
             let pot = Potential {
@@ -206,7 +210,7 @@ fn every_registered_term_matches_finite_differences() {
                     b_prev: &b_prev,
                 }),
                 gravity: Vec3::new(0.0, 0.0, -9.81),
-                friction: Some(shellsim::solve::potential::Friction {
+                friction: Some(shellsim::energy::potential::Friction {
                     x_prev: &xhat,
                     dial_prev: 0.7,
                     normal_force: &normal,
@@ -233,7 +237,7 @@ fn every_registered_term_matches_finite_differences() {
     );
     let p = Pattern::for_scene(&sc);
     let x = deformed(&sc);
-    let phi = vec![0.01; sc.num_edge_dofs()];
+    let phi = vec![0.01; sc.body.num_edge_dofs()];
     let pot = Potential {
         dial: 0.6,
         ..Potential::new(&sc, &p)
@@ -263,7 +267,8 @@ fn every_registered_term_matches_finite_differences() {
 fn rolled(sc: &Scene, turn: Real, noise: Real) -> Vec<Vec3> {
     let kappa = turn / 1.0;
     let mut rng = Rng::new(9);
-    sc.mesh
+    sc.body
+        .mesh
         .positions
         .iter()
         .map(|p| {
@@ -289,7 +294,7 @@ fn end_moment_matches_finite_differences_past_a_half_turn() {
         let i = (0..sc.terms.len())
             .find(|&i| sc.terms[i].name() == "moment")
             .expect("a moment term");
-        let phi = vec![0.02; sc.num_edge_dofs()];
+        let phi = vec![0.02; sc.body.num_edge_dofs()];
         // Accept in steps below π/2, as the solver would.
         let mut states = sc.initial_states.clone();
         for k in 1..=11 {
@@ -302,7 +307,7 @@ fn end_moment_matches_finite_differences_past_a_half_turn() {
         let x = rolled(&sc, 1.3 * std::f64::consts::PI, 0.01);
         let pot = Potential {
             dial: 0.8,
-            terms: &states,
+            states: &states,
             ..Potential::new(&sc, &p)
         };
         check_term(&sc, &p, &pot, &x, &phi, i);
@@ -519,7 +524,7 @@ fn obstacles_match_finite_differences() {
         ));
         let p = Pattern::for_scene(&sc);
         let x = deformed(&sc);
-        let phi = vec![0.0; sc.num_edge_dofs()];
+        let phi = vec![0.0; sc.body.num_edge_dofs()];
         let mut rng = Rng::new(5);
         let x_prev: Vec<Vec3> = x
             .iter()
@@ -528,7 +533,7 @@ fn obstacles_match_finite_differences() {
         let x_lag: Vec<Vec3> = x.iter().map(|v| v + Vec3::new(0.0, 0.0, -0.002)).collect();
         let pot = Potential {
             dial: 0.6,
-            friction: Some(shellsim::solve::potential::Friction {
+            friction: Some(shellsim::energy::potential::Friction {
                 x_prev: &x_prev,
                 dial_prev: 0.55,
                 normal_force: &[],
@@ -698,7 +703,7 @@ impl Term for Tether {
     fn name(&self) -> &'static str {
         "tether"
     }
-    fn stencil(&self, _: &Scene) -> Stencil {
+    fn stencil(&self, _: &Body) -> Stencil {
         Stencil {
             slot_dofs: vec![3],
             nodes: vec![],
@@ -752,11 +757,11 @@ fn low_rank_term_solves_like_the_dense_matrix() {
         "[material]\nbending = \"midedge_average\"\nthickness = 0.05\n[constraints]\n\
          fix_boxes = [{ min = [-1, -1, -1], max = [0.01, 2, 1] }]",
     );
-    let nv = sc.num_vertices();
+    let nv = sc.body.num_vertices();
     let mut rng = Rng::new(8);
     let w: Vec<Real> = (0..3 * nv)
         .map(|k| {
-            if sc.fixed[k / 3] {
+            if sc.body.fixed[k / 3] {
                 0.0
             } else {
                 rng.symmetric()
@@ -775,6 +780,7 @@ fn low_rank_term_solves_like_the_dense_matrix() {
     let pot = Potential::new(&sc, &p);
     // Stretched along x (a positive definite sparse part), slightly rippled.
     let x: Vec<Vec3> = sc
+        .body
         .mesh
         .positions
         .iter()
@@ -883,8 +889,9 @@ fn slide_friction_sticks_at_rest_and_brakes_sliding() {
     let pot = Potential::new(&sc, &p);
     let slides = slides_term(&sc);
     let limit = 0.5 * 2.0 * 0.01;
-    let n = sc.num_vertices();
+    let n = sc.body.num_vertices();
     let x: Vec<Vec3> = sc
+        .body
         .mesh
         .positions
         .iter()
@@ -951,7 +958,7 @@ fn slide_contact_damping_is_an_implicit_dashpot_relative_to_the_slide() {
     let pot = Potential::new(&sc, &p);
     let slides = slides_term(&sc);
     let (k, dt, speed) = (2.0, 1e-3, 2.0);
-    let n = sc.num_vertices();
+    let n = sc.body.num_vertices();
     // Vertex kinds: 0 pressed into the lower slide, moving down; 1 riding the upper slide at its
     // speed; 2 in contact with the upper slide, moving up into it; 3 free in the gap.
     let z = |i: usize| match i % 4 {
@@ -966,6 +973,7 @@ fn slide_contact_damping_is_an_implicit_dashpot_relative_to_the_slide() {
         _ => 0.7,
     };
     let x: Vec<Vec3> = sc
+        .body
         .mesh
         .positions
         .iter()
@@ -973,9 +981,9 @@ fn slide_contact_damping_is_an_implicit_dashpot_relative_to_the_slide() {
         .map(|(i, q)| Vec3::new(q.x, q.y, z(i)))
         .collect();
     let mut states = sc.initial_states.clone();
-    slides.explicit_begin(&sc, pot.dial, &x, dt, states.get_mut("slides"));
+    slides.explicit_begin(&sc.body, pot.dial, &x, dt, states.get_mut("slides"));
     let pot = Potential {
-        terms: &states,
+        states: &states,
         ..pot
     };
     let mut v: Vec<Vec3> = (0..n).map(|i| Vec3::new(0.0, 0.0, vz(i))).collect();
@@ -993,7 +1001,7 @@ fn slide_contact_damping_is_an_implicit_dashpot_relative_to_the_slide() {
     let mut g = g0.clone();
     slides.explicit_step(&pot, &x, &mut v, &mut g, dt);
     for i in 0..n {
-        let m = sc.mass[i];
+        let m = sc.body.mass[i];
         let c = 2.0 * (k * m).sqrt();
         assert_eq!(
             (g[3 * i], g[3 * i + 1]),

@@ -6,9 +6,9 @@
 //! and the `p_i` entries of the gradient and Hessian are zero.
 
 use super::{has_extra, BendingEval, BendingModel};
+use crate::body::Body;
 use crate::geometry::{b_from_q, b_from_q_matrix, edge_slots, AverageQs, UnitNormal};
 use crate::math::{Real, SMat, SVec, Sym2, Vec3};
-use crate::scene::Scene;
 
 /// The mid-edge average model.
 #[derive(Clone, Copy, Debug, Default)]
@@ -27,7 +27,7 @@ impl BendingModel<18, 6> for MidedgeAverage {
     crate::light_via_eval!(18);
 
     #[inline(always)]
-    fn face(&self, _: &Scene, _: usize, nodes: &[usize], _: &[Real]) -> [bool; 3] {
+    fn face(&self, _: &Body, _: usize, nodes: &[usize], _: &[Real]) -> [bool; 3] {
         has_extra(nodes)
     }
 

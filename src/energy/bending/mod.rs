@@ -19,8 +19,8 @@ pub mod midedge_angle;
 pub mod none;
 pub mod patch;
 
+use crate::body::Body;
 use crate::math::{Real, SMat, SVec, Sym2, Vec3};
-use crate::scene::Scene;
 
 /// `b` of one face with its Jacobian and what its Hessian contraction needs.
 pub struct BendingEval<const N: usize, C> {
@@ -43,7 +43,7 @@ pub trait BendingModel<const N: usize, const S: usize>: Send + Sync {
     const NAME: &'static str;
 
     /// The per-face input of face `f` with stencil `nodes` and global edge DOFs `phi`.
-    fn face(&self, scene: &Scene, f: usize, nodes: &[usize], phi: &[Real]) -> Self::Face;
+    fn face(&self, body: &Body, f: usize, nodes: &[usize], phi: &[Real]) -> Self::Face;
 
     /// `b` at stencil positions `x` (slots 0..6; unused slots hold the face's first vertex);
     /// `G` when `grad`, the Hessian scratch when `hess`.

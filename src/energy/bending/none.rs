@@ -3,8 +3,8 @@
 //! DOF order (9): `x[v0], x[v1], x[v2]`.
 
 use super::{BendingEval, BendingModel};
+use crate::body::Body;
 use crate::math::{Real, SMat, Sym2, Vec3};
-use crate::scene::Scene;
 
 /// The pure-membrane "bending model".
 #[derive(Clone, Copy, Debug, Default)]
@@ -16,7 +16,7 @@ impl BendingModel<9, 3> for NoBending {
     const NAME: &'static str = "none";
     crate::light_via_eval!(9);
 
-    fn face(&self, _: &Scene, _: usize, _: &[usize], _: &[Real]) {}
+    fn face(&self, _: &Body, _: usize, _: &[usize], _: &[Real]) {}
 
     #[inline(always)]
     fn eval(&self, _: &(), _: &[Vec3; 6], _: bool, _: bool) -> BendingEval<9, ()> {

@@ -47,12 +47,12 @@
 //! without edge DOFs). Units: m in N·m/m, E in J, gradient N and N·m.
 
 use super::select_vertices;
+use crate::body::Body;
 use crate::energy::term::{ElementKernel, Reports, StateError, Stateful, Stencil, Term, Tracked};
+use crate::energy::Potential;
 use crate::math::{skew, Mat3, Real, SMat, SVec, Vec3};
 use crate::mesh::topology::NONE;
 use crate::mesh::MeshError;
-use crate::scene::Scene;
-use crate::solve::Potential;
 
 /// One loaded boundary edge.
 #[derive(Clone, Copy, Debug)]
@@ -196,7 +196,7 @@ impl ElementKernel<10, 4> for Moment {
         // Half of each angle: θ = (θ_A + θ_B)/2.
         let (ga, gb, ha, hb) = (ga * 0.5, gb * 0.5, ha * 0.5, hb * 0.5);
         let w = -pot.dial * edge.weight;
-        let nv = pot.scene.num_vertices();
+        let nv = pot.body.num_vertices();
         let tilt = if nodes[3] != NONE {
             edge.sigma * phi[nodes[3] - nv]
         } else {
@@ -265,9 +265,9 @@ impl Term for MomentTerm {
     fn name(&self) -> &'static str {
         NAME
     }
-    fn stencil(&self, scene: &Scene) -> Stencil {
-        let p = &scene.mesh.positions;
-        let has_edges = scene.has_edge_dofs();
+    fn stencil(&self, body: &Body) -> Stencil {
+        let p = &body.mesh.positions;
+        let has_edges = body.has_edge_dofs();
         Stencil {
             slot_dofs: vec![3, 3, 3, 1],
             nodes: self
@@ -307,7 +307,7 @@ impl Term for MomentTerm {
                 let gn = projection == crate::energy::HessianProjection::GaussNewton;
                 self.0.eval(pot, e, nodes, x, phi, gn, g, h)
             },
-            &pot.scene.node_fixed,
+            pot.node_fixed,
             projection,
             want,
             grad,
@@ -445,14 +445,16 @@ impl Tracked for MomentTerm {
 }
 
 /// The moment term of a scene (`None` without moments).
-pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
-    let loads = &scene.settings.loads.moment;
+pub fn term(
+    body: &Body,
+    loads: &[crate::config::loads::MomentLoad],
+) -> Result<Option<Box<dyn Term>>, MeshError> {
     if loads.is_empty() {
         return Ok(None);
     }
-    let mesh = &scene.mesh;
-    let topo = &scene.topo;
-    let nv = scene.num_vertices();
+    let mesh = &body.mesh;
+    let topo = &body.topo;
+    let nv = body.num_vertices();
     let mut edges = Vec::new();
     let mut frames = Vec::new();
     for (li, l) in loads.iter().enumerate() {
@@ -475,7 +477,7 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
             let (i, j, k) = (face[(slot + 1) % 3], face[(slot + 2) % 3], face[slot]);
             let pos = &mesh.positions;
             let len = (pos[j] - pos[i]).norm();
-            let sigma = scene.edge_sign.get(f).map_or(1.0, |s| s[slot]);
+            let sigma = body.edge_sign.get(f).map_or(1.0, |s| s[slot]);
             let local = |v: usize| (0..3).find(|&s| face[s] == v).unwrap_or(0);
             let edge = Edge {
                 nodes: [face[0], face[1], face[2], nv + e],

@@ -15,11 +15,11 @@
 //! Units: p in Pa, E in J, gradient N, Hessian N/m. DOF order (9): `x[v0], x[v1], x[v2]`.
 
 use super::select_faces;
+use crate::body::Body;
 use crate::energy::term::{ElementKernel, ElementTerm, Stencil, Term};
+use crate::energy::Potential;
 use crate::math::{Real, SMat, SVec, Vec3};
 use crate::mesh::MeshError;
-use crate::scene::Scene;
-use crate::solve::Potential;
 
 /// The pressure kernel: pressure per face (Pa, 0 where unloaded).
 pub struct Pressure {
@@ -48,20 +48,22 @@ impl ElementKernel<9, 3> for Pressure {
     }
 }
 
-fn stencil(scene: &Scene, k: &Pressure) -> Stencil {
-    Stencil::faces(&scene.mesh, k.faces.iter().map(|&(f, _)| f))
+fn stencil(body: &Body, k: &Pressure) -> Stencil {
+    Stencil::faces(&body.mesh, k.faces.iter().map(|&(f, _)| f))
 }
 
 /// The pressure term of a scene (`None` without pressure loads). A loaded region whose
 /// boundary has a free vertex is refused (module doc); the mesh's orientation is consistent by
 /// the time a scene exists ([`crate::mesh::Topology::build`] refuses an inconsistent one).
-pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
-    let loads = &scene.settings.loads.pressure;
+pub fn term(
+    body: &Body,
+    loads: &[crate::config::loads::PressureLoad],
+) -> Result<Option<Box<dyn Term>>, MeshError> {
     if loads.is_empty() {
         return Ok(None);
     }
-    let mesh = &scene.mesh;
-    let mut p = vec![0.0; scene.num_faces()];
+    let mesh = &body.mesh;
+    let mut p = vec![0.0; body.num_faces()];
     for (i, l) in loads.iter().enumerate() {
         for f in select_faces(mesh, &l.on, &format!("loads.pressure[{i}]"))? {
             p[f] += l.pressure;
@@ -69,10 +71,10 @@ pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
     }
     // Boundary of the loaded region: edges with exactly one loaded face.
     let loaded = |f: usize| f != crate::mesh::topology::NONE && p[f] != 0.0;
-    for (e, ef) in scene.topo.edge_faces.iter().enumerate() {
+    for (e, ef) in body.topo.edge_faces.iter().enumerate() {
         if loaded(ef[0]) != loaded(ef[1]) {
-            for &v in &scene.topo.edges[e] {
-                if !scene.fixed[v] {
+            for &v in &body.topo.edges[e] {
+                if !body.fixed[v] {
                     return Err(mesh.invalid(format!(
                         "loads.pressure: vertex {v} on the boundary of the loaded faces is free; a \
                          pressure on an open surface needs its boundary held (fix or clamp it), or \

@@ -4,29 +4,31 @@
 //! [`super::NodalForces`].
 
 use super::{nodal_term, select_vertices};
+use crate::body::Body;
 use crate::energy::term::Term;
 use crate::math::Vec3;
 use crate::mesh::MeshError;
-use crate::scene::Scene;
 
 /// The traction term of a scene (`None` without tractions).
-pub fn term(scene: &Scene) -> Result<Option<Box<dyn Term>>, MeshError> {
-    let loads = &scene.settings.loads.traction;
+pub fn term(
+    body: &Body,
+    loads: &[crate::config::loads::TractionLoad],
+) -> Result<Option<Box<dyn Term>>, MeshError> {
     if loads.is_empty() {
         return Ok(None);
     }
-    let mesh = &scene.mesh;
-    let mut force = vec![Vec3::zeros(); scene.num_vertices()];
+    let mesh = &body.mesh;
+    let mut force = vec![Vec3::zeros(); body.num_vertices()];
     for (i, l) in loads.iter().enumerate() {
         let what = format!("loads.traction[{i}]");
-        let mut on = vec![false; scene.num_vertices()];
+        let mut on = vec![false; body.num_vertices()];
         for v in select_vertices(mesh, &l.on, &what)? {
             on[v] = true;
         }
         let t = Vec3::from(l.traction);
         let mut edges = 0;
-        for (e, ends) in scene.topo.edges.iter().enumerate() {
-            let boundary = scene.topo.edge_faces[e][1] == crate::mesh::topology::NONE;
+        for (e, ends) in body.topo.edges.iter().enumerate() {
+            let boundary = body.topo.edge_faces[e][1] == crate::mesh::topology::NONE;
             if boundary && on[ends[0]] && on[ends[1]] {
                 let len = (mesh.positions[ends[0]] - mesh.positions[ends[1]]).norm();
                 force[ends[0]] += t * (0.5 * len);

@@ -34,8 +34,9 @@
 //! Units: E in J, λ and μ in Pa, `a` in m².
 
 use super::{bending_wells, psd_ga, Membrane, MembraneLaw, WithKoiterBending};
+use crate::body::Body;
+use crate::energy::Potential;
 use crate::math::{sym_det, Mat3, Real, SVec, Sym2, Vec2};
-use crate::solve::Potential;
 
 /// The Baraff–Witkin membrane: per-face constants and warp directions.
 #[derive(Clone, Debug)]
@@ -174,11 +175,11 @@ impl Membrane for BaraffWitkin {
 /// its rest face; constants from `material.baraff_witkin` or from each face's E and ν.
 /// A zero or non-finite direction, or one normal to a face, is an error naming the face.
 pub fn from_scene(
-    scene: &crate::scene::Scene,
+    body: &Body,
     bw: &crate::config::material::BaraffWitkinSettings,
 ) -> Result<BaraffWitkin, crate::mesh::MeshError> {
     use crate::math::Vec3;
-    let mesh = &scene.mesh;
+    let mesh = &body.mesh;
     let field = mesh.face_field("warp_direction", 3)?;
     let mut directions = Vec::with_capacity(mesh.faces.len());
     for f in 0..mesh.faces.len() {
@@ -198,8 +199,8 @@ pub fn from_scene(
         })?;
         directions.push(Vec2::new(c[0], c[1]));
     }
-    let nu = scene.settings.material.poisson;
-    let moduli = scene
+    let nu = body.poisson;
+    let moduli = body
         .young
         .iter()
         .map(|&e| {

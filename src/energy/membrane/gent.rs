@@ -20,8 +20,8 @@
 
 use super::neo_hookean::{det_derivs, NeoHookeanFace};
 use super::{bending_wells, psd3, psd_ga, Membrane, MembraneLaw, WithKoiterBending};
+use crate::energy::Potential;
 use crate::math::{Mat3, Real, Sym2};
-use crate::solve::Potential;
 
 /// The Gent membrane with limiting extensibility `jm`.
 #[derive(Clone, Copy, Debug)]
@@ -77,7 +77,7 @@ impl Membrane for Gent {
     #[inline]
     fn density(&self, pot: &Potential, f: usize) -> Self::Density {
         let (abar, _) = pot.rest_forms(f);
-        let sc = pot.scene;
+        let sc = pot.body;
         WithKoiterBending {
             law: GentFace {
                 nh: NeoHookeanFace::new(

@@ -4,7 +4,7 @@
 
 use super::Membrane;
 use crate::energy::material::KoiterDensity;
-use crate::solve::Potential;
+use crate::energy::Potential;
 
 /// The Koiter membrane.
 #[derive(Clone, Copy, Debug, Default)]

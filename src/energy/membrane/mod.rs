@@ -21,8 +21,8 @@ pub mod prism;
 
 use crate::energy::material::{DensityDerivs, FaceDensity, KoiterDensity};
 use crate::energy::term::StateError;
+use crate::energy::Potential;
 use crate::math::{Mat3, Real, Sym2, Vec3};
-use crate::solve::Potential;
 
 /// A membrane material: gives each face's energy density at a potential's rest state.
 pub trait Membrane: Send + Sync + 'static {

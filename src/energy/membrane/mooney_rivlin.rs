@@ -14,8 +14,8 @@
 
 use super::neo_hookean::{det_derivs, NeoHookeanFace};
 use super::{bending_wells, psd3, psd_ga, Membrane, MembraneLaw, WithKoiterBending};
+use crate::energy::Potential;
 use crate::math::{Mat3, Real, Sym2};
-use crate::solve::Potential;
 
 /// The Mooney–Rivlin membrane with constants `c1`, `c2` (Pa).
 #[derive(Clone, Copy, Debug)]

@@ -13,8 +13,8 @@
 //! `∂W/∂a = Vμ/2 (t − det ā ∇d/d²)`, `∂²W/∂a² = Vμ/2 det ā (2∇d∇dᵀ/d³ − ∇²d/d²)`.
 
 use super::{bending_wells, psd3, psd_ga, Membrane, MembraneLaw, WithKoiterBending};
+use crate::energy::Potential;
 use crate::math::{sym_det, sym_to_mat, Mat3, Real, SVec, Sym2};
-use crate::solve::Potential;
 
 /// The neo-Hookean membrane.
 #[derive(Clone, Copy, Debug, Default)]
@@ -81,7 +81,7 @@ impl Membrane for NeoHookean {
     #[inline]
     fn density(&self, pot: &Potential, f: usize) -> Self::Density {
         let (abar, _) = pot.rest_forms(f);
-        let sc = pot.scene;
+        let sc = pot.body;
         WithKoiterBending {
             law: NeoHookeanFace::new(&abar, pot.thickness(f), sc.lame[f].beta, pot.stretch_scale),
             koiter: bending_wells(pot, f),

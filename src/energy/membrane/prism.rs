@@ -38,9 +38,10 @@
 //! Units: W in J, a in m², μ and λ in Pa.
 
 use super::{bending_wells, psd3, psd_ga, Membrane, MembraneLaw, WithKoiterBending};
+use crate::body::Body;
+use crate::energy::Potential;
 use crate::math::{sym_det, sym_to_mat, Mat3, Real, SVec, Sym2, Vec3};
 use crate::settings::{PrismLaw, PrismThickness};
-use crate::solve::Potential;
 
 /// The 3D St Venant–Kirchhoff or neo-Hookean prism membrane of one face.
 #[derive(Clone, Copy, Debug)]
@@ -186,14 +187,14 @@ pub struct Prism {
 impl Prism {
     /// The material of a scene with the constants `p` (`[material.prism]`): the current
     /// thickness starts at the rest thickness.
-    pub fn new(scene: &crate::scene::Scene, p: &crate::config::material::PrismSettings) -> Self {
+    pub fn new(body: &Body, p: &crate::config::material::PrismSettings) -> Self {
         Prism {
             law: p.law,
             mode: p.thickness,
             iterations: p.pbd_iterations,
-            poisson: scene.settings.material.poisson,
-            rest_thickness: scene.thickness.clone(),
-            density: scene.settings.material.density,
+            poisson: body.poisson,
+            rest_thickness: body.thickness.clone(),
+            density: body.density,
         }
     }
 
@@ -209,7 +210,7 @@ impl Prism {
     /// The current thickness of every face at positions `x` (m): `h̄ Ā/A` (incompressible) or
     /// the position-based state.
     pub fn current_thickness(&self, pot: &Potential, x: &[Vec3]) -> Vec<Real> {
-        let sc = pot.scene;
+        let sc = pot.body;
         (0..sc.num_faces())
             .map(|f| match self.mode {
                 PrismThickness::Pbd => Self::h(pot, f),
@@ -225,7 +226,7 @@ impl Prism {
 
     /// The skin's volume `Σ A h` over its rest volume `Σ Ā h̄` (dimensionless).
     pub fn volume_ratio(&self, pot: &Potential, x: &[Vec3]) -> Real {
-        let sc = pot.scene;
+        let sc = pot.body;
         let h = self.current_thickness(pot, x);
         let (mut now, mut rest) = (0.0, 0.0);
         for (f, hf) in h.iter().enumerate() {
@@ -256,7 +257,7 @@ impl Prism {
         x: &mut [Vec3],
         own: &mut [Real],
     ) -> Result<Real, crate::energy::term::StateError> {
-        let sc = pot.scene;
+        let sc = pot.body;
         let faces = &sc.mesh.faces;
         let nf = faces.len();
         let nv = x.len();
@@ -378,7 +379,7 @@ impl Membrane for Prism {
     #[inline]
     fn density(&self, pot: &Potential, f: usize) -> Self::Density {
         let (abar, _) = pot.rest_forms(f);
-        let sc = pot.scene;
+        let sc = pot.body;
         let h0 = pot.thickness(f);
         let c = match self.mode {
             PrismThickness::Incompressible => None,

@@ -38,12 +38,12 @@ pub mod pressed;
 pub mod sphere;
 
 use super::term::{Term, VertexKernel, VertexTerm};
+use crate::body::Body;
 use crate::config::obstacle::{Control, Shape};
 use crate::contact::{friction_potential, penalty};
+use crate::energy::Potential;
 use crate::math::{Mat3, Real, Vec3};
 use crate::mesh::MeshError;
-use crate::scene::Scene;
-use crate::solve::Potential;
 
 /// A shape's signed distance (m, negative inside), its gradient and its Hessian (1/m) at `x`.
 pub trait Distance {
@@ -86,7 +86,7 @@ pub(crate) fn penalty_term(
 
 /// A validated shape, dispatched by a `match` (no virtual call per vertex).
 #[derive(Clone, Copy, Debug)]
-pub enum Body {
+pub enum Solid {
     /// See [`sphere`].
     Sphere(sphere::Sphere),
     /// See [`capsule`].
@@ -99,16 +99,16 @@ pub enum Body {
     Box(cuboid::Cuboid),
 }
 
-impl Body {
+impl Solid {
     /// The body of a validated shape.
-    pub fn of(s: &Shape) -> Body {
+    pub fn of(s: &Shape) -> Solid {
         let v = |a: &[Real; 3]| Vec3::from(*a);
         match s {
-            Shape::Sphere { center, radius } => Body::Sphere(sphere::Sphere {
+            Shape::Sphere { center, radius } => Solid::Sphere(sphere::Sphere {
                 center: v(center),
                 radius: *radius,
             }),
-            Shape::Capsule { a, b, radius } => Body::Capsule(capsule::Capsule {
+            Shape::Capsule { a, b, radius } => Solid::Capsule(capsule::Capsule {
                 a: v(a),
                 b: v(b),
                 radius: *radius,
@@ -117,16 +117,16 @@ impl Body {
                 point,
                 axis,
                 radius,
-            } => Body::Cylinder(cylinder::Cylinder {
+            } => Solid::Cylinder(cylinder::Cylinder {
                 point: v(point),
                 axis: v(axis),
                 radius: *radius,
             }),
-            Shape::Plane { point, normal } => Body::Plane(plane::Plane {
+            Shape::Plane { point, normal } => Solid::Plane(plane::Plane {
                 point: v(point),
                 normal: v(normal),
             }),
-            Shape::Box { min, max } => Body::Box(cuboid::Cuboid {
+            Shape::Box { min, max } => Solid::Box(cuboid::Cuboid {
                 min: v(min),
                 max: v(max),
             }),
@@ -134,15 +134,15 @@ impl Body {
     }
 }
 
-impl Distance for Body {
+impl Distance for Solid {
     #[inline]
     fn distance(&self, x: &Vec3) -> (Real, Vec3, Mat3) {
         match self {
-            Body::Sphere(s) => s.distance(x),
-            Body::Capsule(s) => s.distance(x),
-            Body::Cylinder(s) => s.distance(x),
-            Body::Plane(s) => s.distance(x),
-            Body::Box(s) => s.distance(x),
+            Solid::Sphere(s) => s.distance(x),
+            Solid::Capsule(s) => s.distance(x),
+            Solid::Cylinder(s) => s.distance(x),
+            Solid::Plane(s) => s.distance(x),
+            Solid::Box(s) => s.distance(x),
         }
     }
 }
@@ -156,7 +156,7 @@ pub struct Obstacle {
     /// none); such an obstacle is its own term ([`pressed`]), skipped by [`Obstacles`].
     pub pressed: Option<(Vec3, Real, Real)>,
     /// Its shape at dial 0.
-    pub body: Body,
+    pub body: Solid,
     /// Offset at dial 1 (m).
     pub displacement: Vec3,
     /// Penalty stiffness k (Pa/m).
@@ -215,9 +215,9 @@ impl Obstacles {
 /// `D_v = Σ_o μ_o λ_o f₀(‖T_o (x_v − x⁰_v − u_o Δs)‖)`,
 ///
 /// with `λ_o = k_o A_v ψ′(p)` and the tangent projector `T_o = I − n nᵀ`, `n = ∇d_o`, both taken
-/// at the friction lag's iterate ([`crate::solve::potential::Friction::x_lag`]), and
+/// at the friction lag's iterate ([`crate::energy::potential::Friction::x_lag`]), and
 /// `u_o Δs` the obstacle's own motion over the step (the slip is relative to it). Only while the
-/// potential carries a [`crate::solve::potential::Friction`]. Units: N, m, J. DOF order: `x[v]`.
+/// potential carries a [`crate::energy::potential::Friction`]. Units: N, m, J. DOF order: `x[v]`.
 pub struct ObstacleFriction(pub Obstacles);
 
 impl ObstacleFriction {
@@ -226,7 +226,7 @@ impl ObstacleFriction {
     #[inline]
     fn one(
         &self,
-        fr: &crate::solve::potential::Friction,
+        fr: &crate::energy::potential::Friction,
         dial: Real,
         o: &Obstacle,
         v: usize,
@@ -294,7 +294,7 @@ impl VertexKernel for ObstacleFriction {
             let mut f = Vec3::zeros();
             if let Some(fr) = pot.friction.as_ref() {
                 for (v, xv) in x.iter().enumerate() {
-                    if pot.scene.fixed[v] {
+                    if pot.body.fixed[v] {
                         continue;
                     }
                     if let Some((_, g, _)) = self.one(fr, pot.dial, o, v, xv) {
@@ -334,7 +334,7 @@ impl VertexKernel for Obstacles {
     /// (its tangential force and velocity are removed) when `|T v*| ≤ Δt μ N / m`, else it
     /// slides with the force `μ N T v*/|T v*|` against that velocity.
     fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
-        let fixed = &pot.scene.fixed;
+        let fixed = &pot.body.fixed;
         for (i, xi) in x.iter().enumerate() {
             if fixed[i] {
                 continue;
@@ -396,21 +396,24 @@ impl VertexKernel for Obstacles {
 /// The obstacles of a scene with `[[obstacles]]`, else `None`. Errors name the obstacle and
 /// the vertex: a shape that starts closer to a vertex than half its thickness (inside the
 /// sheet; touching, to 1e-9 of the half thickness, is allowed).
-pub fn build(scene: &Scene) -> Result<Option<Obstacles>, MeshError> {
-    let list = &scene.settings.obstacles;
+pub fn build(
+    body: &Body,
+    list: &[crate::config::obstacle::ObstacleSettings],
+    mode: crate::settings::Mode,
+    explicit: &crate::config::explicit::Explicit,
+) -> Result<Option<Obstacles>, MeshError> {
     if list.is_empty() {
         return Ok(None);
     }
-    let mesh = &scene.mesh;
+    let mesh = &body.mesh;
     let nv = mesh.positions.len();
-    let c = crate::scene::ContactAreas::of(mesh, &scene.thickness, &scene.young);
+    let c = crate::body::ContactAreas::of(mesh, &body.thickness, &body.young);
     // The explicit step Δt resolves a vertex spring k A_v with ω Δt ≤ 2, ω² = k A_v / m_v =
     // k / (ρ h): the default stiffness there is ρ h / Δt² (ω Δt = 1) when it is below E/h.
     let mut k_default = c.e_over_h;
-    if scene.settings.solver.mode == crate::settings::Mode::Explicit {
-        let dt =
-            scene.settings.explicit.time_step_prefactor * crate::scales::Scales::of(scene).dt_unit;
-        let rho_h = scene.settings.material.density * c.h_mean;
+    if mode == crate::settings::Mode::Explicit {
+        let dt = explicit.time_step_prefactor * crate::scales::Scales::of(body).dt_unit;
+        let rho_h = body.density * c.h_mean;
         k_default = k_default.min(rho_h / (dt * dt));
     }
     let mut obstacles = Vec::with_capacity(list.len());
@@ -427,7 +430,7 @@ pub fn build(scene: &Scene) -> Result<Option<Obstacles>, MeshError> {
         };
         obstacles.push(Obstacle {
             pressed,
-            body: Body::of(&shape),
+            body: Solid::of(&shape),
             displacement: Vec3::from(o.displacement),
             stiffness: o.stiffness.unwrap_or(k_default),
             smoothing: o.smoothing.unwrap_or(c.h_mean / 100.0),
@@ -464,8 +467,13 @@ pub fn build(scene: &Scene) -> Result<Option<Obstacles>, MeshError> {
 
 /// The terms of a scene with `[[obstacles]]`: their contact (with explicit stick/slip), and in
 /// dynamic mode their friction when any has some.
-pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
-    let Some(obstacles) = build(scene)? else {
+pub fn terms(
+    body: &Body,
+    list: &[crate::config::obstacle::ObstacleSettings],
+    mode: crate::settings::Mode,
+    explicit: &crate::config::explicit::Explicit,
+) -> Result<Vec<Box<dyn Term>>, MeshError> {
+    let Some(obstacles) = build(body, list, mode, explicit)? else {
         return Ok(Vec::new());
     };
     let pressed: Vec<Box<dyn Term>> = obstacles
@@ -493,7 +501,7 @@ pub fn terms(scene: &Scene) -> Result<Vec<Box<dyn Term>>, MeshError> {
             }) as Box<dyn Term>)
         })
         .collect();
-    let dynamic = scene.settings.solver.mode == crate::settings::Mode::Dynamic;
+    let dynamic = mode == crate::settings::Mode::Dynamic;
     let friction =
         (dynamic && obstacles.has_friction()).then(|| ObstacleFriction(obstacles.clone()));
     let mut t: Vec<Box<dyn Term>> = vec![Box::new(VertexTerm {

@@ -21,21 +21,21 @@
 //! Units: m, N, J, kg. DOF order per element: `x_v` (3), then `q` (1); the force's element has
 //! `q` only (its vertex slot is absent).
 
-use super::{Body, Distance, Obstacles};
+use super::{Distance, Obstacles, Solid};
+use crate::body::Body;
 use crate::elements::{assemble_elements, ElementMap, Want};
 use crate::energy::projection::HessianProjection;
 use crate::energy::term::{GlobalDof, GlobalDofs, Reports, Stencil, Term};
+use crate::energy::Potential;
 use crate::math::{Mat3, Real, SMat, SVec, Vec3};
 use crate::mesh::topology::NONE;
-use crate::scene::Scene;
-use crate::solve::Potential;
 
 /// One force-controlled obstacle.
 pub struct Pressed {
     /// Its index among the `[[obstacles]]` (for the log columns).
     pub index: usize,
     /// Its shape at offset 0.
-    pub body: Body,
+    pub body: Solid,
     /// Unit direction of the force.
     pub direction: Vec3,
     /// Magnitude of the force at dial 1 (N).
@@ -153,8 +153,8 @@ impl Term for Pressed {
     }
 
     /// One element per vertex that has an area (`[v, q]`), then the force's (`[·, q]`).
-    fn stencil(&self, scene: &Scene) -> Stencil {
-        let p = &scene.mesh.positions;
+    fn stencil(&self, body: &Body) -> Stencil {
+        let p = &body.mesh.positions;
         let (mut nodes, mut anchors) = (Vec::new(), Vec::new());
         for (v, &a) in self.sheet.area.iter().enumerate() {
             if a > 0.0 {
@@ -185,7 +185,7 @@ impl Term for Pressed {
         assemble_elements::<4, 2, _>(
             map,
             |_, nodes, g, h| self.element(pot, nodes, x, phi, g, h),
-            &pot.scene.node_fixed,
+            pot.node_fixed,
             projection,
             want,
             grad,

@@ -4,9 +4,9 @@
 
 use super::Scales;
 use crate::assembly::Want;
+use crate::energy::Potential;
 use crate::math::{human, Real, Vec3};
-use crate::scene::Scene;
-use crate::solve::Potential;
+use crate::model::Scene;
 
 /// Checks, before anything is written, that an explicit run of `scene` makes sense and
 /// bounds its work; the error names the settings keys. A vertex must be free to move; the drag
@@ -15,15 +15,15 @@ use crate::solve::Potential;
 /// T / Δt`, must not exceed [`crate::settings::MAX_STEPS`].
 pub fn check(scene: &Scene) -> Result<(), String> {
     let cf = &scene.settings.explicit;
-    let nv = scene.num_vertices();
-    if !(0..nv).any(|v| !scene.node_fixed[v] && scene.mass[v] > 0.0) {
+    let nv = scene.body.num_vertices();
+    if !(0..nv).any(|v| !scene.node_fixed[v] && scene.body.mass[v] > 0.0) {
         return Err(
             "every vertex is fixed (constraint_indicators, constraints.fix_tags, \
              fix_boxes, clamp or displacement): the explicit dynamics has nothing to move"
                 .into(),
         );
     }
-    let sca = Scales::of(scene);
+    let sca = Scales::of(&scene.body);
     let dt = cf.time_step_prefactor * sca.dt_unit;
     for (key, p) in [
         ("explicit.damping_prefactor_dial", cf.damping_prefactor_dial),
@@ -73,10 +73,10 @@ pub fn check(scene: &Scene) -> Result<(), String> {
 /// mass-scaled Hessian `M^{-½} H M^{-½}` applied by central differences of the gradient
 /// (`iterations` gradient pairs). Fixed vertices and vertices without mass are left out.
 pub fn max_frequency_squared(pot: &Potential, x: &[Vec3], iterations: usize) -> Real {
-    let sc = pot.scene;
+    let sc = pot.body;
     let n = x.len();
     let free: Vec<bool> = (0..n)
-        .map(|v| !sc.node_fixed[v] && pot.mass[v] > 0.0)
+        .map(|v| !pot.node_fixed[v] && pot.mass[v] > 0.0)
         .collect();
     let inv_sqrt_m: Vec<Real> = (0..n)
         .map(|v| {

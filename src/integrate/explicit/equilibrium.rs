@@ -2,15 +2,15 @@
 //! MorphoShell's force-and-speed test, and the residual a frame reports.
 
 use super::{gradient, Scales};
+use crate::energy::Potential;
 use crate::math::{Real, Vec3};
 use crate::settings::{EquilibriumTest, Explicit};
-use crate::solve::Potential;
 
 /// The largest force (N) a term leaves unbalanced on a degree of freedom of its own
 /// ([`crate::energy::term::ExplicitHooks::explicit_unbalanced`]), or why one never balances.
 pub(super) fn unbalanced(pot: &Potential, x: &[Vec3]) -> Result<Real, String> {
     let mut worst: Real = 0.0;
-    for hooks in pot.scene.terms.iter().filter_map(|t| t.explicit()) {
+    for hooks in pot.terms.iter().filter_map(|t| t.explicit()) {
         worst = worst.max(hooks.explicit_unbalanced(pot, x)?);
     }
     Ok(worst)
@@ -20,7 +20,7 @@ pub(super) fn unbalanced(pot: &Potential, x: &[Vec3]) -> Result<Real, String> {
 /// unbalanced forces included, at positions `x` (`g` is scratch).
 pub(super) fn residual_at(pot: &Potential, x: &[Vec3], g: &mut [Real]) -> Real {
     gradient(pot, x, g);
-    let f = pot.scene.force_scale.max(Real::MIN_POSITIVE);
+    let f = pot.body.force_scale.max(Real::MIN_POSITIVE);
     pot.residual(g).max(unbalanced(pot, x).unwrap_or(0.0) / f)
 }
 

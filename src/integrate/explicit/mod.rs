@@ -73,11 +73,12 @@
 //! unstable state is never written.
 
 use super::{Progress, RunError, Solver};
+use crate::energy::Potential;
 use crate::integrate::report::ExplicitReport;
 use crate::integrate::Sink;
 use crate::math::{human, Real, Vec3};
 use crate::settings::EquilibriumTest;
-use crate::solve::{Potential, State};
+use crate::solve::State;
 
 mod bounds;
 mod equilibrium;
@@ -270,20 +271,20 @@ pub(super) fn run_explicit(
     let pat = s.pattern();
     let cf = sc.settings.explicit.clone();
     let holds = sc.settings.dial.holds.clone();
-    let sca = Scales::of(sc);
+    let sca = Scales::of(&sc.body);
     let n = state.x.len();
     let dt = cf.time_step_prefactor * sca.dt_unit;
     let rate_dial = cf.damping_prefactor_dial * 2.0 * sca.omega_long;
     let rate_wait = cf.damping_prefactor_wait * 2.0 * sca.omega_long;
     let dial_time = cf.dial_long_times * sca.long_time;
-    let area: Real = (0..sc.num_faces())
+    let area: Real = (0..sc.body.num_faces())
         .map(|f| {
-            let [a, b, c] = sc.mesh.face_positions(f);
+            let [a, b, c] = sc.body.mesh.face_positions(f);
             0.5 * (b - a).cross(&(c - a)).norm()
         })
         .sum();
     let blow_up = 100.0 * sca.mu * sca.t * area;
-    let mass = &sc.mass;
+    let mass = &sc.body.mass;
     let inv_m: Vec<Real> = (0..n)
         .map(|v| {
             if !sc.node_fixed[v] && mass[v] > 0.0 {
@@ -328,8 +329,8 @@ pub(super) fn run_explicit(
     let test = Test {
         cf: &cf,
         sca: &sca,
-        size: sc.mesh.bbox_diagonal(),
-        force_scale: sc.force_scale.max(Real::MIN_POSITIVE),
+        size: sc.body.mesh.bbox_diagonal(),
+        force_scale: sc.body.force_scale.max(Real::MIN_POSITIVE),
         inv_m: &inv_m,
         mass,
     };
@@ -407,14 +408,17 @@ pub(super) fn run_explicit(
             let dial = k.dial;
             if k.phase == Phase::Wait && frozen.as_ref().is_none_or(|(d, _)| *d != dial) {
                 let pot = s.potential(&pat, dial);
-                frozen = Some((dial, (0..sc.num_faces()).map(|f| pot.density(f)).collect()));
+                frozen = Some((
+                    dial,
+                    (0..sc.body.num_faces()).map(|f| pot.density(f)).collect(),
+                ));
             }
-            sc.prescribe(&mut state.x, dial);
+            sc.body.prescribe(&mut state.x, dial);
             // Terms whose own state follows the sheet (a moving slide) catch up with it first.
             for t in sc.terms.iter() {
                 if let Some(hooks) = t.explicit() {
                     let own = state.terms.get_mut(t.name());
-                    hooks.explicit_begin(sc, dial, &state.x, dt, own);
+                    hooks.explicit_begin(&sc.body, dial, &state.x, dt, own);
                 }
             }
             let pot = Potential {
@@ -422,7 +426,7 @@ pub(super) fn run_explicit(
                     .as_ref()
                     .filter(|(d, _)| *d == dial)
                     .map(|(_, v)| &v[..]),
-                terms: &state.terms,
+                states: &state.terms,
                 ..s.potential(&pat, dial)
             };
             let c = if k.phase == Phase::Dial {
@@ -561,7 +565,7 @@ pub(super) fn run_explicit(
     drop(team);
     let wall = clock.elapsed().as_secs_f64();
     report.microseconds_per_face_step =
-        1e6 * wall / (k.steps.max(1) as Real * sc.num_faces() as Real);
+        1e6 * wall / (k.steps.max(1) as Real * sc.body.num_faces() as Real);
     finish(
         s,
         writer,

@@ -2,8 +2,8 @@
 //! parallel parts ([`Step`]).
 
 use crate::assembly::Want;
+use crate::energy::Potential;
 use crate::math::{Real, Vec3};
-use crate::solve::Potential;
 
 /// The forces of one explicit step: `g ← ∇Φ(x)` (zeroed first; N), returning Φ (J).
 #[inline]
@@ -60,7 +60,7 @@ impl Disjoint {
 /// not act on the step ([`crate::energy::term::Term::explicit`]), each vertex is
 /// advanced inside the gradient's parallel parts, by the part that owns it, right after that
 /// part has summed its force ([`crate::assembly::assemble_elements_owned`], through
-/// [`crate::solve::Potential::owned`]). The new positions go
+/// [`crate::energy::Potential::owned`]). The new positions go
 /// into a second buffer, since other parts may still be reading the old ones, and the two are
 /// swapped when the parts are done. A step is then one parallel region with no serial pass over
 /// the nodes, and no core rereads the forces and positions another core has just written. The
@@ -82,12 +82,12 @@ pub struct Step {
 impl Step {
     /// The step for `pot`'s scene; `fuse = false` keeps it unfused (for comparisons).
     pub fn new(pot: &Potential, fuse: bool) -> Step {
-        let sc = pot.scene;
+        let sc = pot.body;
         let nv = sc.num_vertices();
         let fusable = fuse
-            && sc.terms.len() == 1
+            && pot.terms.len() == 1
             && pot.pattern.maps.len() == 1
-            && sc.terms[0].explicit().is_none();
+            && pot.terms[0].explicit().is_none();
         let mut used = vec![!fusable; nv];
         if fusable {
             let map = &pot.pattern.maps[0];

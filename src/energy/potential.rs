@@ -11,12 +11,13 @@
 //! inertia, so each implicit step sets them quasi-statically, as the bending they describe is a
 //! through-thickness rotation whose inertia is O(h²) smaller than the translational one).
 
-use crate::assembly::{Pattern, Want};
+use crate::body::Body;
+use crate::elements::pattern::Pattern;
+use crate::elements::Want;
 use crate::energy::material::sv_matrix;
-use crate::energy::term::{LowRank, TermStates};
+use crate::energy::term::{GlobalDof, LowRank, Term, TermStates};
 use crate::energy::{HessianProjection, KoiterDensity};
 use crate::math::{Real, Sym2, Vec3};
-use crate::scene::Scene;
 use rayon::prelude::*;
 
 /// Inertia of an implicit-Euler step.
@@ -62,11 +63,18 @@ pub struct Friction<'a> {
     pub eps: Real,
 }
 
-/// The potential of one solve.
+/// The potential of one solve: the context every term's kernel receives. A scene makes one
+/// with [`Potential::new`] ([`crate::model`]).
 #[derive(Clone, Copy)]
 pub struct Potential<'a> {
-    /// The scene.
-    pub scene: &'a Scene,
+    /// The sheet.
+    pub body: &'a Body,
+    /// The terms, in assembly order.
+    pub terms: &'a [Box<dyn Term>],
+    /// The global DOFs the terms declared, in node order after the edge nodes.
+    pub globals: &'a [GlobalDof],
+    /// True for held DOF nodes ([`crate::model::Scene::node_fixed`]).
+    pub node_fixed: &'a [bool],
     /// The Hessian pattern.
     pub pattern: &'a Pattern,
     /// Dial factor s ∈ [0, 1] of the rest forms.
@@ -91,40 +99,20 @@ pub struct Potential<'a> {
     /// phase, where millions of gradient evaluations share one rest state); `None` computes
     /// them per evaluation.
     pub frozen: Option<&'a [KoiterDensity]>,
-    /// The explicit driver's fused step ([`crate::assembly::OwnedNodes`]): an element term's
+    /// The explicit driver's fused step ([`crate::elements::OwnedNodes`]): an element term's
     /// gradient hands each part's node sums to it instead of writing the gradient vector
-    /// ([`crate::assembly::assemble_elements_owned`]). `None` everywhere else.
-    pub owned: Option<&'a crate::assembly::OwnedNodes<'a>>,
+    /// ([`crate::elements::assemble_elements_owned`]). `None` everywhere else.
+    pub owned: Option<&'a crate::elements::OwnedNodes<'a>>,
     /// The stateful terms' states the potential is evaluated with ([`crate::solve::State::terms`]): the
     /// scene's initial states unless a driver sets its own.
-    pub terms: &'a TermStates,
+    pub states: &'a TermStates,
 }
 
 impl<'a> Potential<'a> {
-    /// The static potential at dial 1 with the scene's masses and no inertia, damping, gravity
-    /// or friction; set the other fields with struct-update syntax.
-    pub fn new(scene: &'a Scene, pattern: &'a Pattern) -> Self {
-        Potential {
-            scene,
-            pattern,
-            dial: 1.0,
-            inertia: None,
-            damping: None,
-            gravity: Vec3::zeros(),
-            stretch_scale: 1.0,
-            rest_override: None,
-            mass: &scene.mass,
-            friction: None,
-            frozen: None,
-            owned: None,
-            terms: &scene.initial_states,
-        }
-    }
-
     /// The state of the stateful term named `name` ([`crate::energy::term::Stateful`]).
     #[inline]
     pub fn term_state(&self, name: &str) -> &'a [Real] {
-        self.terms.get(name)
+        self.states.get(name)
     }
 
     /// The rest forms `(ā, b̄)` of face `f` at this potential's dial (or override).
@@ -132,7 +120,7 @@ impl<'a> Potential<'a> {
     pub fn rest_forms(&self, f: usize) -> (Sym2, Sym2) {
         match self.rest_override {
             Some(r) => r[f],
-            None => self.scene.rest.at(f, self.dial),
+            None => self.body.rest.at(f, self.dial),
         }
     }
 
@@ -140,7 +128,7 @@ impl<'a> Potential<'a> {
     /// scaled by a growth law that grows it ([`crate::rest::RestForms::thickness_ratio`]).
     #[inline(always)]
     pub fn thickness(&self, f: usize) -> Real {
-        let sc = self.scene;
+        let sc = self.body;
         match sc.grown_thickness.get(f) {
             None => sc.thickness[f],
             Some(&r) => sc.thickness[f] * sc.rest.thickness_ratio(r, self.dial),
@@ -153,7 +141,7 @@ impl<'a> Potential<'a> {
         if let Some(d) = self.frozen {
             return d[f];
         }
-        let sc = self.scene;
+        let sc = self.body;
         let (abar, bbar) = self.rest_forms(f);
         let (ws, wb) = KoiterDensity::weights(&abar, self.thickness(f), sc.stretch_factor);
         let ws = ws * self.stretch_scale;
@@ -197,24 +185,24 @@ impl<'a> Potential<'a> {
     /// ([`crate::energy::term::GlobalDof::length`]).
     pub fn residual(&self, grad: &[Real]) -> Real {
         let nx = 3 * self.pattern.num_vertices;
-        let ne = nx + self.scene.num_edge_dofs();
+        let ne = nx + self.body.num_edge_dofs();
         let gx = grad[..nx].iter().fold(0.0 as Real, |m, v| m.max(v.abs()));
         let gp = grad[nx..ne].iter().fold(0.0 as Real, |m, v| m.max(v.abs()));
         let gg = grad[ne..]
             .iter()
-            .zip(&self.scene.globals)
+            .zip(self.globals)
             .fold(0.0 as Real, |m, (v, g)| m.max(v.abs() / g.length));
-        let f = self.scene.force_scale.max(Real::MIN_POSITIVE);
-        gx.max(gp / self.scene.mean_edge).max(gg) / f
+        let f = self.body.force_scale.max(Real::MIN_POSITIVE);
+        gx.max(gp / self.body.mean_edge).max(gg) / f
     }
 
     /// The largest fraction of a Newton step `step` (DOF order) that moves no global DOF by more
     /// than its [`crate::energy::term::GlobalDof::max_step`] (1 when none would).
     pub fn step_bound(&self, step: &[Real]) -> Real {
-        let ne = 3 * self.pattern.num_vertices + self.scene.num_edge_dofs();
+        let ne = 3 * self.pattern.num_vertices + self.body.num_edge_dofs();
         step[ne..]
             .iter()
-            .zip(&self.scene.globals)
+            .zip(self.globals)
             .fold(1.0, |a: Real, (d, g)| {
                 if d.abs() * a > g.max_step {
                     g.max_step / d.abs()
@@ -234,7 +222,7 @@ impl<'a> Potential<'a> {
         grad: &mut [Real],
         values: &mut [Real],
     ) -> Real {
-        let sc = self.scene;
+        let sc = self.body;
         if want != Want::Energy {
             // Within a team's hot loop, rayon's workers stay asleep: waking one would take a
             // core from the team's spinning helpers.
@@ -247,7 +235,7 @@ impl<'a> Potential<'a> {
             values.par_chunks_mut(1 << 14).for_each(|c| c.fill(0.0));
         }
         let mut e = 0.0;
-        for (term, map) in sc.terms.iter().zip(&self.pattern.maps) {
+        for (term, map) in self.terms.iter().zip(&self.pattern.maps) {
             e += term.eval(self, map, x, phi, want, projection, grad, values);
         }
         if want != Want::Energy {
@@ -270,7 +258,7 @@ impl<'a> Potential<'a> {
                 }
             }
             let scale = if cnt > 0 { sum / cnt as Real } else { 1.0 };
-            for (u, &fx) in sc.node_fixed.iter().enumerate() {
+            for (u, &fx) in self.node_fixed.iter().enumerate() {
                 if fx {
                     let (d0, k) = self.pattern.node_dofs(u);
                     for c in 0..k {
@@ -289,7 +277,7 @@ impl<'a> Potential<'a> {
     /// pinned DOFs.
     pub fn low_rank(&self, x: &[Vec3], phi: &[Real]) -> Vec<LowRank> {
         let mut out = Vec::new();
-        for t in self.scene.terms.iter().filter_map(|t| t.low_rank()) {
+        for t in self.terms.iter().filter_map(|t| t.low_rank()) {
             t.low_rank(self, x, phi, &mut out);
         }
         for lr in &mut out {
@@ -301,13 +289,13 @@ impl<'a> Potential<'a> {
     /// Zeroes the entries of a DOF vector on fixed nodes and pinned DOFs (the DOFs the
     /// solver does not move).
     pub fn mask_fixed(&self, v: &mut [Real]) {
-        for (u, &fx) in self.scene.node_fixed.iter().enumerate() {
+        for (u, &fx) in self.node_fixed.iter().enumerate() {
             if fx {
                 let (d0, k) = self.pattern.node_dofs(u);
                 v[d0..d0 + k].fill(0.0);
             }
         }
-        for &d in &self.scene.pinned_dofs {
+        for &d in &self.body.pinned_dofs {
             v[d] = 0.0;
         }
     }
@@ -315,7 +303,7 @@ impl<'a> Potential<'a> {
     /// Energies by term name at `(x, phi)` (each term's [`crate::energy::term::energies`]).
     pub fn energies(&self, x: &[Vec3], phi: &[Real]) -> Vec<(&'static str, Real)> {
         let mut out = Vec::new();
-        for (t, map) in self.scene.terms.iter().zip(&self.pattern.maps) {
+        for (t, map) in self.terms.iter().zip(&self.pattern.maps) {
             out.extend(crate::energy::term::energies(t.as_ref(), self, map, x, phi));
         }
         out

@@ -1,22 +1,27 @@
-//! A scene: the validated mesh, its topology, rest forms, per-face material, per-vertex mass
-//! and the fixed vertices, built once from the settings and the mesh file.
+//! The body: the validated mesh, its topology, rest forms, per-face material, per-vertex mass
+//! and the supports, built once from the settings and the mesh file. It knows no energy terms
+//! and keeps no settings: the model ([`crate::model::Scene`]) adds the terms the settings
+//! enable.
 
-use crate::energy::Lame2d;
+mod lame;
+pub mod patch;
+pub mod select;
+
+pub use lame::Lame2d;
+
 use crate::math::{Real, Sym2, Vec3};
 use crate::mesh::{Mesh, MeshError, Topology};
 use crate::rest::laws::GrowthInputs;
 use crate::rest::RestForms;
 use crate::settings::Settings;
 
-/// Everything the integrators need, derived once.
+/// The sheet: everything about it that the energy terms and the drivers read, derived once.
 #[derive(Clone, Debug)]
-pub struct Scene {
+pub struct Body {
     /// The input mesh (reference positions and fields).
     pub mesh: Mesh,
     /// Its connectivity.
     pub topo: Topology,
-    /// The settings.
-    pub settings: Settings,
     /// Rest forms at dial 0 and 1.
     pub rest: RestForms,
     /// Thickness per face (m).
@@ -44,15 +49,20 @@ pub struct Scene {
     /// Each face's corner shift from the input's order
     /// ([`Mesh::anchor_faces_at_wide_angles`]): frames are written in the input's order.
     pub corner_shift: Vec<u8>,
+    /// The bending model (`material.bending`).
+    pub bending: crate::settings::BendingModel,
+    /// Mass density ρ (kg/m³, `material.density`).
+    pub density: Real,
+    /// Poisson's ratio ν (`material.poisson`).
+    pub poisson: Real,
     /// Patch-fit bending data per face (`material.bending = "patch_fit"`), else empty.
-    pub patches: Vec<crate::energy::patch::Patch>,
+    pub patches: Vec<patch::Patch>,
     /// Edge-DOF models: each face's orientation sign `σ` on its edges (+1 for the edge's first
     /// face, −1 for its second), else empty.
     pub edge_sign: Vec<[Real; 3]>,
-    /// True for fixed DOF nodes: the vertices, then (edge-DOF models) the edges. Edge DOFs are
-    /// free, including on the boundary (the natural free-edge condition, see
-    /// [`crate::energy::midedge_angle`]).
-    pub node_fixed: Vec<bool>,
+    /// The clamped boundary edges: with edge DOFs, their rotations are held too
+    /// ([`crate::model::Scene::node_fixed`]).
+    pub clamped_edges: Vec<usize>,
     /// Static mode with nothing fixed: 6 position DOFs held at their current values to remove
     /// the rigid-body null space of the Hessian (see [`rigid_pins`]), else empty.
     pub pinned_dofs: Vec<usize>,
@@ -60,16 +70,10 @@ pub struct Scene {
     pub growth: GrowthInputs,
     /// Per face, the rest thickness at dial 1 over the reference thickness, when a growth law
     /// scales it (uniform volumetric growth); empty otherwise (see
-    /// [`crate::solve::Potential::thickness`]).
+    /// [`crate::energy::Potential::thickness`]).
     pub grown_thickness: Vec<Real>,
     /// The ground plane (`contact.enabled`), else `None`.
     pub ground: Option<crate::contact::Ground>,
-    /// The energy terms the settings enable, in assembly order ([`crate::energy::registry`]).
-    pub terms: crate::energy::term::Terms,
-    /// The global DOFs the terms declared, in node order after the edge nodes.
-    pub globals: Vec<crate::energy::term::GlobalDof>,
-    /// The stateful terms' states at the start of a run ([`crate::solve::State::terms`]).
-    pub initial_states: crate::energy::term::TermStates,
     /// Vertices on prescribed paths and their displacement at dial 1 (m); they are fixed.
     pub prescribed: Vec<(usize, Vec3)>,
 }
@@ -107,12 +111,12 @@ fn positive_face_field(
     Ok(Some(f.data.clone()))
 }
 
-impl Scene {
-    /// Validates the mesh and builds the scene, in stages: the mesh and its topology, the
+impl Body {
+    /// Validates the mesh and builds the body, in stages: the mesh and its topology, the
     /// material per face, the rest forms (reference, targets, growth), the masses, the supports,
-    /// the checks that the problem is posed, the ground, and last the terms the settings enable
-    /// (the registry). Errors name the file, field and index.
-    pub fn build(mut mesh: Mesh, settings: Settings) -> Result<Scene, MeshError> {
+    /// the checks that the problem is posed, and the ground. Errors name the file, field and
+    /// index.
+    pub fn build(mut mesh: Mesh, settings: &Settings) -> Result<Body, MeshError> {
         let unused = mesh.validate()?;
         let corner_shift = mesh.anchor_faces_at_wide_angles();
         let topo = Topology::build(&mesh)?;
@@ -139,9 +143,9 @@ impl Scene {
             edge_sign,
             growth,
             grown_thickness,
-        } = rest_forms(&mesh, &topo, &settings, &thickness)?;
+        } = rest_forms(&mesh, &topo, settings, &thickness)?;
         if settings.moisture.enabled {
-            check_moisture_regions(&mesh, &settings)?;
+            check_moisture_regions(&mesh, settings)?;
         }
         let mass = lumped_masses(&mesh, &thickness, m.density);
         let is_unused = unused_mask(nv, &unused);
@@ -152,27 +156,19 @@ impl Scene {
         } = supports(&mesh, &topo, &settings.constraints, &is_unused)?;
         // Free: no vertex that carries the sheet is held (unused vertices are held, inertly).
         let free = unused.len() < nv && (0..nv).all(|v| is_unused[v] || !fixed[v]);
-        check_posed(&mesh, &settings, free)?;
+        check_posed(&mesh, settings, free)?;
         let ground = settings
             .contact
             .enabled
             .then(|| build_ground(&mesh, &settings.contact, &thickness, &young))
             .transpose()?;
         let patches = if m.bending == crate::settings::BendingModel::PatchFit {
-            let (p, w) = crate::energy::patch::build_patches(&mesh)?;
+            let (p, w) = patch::build_patches(&mesh)?;
             warnings.extend(w);
             p
         } else {
             Vec::new()
         };
-        let mut node_fixed = fixed.clone();
-        if !edge_sign.is_empty() {
-            // Edge DOFs are free (see the field's doc), except on clamped boundaries.
-            node_fixed.resize(nv + topo.edges.len(), false);
-            for &e in &clamped_edges {
-                node_fixed[nv + e] = true;
-            }
-        }
         // Obstacles hold the sheet where they touch it: pins would carry their reaction.
         let pinned_dofs = if free
             && settings.obstacles.is_empty()
@@ -195,15 +191,17 @@ impl Scene {
             .zip(&thickness)
             .map(|(e, h)| e * h)
             .fold(0.0, Real::max);
-        let mut scene = Scene {
+        Ok(Body {
             stretch_factor: m.stretch_convention.factor(),
             has_bending: m.bending != crate::settings::BendingModel::None,
             bend_stiffening: m.bend_stiffening,
+            bending: m.bending,
+            density: m.density,
+            poisson: m.poisson,
             force_scale: eh * mean_edge,
             mean_edge,
             mesh,
             topo,
-            settings,
             rest,
             thickness,
             young,
@@ -214,22 +212,13 @@ impl Scene {
             corner_shift,
             patches,
             edge_sign,
-            node_fixed,
+            clamped_edges,
             pinned_dofs,
             growth,
             grown_thickness,
             ground,
-            terms: Default::default(),
-            globals: Vec::new(),
-            initial_states: Default::default(),
             prescribed,
-        };
-        let mut terms = crate::energy::registry::terms(&scene)?;
-        scene.bind_globals(&mut terms);
-        scene.initial_states =
-            crate::energy::term::TermStates::initial(&terms).map_err(|e| scene.mesh.invalid(e))?;
-        scene.terms = crate::energy::term::Terms(std::sync::Arc::new(terms));
-        Ok(scene)
+        })
     }
 
     /// Number of vertices.
@@ -243,7 +232,7 @@ impl Scene {
     }
 
     /// Face `f`'s vertices in the input mesh's order (the scene may start a sliver at another
-    /// corner, [`Scene::corner_shift`]).
+    /// corner, [`Body::corner_shift`]).
     pub fn input_face(&self, f: usize) -> [usize; 3] {
         let k = self.corner_shift.get(f).copied().unwrap_or(0) as usize;
         let face = self.mesh.faces[f];
@@ -253,21 +242,6 @@ impl Scene {
     /// Every face in the input mesh's order.
     pub fn input_faces(&self) -> Vec<[usize; 3]> {
         (0..self.num_faces()).map(|f| self.input_face(f)).collect()
-    }
-
-    /// The per-face fields with one value per corner slot (the edge opposite each corner):
-    /// `edge_angles` and the terms' 3-component state fields. Frames write them in the input's
-    /// corner order.
-    pub fn slot_fields(&self) -> Vec<&'static str> {
-        let mut names = vec!["edge_angles"];
-        names.extend(
-            self.terms
-                .iter()
-                .filter_map(|t| t.tracked())
-                .filter(|t| t.state_components() == 3)
-                .map(|t| t.state_field()),
-        );
-        names
     }
 
     /// Reorders per-face slot values (3 per face) between the scene's corner order and the
@@ -305,29 +279,6 @@ impl Scene {
         !self.edge_sign.is_empty()
     }
 
-    /// Numbers the global DOFs of `terms` after the vertex and edge nodes (term order), tells
-    /// each term its first node, records them in [`Scene::globals`] and leaves their nodes free.
-    pub fn bind_globals(&mut self, terms: &mut [Box<dyn crate::energy::term::Term>]) {
-        let nv = self.num_vertices();
-        let mut next = nv + self.num_edge_dofs();
-        self.globals.clear();
-        for g in terms.iter_mut().filter_map(|t| t.global_dofs()) {
-            let dofs = g.dofs();
-            g.bind(next);
-            next += dofs.len();
-            self.globals.extend(dofs);
-        }
-        if !self.globals.is_empty() {
-            self.node_fixed.resize(nv + self.num_edge_dofs(), false);
-            self.node_fixed.resize(next, false);
-        }
-    }
-
-    /// Number of scalar DOFs after the vertices: the edge DOFs, then the global DOFs.
-    pub fn num_scalar_dofs(&self) -> usize {
-        self.num_edge_dofs() + self.globals.len()
-    }
-
     /// Number of edge DOFs (0 without them).
     pub fn num_edge_dofs(&self) -> usize {
         if self.has_edge_dofs() {
@@ -343,31 +294,26 @@ impl Scene {
     /// linear dial to its target metric.
     pub fn dial_from_state(&mut self, x: &[Vec3], phi: &[Real]) {
         let (a, b) = self.forms(x, phi);
-        self.rest.abar0 = a;
-        self.rest.bbar0 = b;
-        self.rest.lce.clear();
+        let rest = &mut self.rest;
+        rest.abar0 = a;
+        rest.bbar0 = b;
+        rest.lce.clear();
     }
 
     /// First and second fundamental forms of every face at `x` (edge DOFs `phi`, empty without
     /// them), with this scene's bending model.
     pub fn forms(&self, x: &[Vec3], phi: &[Real]) -> (Vec<Sym2>, Vec<Sym2>) {
-        if let Some(variant) = self.settings.material.bending.angle_variant() {
-            return midedge_angle_forms(&self.mesh, &self.topo, &self.edge_sign, variant, x, phi);
+        let body = self;
+        if let Some(variant) = self.bending.angle_variant() {
+            return midedge_angle_forms(body, variant, x, phi);
         }
-        if self.patches.is_empty() {
-            return crate::rest::mesh_forms(x, &self.mesh, &self.topo);
+        if body.patches.is_empty() {
+            return crate::rest::mesh_forms(x, &body.mesh, &body.topo);
         }
-        let a = self
-            .mesh
+        body.mesh
             .faces
             .iter()
-            .map(|f| crate::geometry::first_fundamental_form(&f.map(|v| x[v])))
-            .collect();
-        let b = self
-            .mesh
-            .faces
-            .iter()
-            .zip(&self.patches)
+            .zip(&body.patches)
             .map(|(f, p)| {
                 let xs = [
                     x[f[0]],
@@ -377,10 +323,12 @@ impl Scene {
                     x[p.nodes[1]],
                     x[p.nodes[2]],
                 ];
-                crate::energy::patch::patch_b(&xs, &p.weights)
+                (
+                    crate::geometry::first_fundamental_form(&[xs[0], xs[1], xs[2]]),
+                    patch::patch_b(&xs, &p.weights),
+                )
             })
-            .collect();
-        (a, b)
+            .unzip()
     }
 
     /// Moves the vertices on prescribed paths to `reference + dial × displacement`.
@@ -498,8 +446,7 @@ fn rest_forms(
         // The reference curvature in the edge-DOF model's own terms (φ = 0), so that a curved
         // input mesh is stress-free under "no growth" for the tan variant too (sin at φ = 0
         // is the average).
-        let zeros = vec![0.0; topo.edges.len()];
-        let (_, b0) = midedge_angle_forms(mesh, topo, &edge_sign, variant, &mesh.positions, &zeros);
+        let b0 = midedge_angle_reference_b(mesh, topo, variant);
         rest.bbar1.clone_from(&b0);
         rest.bbar0 = b0;
     }
@@ -590,7 +537,7 @@ fn supports(
     for (i, sel) in c.clamp.iter().enumerate() {
         let what = format!("constraints.clamp[{i}]");
         let mut on = vec![false; nv];
-        for v in crate::energy::loads::select_vertices(mesh, sel, &what)? {
+        for v in select::select_vertices(mesh, sel, &what)? {
             on[v] = true;
         }
         let before = clamped_edges.len();
@@ -624,7 +571,7 @@ fn supports(
     let mut prescribed = Vec::new();
     for (i, pd) in c.displacement.iter().enumerate() {
         let what = format!("constraints.displacement[{i}]");
-        for v in crate::energy::loads::select_vertices(mesh, &pd.on, &what)? {
+        for v in select::select_vertices(mesh, &pd.on, &what)? {
             if fixed[v] || prescribed.iter().any(|&(u, _)| u == v) {
                 return Err(mesh.invalid(format!(
                     "{what}: vertex {v} is already fixed or given another prescribed path; a \
@@ -688,32 +635,56 @@ fn check_posed(mesh: &Mesh, settings: &Settings, free: bool) -> Result<(), MeshE
 /// First and second fundamental forms of every face under an edge-DOF bending model, at
 /// positions `x` and edge DOFs `phi`.
 fn midedge_angle_forms(
-    mesh: &Mesh,
-    topo: &Topology,
-    edge_sign: &[[Real; 3]],
-    variant: crate::energy::midedge_angle::AngleVariant,
+    body: &Body,
+    variant: crate::config::shell::AngleVariant,
     x: &[Vec3],
     phi: &[Real],
 ) -> (Vec<Sym2>, Vec<Sym2>) {
-    mesh.faces
-        .iter()
-        .enumerate()
-        .map(|(f, face)| {
-            let o = topo.opposite_vertex[f];
-            let has = o.map(|v| v != crate::mesh::topology::NONE);
-            let xs = [0, 1, 2, 3, 4, 5].map(|k| match k {
-                0..=2 => x[face[k]],
-                _ if has[k - 3] => x[o[k - 3]],
-                _ => x[face[0]],
-            });
-            let xf = [xs[0], xs[1], xs[2]];
-            let ph = topo.face_edges[f].map(|e| phi[e]);
+    (0..body.num_faces())
+        .map(|f| {
+            let (xs, has) = midedge_stencil(&body.mesh, &body.topo, x, f);
+            let ph = body.topo.face_edges[f].map(|e| phi[e]);
             (
-                crate::geometry::first_fundamental_form(&xf),
-                crate::energy::midedge_angle::midedge_angle_b(&xs, has, &ph, edge_sign[f], variant),
+                crate::geometry::first_fundamental_form(&[xs[0], xs[1], xs[2]]),
+                crate::geometry::midedge_angle_b(&xs, has, &ph, body.edge_sign[f], variant),
             )
         })
         .unzip()
+}
+
+/// Each face's second fundamental form on the reference mesh under an edge-DOF bending model
+/// with every edge DOF at zero (the orientation signs then play no part).
+fn midedge_angle_reference_b(
+    mesh: &Mesh,
+    topo: &Topology,
+    variant: crate::config::shell::AngleVariant,
+) -> Vec<Sym2> {
+    (0..mesh.faces.len())
+        .map(|f| {
+            let (xs, has) = midedge_stencil(mesh, topo, &mesh.positions, f);
+            crate::geometry::midedge_angle_b(&xs, has, &[0.0; 3], [1.0; 3], variant)
+        })
+        .collect()
+}
+
+/// Face `f`'s mid-edge stencil at positions `x`: its 3 vertices, then the far vertex across
+/// each edge (the face's first vertex stands in across a boundary edge), and whether each edge
+/// has a neighbour.
+pub fn midedge_stencil(
+    mesh: &Mesh,
+    topo: &Topology,
+    x: &[Vec3],
+    f: usize,
+) -> ([Vec3; 6], [bool; 3]) {
+    let face = mesh.faces[f];
+    let o = topo.opposite_vertex[f];
+    let has = o.map(|v| v != crate::mesh::topology::NONE);
+    let xs = [0, 1, 2, 3, 4, 5].map(|k| match k {
+        0..=2 => x[face[k]],
+        _ if has[k - 3] => x[o[k - 3]],
+        _ => x[face[0]],
+    });
+    (xs, has)
 }
 
 /// Each face's orientation sign on its three edges: +1 for the edge's first face, −1 for its
@@ -740,7 +711,7 @@ pub fn region_faces(
     mesh: &Mesh,
     b: &crate::settings::MoistureBoundary,
 ) -> Result<Vec<usize>, MeshError> {
-    crate::energy::loads::faces_matching(mesh, &b.tags, b.inside.as_ref(), "moisture.boundary")
+    select::faces_matching(mesh, &b.tags, b.inside.as_ref(), "moisture.boundary")
 }
 
 /// Rejects moisture boundary regions that give one face side two different conditions.
