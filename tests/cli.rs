@@ -2128,13 +2128,13 @@ fn every_registered_model_and_law_restarts_exactly() {
             ));
         }
     }
-    for (law, rl) in LAWS {
+    for e in LAWS {
         cases.push((
-            law.name().to_string(),
+            e.law.name().to_string(),
             format!(
                 "[material]\nyoung = 1e6\n[growth]\nlaw = \"{}\"\n{}\n",
-                law.name(),
-                rl.example()
+                e.law.name(),
+                e.example
             ),
         ));
     }

@@ -66,6 +66,55 @@ impl GrowthLaw {
     }
 }
 
+/// A growth law with the coefficients it reads: `[growth]` once validated ([`Growth::model`]).
+/// The isotropic laws' factor `s` and the moisture are per-face inputs
+/// ([`crate::rest::laws::GrowthInputs`]), not coefficients.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GrowthModel {
+    /// No growth law.
+    None,
+    /// Uniform volumetric growth.
+    Isotropic,
+    /// In-plane growth at fixed thickness.
+    IsotropicInPlane,
+    /// Seed 000's law as printed.
+    IsotropicMetricOnly,
+    /// Linear differential swelling.
+    LinearSwelling {
+        /// Moisture–length coefficient (per unit moisture).
+        mu: Real,
+    },
+    /// Piecewise-constant bilayer.
+    Bilayer {
+        /// Coefficient of the top layer (per unit moisture).
+        mu_top: Real,
+        /// Coefficient of the bottom layer (per unit moisture).
+        mu_bottom: Real,
+    },
+    /// Linear swelling with a machine direction.
+    MachineDirection {
+        /// Coefficient along the machine direction (per unit moisture).
+        mu: Real,
+        /// Coefficient across it (per unit moisture).
+        mu_perp: Real,
+    },
+}
+
+impl GrowthModel {
+    /// The law's settings value.
+    pub fn law(self) -> GrowthLaw {
+        match self {
+            GrowthModel::None => GrowthLaw::None,
+            GrowthModel::Isotropic => GrowthLaw::Isotropic,
+            GrowthModel::IsotropicInPlane => GrowthLaw::IsotropicInPlane,
+            GrowthModel::IsotropicMetricOnly => GrowthLaw::IsotropicMetricOnly,
+            GrowthModel::LinearSwelling { .. } => GrowthLaw::LinearSwelling,
+            GrowthModel::Bilayer { .. } => GrowthLaw::Bilayer,
+            GrowthModel::MachineDirection { .. } => GrowthLaw::MachineDirection,
+        }
+    }
+}
+
 /// `[growth]`: the rest-form laws of seed 000 §3. Per-face mesh fields take precedence over the
 /// uniform values here: `moisture_top`, `moisture_bottom` (dimensionless moisture fractions),
 /// `growth_factor` (s), `machine_direction` (3 components, reference Cartesian coordinates).
@@ -112,6 +161,27 @@ impl Default for Growth {
 }
 
 impl Growth {
+    /// The law with its own coefficients. On validated settings every coefficient the law
+    /// needs is given ([`Growth::validate`]); a missing one reads as 0.
+    pub fn model(&self) -> GrowthModel {
+        let c = |v: Option<Real>| v.unwrap_or(0.0);
+        match self.law {
+            GrowthLaw::None => GrowthModel::None,
+            GrowthLaw::Isotropic => GrowthModel::Isotropic,
+            GrowthLaw::IsotropicInPlane => GrowthModel::IsotropicInPlane,
+            GrowthLaw::IsotropicMetricOnly => GrowthModel::IsotropicMetricOnly,
+            GrowthLaw::LinearSwelling => GrowthModel::LinearSwelling { mu: c(self.mu) },
+            GrowthLaw::Bilayer => GrowthModel::Bilayer {
+                mu_top: c(self.mu_top),
+                mu_bottom: c(self.mu_bottom),
+            },
+            GrowthLaw::MachineDirection => GrowthModel::MachineDirection {
+                mu: c(self.mu),
+                mu_perp: c(self.mu_perp),
+            },
+        }
+    }
+
     /// Validates `[growth]`: finite coefficients, a valid `s`, and no growth law together with `rest.target`.
     /// `target` is `rest.target`: a growth law computes the targets, so none may be given.
     pub fn validate(&self, target: TargetForms) -> Result<(), Invalid> {

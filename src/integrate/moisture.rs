@@ -263,7 +263,6 @@ impl Moisture {
                 let m = (top, bottom);
                 let reference = (sc.body.rest.abar0[f], sc.body.rest.bbar0[f]);
                 crate::rest::laws::growth_face(
-                    &sc.settings.growth,
                     &sc.body.growth,
                     f,
                     reference,

@@ -7,13 +7,29 @@
 
 use super::{
     check_stretch, project_through_thickness, reference_metric, FaceInput, Grown, GrowthError,
-    RestLaw,
+    LawEntry, RestLaw,
 };
+use crate::config::growth::{GrowthLaw, GrowthModel};
 use crate::math::{Real, Sym2};
-use crate::settings::Growth;
 
 /// The bilayer law with `growth.mu_top` and `growth.mu_bottom`.
-pub struct Bilayer;
+#[derive(Debug)]
+pub struct Bilayer {
+    /// Coefficient of the top layer (per unit moisture).
+    pub mu_top: Real,
+    /// Coefficient of the bottom layer (per unit moisture).
+    pub mu_bottom: Real,
+}
+
+/// The registry's entry ([`super::LAWS`]).
+pub const ENTRY: LawEntry = LawEntry {
+    law: GrowthLaw::Bilayer,
+    example: "mu_top = 0.05\nmu_bottom = 0.01\nmoisture_top = 0.4\nmoisture_bottom = 0.3",
+    build: |m| match *m {
+        GrowthModel::Bilayer { mu_top, mu_bottom } => Some(Box::new(Bilayer { mu_top, mu_bottom })),
+        _ => None,
+    },
+};
 
 /// Piecewise-constant bilayer: top half swells by `1 + mu_top m_top`, bottom half by
 /// `1 + mu_bottom m_bottom`.
@@ -37,11 +53,8 @@ pub fn bilayer(
 }
 
 impl RestLaw for Bilayer {
-    fn example(&self) -> &'static str {
-        "mu_top = 0.05\nmu_bottom = 0.01\nmoisture_top = 0.4\nmoisture_bottom = 0.3"
-    }
-    fn grow(&self, g: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
-        let (mt, mb) = (g.mu_top.unwrap_or(0.0), g.mu_bottom.unwrap_or(0.0));
+    fn grow(&self, i: &FaceInput) -> Result<Grown, GrowthError> {
+        let (mt, mb) = (self.mu_top, self.mu_bottom);
         check_stretch(i, mt, true, false)?;
         check_stretch(i, mb, false, true)?;
         Ok(Grown::at_fixed_thickness(bilayer(

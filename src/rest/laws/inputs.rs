@@ -32,6 +32,10 @@ pub struct GrowthInputs {
     /// Machine direction per face: barycentric coordinates, and the unit 3D vector in the face
     /// plane (for the diffusivity). Empty unless the law or the diffusion needs it.
     pub direction: Vec<([Real; 2], Vec3)>,
+    /// `growth.law`.
+    pub which: crate::settings::GrowthLaw,
+    /// The growth law with its coefficients (`None`: no growth law).
+    pub law: Option<std::sync::Arc<dyn super::RestLaw>>,
 }
 
 impl GrowthInputs {
@@ -39,14 +43,14 @@ impl GrowthInputs {
     /// diffusivity follows it). Errors name the field or key and the face.
     pub fn read(mesh: &Mesh, settings: &Settings) -> Result<Self, MeshError> {
         let g = &settings.growth;
-        let law = super::law(g.law);
+        let law = super::law(&g.model());
         let mut out = GrowthInputs {
             moisture_top: face_values(mesh, "moisture_top", g.moisture_top)?,
             moisture_bottom: face_values(mesh, "moisture_bottom", g.moisture_bottom)?,
             s: match (mesh.face_field("growth_factor", 1)?, &g.s) {
                 (Some(_), _) => face_values(mesh, "growth_factor", 0.0)?,
                 (None, Some(s)) => settings_field(mesh, s, "growth.s")?,
-                (None, None) if law.is_some_and(|l| l.needs_s()) => {
+                (None, None) if law.as_ref().is_some_and(|l| l.needs_s()) => {
                     return Err(mesh.invalid(format!(
                         "growth.law = \"{}\" needs its growth factor s: give growth.s (a number \
                          or an expression of x, y) or the face field 'growth_factor'",
@@ -56,8 +60,10 @@ impl GrowthInputs {
                 (None, None) => vec![0.0; mesh.faces.len()],
             },
             direction: Vec::new(),
+            which: g.law,
+            law: law.clone(),
         };
-        if law.is_some_and(|l| l.needs_direction()) || settings.moisture.enabled {
+        if law.as_ref().is_some_and(|l| l.needs_direction()) || settings.moisture.enabled {
             let dirs = mesh.face_field("machine_direction", 3)?;
             for f in 0..mesh.faces.len() {
                 let (d, what) = match dirs {

@@ -7,12 +7,20 @@
 //! (derivation in [`super`]; `REFERENCES.md`, "Growth of a curved shell"). A curved shell grown
 //! this way reaches its scaled shape with zero energy. Units: ā in m², b̄ in m, s dimensionless.
 
-use super::{FaceInput, Grown, GrowthError, RestLaw};
+use super::{FaceInput, Grown, GrowthError, LawEntry, RestLaw};
+use crate::config::growth::{GrowthLaw, GrowthModel};
 use crate::math::{Real, Sym2};
-use crate::settings::Growth;
 
 /// Uniform volumetric growth.
+#[derive(Debug)]
 pub struct Isotropic;
+
+/// The registry's entry ([`super::LAWS`]).
+pub const ENTRY: LawEntry = LawEntry {
+    law: GrowthLaw::Isotropic,
+    example: "s = \"0.05 * x\"",
+    build: |m| matches!(m, GrowthModel::Isotropic).then(|| Box::new(Isotropic) as Box<dyn RestLaw>),
+};
 
 /// `(ā, b̄, h̄/h) = (e^{2s} a⁰, e^s b⁰, e^s)`.
 pub fn isotropic(a0: &Sym2, b0: &Sym2, s: Real) -> (Sym2, Sym2, Real) {
@@ -21,10 +29,7 @@ pub fn isotropic(a0: &Sym2, b0: &Sym2, s: Real) -> (Sym2, Sym2, Real) {
 }
 
 impl RestLaw for Isotropic {
-    fn example(&self) -> &'static str {
-        "s = \"0.05 * x\""
-    }
-    fn grow(&self, _: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
+    fn grow(&self, i: &FaceInput) -> Result<Grown, GrowthError> {
         let (abar, bbar, thickness_ratio) = isotropic(&i.a0, &i.b0, i.s);
         Ok(Grown {
             abar,

@@ -7,12 +7,23 @@
 //! thickness to radius, so a curved shell grown this way is frustrated: a 60° cap grown by
 //! s = ln 0.9 keeps energy that grows with h/R. Units: ā in m², b̄ in m, s dimensionless.
 
-use super::{FaceInput, Grown, GrowthError, RestLaw};
+use super::{FaceInput, Grown, GrowthError, LawEntry, RestLaw};
+use crate::config::growth::{GrowthLaw, GrowthModel};
 use crate::math::{Real, Sym2};
-use crate::settings::Growth;
 
 /// In-plane growth at fixed thickness.
+#[derive(Debug)]
 pub struct IsotropicInPlane;
+
+/// The registry's entry ([`super::LAWS`]).
+pub const ENTRY: LawEntry = LawEntry {
+    law: GrowthLaw::IsotropicInPlane,
+    example: "s = \"0.05 * x\"",
+    build: |m| {
+        matches!(m, GrowthModel::IsotropicInPlane)
+            .then(|| Box::new(IsotropicInPlane) as Box<dyn RestLaw>)
+    },
+};
 
 /// `(ā, b̄) = (e^{2s} a⁰, e^{2s} b⁰)`.
 pub fn isotropic_in_plane(a0: &Sym2, b0: &Sym2, s: Real) -> (Sym2, Sym2) {
@@ -21,10 +32,7 @@ pub fn isotropic_in_plane(a0: &Sym2, b0: &Sym2, s: Real) -> (Sym2, Sym2) {
 }
 
 impl RestLaw for IsotropicInPlane {
-    fn example(&self) -> &'static str {
-        "s = \"0.05 * x\""
-    }
-    fn grow(&self, _: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
+    fn grow(&self, i: &FaceInput) -> Result<Grown, GrowthError> {
         Ok(Grown::at_fixed_thickness(isotropic_in_plane(
             &i.a0, &i.b0, i.s,
         )))

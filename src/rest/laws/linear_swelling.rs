@@ -13,13 +13,27 @@
 
 use super::{
     check_stretch, moisture_at, project_through_thickness, reference_metric, FaceInput, Grown,
-    GrowthError, RestLaw,
+    GrowthError, LawEntry, RestLaw,
 };
+use crate::config::growth::{GrowthLaw, GrowthModel};
 use crate::math::{Real, Sym2};
-use crate::settings::Growth;
 
 /// Linear differential swelling with `growth.mu`.
-pub struct LinearSwelling;
+#[derive(Debug)]
+pub struct LinearSwelling {
+    /// Moisture–length coefficient (per unit moisture).
+    pub mu: Real,
+}
+
+/// The registry's entry ([`super::LAWS`]).
+pub const ENTRY: LawEntry = LawEntry {
+    law: GrowthLaw::LinearSwelling,
+    example: "mu = 0.05\nmoisture_top = 0.4\nmoisture_bottom = 0.1",
+    build: |m| match *m {
+        GrowthModel::LinearSwelling { mu } => Some(Box::new(LinearSwelling { mu })),
+        _ => None,
+    },
+};
 
 /// Linear differential swelling with moisture `m_top` at `z = +h/2`, `m_bottom` at `z = −h/2`
 /// and moisture-length coefficient `mu`.
@@ -39,11 +53,8 @@ pub fn linear_swelling(
 }
 
 impl RestLaw for LinearSwelling {
-    fn example(&self) -> &'static str {
-        "mu = 0.05\nmoisture_top = 0.4\nmoisture_bottom = 0.1"
-    }
-    fn grow(&self, g: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
-        let mu = g.mu.unwrap_or(0.0);
+    fn grow(&self, i: &FaceInput) -> Result<Grown, GrowthError> {
+        let mu = self.mu;
         check_stretch(i, mu, true, true)?;
         Ok(Grown::at_fixed_thickness(linear_swelling(
             &i.a0, &i.b0, i.h, i.m_top, i.m_bottom, mu,

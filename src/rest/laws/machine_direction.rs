@@ -9,13 +9,31 @@
 
 use super::{
     check_stretch, moisture_at, project_through_thickness, reference_metric, FaceInput, Grown,
-    GrowthError, RestLaw,
+    GrowthError, LawEntry, RestLaw,
 };
+use crate::config::growth::{GrowthLaw, GrowthModel};
 use crate::math::{sym_to_mat, Mat2, Real, Sym2};
-use crate::settings::Growth;
 
 /// Swelling with a machine direction, `growth.mu` along it and `growth.mu_perp` across.
-pub struct MachineDirection;
+#[derive(Debug)]
+pub struct MachineDirection {
+    /// Coefficient along the machine direction (per unit moisture).
+    pub mu: Real,
+    /// Coefficient across it (per unit moisture).
+    pub mu_perp: Real,
+}
+
+/// The registry's entry ([`super::LAWS`]).
+pub const ENTRY: LawEntry = LawEntry {
+    law: GrowthLaw::MachineDirection,
+    example: "mu = 0.02\nmu_perp = 0.06\nmoisture_top = 0.4\nmoisture_bottom = 0.1\nmachine_direction = [1, 1, 0]",
+    build: |m| match *m {
+        GrowthModel::MachineDirection { mu, mu_perp } => {
+            Some(Box::new(MachineDirection { mu, mu_perp }))
+        }
+        _ => None,
+    },
+};
 
 /// Linear swelling with a machine direction `d` (barycentric, non-zero): `mu` along `d`,
 /// `mu_perp` across it (see the module doc).
@@ -45,11 +63,8 @@ pub fn machine_direction(
 }
 
 impl RestLaw for MachineDirection {
-    fn example(&self) -> &'static str {
-        "mu = 0.02\nmu_perp = 0.06\nmoisture_top = 0.4\nmoisture_bottom = 0.1\nmachine_direction = [1, 1, 0]"
-    }
-    fn grow(&self, g: &Growth, i: &FaceInput) -> Result<Grown, GrowthError> {
-        let (mu, mp) = (g.mu.unwrap_or(0.0), g.mu_perp.unwrap_or(0.0));
+    fn grow(&self, i: &FaceInput) -> Result<Grown, GrowthError> {
+        let (mu, mp) = (self.mu, self.mu_perp);
         check_stretch(i, mu, true, true)?;
         check_stretch(i, mp, true, true)?;
         Ok(Grown::at_fixed_thickness(machine_direction(

@@ -83,9 +83,10 @@ pub mod uniform_forms;
 pub use inputs::GrowthInputs;
 
 use super::RestForms;
+use crate::config::growth::GrowthModel;
 use crate::math::{mat_to_sym, sym_to_mat, Mat2, Real, Sym2};
 use crate::mesh::{Mesh, MeshError};
-use crate::settings::{Growth, GrowthLaw, Rest, Settings, TargetForms};
+use crate::settings::{GrowthLaw, Rest, Settings, TargetForms};
 
 /// What a law reads for one face.
 #[derive(Clone, Copy, Debug)]
@@ -130,13 +131,11 @@ impl Grown {
     }
 }
 
-/// A rest-form law: `[growth]`'s coefficients and a face's inputs → its rest forms.
-pub trait RestLaw: Sync {
+/// A rest-form law with its coefficients (built from [`GrowthModel`] by its registry entry):
+/// a face's inputs → its rest forms.
+pub trait RestLaw: Send + Sync + std::fmt::Debug {
     /// The grown forms of one face. Errors name the face.
-    fn grow(&self, g: &Growth, input: &FaceInput) -> Result<Grown, GrowthError>;
-    /// The `[growth]` keys besides `law` of a valid example on a flat sheet, for the tests that
-    /// every registered law passes (restarts).
-    fn example(&self) -> &'static str;
+    fn grow(&self, input: &FaceInput) -> Result<Grown, GrowthError>;
     /// True when the law reads the machine direction.
     fn needs_direction(&self) -> bool {
         false
@@ -148,41 +147,52 @@ pub trait RestLaw: Sync {
     }
 }
 
-/// Every rest-form law, one line each.
-pub const LAWS: &[(GrowthLaw, &dyn RestLaw)] = &[
-    (GrowthLaw::Isotropic, &isotropic::Isotropic),
-    (
-        GrowthLaw::IsotropicInPlane,
-        &isotropic_in_plane::IsotropicInPlane,
-    ),
-    (
-        GrowthLaw::IsotropicMetricOnly,
-        &isotropic_metric_only::IsotropicMetricOnly,
-    ),
-    (GrowthLaw::LinearSwelling, &linear_swelling::LinearSwelling),
-    (GrowthLaw::Bilayer, &bilayer::Bilayer),
-    (
-        GrowthLaw::MachineDirection,
-        &machine_direction::MachineDirection,
-    ),
-];
-
-/// The law of `growth.law` (`None` for `"none"`).
-pub fn law(which: GrowthLaw) -> Option<&'static dyn RestLaw> {
-    LAWS.iter().find(|(l, _)| *l == which).map(|(_, r)| *r)
+/// A registered rest-form law: its settings value, a valid example, and how it is built from
+/// its own variant of [`GrowthModel`].
+pub struct LawEntry {
+    /// `growth.law`.
+    pub law: GrowthLaw,
+    /// The `[growth]` keys besides `law` of a valid example on a flat sheet, for the tests that
+    /// every registered law passes (restarts).
+    pub example: &'static str,
+    /// The law with its coefficients; `None` for another law's variant (never asked: [`law`]
+    /// picks the entry by the law).
+    pub build: fn(&GrowthModel) -> Option<Box<dyn RestLaw>>,
 }
 
-/// The grown forms of a face under `g.law`, checked: ā positive definite, b̄ and the thickness
-/// finite and positive. `"none"` keeps the reference forms.
-pub fn grow_face(g: &Growth, input: &FaceInput) -> Result<Grown, GrowthError> {
-    let Some(l) = law(g.law) else {
+/// Every rest-form law, one line each.
+pub const LAWS: &[LawEntry] = &[
+    isotropic::ENTRY,
+    isotropic_in_plane::ENTRY,
+    isotropic_metric_only::ENTRY,
+    linear_swelling::ENTRY,
+    bilayer::ENTRY,
+    machine_direction::ENTRY,
+];
+
+/// The law of `model` with its coefficients (`None` for `"none"`).
+pub fn law(model: &GrowthModel) -> Option<std::sync::Arc<dyn RestLaw>> {
+    LAWS.iter()
+        .find(|e| e.law == model.law())
+        .and_then(|e| (e.build)(model))
+        .map(std::sync::Arc::from)
+}
+
+/// The grown forms of a face under `law` (`which` names it in errors), checked: ā positive
+/// definite, b̄ and the thickness finite and positive. No law keeps the reference forms.
+pub fn grow_face(
+    law: Option<&dyn RestLaw>,
+    which: GrowthLaw,
+    input: &FaceInput,
+) -> Result<Grown, GrowthError> {
+    let Some(l) = law else {
         return Ok(Grown {
             abar: input.a0,
             bbar: input.b0,
             thickness_ratio: 1.0,
         });
     };
-    let out = l.grow(g, input)?;
+    let out = l.grow(input)?;
     let a = out.abar;
     if !(a[0] > 0.0
         && crate::math::sym_det(&a) > 0.0
@@ -192,7 +202,7 @@ pub fn grow_face(g: &Growth, input: &FaceInput) -> Result<Grown, GrowthError> {
     {
         return Err(GrowthError::NotPositiveDefinite {
             face: input.face,
-            law: g.law,
+            law: which,
             top: input.m_top,
             bottom: input.m_bottom,
         });
@@ -258,7 +268,7 @@ pub fn targets(
                 (growth.moisture_top[f], growth.moisture_bottom[f])
             };
             let reference = (rest.abar0[f], rest.bbar0[f]);
-            let g = growth_face(&settings.growth, &growth, f, reference, h, m)
+            let g = growth_face(&growth, f, reference, h, m)
                 .map_err(|e| mesh.invalid(e.to_string()))?;
             rest.abar1[f] = g.abar;
             rest.bbar1[f] = g.bbar;
@@ -275,7 +285,6 @@ pub fn targets(
 /// `(m_top, m_bottom)`. Errors name the face: a stretch `1 + μ m ≤ 0`, or an ā that is not
 /// positive definite.
 pub fn growth_face(
-    growth: &Growth,
     inputs: &GrowthInputs,
     f: usize,
     reference: (Sym2, Sym2),
@@ -292,7 +301,7 @@ pub fn growth_face(
         s: inputs.s.get(f).copied().unwrap_or(0.0),
         direction: inputs.direction.get(f).map_or([1.0, 0.0], |d| d.0),
     };
-    grow_face(growth, &input)
+    grow_face(inputs.law.as_deref(), inputs.which, &input)
 }
 
 /// A rest form that a growth law cannot produce.
@@ -412,12 +421,33 @@ mod tests {
     #[test]
     fn every_law_is_registered_once() {
         for l in GrowthLaw::ALL {
-            let n = LAWS.iter().filter(|(k, _)| *k == l).count();
+            let n = LAWS.iter().filter(|e| e.law == l).count();
             assert_eq!(n, usize::from(l != GrowthLaw::None), "{l:?}");
         }
         for l in TargetForms::ALL {
             let n = TARGETS.iter().filter(|(k, _)| *k == l).count();
             assert_eq!(n, usize::from(l != TargetForms::None), "{l:?}");
+        }
+    }
+
+    /// Each entry's example is valid settings, and its law builds from that example's
+    /// coefficients and from no other law's.
+    #[test]
+    fn every_law_builds_from_its_own_coefficients_only() {
+        for e in LAWS {
+            let text = format!("[growth]\nlaw = \"{}\"\n{}\n", e.law.name(), e.example);
+            let s = Settings::from_str_with(&text, "example", &[]).unwrap();
+            let model = s.growth.model();
+            assert_eq!(model.law(), e.law);
+            assert!((e.build)(&model).is_some(), "{:?}", e.law);
+            for other in LAWS.iter().filter(|o| o.law != e.law) {
+                assert!(
+                    (other.build)(&model).is_none(),
+                    "{:?} from {:?}",
+                    other.law,
+                    e.law
+                );
+            }
         }
     }
 }
