@@ -87,6 +87,7 @@ impl<'a> Potential<'a> {
             friction: None,
             frozen: None,
             owned: None,
+            force_scale: scene.body.force_scale,
             states: &scene.initial_states,
         }
     }

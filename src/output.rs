@@ -697,7 +697,21 @@ impl Writer {
             .terms
             .iter()
             .flat_map(|t| crate::energy::term::observables(t.as_ref(), pot, x, phi))
+            .chain(row.reactions.iter().flat_map(|r| r.columns()))
             .collect();
+        if !row.reaction_field.is_empty() {
+            self.frame_mesh.vertex_fields.insert(
+                "reaction".into(),
+                Field {
+                    components: 3,
+                    data: row
+                        .reaction_field
+                        .iter()
+                        .flat_map(|r| [r.x, r.y, r.z])
+                        .collect(),
+                },
+            );
+        }
         let m = &mut self.frame_mesh;
         let keep = |n: &String| Self::writes(&self.selection, &self.restart_fields, n);
         m.face_fields.retain(|n, _| keep(n));

@@ -63,9 +63,14 @@ pub struct Body {
     /// The clamped boundary edges: with edge DOFs, their rotations are held too
     /// ([`crate::model::Scene::node_fixed`]).
     pub clamped_edges: Vec<usize>,
-    /// Static mode with nothing fixed: 6 position DOFs held at their current values to remove
-    /// the rigid-body null space of the Hessian (see [`rigid_pins`]), else empty.
+    /// Position DOFs (`3v + k`) held at their current values while their vertex is otherwise
+    /// free: the components held by `[[constraints.support]]` and by partial paths; or, in
+    /// static mode with nothing held, the 6 that remove the rigid-body null space of the
+    /// Hessian (see [`rigid_pins`]).
     pub pinned_dofs: Vec<usize>,
+    /// The position DOFs of [`Body::pinned_dofs`] that supports and partial paths hold (not
+    /// the automatic rigid pins), sorted.
+    pub held_dofs: Vec<usize>,
     /// Per-face inputs of the growth law.
     pub growth: GrowthInputs,
     /// Per face, the rest thickness at dial 1 over the reference thickness, when a growth law
@@ -74,8 +79,13 @@ pub struct Body {
     pub grown_thickness: Vec<Real>,
     /// The ground plane (`contact.enabled`), else `None`.
     pub ground: Option<crate::contact::Ground>,
-    /// Vertices on prescribed paths and their displacement at dial 1 (m); they are fixed.
-    pub prescribed: Vec<(usize, Vec3)>,
+    /// Vertices on prescribed paths, their displacement at dial 1 (m) and the components that
+    /// follow it: a vertex whose three components follow is held, otherwise its path's
+    /// components are in [`Body::pinned_dofs`].
+    pub prescribed: Vec<(usize, Vec3, [bool; 3])>,
+    /// Every support of `[constraints]` (and the automatic rigid pins) with the position DOFs
+    /// it holds, for its reaction.
+    pub supports: Vec<SupportGroup>,
 }
 
 /// The per-face field `name`, checked to lie in (0, `max`] (an error naming the face), when
@@ -153,9 +163,12 @@ impl Body {
             fixed,
             clamped_edges,
             prescribed,
+            held_dofs,
+            mut groups,
         } = supports(&mesh, &topo, &settings.constraints, &is_unused)?;
         // Free: no vertex that carries the sheet is held (unused vertices are held, inertly).
-        let free = unused.len() < nv && (0..nv).all(|v| is_unused[v] || !fixed[v]);
+        let free =
+            unused.len() < nv && (0..nv).all(|v| is_unused[v] || !fixed[v]) && held_dofs.is_empty();
         check_posed(&mesh, settings, free)?;
         let ground = settings
             .contact
@@ -181,9 +194,15 @@ impl Body {
             if settings.loads.any_external() {
                 pins.truncate(3);
             }
+            let mut sorted = pins.clone();
+            sorted.sort_unstable();
+            groups.push(SupportGroup {
+                name: "rigid_pins".into(),
+                dofs: sorted,
+            });
             pins
         } else {
-            Vec::new()
+            held_dofs.clone()
         };
         let mean_edge = mesh.mean_edge_length();
         let eh = young
@@ -214,10 +233,12 @@ impl Body {
             edge_sign,
             clamped_edges,
             pinned_dofs,
+            held_dofs,
             growth,
             grown_thickness,
             ground,
             prescribed,
+            supports: groups,
         })
     }
 
@@ -333,8 +354,12 @@ impl Body {
 
     /// Moves the vertices on prescribed paths to `reference + dial × displacement`.
     pub fn prescribe(&self, x: &mut [Vec3], dial: Real) {
-        for &(v, u) in &self.prescribed {
-            x[v] = self.mesh.positions[v] + u * dial;
+        for &(v, u, mask) in &self.prescribed {
+            for k in 0..3 {
+                if mask[k] {
+                    x[v][k] = self.mesh.positions[v][k] + u[k] * dial;
+                }
+            }
         }
     }
 
@@ -481,8 +506,25 @@ struct Supports {
     fixed: Vec<bool>,
     /// The clamped boundary edges.
     clamped_edges: Vec<usize>,
-    /// Vertices on prescribed paths and their displacement at dial 1 (m).
-    prescribed: Vec<(usize, Vec3)>,
+    /// Vertices on prescribed paths, their displacement at dial 1 (m) and the components that
+    /// follow it.
+    prescribed: Vec<(usize, Vec3, [bool; 3])>,
+    /// The position DOFs (`3v + k`) held by component supports and partial paths, of vertices
+    /// not otherwise held, sorted.
+    held_dofs: Vec<usize>,
+    /// Every support, with the DOFs it holds.
+    groups: Vec<SupportGroup>,
+}
+
+/// One support of `[constraints]` (a key, or one entry of a list) and the position DOFs it
+/// holds (`3v + k`, vertex `v`, component `k`), for its reaction. A DOF held by two supports
+/// belongs to the first, in the order of the settings reference.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SupportGroup {
+    /// The settings key, e.g. `fix_boxes[0]`, `clamp[1]`, `support[0]`.
+    pub name: String,
+    /// The held DOFs, ascending.
+    pub dofs: Vec<usize>,
 }
 
 /// The supports of `[constraints]` on `mesh`, with the unused vertices held. Errors name the key
@@ -495,10 +537,28 @@ fn supports(
 ) -> Result<Supports, MeshError> {
     let nv = mesh.positions.len();
     let mut fixed: Vec<bool> = is_unused.to_vec();
+    // Which DOF each support holds, in order; `claimed` keeps a DOF in its first support.
+    let mut groups: Vec<SupportGroup> = Vec::new();
+    let mut claimed = vec![false; 3 * nv];
+    let mut group = |name: String, dofs: &mut dyn Iterator<Item = usize>| {
+        let mut d: Vec<usize> = dofs.filter(|&d| !is_unused[d / 3]).collect();
+        d.sort_unstable();
+        d.dedup();
+        d.retain(|&k| !std::mem::replace(&mut claimed[k], true));
+        groups.push(SupportGroup { name, dofs: d });
+    };
+    let all3 = |v: usize| 3 * v..3 * v + 3;
     if c.use_constraint_indicators {
         if let Some(ci) = mesh.vertex_field("constraint_indicators", 1)? {
-            for (v, &val) in ci.data.iter().enumerate() {
-                fixed[v] |= val != 0.0;
+            let on: Vec<usize> = (0..nv).filter(|&v| ci.data[v] != 0.0).collect();
+            for &v in &on {
+                fixed[v] = true;
+            }
+            if !on.is_empty() {
+                group(
+                    "constraint_indicators".into(),
+                    &mut on.iter().flat_map(|&v| all3(v)),
+                );
             }
         }
     }
@@ -506,9 +566,6 @@ fn supports(
         let tags = mesh.vertex_field("node_tags", 1)?.ok_or_else(|| {
             mesh.invalid("constraints.fix_tags needs the per-vertex field 'node_tags'")
         })?;
-        for (v, &t) in tags.data.iter().enumerate() {
-            fixed[v] |= c.fix_tags.contains(&(t.round() as i64));
-        }
         // A tag that fixes nothing is a mistake (a load selecting nothing is one too).
         for (i, &tag) in c.fix_tags.iter().enumerate() {
             if !tags.data.iter().any(|&t| t.round() as i64 == tag) {
@@ -518,20 +575,34 @@ fn supports(
                 )));
             }
         }
+        let on: Vec<usize> = (0..nv)
+            .filter(|&v| c.fix_tags.contains(&(tags.data[v].round() as i64)))
+            .collect();
+        for &v in &on {
+            fixed[v] = true;
+        }
+        group("fix_tags".into(), &mut on.iter().flat_map(|&v| all3(v)));
     }
     for (i, b) in c.fix_boxes.iter().enumerate() {
-        let mut any = false;
-        for (v, p) in mesh.positions.iter().enumerate() {
-            let inside = (0..3).all(|k| p[k] >= b.min[k] && p[k] <= b.max[k]);
-            fixed[v] |= inside;
-            any |= inside;
-        }
-        if !any {
+        let on: Vec<usize> = (0..nv)
+            .filter(|&v| {
+                let p = mesh.positions[v];
+                (0..3).all(|k| p[k] >= b.min[k] && p[k] <= b.max[k])
+            })
+            .collect();
+        if on.is_empty() {
             return Err(mesh.invalid(format!(
                 "constraints.fix_boxes[{i}] (min {:?}, max {:?}) selects no vertex",
                 b.min, b.max
             )));
         }
+        for &v in &on {
+            fixed[v] = true;
+        }
+        group(
+            format!("fix_boxes[{i}]"),
+            &mut on.iter().flat_map(|&v| all3(v)),
+        );
     }
     let mut clamped_edges = Vec::new();
     for (i, sel) in c.clamp.iter().enumerate() {
@@ -555,10 +626,11 @@ fn supports(
                 ring[v] = true;
             }
         }
+        let mut held = vec![false; nv];
         for ends in &topo.edges {
             if ring[ends[0]] || ring[ends[1]] {
-                fixed[ends[0]] = true;
-                fixed[ends[1]] = true;
+                held[ends[0]] = true;
+                held[ends[1]] = true;
             }
         }
         if clamped_edges.len() == before {
@@ -567,28 +639,85 @@ fn supports(
                  a boundary edge must be selected"
             )));
         }
+        for v in 0..nv {
+            fixed[v] |= held[v];
+        }
+        group(
+            format!("clamp[{i}]"),
+            &mut (0..nv).filter(|&v| held[v]).flat_map(all3),
+        );
     }
-    let mut prescribed = Vec::new();
+    // Components held by supports, per vertex.
+    let mut comp = vec![[false; 3]; nv];
+    for (i, sp) in c.support.iter().enumerate() {
+        let what = format!("constraints.support[{i}]");
+        let mask = crate::config::constraints::component_mask(Some(&sp.components));
+        let on = select::select_vertices(mesh, &sp.on, &what)?;
+        for &v in &on {
+            for k in 0..3 {
+                comp[v][k] |= mask[k];
+            }
+        }
+        group(
+            format!("support[{i}]"),
+            &mut on
+                .iter()
+                .flat_map(|&v| (0..3).filter(|&k| mask[k]).map(move |k| 3 * v + k)),
+        );
+    }
+    let mut prescribed: Vec<(usize, Vec3, [bool; 3])> = Vec::new();
     for (i, pd) in c.displacement.iter().enumerate() {
         let what = format!("constraints.displacement[{i}]");
-        for v in select::select_vertices(mesh, &pd.on, &what)? {
-            if fixed[v] || prescribed.iter().any(|&(u, _)| u == v) {
+        let mask = crate::config::constraints::component_mask(pd.components.as_deref());
+        let on = select::select_vertices(mesh, &pd.on, &what)?;
+        for &v in &on {
+            if fixed[v] || prescribed.iter().any(|&(u, _, _)| u == v) {
                 return Err(mesh.invalid(format!(
                     "{what}: vertex {v} is already fixed or given another prescribed path; a \
                      vertex is either held, or moved along one path"
                 )));
             }
-            prescribed.push((v, Vec3::from(pd.displacement)));
+            if let Some(k) = (0..3).find(|&k| mask[k] && comp[v][k]) {
+                return Err(mesh.invalid(format!(
+                    "{what}: vertex {v}'s {} component is also held by a support \
+                     (constraints.support); a component is either held, or moved along a path",
+                    ["x", "y", "z"][k]
+                )));
+            }
+            prescribed.push((v, Vec3::from(pd.displacement), mask));
+        }
+        group(
+            format!("displacement[{i}]"),
+            &mut on
+                .iter()
+                .flat_map(|&v| (0..3).filter(|&k| mask[k]).map(move |k| 3 * v + k)),
+        );
+    }
+    for &(v, _, mask) in &prescribed {
+        for k in 0..3 {
+            comp[v][k] |= mask[k];
         }
     }
-    for &(v, _) in &prescribed {
-        fixed[v] = true;
+    // A vertex with its three components held is a held vertex.
+    for v in 0..nv {
+        if comp[v] == [true; 3] {
+            fixed[v] = true;
+        }
     }
+    let held_dofs = (0..nv)
+        .filter(|&v| !fixed[v])
+        .flat_map(|v| {
+            let c = comp[v];
+            (0..3).filter(move |&k| c[k]).map(move |k| 3 * v + k)
+        })
+        .collect();
 
     Ok(Supports {
         fixed,
         clamped_edges,
         prescribed,
+        held_dofs,
+        groups,
     })
 }
 

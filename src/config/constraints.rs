@@ -1,4 +1,5 @@
-//! `[constraints]`: held vertices (boxes, tags, selections), clamps and prescribed paths.
+//! `[constraints]`: held vertices (boxes, tags, selections), clamps, per-component supports and
+//! prescribed paths.
 
 use super::selection::{FixBox, Selection};
 use super::values::vec_e;
@@ -20,9 +21,55 @@ pub struct Constraints {
     /// are selected, those vertices and their edge neighbours (one ring) are held, and with
     /// edge DOFs the boundary edges' rotations too: positions and rotation (default: none).
     pub clamp: Vec<Selection>,
+    /// Per-component supports (`[[constraints.support]]`): the selected vertices' listed
+    /// components are held at their reference values, the others stay free (rollers,
+    /// diaphragms, a symmetry plane that is a coordinate plane) (default: none).
+    pub support: Vec<Support>,
     /// Prescribed displacements (`[[constraints.displacement]]`): selected vertices move to
     /// `reference + dial × displacement` (default: none).
     pub displacement: Vec<Prescribed>,
+}
+
+/// A Cartesian component of a vertex's position.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Axis {
+    /// x.
+    X,
+    /// y.
+    Y,
+    /// z.
+    Z,
+}
+
+impl Axis {
+    /// The component's index (x 0, y 1, z 2).
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+            Axis::Z => 2,
+        }
+    }
+}
+
+/// The components in `list` as a mask (all three when `list` is `None`).
+pub fn component_mask(list: Option<&[Axis]>) -> [bool; 3] {
+    match list {
+        None => [true; 3],
+        Some(l) => [0, 1, 2].map(|k| l.iter().any(|a| a.index() == k)),
+    }
+}
+
+/// A per-component support.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Support {
+    /// The held components, e.g. `["x", "z"]` (at least one).
+    pub components: Vec<Axis>,
+    /// The vertices.
+    #[serde(flatten)]
+    pub on: Selection,
 }
 
 /// A prescribed displacement path.
@@ -31,6 +78,10 @@ pub struct Constraints {
 pub struct Prescribed {
     /// Displacement at dial 1 (m).
     pub displacement: [Real; 3],
+    /// The components that follow the path (default: all three); the others stay free and
+    /// their entries of `displacement` are not used.
+    #[serde(default)]
+    pub components: Option<Vec<Axis>>,
     /// The vertices.
     #[serde(flatten)]
     pub on: Selection,
@@ -43,6 +94,7 @@ impl Default for Constraints {
             fix_tags: Vec::new(),
             fix_boxes: Vec::new(),
             clamp: Vec::new(),
+            support: Vec::new(),
             displacement: Vec::new(),
         }
     }
@@ -66,7 +118,16 @@ impl Constraints {
         for (i, sel) in cs.clamp.iter().enumerate() {
             ck.selection(&format!("constraints.clamp[{i}]"), sel)?;
         }
+        for (i, sp) in cs.support.iter().enumerate() {
+            let key = format!("constraints.support[{i}]");
+            components(&format!("{key}.components"), Some(&sp.components))?;
+            ck.selection(&key, &sp.on)?;
+        }
         for (i, d) in cs.displacement.iter().enumerate() {
+            components(
+                &format!("constraints.displacement[{i}].components"),
+                d.components.as_deref(),
+            )?;
             // A displacement moves vertices: it is bounded like the coordinates themselves.
             let max = crate::mesh::MAX_COORDINATE;
             if !d
@@ -86,5 +147,67 @@ impl Constraints {
             ck.selection(&format!("constraints.displacement[{i}]"), &d.on)?;
         }
         Ok(())
+    }
+}
+
+/// A component list must name at least one component, each once.
+fn components(key: &str, list: Option<&[Axis]>) -> Result<(), Invalid> {
+    let Some(l) = list else {
+        return Ok(());
+    };
+    if l.is_empty() {
+        return Check.inv(key, "needs at least one of \"x\", \"y\", \"z\"".into());
+    }
+    if let Some(a) = l
+        .iter()
+        .enumerate()
+        .find_map(|(i, a)| l[..i].contains(a).then_some(a))
+    {
+        return Check.inv(key, format!("lists {a:?} twice"));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Constraints {
+        toml::from_str(text).unwrap()
+    }
+
+    #[test]
+    fn a_support_needs_distinct_components() {
+        let ok = parse("[[support]]\ncomponents = [\"x\", \"z\"]\ntags = [1]\n");
+        assert!(ok.validate().is_ok());
+        assert_eq!(
+            component_mask(Some(&ok.support[0].components)),
+            [true, false, true]
+        );
+        let none = parse("[[support]]\ncomponents = []\ntags = [1]\n");
+        let e = none.validate().unwrap_err();
+        assert_eq!(e.key, "constraints.support[0].components");
+        let twice = parse("[[support]]\ncomponents = [\"y\", \"y\"]\ntags = [1]\n");
+        assert!(twice.validate().unwrap_err().reason.contains("twice"));
+        assert!(
+            toml::from_str::<Constraints>("[[support]]\ncomponents = [\"w\"]\ntags = [1]\n")
+                .is_err()
+        );
+    }
+
+    #[test]
+    fn a_path_defaults_to_all_components() {
+        let c = parse("[[displacement]]\ndisplacement = [0, 0, 1]\ntags = [1]\n");
+        assert!(c.validate().is_ok());
+        assert_eq!(
+            component_mask(c.displacement[0].components.as_deref()),
+            [true; 3]
+        );
+        let z =
+            parse("[[displacement]]\ndisplacement = [0, 0, 1]\ncomponents = [\"z\"]\ntags = [1]\n");
+        assert_eq!(
+            component_mask(z.displacement[0].components.as_deref()),
+            [false, false, true]
+        );
     }
 }

@@ -28,7 +28,9 @@ pub struct Solver {
     /// `"static"` or `"dynamic"` (default: `"static"`).
     pub mode: Mode,
     /// Newton converges when ‖∇E‖∞ ≤ tolerance × F, with F = max(E·h) × mean edge length, the
-    /// membrane force of a unit strain on one edge (dimensionless, default: `1e-9`).
+    /// membrane force of a unit strain on one edge, or in static mode the largest applied
+    /// nodal load (at least 1e-4 of the former) when that is smaller (dimensionless, default:
+    /// `1e-9`).
     pub tolerance: Real,
     /// Newton iterations allowed per solve before the step is cut (default: `40`).
     pub max_newton_iterations: usize,

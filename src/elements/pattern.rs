@@ -146,9 +146,13 @@ impl Pattern {
     /// Records the entries in the rows and columns of `dofs` (see [`Pattern::pinned_entries`]).
     pub fn pin(&mut self, dofs: &[usize]) {
         self.pinned.clear();
+        let mut pinned = vec![false; self.n];
+        for &d in dofs {
+            pinned[d] = true;
+        }
         for col in 0..self.n {
             for k in self.col_ptr[col]..self.col_ptr[col + 1] {
-                if dofs.contains(&col) || dofs.contains(&self.row_idx[k]) {
+                if pinned[col] || pinned[self.row_idx[k]] {
                     self.pinned.push(k);
                 }
             }

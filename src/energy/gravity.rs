@@ -9,6 +9,7 @@ use crate::math::{Mat3, Real, Vec3};
 pub struct Gravity;
 
 impl VertexKernel for Gravity {
+    const LOAD: bool = true;
     #[inline]
     fn eval(&self, pot: &Potential, _: &[Real], v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
         let g = pot.gravity;

@@ -103,6 +103,9 @@ pub struct Potential<'a> {
     /// gradient hands each part's node sums to it instead of writing the gradient vector
     /// ([`crate::elements::assemble_elements_owned`]). `None` everywhere else.
     pub owned: Option<&'a crate::elements::OwnedNodes<'a>>,
+    /// The force scale F of the residual (N): the body's, `max(E h) × mean edge`, or in
+    /// statics the applied loads' when smaller ([`Potential::load_scale`]).
+    pub force_scale: Real,
     /// The stateful terms' states the potential is evaluated with ([`crate::solve::State::terms`]): the
     /// scene's initial states unless a driver sets its own.
     pub states: &'a TermStates,
@@ -180,7 +183,7 @@ impl<'a> Potential<'a> {
     }
 
     /// The relative residual of a gradient: `max(‖g_x‖∞, ‖g_φ‖∞ / ℓ, maxₖ |g_k| / ℓ_k) / F`,
-    /// with `F` the scene's force scale, `ℓ` its mean edge length (an edge DOF's gradient is a
+    /// with `F` the potential's force scale ([`Potential::force_scale`]), `ℓ` the mean edge length (an edge DOF's gradient is a
     /// moment, N·m) and `ℓ_k` global DOF k's declared length
     /// ([`crate::energy::term::GlobalDof::length`]).
     pub fn residual(&self, grad: &[Real]) -> Real {
@@ -192,7 +195,7 @@ impl<'a> Potential<'a> {
             .iter()
             .zip(self.globals)
             .fold(0.0 as Real, |m, (v, g)| m.max(v.abs() / g.length));
-        let f = self.body.force_scale.max(Real::MIN_POSITIVE);
+        let f = self.force_scale.max(Real::MIN_POSITIVE);
         gx.max(gp / self.body.mean_edge).max(gg) / f
     }
 
@@ -298,6 +301,76 @@ impl<'a> Potential<'a> {
         for &d in &self.body.pinned_dofs {
             v[d] = 0.0;
         }
+    }
+
+    /// The applied loads' force scale at `(x, phi)` (N): the largest component of their forces
+    /// on the free DOFs of the vertices ([`crate::energy::term::Term::applied_load`]), 0
+    /// without loads. A static solve measures its residual against it when it is below the
+    /// body's scale, so that a load small against the sheet's stiffness is still solved to the
+    /// tolerance relative to itself.
+    pub fn load_scale(&self, x: &[Vec3], phi: &[Real]) -> Real {
+        let mut g = vec![0.0; self.pattern.n];
+        for (term, map) in self.terms.iter().zip(&self.pattern.maps) {
+            if term.applied_load() {
+                term.eval(
+                    self,
+                    map,
+                    x,
+                    phi,
+                    Want::Gradient,
+                    HessianProjection::None,
+                    &mut g,
+                    &mut [],
+                );
+            }
+        }
+        for &d in &self.body.pinned_dofs {
+            g[d] = 0.0;
+        }
+        g[..3 * self.pattern.num_vertices]
+            .iter()
+            .fold(0.0, |m: Real, v| m.max(v.abs()))
+    }
+
+    /// The support reactions at `(x, phi)`: per vertex, the force the supports exert on it (N),
+    /// `∂Φ/∂x` evaluated with nothing held, on the held vertices and the held components of the
+    /// others ([`crate::body::Body::pinned_dofs`]), zero elsewhere. At an equilibrium the
+    /// reactions and the applied loads sum to zero (every term but the loads is invariant under
+    /// translations), and so do their moments (the edge rotations a clamp holds are relative
+    /// to the faces and carry no moment of their own).
+    pub fn reactions(&self, x: &[Vec3], phi: &[Real]) -> Vec<Vec3> {
+        let nv = self.pattern.num_vertices;
+        let free = vec![false; self.node_fixed.len()];
+        let pot = Potential {
+            node_fixed: &free,
+            owned: None,
+            ..*self
+        };
+        let mut g = vec![0.0; self.pattern.n];
+        for (term, map) in self.terms.iter().zip(&self.pattern.maps) {
+            term.eval(
+                &pot,
+                map,
+                x,
+                phi,
+                Want::Gradient,
+                HessianProjection::None,
+                &mut g,
+                &mut [],
+            );
+        }
+        let mut held = vec![[false; 3]; nv];
+        for (v, h) in held.iter_mut().enumerate() {
+            if self.node_fixed[v] {
+                *h = [true; 3];
+            }
+        }
+        for &d in &self.body.pinned_dofs {
+            held[d / 3][d % 3] = true;
+        }
+        (0..nv)
+            .map(|v| Vec3::from_fn(|k, _| if held[v][k] { g[3 * v + k] } else { 0.0 }))
+            .collect()
     }
 
     /// Energies by term name at `(x, phi)` (each term's [`crate::energy::term::energies`]).

@@ -132,6 +132,12 @@ pub trait Term: Send + Sync {
         None
     }
 
+    /// Whether the term is an applied load (gravity, point, traction, pressure, moment): its
+    /// forces set the static solver's force scale ([`Potential::load_scale`]) (default: no).
+    fn applied_load(&self) -> bool {
+        false
+    }
+
     /// A term with a dense low-rank Hessian part declares it here (default: none).
     fn low_rank(&self) -> Option<&dyn LowRankPart> {
         None
@@ -517,6 +523,8 @@ pub trait ElementKernel<const N: usize, const S: usize>: Send + Sync {
     /// element Hessians (not for a split that is not itself meaningful, such as the cones of an
     /// enclosed volume, whose per-face Hessians depend on the origin).
     const PROJECTABLE: bool = true;
+    /// Whether the kernel is an applied load ([`Term::applied_load`]).
+    const LOAD: bool = false;
 
     /// Energy of element `e` with stencil `nodes`, optional gradient and Hessian in the local
     /// DOF order of the stencil's slots. `gauss_newton` asks for a positive semi-definite
@@ -548,6 +556,9 @@ pub struct ElementTerm<K, const N: usize, const S: usize> {
 impl<K: ElementKernel<N, S>, const N: usize, const S: usize> Term for ElementTerm<K, N, S> {
     fn name(&self) -> &'static str {
         self.name
+    }
+    fn applied_load(&self) -> bool {
+        K::LOAD
     }
     fn stencil(&self, body: &Body) -> Stencil {
         (self.stencil)(body, &self.kernel)
@@ -584,6 +595,8 @@ impl<K: ElementKernel<N, S>, const N: usize, const S: usize> Term for ElementTer
 
 /// A per-vertex kernel: energy, gradient (N) and Hessian (N/m) of one vertex at `x`.
 pub trait VertexKernel: Send + Sync {
+    /// Whether the kernel is an applied load ([`Term::applied_load`]).
+    const LOAD: bool = false;
     /// `None` when the vertex does not contribute. `own` is the kernel's own state
     /// ([`VertexKernel::initial_state`], fetched once per evaluation; empty without one).
     fn eval(&self, pot: &Potential, own: &[Real], v: usize, x: &Vec3)
@@ -652,6 +665,9 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
     fn name(&self) -> &'static str {
         self.name
     }
+    fn applied_load(&self) -> bool {
+        K::LOAD
+    }
     fn explicit(&self) -> Option<&dyn ExplicitHooks> {
         self.kernel.explicit_hooks().then_some(self)
     }
@@ -678,7 +694,7 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
         grad: &mut [Real],
         values: &mut [Real],
     ) -> Real {
-        let fixed = &pot.body.fixed;
+        let fixed = pot.node_fixed;
         let own = pot.term_state(self.name);
         assemble_elements::<3, 1, _>(
             map,

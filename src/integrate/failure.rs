@@ -38,7 +38,18 @@ pub enum RunError {
 #[non_exhaustive]
 pub enum RunFailure {
     /// Statics: the dial increment was halved below `solver.min_continuation_step`.
-    #[error("continuation step fell below {min_h} at dial {dial:.6}: {cause}", min_h = crate::math::human(*.min))]
+    #[error(
+        "continuation step fell below {min_h} at dial {dial:.6}: {cause}. The residual is \
+         ‖∇Φ‖∞ relative to the force scale F = {f_h} N ({scale_of}) and must reach \
+         solver.tolerance = {tol_h} (a hold, the end, or a written frame) or {loose_h} (other \
+         steps); {ran_out}",
+        min_h = crate::math::human(*.min),
+        f_h = crate::math::human(*.force_scale),
+        tol_h = crate::math::human(*.tolerance),
+        loose_h = crate::math::human(*.loose),
+        scale_of = if *.from_loads { "from the applied loads" } else { "max(E h) × mean edge" },
+        ran_out = ran_out(cause)
+    )]
     ContinuationStep {
         /// The minimum increment.
         min: Real,
@@ -46,6 +57,14 @@ pub enum RunFailure {
         dial: Real,
         /// The last solve's failure.
         cause: SolveError,
+        /// The tolerance of holds, the end and written frames.
+        tolerance: Real,
+        /// The tolerance of the other steps.
+        loose: Real,
+        /// The force scale F (N).
+        force_scale: Real,
+        /// Whether F is the applied loads' scale.
+        from_loads: bool,
     },
     /// Statics under a prescribed gas pressure: no equilibrium beyond a pressure (a limit
     /// point of the pressure–volume curve, or a snap).
@@ -168,4 +187,20 @@ pub(super) fn interruption(what: &'static str, at: Real) -> Option<RunFailure> {
         what,
         at,
     })
+}
+
+/// What ran out in a failed continuation step, and what to change.
+fn ran_out(cause: &SolveError) -> &'static str {
+    match cause {
+        SolveError::NotConverged { .. } => {
+            "the Newton iterations ran out first: raise solver.max_newton_iterations, or lower \
+             solver.continuation_step so that each step starts closer to its equilibrium"
+        }
+        SolveError::LineSearchStalled { .. } => {
+            "the line search stalled before the tolerance: the tolerance may be below the \
+             round-off of the energy at this force scale (raise solver.tolerance), or the path \
+             has a limit point here (the load has a maximum: control a displacement instead)"
+        }
+        _ => "the step size ran out: every smaller step failed the same way",
+    }
 }

@@ -215,14 +215,15 @@ pub fn run(
         }
     }
     let sb = s.config.symmetry_breaking;
-    // A restart with its driver's state continues the state it is given, planar or not.
-    if sb > 0.0 && driver.is_none() && is_planar(scene, &state.x) {
-        perturb(
-            scene,
-            &mut state.x,
-            sb * scene.body.mean_edge,
-            s.config.seed,
-        );
+    // A restart with its driver's state continues the state it is given, planar or not,
+    // unless that state is a planar start the run perturbed right after writing it.
+    let pending = driver.as_ref().is_none_or(|d| d.perturb_pending);
+    if sb > 0.0 && pending && is_planar(scene, &state.x) {
+        // The first frame shows the reference state; the drivers start from the perturbed one.
+        s.reference = Some(state.clone());
+        let amplitude = sb * scene.body.mean_edge;
+        perturb(scene, &mut state.x, amplitude, s.config.seed);
+        s.summary.symmetry_breaking = Some(amplitude);
     }
     let ran = match s.config.mode {
         Mode::Static => statics::run_static(&mut s, writer, progress, state, dial.or(start)),

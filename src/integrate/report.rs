@@ -121,6 +121,12 @@ pub struct LogRow {
     /// Quantities the terms log (load–displacement measures), by column name.
     #[serde(skip)]
     pub observables: Vec<(String, Real)>,
+    /// Each support's total reaction ([`reactions`]).
+    #[serde(skip)]
+    pub reactions: Vec<Reaction>,
+    /// The reaction at every vertex (N; zero where nothing is held).
+    #[serde(skip)]
+    pub reaction_field: Vec<Vec3>,
     /// Relative residual ‖∇Φ‖∞/F of the last solve.
     pub residual: Real,
     /// Newton iterations since the previous frame.
@@ -224,6 +230,16 @@ pub struct Summary {
     /// Explicit mode: its time step, time scales and cost.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub explicit: Option<ExplicitReport>,
+    /// The residual's force scale F (N): `max(E h) × mean edge`, or in statics the largest
+    /// applied nodal load when smaller.
+    pub force_scale: Real,
+    /// The amplitude of the symmetry-breaking perturbation of a planar start (m): every free
+    /// vertex moved along its normal by up to this much after the first frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub symmetry_breaking: Option<Real>,
+    /// Each support's total reaction at the last frame (none without supports).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub reactions: Vec<Reaction>,
 }
 
 impl Summary {
@@ -315,6 +331,72 @@ pub fn energies_of(pot: &Potential, terms: Vec<(&'static str, Real)>, v: &[Vec3]
         terms,
         kinetic,
     }
+}
+
+/// The total reaction of one support (`[constraints]` key or list entry): the sum of the forces
+/// it exerts on the sheet and their moment about the origin, `Σ x × R`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Reaction {
+    /// The support, as in the settings (`fix_boxes[0]`, `support[1]`, `rigid_pins`, ...).
+    pub support: String,
+    /// Total force (N).
+    pub force: [Real; 3],
+    /// Total moment about the origin (N·m).
+    pub moment: [Real; 3],
+}
+
+impl Reaction {
+    /// The support's name in column names: `fix_boxes[0]` → `fix_boxes_0`.
+    pub fn column_name(&self) -> String {
+        self.support.replace('[', "_").replace(']', "")
+    }
+
+    /// `log.csv`'s columns: `reaction_force_NAME_x|y|z` (N) and `reaction_moment_NAME_x|y|z`
+    /// (N·m).
+    pub fn columns(&self) -> Vec<(String, Real)> {
+        let n = self.column_name();
+        let mut out = Vec::with_capacity(6);
+        for (what, v) in [("force", self.force), ("moment", self.moment)] {
+            for (c, x) in ["x", "y", "z"].iter().zip(v) {
+                out.push((format!("reaction_{what}_{n}_{c}"), x));
+            }
+        }
+        out
+    }
+}
+
+/// The reactions of `pot`'s supports at `state`: per vertex ([`Potential::reactions`]) and
+/// per support ([`crate::body::Body::supports`]), in the settings' order.
+pub fn reactions(pot: &Potential, state: &State) -> (Vec<Vec3>, Vec<Reaction>) {
+    let body = pot.body;
+    if body.supports.is_empty() {
+        return (Vec::new(), Vec::new());
+    }
+    let pot = &Potential {
+        states: &state.terms,
+        ..*pot
+    };
+    let r = pot.reactions(&state.x, &state.dofs);
+    let totals = body
+        .supports
+        .iter()
+        .map(|g| {
+            let (mut f, mut m) = (Vec3::zeros(), Vec3::zeros());
+            for &d in &g.dofs {
+                let (v, k) = (d / 3, d % 3);
+                let mut rv = Vec3::zeros();
+                rv[k] = r[v][k];
+                f += rv;
+                m += state.x[v].cross(&rv);
+            }
+            Reaction {
+                support: g.name.clone(),
+                force: f.into(),
+                moment: m.into(),
+            }
+        })
+        .collect();
+    (r, totals)
 }
 
 /// `summary` as JSON with every `null` (a non-finite number) left out, and the dotted paths

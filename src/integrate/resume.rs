@@ -47,6 +47,9 @@ pub struct DriverState {
     pub globals: Vec<Real>,
     /// Their velocities (dynamics).
     pub global_velocities: Vec<Real>,
+    /// The frame is the reference state of a planar start, which the run perturbs right after
+    /// writing it (the symmetry breaking): a restart from it perturbs it the same way.
+    pub perturb_pending: bool,
 }
 
 impl DriverState {

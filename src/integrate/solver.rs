@@ -32,6 +32,11 @@ pub(super) fn apply_inverse(
 /// Multiplier updates allowed per solve (see [`Solver::solve`]).
 pub(super) const MAX_UPDATES: usize = 50;
 
+/// The smallest static force scale, relative to the body's `max(E h) × mean edge`: with the
+/// default tolerance 1e-9, a residual of 1e-13 of the body's scale, 25× the round-off floor
+/// measured on a cantilever whose load is 6e-7 of its membrane stiffness.
+const ROUND_OFF_FLOOR: Real = 1e-4;
+
 pub(super) struct Solver<'a> {
     pub(super) scene: &'a Scene,
     /// The current sparsity pattern (replaced when a term's elements change, see
@@ -50,6 +55,12 @@ pub(super) struct Solver<'a> {
     pub(super) at_last_frame: Counters,
     /// The driver's state as of the next frame (the drivers keep it current).
     pub(super) driver: DriverState,
+    /// The residual's force scale (N): the body's, or in statics the applied loads' when
+    /// smaller ([`Potential::load_scale`]).
+    pub(super) force_scale: Real,
+    /// The unperturbed start of a perturbed planar one: the first frame shows it, not the
+    /// perturbation (which the summary reports as `symmetry_breaking`).
+    pub(super) reference: Option<State>,
 }
 
 /// Counters that log rows report per frame.
@@ -97,7 +108,7 @@ impl<'a> Solver<'a> {
             warnings: scene.body.warnings.clone(),
             ..Default::default()
         };
-        Ok(Solver {
+        let mut s = Solver {
             scene,
             pattern: std::sync::Arc::new(pattern),
             changing,
@@ -108,7 +119,27 @@ impl<'a> Solver<'a> {
             start: Instant::now(),
             at_last_frame: Counters::default(),
             driver: DriverState::default(),
-        })
+            reference: None,
+            force_scale: scene.body.force_scale,
+        };
+        // Statics: a load small against the sheet's stiffness sets the residual's scale, so
+        // that every load step is solved relative to the load itself; but not below
+        // ROUND_OFF_FLOOR × the body's scale, where the gradient's round-off (about 4e-15 of
+        // it, measured on a stiff cantilever) would keep the tolerance out of reach.
+        if s.config.mode == Mode::Static {
+            let pat = s.pattern();
+            let phi = vec![0.0; scene.num_scalar_dofs()];
+            let load = s
+                .potential(&pat, 1.0)
+                .load_scale(&scene.body.mesh.positions, &phi);
+            if load > 0.0 {
+                s.force_scale = s
+                    .force_scale
+                    .min(load.max(ROUND_OFF_FLOOR * scene.body.force_scale));
+            }
+        }
+        s.summary.force_scale = s.force_scale;
+        Ok(s)
     }
 
     /// The current pattern, for potentials to borrow.
@@ -172,6 +203,7 @@ impl<'a> Solver<'a> {
             dial,
             gravity: self.config.gravity,
             stretch_scale,
+            force_scale: self.force_scale,
             ..Potential::new(self.scene, pattern)
         }
     }
@@ -242,13 +274,19 @@ impl<'a> Solver<'a> {
         v: &[Vec3],
         time: Real,
     ) -> Result<(), RunError> {
+        let reference = self.reference.take();
+        let state = reference.as_ref().unwrap_or(state);
         let (now, last) = (Counters::of(&self.summary), self.at_last_frame);
+        let (reaction_field, reactions) = super::report::reactions(pot, state);
+        self.summary.reactions.clone_from(&reactions);
         let row = LogRow {
             frame: 0,
             time,
             dial: pot.dial,
             energy: Default::default(),
             observables: Vec::new(),
+            reactions,
+            reaction_field,
             residual: self.summary.residual,
             newton_iterations: now.newton - last.newton,
             steps: now.steps - last.steps,
@@ -261,6 +299,7 @@ impl<'a> Solver<'a> {
         let clock = Instant::now();
         let mut driver = self.driver.clone();
         driver.mode = self.summary.mode.clone();
+        driver.perturb_pending = reference.is_some();
         driver.globals = state.dofs[self.scene.body.num_edge_dofs()..].to_vec();
         for (name, own) in state.terms.iter() {
             if !own.is_empty() {

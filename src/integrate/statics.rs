@@ -16,6 +16,10 @@ pub(super) fn run_static(
     let cf = s.config.statics.clone();
     let opts = s.config.newton;
     let tol = opts.tol;
+    // Intermediate continuation steps need not be solved to full accuracy, unless they are
+    // written: every frame (and its row of the load–displacement curve) is converged to the
+    // tolerance.
+    let loose = (tol * 1e3).min(1e-5).max(tol);
     let (min_step, sb, seed) = (cf.min_step, s.config.symmetry_breaking, s.config.seed);
     let (check, max_escapes) = (cf.check_stability, cf.max_saddle_escapes);
     let cont_frames = cf.continuation_frames;
@@ -63,12 +67,9 @@ pub(super) fn run_static(
         } else {
             (1.0, (scale * ratio).min(1.0))
         };
-        // Intermediate continuation steps need not be solved to full accuracy, unless they are
-        // written: every frame (and its row of the load–displacement curve) is converged to
-        // the tolerance.
         let at_hold = holds.contains(&target) && target > dial;
         let t = if (target < 1.0 || target_scale < 1.0) && !cont_frames && !at_hold {
-            (tol * 1e3).min(1e-5).max(tol)
+            loose
         } else {
             tol
         };
@@ -148,6 +149,10 @@ pub(super) fn run_static(
                         min: min_step,
                         dial,
                         cause: rep.failure_or_unknown(),
+                        tolerance: tol,
+                        loose,
+                        force_scale: s.force_scale,
+                        from_loads: s.force_scale < s.scene.body.force_scale,
                     },
                 });
                 break;

@@ -40,14 +40,23 @@ pub fn is_planar(scene: &Scene, x: &[Vec3]) -> bool {
     true
 }
 
-/// Moves free vertices along their normals by `amp × u`, u uniform in [−1, 1) (seeded).
+/// Moves free vertices along their normals by `amp × u`, u uniform in [−1, 1) (seeded); the
+/// components a support holds ([`crate::body::Body::held_dofs`]) stay.
 pub fn perturb(scene: &Scene, x: &mut [Vec3], amp: Real, seed: u64) {
     let normals = vertex_normals(scene, x);
+    let mut free = vec![[true; 3]; x.len()];
+    for &d in &scene.body.held_dofs {
+        free[d / 3][d % 3] = false;
+    }
     let mut rng = Rng::new(seed);
     for (v, p) in x.iter_mut().enumerate() {
         let u = rng.symmetric();
         if !scene.body.fixed[v] {
-            *p += normals[v] * (amp * u);
+            for k in 0..3 {
+                if free[v][k] {
+                    p[k] += normals[v][k] * (amp * u);
+                }
+            }
         }
     }
 }

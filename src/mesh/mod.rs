@@ -226,6 +226,7 @@ pub const FRAME_FIELDS: [&[&str]; 2] = [
     &[
         "displacement",
         "velocity",
+        "reaction",
         "angle_deficit",
         "angle_deficit_gauss_curvature",
     ],

@@ -25,6 +25,7 @@ pub struct NodalForces {
 }
 
 impl VertexKernel for NodalForces {
+    const LOAD: bool = true;
     #[inline]
     fn eval(&self, pot: &Potential, _: &[Real], v: usize, x: &Vec3) -> Option<(Real, Vec3, Mat3)> {
         let f = self.force[v] * pot.dial;

@@ -265,6 +265,9 @@ impl Term for MomentTerm {
     fn name(&self) -> &'static str {
         NAME
     }
+    fn applied_load(&self) -> bool {
+        true
+    }
     fn stencil(&self, body: &Body) -> Stencil {
         let p = &body.mesh.positions;
         let has_edges = body.has_edge_dofs();

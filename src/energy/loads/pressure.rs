@@ -30,6 +30,7 @@ pub struct Pressure {
 impl ElementKernel<9, 3> for Pressure {
     /// The per-face split of `∇²V` depends on the origin: never projected face by face.
     const PROJECTABLE: bool = false;
+    const LOAD: bool = true;
 
     #[inline]
     fn eval(

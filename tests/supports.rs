@@ -1,0 +1,305 @@
+//! Supports through the binary: per-component supports and partial paths against the exact
+//! uniaxial state of a St Venant–Kirchhoff sheet, the reactions of every support against the
+//! applied loads (force and moment balance), and the bad inputs of supports.
+
+mod common;
+use common::{run_status, shellsim};
+use shellsim::mesh::io::read_mesh;
+use std::path::Path;
+
+fn summary(dir: &Path, out: &str) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join(out).join("summary.json")).unwrap())
+        .unwrap()
+}
+
+fn rectangle(dir: &Path, lx: f64, ly: f64, edge: f64, jitter: &str, name: &str) {
+    let (lx, ly, edge) = (lx.to_string(), ly.to_string(), edge.to_string());
+    shellsim(
+        &[
+            "mesh",
+            "rectangle",
+            "--lx",
+            &lx,
+            "--ly",
+            &ly,
+            "--edge",
+            &edge,
+            "--jitter",
+            jitter,
+            "-o",
+            name,
+        ],
+        dir,
+    );
+}
+
+/// The reaction of support `name` in a summary: (force, moment).
+fn reaction(s: &serde_json::Value, name: &str) -> ([f64; 3], [f64; 3]) {
+    let r = s["reactions"]
+        .as_array()
+        .unwrap_or_else(|| panic!("no reactions in {s}"))
+        .iter()
+        .find(|r| r["support"] == name)
+        .unwrap_or_else(|| panic!("no reaction of {name} in {s}"));
+    let v = |k: &str| [0, 1, 2].map(|i| r[k][i].as_f64().unwrap());
+    (v("force"), v("moment"))
+}
+
+/// The stretch λ of a St Venant–Kirchhoff bar in uniaxial stress with first Piola–Kirchhoff
+/// stress `p` (Pa): `λ E (λ² − 1)/2 = p`, by Newton.
+fn uniaxial_stretch(e: f64, p: f64) -> f64 {
+    let mut l: f64 = 1.0;
+    for _ in 0..60 {
+        l -= (l * e * (l * l - 1.0) / 2.0 - p) / (e * (3.0 * l * l - 1.0) / 2.0);
+    }
+    l
+}
+
+/// A jittered square on rollers: x held on the edge x = −0.5, y held at one corner, z held
+/// everywhere (an in-plane problem), pulled by a uniform traction t on x = +0.5. The exact
+/// state is uniaxial: `λx E (λx² − 1)/2 = t/h`, `E_yy = −ν E_xx`, so the rollers let the sheet
+/// contract across; every edge must have its exact length to 1e-6, the roller vertices keep
+/// their x, and the rollers' reaction is −t·width in x, with zero y and z components, to 1e-9
+/// of the load.
+#[test]
+fn rollers_let_a_pulled_sheet_contract_exactly() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    rectangle(dir, 1.0, 1.0, 0.1, "0.25", "sq.vtk");
+    let (e, nu, h, t) = (1e6, 0.3, 0.01, 500.0);
+    std::fs::write(
+        dir.join("r.toml"),
+        format!(
+            "[material]\nyoung = {e}\npoisson = {nu}\nthickness = {h}\n\
+             [solver]\ntolerance = 1e-11\nsymmetry_breaking = 0\n\
+             [[constraints.support]]\ncomponents = [\"x\"]\ninside = {{ min = [-1, -1, -1], max = [-0.499, 1, 1] }}\n\
+             [[constraints.support]]\ncomponents = [\"y\"]\ninside = {{ min = [-1, -1, -1], max = [-0.499, -0.499, 1] }}\n\
+             [[constraints.support]]\ncomponents = [\"z\"]\ninside = {{ min = [-1, -1, -1], max = [1, 1, 1] }}\n\
+             [[loads.traction]]\ntraction = [{t}, 0, 0]\ninside = {{ min = [0.499, -1, -1], max = [1, 1, 1] }}\n"
+        ),
+    )
+    .unwrap();
+    shellsim(&["r.toml", "sq.vtk", "--out", "o", "-q"], dir);
+    let s = summary(dir, "o");
+    assert_eq!(s["converged"], true, "{s}");
+    let lx = uniaxial_stretch(e, t / h);
+    let exx = (lx * lx - 1.0) / 2.0;
+    let ly = (1.0 - 2.0 * nu * exx).sqrt();
+    let mesh = read_mesh(&dir.join("sq.vtk")).unwrap();
+    let frame = read_mesh(&dir.join("o").join(s["final_frame"].as_str().unwrap())).unwrap();
+    let x = &frame.positions;
+    let mut worst: f64 = 0.0;
+    for f in &mesh.faces {
+        for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+            let r = mesh.positions[f[j]] - mesh.positions[f[i]];
+            let want = (lx * r.x).powi(2) + (ly * r.y).powi(2);
+            worst = worst.max(((x[f[j]] - x[f[i]]).norm_squared() / want - 1.0).abs());
+        }
+    }
+    println!("rollers: λx = {lx}, λy = {ly}, worst edge-length² error {worst:.2e}");
+    assert!(
+        1.0 - ly > 0.005,
+        "the sheet must contract measurably: λy = {ly}"
+    );
+    assert!(worst < 1e-6, "not the uniaxial state: {worst:e}");
+    let mut contracted: f64 = 0.0;
+    for (v, p) in mesh.positions.iter().enumerate() {
+        assert_eq!(x[v].z, p.z, "vertex {v} left its plane");
+        if p.x < -0.499 {
+            assert_eq!(x[v].x, p.x, "roller vertex {v} moved in x");
+            contracted = contracted.max((x[v].y - p.y).abs());
+        }
+    }
+    assert!(contracted > 1e-3, "the rollers held y: {contracted}");
+    let load = t * 1.0;
+    let (f, _) = reaction(&s, "support[0]");
+    println!("roller reaction {f:?} against the load {load} N");
+    assert!((f[0] + load).abs() < 1e-9 * load, "{f:?}");
+    let (fy, _) = reaction(&s, "support[1]");
+    let (fz, _) = reaction(&s, "support[2]");
+    assert!(
+        fy[1].abs() < 1e-9 * load && fz[2].abs() < 1e-9 * load,
+        "{fy:?} {fz:?}"
+    );
+    // The frame's per-vertex reactions sum to the supports' totals.
+    let field = &frame.vertex_fields["reaction"];
+    let total_x: f64 = field.data.chunks(3).map(|r| r[0]).sum();
+    assert!((total_x + load).abs() < 1e-9 * load, "{total_x}");
+}
+
+/// A partial path: the edge x = +0.5 of the same sheet is moved by δ along x only (its y and z
+/// free), on the rollers of the previous test. The sheet is then in uniaxial stress with
+/// `λx = 1 + δ`, and the path's reaction is the force that stretch needs,
+/// `P = λx E E_xx h · width` (first Piola–Kirchhoff), within 1e-6; the rollers carry −P.
+#[test]
+fn a_partial_path_stretches_and_reports_its_force() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    rectangle(dir, 1.0, 1.0, 0.1, "0.25", "sq.vtk");
+    let (e, nu, h, delta) = (1e6, 0.3, 0.01, 0.02);
+    std::fs::write(
+        dir.join("p.toml"),
+        format!(
+            "[material]\nyoung = {e}\npoisson = {nu}\nthickness = {h}\n\
+             [solver]\ntolerance = 1e-11\nsymmetry_breaking = 0\n\
+             [[constraints.support]]\ncomponents = [\"x\"]\ninside = {{ min = [-1, -1, -1], max = [-0.499, 1, 1] }}\n\
+             [[constraints.support]]\ncomponents = [\"y\"]\ninside = {{ min = [-1, -1, -1], max = [-0.499, -0.499, 1] }}\n\
+             [[constraints.support]]\ncomponents = [\"z\"]\ninside = {{ min = [-1, -1, -1], max = [0.499, 1, 1] }}\n\
+             [[constraints.displacement]]\ndisplacement = [{delta}, 5, 5]\ncomponents = [\"x\"]\n\
+             inside = {{ min = [0.499, -1, -1], max = [1, 1, 1] }}\n"
+        ),
+    )
+    .unwrap();
+    shellsim(&["p.toml", "sq.vtk", "--out", "o", "-q"], dir);
+    let s = summary(dir, "o");
+    assert_eq!(s["converged"], true, "{s}");
+    let lx = 1.0 + delta;
+    let exx = (lx * lx - 1.0) / 2.0;
+    let force = lx * e * exx * h * 1.0;
+    let mesh = read_mesh(&dir.join("sq.vtk")).unwrap();
+    let frame = read_mesh(&dir.join("o").join(s["final_frame"].as_str().unwrap())).unwrap();
+    for (v, p) in mesh.positions.iter().enumerate() {
+        if p.x > 0.499 {
+            assert_eq!(frame.positions[v].x, p.x + delta, "vertex {v} off its path");
+            assert!(
+                frame.positions[v].y != p.y || (p.y + 0.5).abs() < 1e-9,
+                "y held at {v}"
+            );
+        }
+    }
+    let (path, _) = reaction(&s, "displacement[0]");
+    let (rollers, _) = reaction(&s, "support[0]");
+    println!("path reaction {path:?}, rollers {rollers:?}, closed form {force} N");
+    assert!((path[0] / force - 1.0).abs() < 1e-6, "{path:?} vs {force}");
+    assert!((path[0] + rollers[0]).abs() < 1e-9 * force);
+}
+
+/// A cantilever strip clamped at x = −0.5 under gravity and a point load at its tip, bent
+/// far (tip deflection ≈ 0.3 of its length). At the equilibrium the clamp's reaction balances
+/// the weight and the load, and its moment about the origin balances theirs (Σ x × f over the
+/// final positions): the imbalance is the sum of the free DOFs' residual forces, so it is
+/// bounded by their number × tolerance × F (`force_scale`), and here below 1e-7 of the load.
+#[test]
+fn a_clamp_reaction_balances_the_weight_and_the_load() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    rectangle(dir, 1.0, 0.1, 0.025, "0", "c.vtk");
+    let (e, h, rho, g, p) = (1e7, 0.02, 100.0, 9.81, 0.05);
+    std::fs::write(
+        dir.join("c.toml"),
+        format!(
+            "[material]\nyoung = {e}\npoisson = 0.3\nthickness = {h}\ndensity = {rho}\n\
+             [solver]\nsymmetry_breaking = 0\n\
+             [loads]\ngravity = [0, 0, -{g}]\n\
+             [[loads.point]]\nforce = [0, 0, -{p}]\ninside = {{ min = [0.499, -1, -1], max = [1, 1, 1] }}\n\
+             [[constraints.clamp]]\ninside = {{ min = [-1, -1, -1], max = [-0.499, 1, 1] }}\n"
+        ),
+    )
+    .unwrap();
+    shellsim(&["c.toml", "c.vtk", "--out", "o", "-q"], dir);
+    let s = summary(dir, "o");
+    assert_eq!(s["converged"], true, "{s}");
+    let mesh = read_mesh(&dir.join("c.vtk")).unwrap();
+    let frame = read_mesh(&dir.join("o").join(s["final_frame"].as_str().unwrap())).unwrap();
+    let x = &frame.positions;
+    let nv = mesh.positions.len();
+    // The applied loads: the lumped weights (ρ h A/3 per face corner) and the tip load shared
+    // by the tip vertices, at the final positions.
+    let mut f_ext = vec![[0.0f64; 3]; nv];
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let w = rho * h * mesh.face_area(f) / 3.0 * g;
+        for &v in face {
+            f_ext[v][2] -= w;
+        }
+    }
+    let tip: Vec<usize> = (0..nv).filter(|&v| mesh.positions[v].x >= 0.499).collect();
+    for &v in &tip {
+        f_ext[v][2] -= p / tip.len() as f64;
+    }
+    // Every vertex's load counts, the held ones' too: it goes straight into their support.
+    let (mut fsum, mut msum) = ([0.0f64; 3], [0.0f64; 3]);
+    for v in 0..nv {
+        let (r, q) = (f_ext[v], x[v]);
+        let m = [
+            q.y * r[2] - q.z * r[1],
+            q.z * r[0] - q.x * r[2],
+            q.x * r[1] - q.y * r[0],
+        ];
+        for k in 0..3 {
+            fsum[k] += r[k];
+            msum[k] += m[k];
+        }
+    }
+    let (f, m) = reaction(&s, "clamp[0]");
+    let load = -fsum[2];
+    let tip_z = tip.iter().map(|&v| x[v].z).sum::<f64>() / tip.len() as f64;
+    println!("clamp reaction {f:?} / {m:?}; loads {fsum:?} / {msum:?}; tip z {tip_z}");
+    assert!(tip_z < -0.2, "the strip must bend far: tip z {tip_z}");
+    for k in 0..3 {
+        assert!(
+            (f[k] + fsum[k]).abs() < 1e-9 * load,
+            "force {k}: {f:?} vs {fsum:?}"
+        );
+        assert!(
+            (m[k] + msum[k]).abs() < 1e-9 * load,
+            "moment {k}: {m:?} vs {msum:?}"
+        );
+    }
+    // log.csv carries the same totals at the last frame.
+    let log = std::fs::read_to_string(dir.join("o/log.csv")).unwrap();
+    let head: Vec<&str> = log.lines().next().unwrap().split(',').collect();
+    let last: Vec<&str> = log.lines().last().unwrap().split(',').collect();
+    let col = head
+        .iter()
+        .position(|h| *h == "reaction_force_clamp_0_z")
+        .unwrap_or_else(|| panic!("no reaction column in {head:?}"));
+    let logged: f64 = last[col].parse().unwrap();
+    assert!(
+        (logged - f[2]).abs() <= 1e-12 * load,
+        "{logged} vs {}",
+        f[2]
+    );
+}
+
+/// Bad supports: a selection of no vertex, no component, a component listed twice, an unknown
+/// component, and a component both held and on a path, each exit 2 naming the key.
+#[test]
+fn bad_supports_are_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    rectangle(dir, 1.0, 0.5, 0.1, "0", "r.vtk");
+    let cases: [(&str, &[&str]); 5] = [
+        (
+            "[[constraints.support]]\ncomponents = [\"x\"]\ninside = { min = [5, 5, 5], max = [6, 6, 6] }\n",
+            &["constraints.support[0]", "selects no vertex"],
+        ),
+        (
+            "[[constraints.support]]\ncomponents = []\ntags = [1]\n",
+            &["constraints.support[0].components", "at least one"],
+        ),
+        (
+            "[[constraints.support]]\ncomponents = [\"z\", \"z\"]\ntags = [1]\n",
+            &["constraints.support[0].components", "twice"],
+        ),
+        (
+            "[[constraints.support]]\ncomponents = [\"w\"]\ntags = [1]\n",
+            &["components", "w"],
+        ),
+        (
+            "[[constraints.support]]\ncomponents = [\"x\"]\ninside = { min = [0.49, -1, -1], max = [1, 1, 1] }\n\
+             [[constraints.displacement]]\ndisplacement = [0.1, 0, 0]\ncomponents = [\"x\", \"y\"]\n\
+             inside = { min = [0.49, -1, -1], max = [1, 1, 1] }\n",
+            &["constraints.displacement[0]", "x component", "constraints.support"],
+        ),
+    ];
+    for (settings, needles) in cases {
+        std::fs::write(dir.join("bad.toml"), settings).unwrap();
+        let (code, _, err) = run_status(&["bad.toml", "r.vtk", "--out", "obad", "-q"], dir);
+        assert_eq!(code, 2, "{settings}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{settings}: '{n}' not in: {err}");
+        }
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(!dir.join("obad").exists(), "a refused run wrote its folder");
+    }
+}
