@@ -23,7 +23,8 @@ pub struct Constraints {
     pub clamp: Vec<Selection>,
     /// Per-component supports (`[[constraints.support]]`): the selected vertices' listed
     /// components are held at their reference values, the others stay free (rollers,
-    /// diaphragms, a symmetry plane that is a coordinate plane) (default: none).
+    /// diaphragms; the in-plane half of a symmetry condition, whose rotation stays free)
+    /// (default: none).
     pub support: Vec<Support>,
     /// Prescribed displacements (`[[constraints.displacement]]`): selected vertices move to
     /// `reference + dial × displacement` (default: none).
