@@ -199,9 +199,15 @@ impl<'a> Solver<'a> {
     where
         'a: 'p,
     {
+        // Statics ramps every applied load with the dial, gravity too: a continuation step
+        // then adds a fraction of the weight, not all of it at once from the reference shape.
+        let gravity = match self.config.mode {
+            Mode::Static => self.config.gravity * dial,
+            _ => self.config.gravity,
+        };
         Potential {
             dial,
-            gravity: self.config.gravity,
+            gravity,
             stretch_scale,
             force_scale: self.force_scale,
             ..Potential::new(self.scene, pattern)
