@@ -466,12 +466,14 @@ pub fn height_from_a(a: &Sym2, i: usize) -> (Real, SVec<3>, Mat3) {
     (h, gh, hh)
 }
 
-/// Second fundamental form of one face (value only), 6 stencil positions as in the module doc.
+/// Second fundamental form of one face (value only), 6 stencil positions as in the module doc;
+/// a boundary edge with its mid-edge normal set in space (`set[i]`) takes [`set_edge_u`].
 pub fn midedge_angle_b(
     x: &[Vec3; 6],
     has: [bool; 3],
     phi: &[Real; 3],
     sigma: [Real; 3],
+    set: [Option<EdgeNormal>; 3],
     variant: AngleVariant,
 ) -> Sym2 {
     let xf = [x[0], x[1], x[2]];
@@ -480,15 +482,124 @@ pub fn midedge_angle_b(
     let mut q = SVec::<3>::zeros();
     for i in 0..3 {
         let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-        let qt = if has[i] {
+        let (qt, psi) = if let Some(en) = &set[i] {
+            (set_edge_u(en, &xf, i).0, 0.0)
+        } else if has[i] {
             let ng = UnitNormal::new(&[x[3 + i], xf[k], xf[j]]).n;
-            (xf[j] - xf[i]).dot(&ng) / (nf.n + ng).norm()
+            (
+                (xf[j] - xf[i]).dot(&ng) / (nf.n + ng).norm(),
+                sigma[i] * phi[i],
+            )
         } else {
-            0.0
+            (0.0, sigma[i] * phi[i])
         };
         let h = height_from_a(&a, i).0;
         let w = (h * h - qt * qt).max(0.0).sqrt();
-        q[i] = h * variant.eval(qt.atan2(w) + sigma[i] * phi[i]).0;
+        q[i] = h * variant.eval(qt.atan2(w) + psi).0;
     }
     b_from_q(&q)
+}
+
+/// A boundary edge's mid-edge normal set in space, for the bending models with edge DOFs: the
+/// second-order clamp and the symmetry plane. The edge's own rotation DOF is then unused (and
+/// held); its `q` follows from the normal ([`set_edge_u`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EdgeNormal {
+    /// The normal is this fixed unit vector: a clamp holds the reference face normal (its rest
+    /// angle), whatever the face does.
+    Fixed(Vec3),
+    /// The normal lies in the symmetry plane of unit normal `normal`, across the edge:
+    /// `t = sign · N × e / |N × e|` (`e` the edge in the face's order, `sign` making `t` point
+    /// to the face's side at the reference), so that the surface meets the plane at a right
+    /// angle as mirror symmetry requires.
+    Plane {
+        /// The plane's unit normal `N`.
+        normal: Vec3,
+        /// ±1.
+        sign: Real,
+    },
+}
+
+/// `u = (m − v_i)·t` (m) of the face's edge `i` (opposite `v_i`, from `v_j` to `v_k` in face
+/// order, midpoint `m`) whose mid-edge normal `t` is set in space ([`EdgeNormal`]), with its
+/// gradient over the face's three vertices (9 entries, `[v0, v1, v2]`). With `t` a unit vector
+/// normal to the edge, `u = h_i sin ψ` for the angle ψ from the face normal to `t` about the
+/// edge, the same quantity as the mid-edge average's `q_i = (v_j − v_i)·n_e` with `n_e = t`
+/// ([`midedge_average_q`]); so the edge-DOF models take `u` in place of the average's `q̃_i`
+/// with no rotation of their own (`q_i = h_i g(asin(u/h_i))`).
+///
+/// Fixed `t`: `∇u = (−t at v_i, t/2 at v_j and v_k)`, no second derivative. Plane: with
+/// `p = v_i − m`, `e = v_k − v_j`, `c = N × e`, `r = |c|` and `P = I − N Nᵀ`,
+/// `u = −sign · p·c / r`, `∂/∂p = c/r`, `∂/∂e = (p × N)/r − (p·c) P e / r³` (times `−sign`).
+#[inline]
+pub fn set_edge_u(en: &EdgeNormal, xf: &[Vec3; 3], i: usize) -> (Real, SVec<9>) {
+    let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+    let p = xf[i] - (xf[j] + xf[k]) * 0.5;
+    let mut g = SVec::<9>::zeros();
+    let (u, gp, ge) = match *en {
+        EdgeNormal::Fixed(t) => (-p.dot(&t), -t, Vec3::zeros()),
+        EdgeNormal::Plane { normal: n, sign } => {
+            let e = xf[k] - xf[j];
+            let c = n.cross(&e);
+            let r = c.norm();
+            let pc = p.dot(&c);
+            let pe = e - n * n.dot(&e);
+            (
+                -sign * pc / r,
+                c * (-sign / r),
+                (p.cross(&n) / r - pe * (pc / (r * r * r))) * (-sign),
+            )
+        }
+    };
+    // p = v_i − (v_j + v_k)/2, e = v_k − v_j.
+    for c in 0..3 {
+        g[3 * i + c] = gp[c];
+        g[3 * j + c] = -0.5 * gp[c] - ge[c];
+        g[3 * k + c] = -0.5 * gp[c] + ge[c];
+    }
+    (u, g)
+}
+
+/// The Hessian of [`set_edge_u`] over `[v0, v1, v2]` (9×9): zero for a fixed normal; for a
+/// plane, `−sign` times the second derivatives of `p·c/r` in `(p, e)`:
+/// `H_pp = 0`, `H_pe = [N]ₓ/r − c (Pe)ᵀ/r³`,
+/// `H_ee = −((p×N)(Pe)ᵀ + (Pe)(p×N)ᵀ + (p·c) P)/r³ + 3 (p·c)(Pe)(Pe)ᵀ/r⁵`,
+/// pulled back through `p = v_i − (v_j + v_k)/2`, `e = v_k − v_j`.
+#[inline]
+pub fn set_edge_u_hessian(en: &EdgeNormal, xf: &[Vec3; 3], i: usize) -> SMat<9, 9> {
+    let mut h = SMat::<9, 9>::zeros();
+    let EdgeNormal::Plane { normal: n, sign } = *en else {
+        return h;
+    };
+    let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+    let p = xf[i] - (xf[j] + xf[k]) * 0.5;
+    let e = xf[k] - xf[j];
+    let c = n.cross(&e);
+    let r = c.norm();
+    let (r3, r5) = (r * r * r, r * r * r * r * r);
+    let pc = p.dot(&c);
+    let pe = e - n * n.dot(&e);
+    let pxn = p.cross(&n);
+    let nx = skew(&n);
+    let proj = Mat3::identity() - n * n.transpose();
+    let hpe = (nx / r - c * pe.transpose() / r3) * (-sign);
+    let hee = ((pxn * pe.transpose() + pe * pxn.transpose() + proj * pc) * (-1.0 / r3)
+        + pe * pe.transpose() * (3.0 * pc / r5))
+        * (-sign);
+    // Coefficients of p and e per vertex (i, j, k).
+    let mut cp = [0.0; 3];
+    let mut ce = [0.0; 3];
+    cp[i] = 1.0;
+    cp[j] = -0.5;
+    cp[k] = -0.5;
+    ce[j] = -1.0;
+    ce[k] = 1.0;
+    for a in 0..3 {
+        for b in 0..3 {
+            let blk =
+                hpe * (cp[a] * ce[b]) + hpe.transpose() * (ce[a] * cp[b]) + hee * (ce[a] * ce[b]);
+            h.fixed_view_mut::<3, 3>(3 * a, 3 * b).copy_from(&blk);
+        }
+    }
+    h
 }

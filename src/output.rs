@@ -697,6 +697,7 @@ impl Writer {
             .terms
             .iter()
             .flat_map(|t| crate::energy::term::observables(t.as_ref(), pot, x, phi))
+            .chain(row.path.iter().cloned())
             .chain(row.reactions.iter().flat_map(|r| r.columns()))
             .collect();
         if !row.reaction_field.is_empty() {

@@ -45,10 +45,28 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
         path: name.clone(),
         reason,
     };
+    let driver = read_driver_state(path)?;
+    // An arc-length frame's series time is its path coordinate; its dial is in its state file.
+    let arc_dial = driver
+        .as_ref()
+        .filter(|d| !d.arc_length.is_empty())
+        .map(|d| d.dial);
     let time = match series_time(path) {
         Some(t) => {
             let t = t.map_err(&bad)?;
-            check_time(scene, t).map_err(bad)?;
+            match arc_dial {
+                Some(d) => {
+                    if !(t.is_finite() && t >= 0.0) {
+                        return Err(bad(format!(
+                            "series.pvd gives the arc-length frame the path coordinate {}, \
+                             not a finite number ≥ 0",
+                            crate::math::human(t)
+                        )));
+                    }
+                    check_time(scene, d).map_err(&bad)?;
+                }
+                None => check_time(scene, t).map_err(&bad)?,
+            }
             Some(t)
         }
         None => None,
@@ -59,7 +77,6 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
             "{name}: not listed in a series.pvd next to it; the restart starts at time 0"
         ));
     }
-    let driver = read_driver_state(path)?;
     let mut state = state;
     if !scene.globals.is_empty() {
         // The global DOFs (a force-controlled obstacle's offset) are in the state file only.
@@ -105,7 +122,7 @@ pub fn read_restart(path: &Path, scene: &Scene) -> Result<(InitialState, Vec<Str
             state,
             v,
             time: time.unwrap_or(0.0),
-            dial: None,
+            dial: arc_dial,
             driver,
         },
         warnings,

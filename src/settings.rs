@@ -25,7 +25,7 @@ pub use crate::config::output::{Output, Precision, Snapshots, NOT_DEFAULT_FIELDS
 pub use crate::config::rest::{LceSettings, Rest, TargetForms};
 pub use crate::config::selection::{FixBox, Selection};
 pub use crate::config::slides::{SlideControl, Slides};
-pub use crate::config::solver::{Mode, Solver};
+pub use crate::config::solver::{Continuation, Mode, Solver};
 pub use crate::config::time::Time;
 pub use crate::config::values::{Auto, AutoOr, Field, Softening};
 

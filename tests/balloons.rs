@@ -348,7 +348,8 @@ fn gas_amount_equilibria_satisfy_the_gas_law_and_the_membrane_law() {
 }
 
 /// Under a prescribed pressure above the neo-Hookean limit the run stops (exit 1) naming the
-/// limit point, never reporting a false equilibrium; below it, it converges on the rising branch.
+/// limit point and the material's own limit stretch (a Mooney–Rivlin balloon's too), never
+/// reporting a false equilibrium; below it, it converges on the rising branch.
 #[test]
 fn pressure_control_stops_at_the_limit_point() {
     let dir = tempfile::tempdir().unwrap();
@@ -377,9 +378,35 @@ fn pressure_control_stops_at_the_limit_point() {
     );
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("limit point"), "{err}");
+    // It names the material's own limit stretch, 7^(1/6), and the controls that pass it.
+    assert!(err.contains("peaks at the stretch 1.3831"), "{err}");
+    assert!(err.contains("arc_length"), "{err}");
     let sm = summary(&out);
     assert_eq!(sm["converged"], false);
     assert!(sm["reason"].as_str().unwrap().contains("volume"), "{sm}");
+    // A Mooney–Rivlin balloon (c₂/c₁ = 0.1) peaks later, at λ = 1.47607, and says so.
+    let mr = write(
+        d,
+        "mr.toml",
+        &format!(
+            "[material]\nbending = \"none\"\nthickness = 0.01\nmodel = \"mooney_rivlin\"\n\
+             c1 = 5e5\nc2 = 5e4\n[gas]\ncontrol = \"pressure\"\npressure = {}\n",
+            1.05 * 14906.2 / 0.9985
+        ),
+    );
+    let out = d.join("mr");
+    let (code, err) = run(
+        &[
+            mr.to_str().unwrap(),
+            &mesh,
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+        ],
+        d,
+    );
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("peaks at the stretch 1.4761"), "{err}");
     // Below the limit: an equilibrium on the rising branch, λ < λ*.
     let out = d.join("below");
     shellsim(

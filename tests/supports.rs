@@ -1,9 +1,10 @@
 //! Supports through the binary: per-component supports and partial paths against the exact
 //! uniaxial state of a St Venant–Kirchhoff sheet, the reactions of every support against the
-//! applied loads (force and moment balance), and the bad inputs of supports.
+//! applied loads (force and moment balance), symmetry planes (a quarter model equals the whole),
+//! and the bad inputs of supports.
 
 mod common;
-use common::{run_status, shellsim};
+use common::{cylinder_patch, run_status, shellsim};
 use shellsim::mesh::io::read_mesh;
 use std::path::Path;
 
@@ -178,8 +179,9 @@ fn a_partial_path_stretches_and_reports_its_force() {
 /// far (tip deflection ≈ 0.4 of its length), solved from the flat strip with default solver
 /// settings (statics ramps the weight with the dial like the tip load; with the full weight in
 /// every step this run did not converge). At the equilibrium the clamp's reaction balances
-/// the weight and the load, and its moment about the origin balances theirs (Σ x × f over the
-/// final positions): the imbalance is the sum of the free DOFs' residual forces, so it is
+/// the weight and the load, and its moment about the origin (its forces' moments and the
+/// couple through the boundary normals it sets, `boundary_rotations`) balances theirs (Σ x × f
+/// over the final positions): the imbalance is the sum of the free DOFs' residual forces, so it is
 /// bounded by their number × tolerance × F (`force_scale`), and here below 1e-7 of the load.
 #[test]
 fn a_clamp_reaction_balances_the_weight_and_the_load() {
@@ -232,7 +234,16 @@ fn a_clamp_reaction_balances_the_weight_and_the_load() {
             msum[k] += m[k];
         }
     }
-    let (f, m) = reaction(&s, "clamp[0]");
+    // The clamp's forces at its boundary vertices, and the couple it carries through the
+    // boundary normals it sets (the strip's bending moment at the wall).
+    let (f, mf) = reaction(&s, "clamp[0]");
+    let (f0, couple) = reaction(&s, "boundary_rotations");
+    assert_eq!(f0, [0.0; 3]);
+    let m = [0, 1, 2].map(|k| mf[k] + couple[k]);
+    assert!(
+        couple[1].abs() > 0.1 * msum[1].abs(),
+        "the clamp carries a couple: {couple:?} against {msum:?}"
+    );
     let load = -fsum[2];
     let tip_z = tip.iter().map(|&v| x[v].z).sum::<f64>() / tip.len() as f64;
     println!("clamp reaction {f:?} / {m:?}; loads {fsum:?} / {msum:?}; tip z {tip_z}");
@@ -261,6 +272,171 @@ fn a_clamp_reaction_balances_the_weight_and_the_load() {
         "{logged} vs {}",
         f[2]
     );
+}
+
+/// The Scordelis–Lo roof (MacNeal & Harder 1985): a cylindrical shell of radius 25, length 50,
+/// half angle 40°, t = 0.25, E = 4.32e8, ν = 0, on rigid diaphragms at its curved ends (x and z
+/// held; the axis is y), its straight edges free, under its weight 90 per unit area (here
+/// × 1e-3, so the response is linear: the deflection × 1e3 against the reference 0.3024 at the
+/// middle of a free edge). The quarter model θ ∈ [0, 40°], y ∈ [0, 25] with symmetry planes
+/// x = 0 and y = 0 equals the whole roof on the mirrored mesh (each quarter of the 32² roof is
+/// the 16² quarter) to the solver's tolerance: measured 1e-9. A plane through a shell that
+/// bends across it is a symmetry plane only with its boundary rotation set, so this also
+/// checks that condition. The numbers: 2048 faces whole, 0.2907 (−3.9%); quarters of 2048 and
+/// 4608 faces: 0.2980 (−1.5%) and 0.2994 (−1.0%) (docs/benchmarks.md).
+#[test]
+fn a_quarter_model_with_symmetry_planes_equals_the_whole() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let (r, th) = (25.0f64, 40f64.to_radians());
+    cylinder_patch(dir, "full.vtk", r, (-th, th), (-25.0, 25.0), (32, 32), 0.0);
+    cylinder_patch(dir, "quarter.vtk", r, (0.0, th), (0.0, 25.0), (16, 16), 0.0);
+    let common = "[material]\nthickness = 0.25\nyoung = 4.32e8\npoisson = 0.0\ndensity = 360\n\
+        [loads]\ngravity = [0, 0, -0.001]\n\
+        [[constraints.support]]\ncomponents = [\"x\", \"z\"]\n\
+        inside = { min = [-30, 24.999, -30], max = [30, 25.001, 30] }\n";
+    std::fs::write(
+        dir.join("full.toml"),
+        format!(
+            "{common}[[constraints.support]]\ncomponents = [\"x\", \"z\"]\n\
+             inside = {{ min = [-30, -25.001, -30], max = [30, -24.999, 30] }}\n\
+             [[constraints.support]]\ncomponents = [\"y\"]\n\
+             inside = {{ min = [-30, -0.001, -30], max = [30, 0.001, 30] }}\n"
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("quarter.toml"),
+        format!(
+            "{common}[[constraints.symmetry]]\naxis = \"x\"\n\
+             [[constraints.symmetry]]\naxis = \"y\"\n"
+        ),
+    )
+    .unwrap();
+    let mut w = Vec::new();
+    for m in ["full", "quarter"] {
+        shellsim(
+            &[&format!("{m}.toml"), &format!("{m}.vtk"), "--out", m, "-q"],
+            dir,
+        );
+        let s = summary(dir, m);
+        assert_eq!(s["converged"], true, "{m}: {s}");
+        let mesh = read_mesh(&dir.join(format!("{m}.vtk"))).unwrap();
+        let frame = read_mesh(&dir.join(m).join(s["final_frame"].as_str().unwrap())).unwrap();
+        // The middle of a free edge: θ = 40°, y = 0.
+        let v = (0..mesh.positions.len())
+            .min_by(|&a, &b| {
+                let dist = |v: usize| {
+                    let p = mesh.positions[v];
+                    (p.x - r * th.sin()).hypot(p.y)
+                };
+                dist(a).total_cmp(&dist(b))
+            })
+            .unwrap();
+        w.push(-1e3 * (frame.positions[v].z - mesh.positions[v].z));
+    }
+    println!(
+        "Scordelis–Lo deflection ×1e3: whole {}, quarter {} (reference 0.3024)",
+        w[0], w[1]
+    );
+    assert!((w[0] / w[1] - 1.0).abs() < 1e-6, "{w:?}");
+    assert!((w[0] / 0.3024 - 1.0).abs() < 0.05, "{w:?}");
+}
+
+/// The pinched hemisphere with an 18° hole (MacNeal & Harder 1985): radius 10, t = 0.04,
+/// E = 6.825e7, ν = 0.3, free edges, four radial point loads ±2 alternating on the equator;
+/// reference displacement 0.094 under a load. The quarter model (azimuth 0–90°, polar angle
+/// 18–90°) with symmetry planes x = 0 and y = 0 carries +1 outward at (10, 0, 0) and −1 at
+/// (0, 10, 0) (each point on a plane takes half its load), scaled by 1e-3 for a linear
+/// response; one equator vertex holds z (it carries nothing). 1152 faces: measured 0.09389
+/// (−0.12%); 2048 / 4608: −0.43% / −0.53% (MacNeal & Harder's 0.094 is itself ~0.5% above the
+/// converged thin-shell value). Asserted: within 2%, and the two loads' displacements equal.
+#[test]
+fn the_pinched_hemisphere_quarter_matches_the_reference() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let (r, n) = (10.0f64, 24usize);
+    let a0 = 18f64.to_radians();
+    let mut s = format!(
+        "# vtk DataFile Version 3.0\nhemisphere\nASCII\nDATASET POLYDATA\nPOINTS {} double\n",
+        (n + 1) * (n + 1)
+    );
+    for j in 0..=n {
+        for i in 0..=n {
+            let al = a0 + (std::f64::consts::FRAC_PI_2 - a0) * j as f64 / n as f64;
+            let be = std::f64::consts::FRAC_PI_2 * i as f64 / n as f64;
+            s += &format!(
+                "{} {} {}\n",
+                r * al.sin() * be.cos(),
+                r * al.sin() * be.sin(),
+                r * al.cos()
+            );
+        }
+    }
+    s += &format!("POLYGONS {} {}\n", 2 * n * n, 8 * n * n);
+    for j in 0..n {
+        for i in 0..n {
+            let a = j * (n + 1) + i;
+            let (b, c, e) = (a + 1, a + n + 1, a + n + 2);
+            if (i + j) % 2 == 0 {
+                s += &format!("3 {a} {e} {b}\n3 {a} {c} {e}\n");
+            } else {
+                s += &format!("3 {a} {c} {b}\n3 {b} {c} {e}\n");
+            }
+        }
+    }
+    std::fs::write(dir.join("h.vtk"), s).unwrap();
+    std::fs::write(
+        dir.join("h.toml"),
+        "[material]\nthickness = 0.04\nyoung = 6.825e7\npoisson = 0.3\n\
+         [[loads.point]]\nforce = [0.001, 0, 0]\n\
+         inside = { min = [9.999, -1e-6, -1e-6], max = [10.001, 1e-6, 1e-6] }\n\
+         [[loads.point]]\nforce = [0, -0.001, 0]\n\
+         inside = { min = [-1e-6, 9.999, -1e-6], max = [1e-6, 10.001, 1e-6] }\n\
+         [[constraints.symmetry]]\naxis = \"x\"\n[[constraints.symmetry]]\naxis = \"y\"\n\
+         [[constraints.support]]\ncomponents = [\"z\"]\n\
+         inside = { min = [7.0, 7.0, -1e-6], max = [7.1, 7.1, 1e-6] }\n",
+    )
+    .unwrap();
+    shellsim(&["h.toml", "h.vtk", "--out", "o", "-q"], dir);
+    let s = summary(dir, "o");
+    assert_eq!(s["converged"], true, "{s}");
+    let frame = read_mesh(&dir.join("o").join(s["final_frame"].as_str().unwrap())).unwrap();
+    let mesh = read_mesh(&dir.join("h.vtk")).unwrap();
+    let (va, vb) = (n * (n + 1), n * (n + 1) + n);
+    let ua = 1e3 * (frame.positions[va].x - mesh.positions[va].x);
+    let ub = -1e3 * (frame.positions[vb].y - mesh.positions[vb].y);
+    println!("pinched hemisphere, quarter of 1152 faces: {ua} and {ub} (reference 0.094)");
+    assert!((ua / 0.094 - 1.0).abs() < 0.02, "{ua}");
+    assert!((ua / ub - 1.0).abs() < 1e-4, "{ua} {ub}");
+}
+
+/// Bad symmetry planes: one that no vertex lies on, and one with a bending model that has no
+/// boundary rotation to set; each exit 2 naming the key.
+#[test]
+fn bad_symmetry_planes_are_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    rectangle(dir, 1.0, 0.5, 0.1, "0", "r.vtk");
+    let cases: [(&str, &[&str]); 2] = [
+        (
+            "[[constraints.symmetry]]\naxis = \"x\"\nat = 0.123\n",
+            &["constraints.symmetry[0]", "no vertex lies on the plane x = 0.123"],
+        ),
+        (
+            "[material]\nbending = \"patch_fit\"\n[[constraints.symmetry]]\naxis = \"x\"\nat = 0.5\n",
+            &["constraints.symmetry[0]", "midedge_sin"],
+        ),
+    ];
+    for (settings, needles) in cases {
+        std::fs::write(dir.join("bad.toml"), settings).unwrap();
+        let (code, _, err) = run_status(&["bad.toml", "r.vtk", "--out", "obad", "-q"], dir);
+        assert_eq!(code, 2, "{settings}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{settings}: '{n}' not in: {err}");
+        }
+        assert!(!dir.join("obad").exists(), "a refused run wrote its folder");
+    }
 }
 
 /// Bad supports: a selection of no vertex, no component, a component listed twice, an unknown

@@ -60,9 +60,12 @@ pub struct Body {
     /// Edge-DOF models: each face's orientation sign `σ` on its edges (+1 for the edge's first
     /// face, −1 for its second), else empty.
     pub edge_sign: Vec<[Real; 3]>,
-    /// The clamped boundary edges: with edge DOFs, their rotations are held too
-    /// ([`crate::model::Scene::node_fixed`]).
+    /// The boundary edges whose rotation a clamp holds or a symmetry plane sets: with edge
+    /// DOFs, those DOFs are held ([`crate::model::Scene::node_fixed`]).
     pub clamped_edges: Vec<usize>,
+    /// Per edge, its mid-edge normal when a clamp or a symmetry plane sets it in space (the
+    /// edge-DOF bending models, [`crate::geometry::EdgeNormal`]); empty when none is.
+    pub edge_normal: Vec<Option<crate::geometry::EdgeNormal>>,
     /// Position DOFs (`3v + k`) held at their current values while their vertex is otherwise
     /// free: the components held by `[[constraints.support]]` and by partial paths; or, in
     /// static mode with nothing held, the 6 that remove the rigid-body null space of the
@@ -148,24 +151,26 @@ impl Body {
             young,
             lame,
         } = face_material(&mesh, m)?;
+        let is_unused = unused_mask(nv, &unused);
+        // The supports first: the boundary normals they set enter the reference curvature.
+        let Supports {
+            fixed,
+            clamped_edges,
+            edge_normal,
+            prescribed,
+            held_dofs,
+            mut groups,
+        } = supports(&mesh, &topo, settings, &is_unused)?;
         let RestStage {
             rest,
             edge_sign,
             growth,
             grown_thickness,
-        } = rest_forms(&mesh, &topo, settings, &thickness)?;
+        } = rest_forms(&mesh, &topo, settings, &thickness, &edge_normal)?;
         if settings.moisture.enabled {
             check_moisture_regions(&mesh, settings)?;
         }
         let mass = lumped_masses(&mesh, &thickness, m.density);
-        let is_unused = unused_mask(nv, &unused);
-        let Supports {
-            fixed,
-            clamped_edges,
-            prescribed,
-            held_dofs,
-            mut groups,
-        } = supports(&mesh, &topo, &settings.constraints, &is_unused)?;
         // Free: no vertex that carries the sheet is held (unused vertices are held, inertly).
         let free =
             unused.len() < nv && (0..nv).all(|v| is_unused[v] || !fixed[v]) && held_dofs.is_empty();
@@ -232,6 +237,7 @@ impl Body {
             patches,
             edge_sign,
             clamped_edges,
+            edge_normal,
             pinned_dofs,
             held_dofs,
             growth,
@@ -459,6 +465,7 @@ fn rest_forms(
     topo: &Topology,
     settings: &Settings,
     thickness: &[Real],
+    edge_normal: &[Option<crate::geometry::EdgeNormal>],
 ) -> Result<RestStage, MeshError> {
     let m = &settings.material;
     let mut rest = RestForms::no_growth(mesh, topo);
@@ -471,7 +478,7 @@ fn rest_forms(
         // The reference curvature in the edge-DOF model's own terms (φ = 0), so that a curved
         // input mesh is stress-free under "no growth" for the tan variant too (sin at φ = 0
         // is the average).
-        let b0 = midedge_angle_reference_b(mesh, topo, variant);
+        let b0 = midedge_angle_reference_b(mesh, topo, variant, edge_normal);
         rest.bbar1.clone_from(&b0);
         rest.bbar0 = b0;
     }
@@ -500,12 +507,18 @@ fn lumped_masses(mesh: &Mesh, thickness: &[Real], density: Real) -> Vec<Real> {
     mass
 }
 
+/// How far from a symmetry plane a vertex may lie and be on it, relative to the mesh's
+/// bounding-box diagonal (meshes cut at a plane put their vertices on it to round-off).
+const SYMMETRY_TOLERANCE: Real = 1e-9;
+
 /// What `[constraints]` holds.
 struct Supports {
     /// True for held vertices (unused ones, indicators, tags, boxes, clamp rings, paths).
     fixed: Vec<bool>,
-    /// The clamped boundary edges.
+    /// The boundary edges whose rotation is held or set.
     clamped_edges: Vec<usize>,
+    /// Per edge, its set mid-edge normal (empty when none).
+    edge_normal: Vec<Option<crate::geometry::EdgeNormal>>,
     /// Vertices on prescribed paths, their displacement at dial 1 (m) and the components that
     /// follow it.
     prescribed: Vec<(usize, Vec3, [bool; 3])>,
@@ -532,10 +545,35 @@ pub struct SupportGroup {
 fn supports(
     mesh: &Mesh,
     topo: &Topology,
-    c: &crate::settings::Constraints,
+    settings: &Settings,
     is_unused: &[bool],
 ) -> Result<Supports, MeshError> {
+    use crate::geometry::EdgeNormal;
+    let c = &settings.constraints;
+    let bending = settings.material.bending;
+    // The edge-DOF models set a boundary edge's mid-edge normal in space.
+    let angle = bending.angle_variant().is_some();
     let nv = mesh.positions.len();
+    let mut edge_normal: Vec<Option<EdgeNormal>> = Vec::new();
+    let mut set_normal = |e: usize, en: EdgeNormal| {
+        if edge_normal.is_empty() {
+            edge_normal = vec![None; topo.edges.len()];
+        }
+        if edge_normal[e].is_none() {
+            edge_normal[e] = Some(en);
+        }
+    };
+    // A boundary edge's face, the edge's local index there (opposite vertex), and its unit
+    // reference normal.
+    let face_of = |e: usize| {
+        let f = topo.edge_faces[e][0];
+        let fv = mesh.faces[f];
+        let i = (0..3)
+            .find(|&i| !topo.edges[e].contains(&fv[i]))
+            .unwrap_or(0);
+        let [a, b, c] = mesh.face_positions(f);
+        (f, i, (b - a).cross(&(c - a)).normalize())
+    };
     let mut fixed: Vec<bool> = is_unused.to_vec();
     // Which DOF each support holds, in order; `claimed` keeps a DOF in its first support.
     let mut groups: Vec<SupportGroup> = Vec::new();
@@ -618,19 +656,26 @@ fn supports(
                 clamped_edges.push(e);
             }
         }
-        // The clamped boundary vertices and their edge neighbours (one ring) are held: the
-        // first row of faces stays rigid, which fixes the boundary's rotation.
+        // The clamped boundary vertices are held. With edge DOFs the boundary edges' mid-edge
+        // normals keep their reference direction, which holds the boundary's rotation on the
+        // boundary line itself; otherwise their edge neighbours (one ring) are held too, so the
+        // first row of faces stays rigid.
         let mut ring = vec![false; nv];
         for &e in &clamped_edges[before..] {
             for v in topo.edges[e] {
                 ring[v] = true;
             }
+            if angle {
+                set_normal(e, EdgeNormal::Fixed(face_of(e).2));
+            }
         }
-        let mut held = vec![false; nv];
-        for ends in &topo.edges {
-            if ring[ends[0]] || ring[ends[1]] {
-                held[ends[0]] = true;
-                held[ends[1]] = true;
+        let mut held = ring.clone();
+        if !angle {
+            for ends in &topo.edges {
+                if ring[ends[0]] || ring[ends[1]] {
+                    held[ends[0]] = true;
+                    held[ends[1]] = true;
+                }
             }
         }
         if clamped_edges.len() == before {
@@ -665,6 +710,86 @@ fn supports(
                 .flat_map(|&v| (0..3).filter(|&k| mask[k]).map(move |k| 3 * v + k)),
         );
     }
+    // Symmetry planes: the normal component held on the plane, and the boundary edges on it
+    // keep their mid-edge normal in the plane.
+    let tol = SYMMETRY_TOLERANCE * mesh.bbox_diagonal();
+    for (i, sy) in c.symmetry.iter().enumerate() {
+        let what = format!("constraints.symmetry[{i}]");
+        let k = sy.axis.index();
+        let axis = ["x", "y", "z"][k];
+        let on: Vec<bool> = (0..nv)
+            .map(|v| !is_unused[v] && (mesh.positions[v][k] - sy.at).abs() <= tol)
+            .collect();
+        if !on.contains(&true) {
+            return Err(mesh.invalid(format!(
+                "{what}: no vertex lies on the plane {axis} = {} (within {} m, 1e-9 of the \
+                 mesh's size); a symmetry plane cuts the model along its boundary",
+                crate::math::human(sy.at),
+                crate::math::human(tol)
+            )));
+        }
+        if matches!(
+            bending,
+            crate::settings::BendingModel::PatchFit | crate::settings::BendingModel::MidedgeAverage
+        ) {
+            return Err(mesh.invalid(format!(
+                "{what}: mirror symmetry sets the boundary's rotation (the surface meets the \
+                 plane at a right angle), which needs a bending model with edge rotations \
+                 (material.bending = \"midedge_sin\" or \"midedge_tan\"); with {bending:?} \
+                 hold the normal component with [[constraints.support]] and model the whole"
+            )));
+        }
+        let mut normal = Vec3::zeros();
+        normal[k] = 1.0;
+        let mut edges = 0usize;
+        for (e, ends) in topo.edges.iter().enumerate() {
+            if topo.edge_faces[e][1] != crate::mesh::topology::NONE || !on[ends[0]] || !on[ends[1]]
+            {
+                continue;
+            }
+            edges += 1;
+            if !angle {
+                continue;
+            }
+            let (f, li, nf) = face_of(e);
+            let fv = mesh.faces[f];
+            let ev = mesh.positions[fv[(li + 2) % 3]] - mesh.positions[fv[(li + 1) % 3]];
+            let t = normal.cross(&ev).normalize();
+            let cos = t.dot(&nf);
+            if cos.abs() < 0.1 {
+                return Err(mesh.invalid(format!(
+                    "{what}: face {f} meets the plane {axis} = {} at {:.1}° from the plane \
+                     itself; a mirror-symmetric surface crosses its plane (at 90° in the \
+                     limit of a fine mesh)",
+                    crate::math::human(sy.at),
+                    cos.abs().asin().to_degrees()
+                )));
+            }
+            set_normal(
+                e,
+                EdgeNormal::Plane {
+                    normal,
+                    sign: cos.signum(),
+                },
+            );
+            clamped_edges.push(e);
+        }
+        if angle && edges == 0 {
+            return Err(mesh.invalid(format!(
+                "{what}: no boundary edge lies on the plane {axis} = {}; a symmetry plane cuts \
+                 the model along its boundary",
+                crate::math::human(sy.at)
+            )));
+        }
+        let list: Vec<usize> = (0..nv).filter(|&v| on[v]).collect();
+        for &v in &list {
+            comp[v][k] = true;
+        }
+        group(
+            format!("symmetry[{i}]"),
+            &mut list.iter().map(|&v| 3 * v + k),
+        );
+    }
     let mut prescribed: Vec<(usize, Vec3, [bool; 3])> = Vec::new();
     for (i, pd) in c.displacement.iter().enumerate() {
         let what = format!("constraints.displacement[{i}]");
@@ -680,7 +805,8 @@ fn supports(
             if let Some(k) = (0..3).find(|&k| mask[k] && comp[v][k]) {
                 return Err(mesh.invalid(format!(
                     "{what}: vertex {v}'s {} component is also held by a support \
-                     (constraints.support); a component is either held, or moved along a path",
+                     (constraints.support or constraints.symmetry); a component is either \
+                     held, or moved along a path",
                     ["x", "y", "z"][k]
                 )));
             }
@@ -715,6 +841,7 @@ fn supports(
     Ok(Supports {
         fixed,
         clamped_edges,
+        edge_normal,
         prescribed,
         held_dofs,
         groups,
@@ -775,25 +902,49 @@ fn midedge_angle_forms(
             let ph = body.topo.face_edges[f].map(|e| phi[e]);
             (
                 crate::geometry::first_fundamental_form(&[xs[0], xs[1], xs[2]]),
-                crate::geometry::midedge_angle_b(&xs, has, &ph, body.edge_sign[f], variant),
+                crate::geometry::midedge_angle_b(
+                    &xs,
+                    has,
+                    &ph,
+                    body.edge_sign[f],
+                    set_normals(&body.edge_normal, &body.topo, f),
+                    variant,
+                ),
             )
         })
         .unzip()
 }
 
 /// Each face's second fundamental form on the reference mesh under an edge-DOF bending model
-/// with every edge DOF at zero (the orientation signs then play no part).
+/// with every edge DOF at zero (the orientation signs then play no part), and the boundary
+/// edges' mid-edge normals set where `edge_normal` sets them (a symmetry plane's: the
+/// reference shape is its rest shape with the mirror condition).
 fn midedge_angle_reference_b(
     mesh: &Mesh,
     topo: &Topology,
     variant: crate::config::shell::AngleVariant,
+    edge_normal: &[Option<crate::geometry::EdgeNormal>],
 ) -> Vec<Sym2> {
     (0..mesh.faces.len())
         .map(|f| {
             let (xs, has) = midedge_stencil(mesh, topo, &mesh.positions, f);
-            crate::geometry::midedge_angle_b(&xs, has, &[0.0; 3], [1.0; 3], variant)
+            let set = set_normals(edge_normal, topo, f);
+            crate::geometry::midedge_angle_b(&xs, has, &[0.0; 3], [1.0; 3], set, variant)
         })
         .collect()
+}
+
+/// The set mid-edge normals of face `f`'s edges (opposite `v0, v1, v2`).
+fn set_normals(
+    edge_normal: &[Option<crate::geometry::EdgeNormal>],
+    topo: &Topology,
+    f: usize,
+) -> [Option<crate::geometry::EdgeNormal>; 3] {
+    if edge_normal.is_empty() {
+        [None; 3]
+    } else {
+        topo.face_edges[f].map(|e| edge_normal[e])
+    }
 }
 
 /// Face `f`'s mid-edge stencil at positions `x`: its 3 vertices, then the far vertex across

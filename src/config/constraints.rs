@@ -1,5 +1,5 @@
-//! `[constraints]`: held vertices (boxes, tags, selections), clamps, per-component supports and
-//! prescribed paths.
+//! `[constraints]`: held vertices (boxes, tags, selections), clamps, per-component supports,
+//! symmetry planes and prescribed paths.
 
 use super::selection::{FixBox, Selection};
 use super::values::vec_e;
@@ -18,17 +18,35 @@ pub struct Constraints {
     /// Fix vertices inside any of these boxes (default: none).
     pub fix_boxes: Vec<FixBox>,
     /// Clamped boundaries (`[[constraints.clamp]]`): on the boundary edges whose two vertices
-    /// are selected, those vertices and their edge neighbours (one ring) are held, and with
-    /// edge DOFs the boundary edges' rotations too: positions and rotation (default: none).
+    /// are selected, those vertices are held and, with the edge-DOF bending models, the edges'
+    /// mid-edge normals keep their reference direction (a clamp on the boundary line itself);
+    /// with the other bending models the vertices' edge neighbours (one ring) are held too
+    /// (default: none).
     pub clamp: Vec<Selection>,
     /// Per-component supports (`[[constraints.support]]`): the selected vertices' listed
     /// components are held at their reference values, the others stay free (rollers,
     /// diaphragms; the in-plane half of a symmetry condition, whose rotation stays free)
     /// (default: none).
     pub support: Vec<Support>,
+    /// Symmetry planes (`[[constraints.symmetry]]`): the vertices on the plane keep their
+    /// normal component, and with the edge-DOF bending models the boundary edges on it keep
+    /// their mid-edge normal in the plane, so a half, quarter or octant model behaves as the
+    /// whole (default: none).
+    pub symmetry: Vec<Symmetry>,
     /// Prescribed displacements (`[[constraints.displacement]]`): selected vertices move to
     /// `reference + dial × displacement` (default: none).
     pub displacement: Vec<Prescribed>,
+}
+
+/// A symmetry plane normal to a coordinate axis.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Symmetry {
+    /// The plane's normal: `"x"`, `"y"` or `"z"`.
+    pub axis: Axis,
+    /// Where the plane cuts that axis (m, default: `0`).
+    #[serde(default)]
+    pub at: Real,
 }
 
 /// A Cartesian component of a vertex's position.
@@ -96,6 +114,7 @@ impl Default for Constraints {
             fix_boxes: Vec::new(),
             clamp: Vec::new(),
             support: Vec::new(),
+            symmetry: Vec::new(),
             displacement: Vec::new(),
         }
     }
@@ -123,6 +142,19 @@ impl Constraints {
             let key = format!("constraints.support[{i}]");
             components(&format!("{key}.components"), Some(&sp.components))?;
             ck.selection(&key, &sp.on)?;
+        }
+        for (i, sy) in cs.symmetry.iter().enumerate() {
+            let max = crate::mesh::MAX_COORDINATE;
+            if !(sy.at.is_finite() && sy.at.abs() <= max) {
+                return ck.inv(
+                    &format!("constraints.symmetry[{i}].at"),
+                    format!(
+                        "must be finite within ±{} m, got {}",
+                        crate::math::human(max),
+                        crate::math::human(sy.at)
+                    ),
+                );
+            }
         }
         for (i, d) in cs.displacement.iter().enumerate() {
             components(

@@ -21,6 +21,20 @@ pub enum Mode {
     Explicit,
 }
 
+/// How statics follow the dial (the load factor).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Continuation {
+    /// Load control: the dial rises monotonically from 0 to 1 in adaptive steps, each solved by
+    /// minimising the potential at that dial.
+    #[default]
+    Load,
+    /// Arc-length control (Crisfield's spherical method): the dial is an unknown beside the
+    /// positions, so the path continues through limit points of the load (snap-through,
+    /// snap-back, a balloon's pressure maximum).
+    ArcLength,
+}
+
 /// Solver controls.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -46,6 +60,19 @@ pub struct Solver {
     /// Static mode: the largest increment of the dial factor (dimensionless, (0, 1], default:
     /// `1.0`); with `output.continuation_frames`, the spacing of the frames along the path.
     pub max_continuation_step: Real,
+    /// Static mode: `"load"` (default) dials the loads and rest forms up monotonically;
+    /// `"arc_length"` follows the equilibrium path with the dial as an unknown, through limit
+    /// points, writing a frame per step.
+    pub continuation: Continuation,
+    /// Arc-length control: the first step's length along the path, in dial units (the path
+    /// coordinate `s` with `ds² = ‖W du‖²/ψ² + dλ²`, ψ the first tangent's displacement per unit
+    /// dial; dimensionless, default: `0.05`).
+    pub arc_length_step: Real,
+    /// Arc-length control: the largest step along the path (dimensionless, default: `0.5`).
+    pub max_arc_length_step: Real,
+    /// Arc-length control: the run ends after this many accepted steps if the dial has not
+    /// reached 1 (default: `1000`).
+    pub max_arc_length_steps: usize,
     /// Static mode: membrane continuation. The dial continuation runs with the stretching
     /// weight divided by a factor c (a sheet √c times thicker, relative to bending), then the
     /// weight is raised to its true value in warm-started solves (×10, ×100, … per solve). Thin
@@ -78,6 +105,10 @@ impl Default for Solver {
             continuation_step: 1.0,
             min_continuation_step: 1e-4,
             max_continuation_step: 1.0,
+            continuation: Continuation::Load,
+            arc_length_step: 0.05,
+            max_arc_length_step: 0.5,
+            max_arc_length_steps: 1000,
             membrane_continuation: Softening::Auto(Auto::Auto),
             symmetry_breaking: 1e-3,
             seed: 1,
@@ -127,6 +158,29 @@ impl Solver {
             }
         }
         ck.nonneg("solver.symmetry_breaking", s.symmetry_breaking)?;
+        ck.pos("solver.arc_length_step", s.arc_length_step)?;
+        ck.pos("solver.max_arc_length_step", s.max_arc_length_step)?;
+        if s.max_arc_length_step < s.arc_length_step {
+            return ck.inv(
+                "solver.max_arc_length_step",
+                format!(
+                    "must be at least solver.arc_length_step ({}), got {}",
+                    crate::math::human(s.arc_length_step),
+                    crate::math::human(s.max_arc_length_step)
+                ),
+            );
+        }
+        if s.max_arc_length_steps == 0 {
+            return ck.inv("solver.max_arc_length_steps", "must be at least 1".into());
+        }
+        if s.continuation == Continuation::ArcLength && s.mode != Mode::Static {
+            return ck.inv(
+                "solver.continuation",
+                "\"arc_length\" follows a static equilibrium path; dynamics have no load \
+                 factor to control (use mode = \"static\")"
+                    .into(),
+            );
+        }
         Ok(())
     }
 }

@@ -234,8 +234,9 @@ impl Term for Gas {
         st.energy
     }
 
+    /// Only a prescribed volume has a multiplier to update.
     fn updates(&self) -> Option<&dyn Multiplier> {
-        Some(self)
+        (self.control == GasControl::Volume).then_some(self)
     }
 
     /// Only a controlled gas predicts (amount, pressure or volume control).

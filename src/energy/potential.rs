@@ -373,6 +373,43 @@ impl<'a> Potential<'a> {
             .collect()
     }
 
+    /// The couple (N·m, about the origin) that the supports exert through the boundary
+    /// rotations they set in space (clamps and symmetry planes with edge DOFs,
+    /// [`crate::body::Body::edge_normal`]): `−Σ_v x_v × ∂E/∂x_v` over the shell's energy,
+    /// which is invariant under rigid rotations of the positions except through those set
+    /// normals. Zero when none is set. The held vertices' forces
+    /// ([`Potential::reactions`]), their moments, this couple and the applied loads balance.
+    pub fn rotation_couple(&self, x: &[Vec3], phi: &[Real]) -> Vec3 {
+        if self.body.edge_normal.is_empty() {
+            return Vec3::zeros();
+        }
+        let free = vec![false; self.node_fixed.len()];
+        let pot = Potential {
+            node_fixed: &free,
+            owned: None,
+            ..*self
+        };
+        let mut g = vec![0.0; self.pattern.n];
+        for (term, map) in self.terms.iter().zip(&self.pattern.maps) {
+            if term.name() == crate::energy::shell::NAME {
+                term.eval(
+                    &pot,
+                    map,
+                    x,
+                    phi,
+                    Want::Gradient,
+                    HessianProjection::None,
+                    &mut g,
+                    &mut [],
+                );
+            }
+        }
+        -x.iter()
+            .enumerate()
+            .map(|(v, p)| p.cross(&Vec3::new(g[3 * v], g[3 * v + 1], g[3 * v + 2])))
+            .sum::<Vec3>()
+    }
+
     /// Energies by term name at `(x, phi)` (each term's [`crate::energy::term::energies`]).
     pub fn energies(&self, x: &[Vec3], phi: &[Real]) -> Vec<(&'static str, Real)> {
         let mut out = Vec::new();

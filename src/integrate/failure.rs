@@ -66,12 +66,45 @@ pub enum RunFailure {
         /// Whether F is the applied loads' scale.
         from_loads: bool,
     },
+    /// Arc-length continuation: the step along the path was halved below
+    /// `solver.min_continuation_step`.
+    #[error(
+        "arc-length step fell below {min_h} at dial {dial:.6} (arc length {arc_h}): {cause}. \
+         The residual is ‖∇Φ‖∞ relative to F = {f_h} N and must reach solver.tolerance = \
+         {tol_h} at every step; {ran_out}",
+        min_h = crate::math::human(*.min),
+        arc_h = crate::math::human(*.arc_length),
+        f_h = crate::math::human(*.force_scale),
+        tol_h = crate::math::human(*.tolerance),
+        ran_out = arc_ran_out(cause)
+    )]
+    ArcLengthStep {
+        /// The minimum step.
+        min: Real,
+        /// The dial reached.
+        dial: Real,
+        /// The path coordinate reached.
+        arc_length: Real,
+        /// The last solve's failure.
+        cause: SolveError,
+        /// The tolerance.
+        tolerance: Real,
+        /// The force scale F (N).
+        force_scale: Real,
+    },
+    /// Arc-length continuation: no path can start from the first state.
+    #[error("arc-length continuation cannot start: {0}")]
+    ArcLengthStart(String),
     /// Statics under a prescribed gas pressure: no equilibrium beyond a pressure (a limit
     /// point of the pressure–volume curve, or a snap).
     #[error(
-        "no equilibrium found beyond a gauge pressure of {} Pa (dial {dial:.6}, enclosed volume {} m³): the balloon's pressure has a maximum there (its limit point: a rubber sphere's pressure peaks at a stretch of 7^(1/6) = 1.38) and a higher pressure has no equilibrium nearby. Prescribe the volume (gas.control = \"volume\") or the amount of gas (\"amount\") to follow the curve through it. Last solve: {cause}",
+        "no equilibrium found beyond a gauge pressure of {} Pa (dial {dial:.6}, enclosed volume {} m³): the balloon's pressure has a maximum there (its limit point{limit}) and a higher pressure has no equilibrium nearby. Follow the path through it with solver.continuation = \"arc_length\", or prescribe the volume (gas.control = \"volume\") or the amount of gas (\"amount\"). Last solve: {cause}",
         crate::math::human(*.pressure),
-        crate::math::human(*.volume)
+        crate::math::human(*.volume),
+        limit = match .limit_stretch {
+            Some(l) => format!(": a thin sphere of this material peaks at the stretch {l:.4}"),
+            None => String::new(),
+        }
     )]
     PressureLimit {
         /// The last gauge pressure with an equilibrium (Pa).
@@ -82,6 +115,9 @@ pub enum RunFailure {
         volume: Real,
         /// The last solve's failure.
         cause: SolveError,
+        /// The thin-sphere limit stretch of the material, when it has one
+        /// ([`crate::energy::membrane::thin_sphere_limit_stretch`]).
+        limit_stretch: Option<Real>,
     },
     /// Statics: raising the stretching weight back to 1 failed.
     #[error("membrane continuation stalled at stretching weight {scale_h}: {cause}", scale_h = crate::math::human(*.scale))]
@@ -199,8 +235,24 @@ fn ran_out(cause: &SolveError) -> &'static str {
         SolveError::LineSearchStalled { .. } => {
             "the line search stalled before the tolerance: the tolerance may be below the \
              round-off of the energy at this force scale (raise solver.tolerance), or the path \
-             has a limit point here (the load has a maximum: control a displacement instead)"
+             has a limit point here (the load has a maximum: follow the path through it with \
+             solver.continuation = \"arc_length\", or control a displacement)"
         }
         _ => "the step size ran out: every smaller step failed the same way",
+    }
+}
+
+/// What ran out in a failed arc-length step.
+fn arc_ran_out(cause: &SolveError) -> &'static str {
+    match cause {
+        SolveError::NotConverged { .. } => {
+            "the Newton iterations ran out first at every step length: raise \
+             solver.max_newton_iterations"
+        }
+        SolveError::Factor | SolveError::LowRankSingular => {
+            "the Hessian was singular at every step length (a support that leaves a rigid \
+             motion free, or a path exactly through a singular point)"
+        }
+        _ => "the step length ran out: every shorter step failed the same way",
     }
 }

@@ -22,6 +22,7 @@
 //! and summary to a [`Sink`] (`report.rs`: the records a run fills, the energies, and the sink
 //! that [`crate::output::Writer`] implements).
 
+mod arclength;
 pub mod config;
 mod dynamics;
 pub mod explicit;
@@ -35,6 +36,7 @@ mod solver;
 mod statics;
 mod symmetry;
 
+pub use arclength::check as check_continuation;
 pub use failure::{catch_signals, interrupted, RunError, RunFailure};
 pub use resume::{DriverState, InitialState};
 pub use symmetry::{is_planar, perturb, vertex_normals};
@@ -46,7 +48,7 @@ use solver::Solver;
 use crate::assembly::Pattern;
 use crate::math::Real;
 use crate::model::Scene;
-use crate::settings::Mode;
+use crate::settings::{Continuation, Mode};
 use crate::solve::State;
 pub use report::{OutputError, Sink, Summary};
 
@@ -226,6 +228,9 @@ pub fn run(
         s.summary.symmetry_breaking = Some(amplitude);
     }
     let ran = match s.config.mode {
+        Mode::Static if scene.settings.solver.continuation == Continuation::ArcLength => {
+            arclength::run_arc_length(&mut s, writer, progress, state, dial.or(start), driver)
+        }
         Mode::Static => statics::run_static(&mut s, writer, progress, state, dial.or(start)),
         Mode::Dynamic | Mode::Explicit => {
             let from = Resume {

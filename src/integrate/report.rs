@@ -121,6 +121,10 @@ pub struct LogRow {
     /// Quantities the terms log (load–displacement measures), by column name.
     #[serde(skip)]
     pub observables: Vec<(String, Real)>,
+    /// The driver's own columns (the arc-length path: `arc_length`, `negative_eigenvalues`,
+    /// `critical_point`), before the reactions.
+    #[serde(skip)]
+    pub path: Vec<(String, Real)>,
     /// Each support's total reaction ([`reactions`]).
     #[serde(skip)]
     pub reactions: Vec<Reaction>,
@@ -240,6 +244,47 @@ pub struct Summary {
     /// Each support's total reaction at the last frame (none without supports).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub reactions: Vec<Reaction>,
+    /// Arc-length continuation: the path traced and its critical points.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub arc_length: Option<ArcLengthReport>,
+}
+
+/// What an arc-length run traced (`summary.json`'s `arc_length`).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct ArcLengthReport {
+    /// Accepted steps.
+    pub steps: usize,
+    /// The path coordinate at the end (dial units, see `solver.arc_length_step`).
+    pub length: Real,
+    /// ψ: the displacement per unit dial of the first tangent (m), which scales the
+    /// displacement part of the arc length.
+    pub psi: Real,
+    /// How the path ended: `"dial 1"`, `"unloaded"` (back at dial 0), `"steps"`
+    /// (`solver.max_arc_length_steps`) or `"failed"` (see `reason`).
+    pub end: String,
+    /// Negative eigenvalues of the Hessian at the last point (0: a stable equilibrium).
+    pub negative_eigenvalues: usize,
+    /// Limit and bifurcation points passed, in path order.
+    pub critical_points: Vec<CriticalPoint>,
+}
+
+/// A critical point of an arc-length path.
+#[derive(Clone, Debug, Serialize)]
+pub struct CriticalPoint {
+    /// `"load_maximum"`, `"load_minimum"` (limit points: the dial's extremum along the path)
+    /// or `"bifurcation"` (a Hessian eigenvalue crossed zero with the dial still rising or
+    /// falling).
+    pub kind: String,
+    /// Its dial: a limit point's from the cubic Hermite interpolant of the dial along the path
+    /// between the two frames around it (values and slopes), a bifurcation's midway between
+    /// them.
+    pub dial: Real,
+    /// Its path coordinate, likewise.
+    pub arc_length: Real,
+    /// The first frame past it.
+    pub frame: usize,
+    /// Negative eigenvalues of the Hessian at that frame.
+    pub negative_eigenvalues: usize,
 }
 
 impl Summary {
@@ -395,6 +440,11 @@ pub fn reactions(pot: &Potential, state: &State) -> (Vec<Vec3>, Vec<Reaction>) {
                 moment: m.into(),
             }
         })
+        .chain((!body.edge_normal.is_empty()).then(|| Reaction {
+            support: "boundary_rotations".into(),
+            force: [0.0; 3],
+            moment: pot.rotation_couple(&state.x, &state.dofs).into(),
+        }))
         .collect();
     (r, totals)
 }

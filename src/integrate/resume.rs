@@ -50,6 +50,10 @@ pub struct DriverState {
     /// The frame is the reference state of a planar start, which the run perturbs right after
     /// writing it (the symmetry breaking): a restart from it perturbs it the same way.
     pub perturb_pending: bool,
+    /// The arc-length driver's numbers: `arc_length` (the path coordinate), `psi` (m per unit
+    /// dial), `step` (the next step), `direction` (±1, the sign of dλ/ds) and
+    /// `negative_eigenvalues` (the Hessian's, at this frame).
+    pub arc_length: std::collections::BTreeMap<String, Real>,
 }
 
 impl DriverState {

@@ -61,6 +61,8 @@ pub(super) struct Solver<'a> {
     /// The unperturbed start of a perturbed planar one: the first frame shows it, not the
     /// perturbation (which the summary reports as `symmetry_breaking`).
     pub(super) reference: Option<State>,
+    /// The driver's own `log.csv` columns for the next frame (the arc-length path's).
+    pub(super) path_columns: Vec<(String, Real)>,
 }
 
 /// Counters that log rows report per frame.
@@ -120,6 +122,7 @@ impl<'a> Solver<'a> {
             at_last_frame: Counters::default(),
             driver: DriverState::default(),
             reference: None,
+            path_columns: Vec::new(),
             force_scale: scene.body.force_scale,
         };
         // Statics: a load small against the sheet's stiffness sets the residual's scale, so
@@ -291,6 +294,7 @@ impl<'a> Solver<'a> {
             dial: pot.dial,
             energy: Default::default(),
             observables: Vec::new(),
+            path: std::mem::take(&mut self.path_columns),
             reactions,
             reaction_field,
             residual: self.summary.residual,

@@ -144,6 +144,9 @@ pub(super) fn run_static(
                             &s.scene.body.mesh.faces,
                         ),
                         cause: rep.failure_or_unknown(),
+                        limit_stretch: crate::energy::membrane::thin_sphere_limit_stretch(
+                            &s.scene.settings.material.membrane(),
+                        ),
                     },
                     None => RunFailure::ContinuationStep {
                         min: min_step,

@@ -63,3 +63,43 @@ pub fn finite_frames(out: &Path, ext: &str, label: &str) -> Vec<shellsim::mesh::
     }
     frames
 }
+
+/// Writes `dir/name`: a cylinder patch of radius `r` about the y axis, angle `θ ∈ [t.0, t.1]`
+/// (from +z towards +x) and `y ∈ [y.0, y.1]`, on an n × m grid of quads split along alternating
+/// diagonals (mirror-symmetric about the grid's middle lines when n and m are even), points
+/// `(r sin θ, y, r cos θ − drop)`, as legacy ASCII VTK.
+#[allow(dead_code)] // not every test crate builds shells
+pub fn cylinder_patch(
+    dir: &Path,
+    name: &str,
+    r: f64,
+    t: (f64, f64),
+    y: (f64, f64),
+    (n, m): (usize, usize),
+    drop: f64,
+) {
+    let mut s = format!(
+        "# vtk DataFile Version 3.0\npatch\nASCII\nDATASET POLYDATA\nPOINTS {} double\n",
+        (n + 1) * (m + 1)
+    );
+    for j in 0..=m {
+        for i in 0..=n {
+            let th = t.0 + (t.1 - t.0) * i as f64 / n as f64;
+            let yy = y.0 + (y.1 - y.0) * j as f64 / m as f64;
+            s += &format!("{} {} {}\n", r * th.sin(), yy, r * th.cos() - drop);
+        }
+    }
+    s += &format!("POLYGONS {} {}\n", 2 * n * m, 8 * n * m);
+    for j in 0..m {
+        for i in 0..n {
+            let a = j * (n + 1) + i;
+            let (b, c, d) = (a + 1, a + n + 1, a + n + 2);
+            if (i + j) % 2 == 0 {
+                s += &format!("3 {a} {b} {d}\n3 {a} {d} {c}\n");
+            } else {
+                s += &format!("3 {a} {b} {c}\n3 {b} {d} {c}\n");
+            }
+        }
+    }
+    std::fs::write(dir.join(name), s).unwrap();
+}

@@ -298,3 +298,108 @@ fn midedge_angle_derivatives_match_finite_differences() {
         }
     }
 }
+
+/// Mid-edge shell with a boundary edge's normal set in space (a clamp's fixed normal, a
+/// symmetry plane's): gradient and Hessian against central differences in all 21 DOFs, both
+/// variants; the set edge's rotation DOF does not enter; and `u` with the average's normal is
+/// the average's `q` (the convention that makes `u` the edge's `h sin ψ`).
+#[test]
+fn set_edge_normals_match_finite_differences() {
+    use shellsim::energy::midedge_angle::{midedge_angle_face_with, AngleVariant};
+    use shellsim::geometry::{set_edge_u, AverageQs, EdgeNormal, UnitNormal};
+    let mut rng = Rng::new(47);
+    for trial in 0..40 {
+        let variant = if trial % 2 == 0 {
+            AngleVariant::Sin
+        } else {
+            AngleVariant::Tan
+        };
+        let x = random_patch(&mut rng, 0.25);
+        let d = random_density(&mut rng, trial % 3 == 1);
+        // Edge 0 (v1 → v2) on the boundary with its normal set; edge 1 interior or boundary.
+        let has = [false, trial % 4 < 2, true];
+        let xf = [x[0], x[1], x[2]];
+        let nf = (xf[1] - xf[0]).cross(&(xf[2] - xf[0])).normalize();
+        let e = (xf[2] - xf[1]).normalize();
+        let m = e.cross(&nf);
+        let set0 = if trial % 3 == 0 {
+            // A clamp: a fixed unit normal across the edge, 0.3 rad off the face's.
+            EdgeNormal::Fixed((nf * 0.3f64.cos() + m * 0.3f64.sin()).normalize())
+        } else {
+            // A symmetry plane through the edge, tilted 0.2 rad from the face's perpendicular.
+            let n = (m * 0.2f64.cos() + nf * 0.2f64.sin()).normalize();
+            EdgeNormal::Plane {
+                normal: n,
+                sign: if n.cross(&(xf[2] - xf[1])).dot(&nf) >= 0.0 {
+                    1.0
+                } else {
+                    -1.0
+                },
+            }
+        };
+        let set = [Some(set0), None, None];
+        let phi = [0.0; 3].map(|_: Real| 0.3 * rng.symmetric());
+        let sigma = [1.0, -1.0, 1.0];
+        let eval = |v: &SVec<21>, g: Option<&mut SVec<21>>, h: Option<&mut SMat<21, 21>>| {
+            let x = unflat(&v.fixed_rows::<18>(0).into_owned());
+            let p = [v[18], v[19], v[20]];
+            midedge_angle_face_with::<_, false>(&x, has, &p, sigma, set, variant, &d, g, h)
+        };
+        let mut v0 = SVec::<21>::zeros();
+        v0.fixed_rows_mut::<18>(0).copy_from(&flat(&x));
+        for i in 0..3 {
+            v0[18 + i] = phi[i];
+        }
+        let mut g = SVec::<21>::zeros();
+        let mut h = SMat::<21, 21>::zeros();
+        let e0 = eval(&v0, Some(&mut g), Some(&mut h));
+        assert!(e0.is_finite() && g.amax() > 0.0);
+        assert_eq!(
+            g[18], 0.0,
+            "trial {trial}: the set edge's own DOF does not enter"
+        );
+        let eps = 1e-6;
+        let mut gfd = SVec::<21>::zeros();
+        let mut hfd = SMat::<21, 21>::zeros();
+        for k in 0..21 {
+            let (mut vp, mut vm) = (v0, v0);
+            vp[k] += eps;
+            vm[k] -= eps;
+            let (mut gp, mut gm) = (SVec::<21>::zeros(), SVec::<21>::zeros());
+            let ep = eval(&vp, Some(&mut gp), None);
+            let em = eval(&vm, Some(&mut gm), None);
+            gfd[k] = (ep - em) / (2.0 * eps);
+            hfd.set_column(k, &((gp - gm) / (2.0 * eps)));
+        }
+        let ge = (g - gfd).amax() / g.amax();
+        let he = (h - hfd).amax() / h.amax();
+        assert!(
+            ge < 1e-6,
+            "trial {trial} {variant:?} {set0:?}: gradient {ge:e}"
+        );
+        assert!(
+            he < 1e-6,
+            "trial {trial} {variant:?} {set0:?}: Hessian {he:e}"
+        );
+        assert!((h - h.transpose()).amax() < 1e-12 * h.amax());
+    }
+    // The convention: with the mid-edge average's normal (N_f + N_g)/|N_f + N_g| set on an
+    // interior edge, u is the average's q.
+    for _ in 0..20 {
+        let x = random_patch(&mut rng, 0.25);
+        let xf = [x[0], x[1], x[2]];
+        let nf = UnitNormal::new(&xf);
+        let qs = AverageQs::new(&nf, &x, [true; 3], false);
+        for i in 0..3 {
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            let ng = (x[k] - x[3 + i]).cross(&(x[j] - x[3 + i])).normalize();
+            let t = (nf.n + ng).normalize();
+            let (u, _) = set_edge_u(&EdgeNormal::Fixed(t), &xf, i);
+            assert!(
+                (u - qs.q[i]).abs() < 1e-14,
+                "edge {i}: u {u} against q {}",
+                qs.q[i]
+            );
+        }
+    }
+}

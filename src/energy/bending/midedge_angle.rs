@@ -33,6 +33,12 @@
 //! boundary condition. (The mid-edge average instead pins `q = 0`, a spurious clamp that is the
 //! source of its corner error on curved shapes.)
 //!
+//! A boundary edge whose mid-edge normal `t` is set in space ([`EdgeNormal`]: a clamp holds its
+//! reference normal, a symmetry plane keeps it in the plane) has no rotation of its own: it
+//! takes `u = (m − v_i)·t = h_i sin ψ` ([`set_edge_u`]) in the place of the average's `q̃_i`
+//! and `ψ = 0`, so `q_i = h_i g(asin(u/h_i))`, with `u`'s derivatives in the positions. Its DOF
+//! is held.
+//!
 //! DOF order (21): `x[v0], x[v1], x[v2], x[p0], x[p1], x[p2]` (18, as [`crate::energy::shell`]), then
 //! `φ_{e0}, φ_{e1}, φ_{e2}` (rad), the DOFs of the edges opposite `v0, v1, v2`. Units: energy J,
 //! gradient N (positions) and N·m (angles).
@@ -42,7 +48,8 @@ use crate::body::Body;
 use crate::energy::material::FaceDensity;
 use crate::geometry::{
     b_from_q, b_from_q_matrix, edge_slots, first_fundamental_form,
-    first_fundamental_form_hessian_pattern, first_fundamental_form_jacobian, AverageQs, UnitNormal,
+    first_fundamental_form_hessian_pattern, first_fundamental_form_jacobian, set_edge_u,
+    set_edge_u_hessian, AverageQs, EdgeNormal, UnitNormal,
 };
 use crate::math::{Mat3, Real, SMat, SVec, Sym2, Vec3};
 
@@ -91,10 +98,29 @@ pub fn midedge_angle_face<D: FaceDensity, const GN: bool>(
     grad: Option<&mut SVec<21>>,
     hess: Option<&mut SMat<21, 21>>,
 ) -> Real {
+    midedge_angle_face_with::<D, GN>(x, has, phi, sigma, [None; 3], variant, dens, grad, hess)
+}
+
+/// [`midedge_angle_face`] with the mid-edge normals of some boundary edges set in space
+/// (`set[i]` for the edge opposite `v_i`; see the module doc).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn midedge_angle_face_with<D: FaceDensity, const GN: bool>(
+    x: &[Vec3; 6],
+    has: [bool; 3],
+    phi: &[Real; 3],
+    sigma: [Real; 3],
+    set: [Option<EdgeNormal>; 3],
+    variant: AngleVariant,
+    dens: &D,
+    grad: Option<&mut SVec<21>>,
+    hess: Option<&mut SMat<21, 21>>,
+) -> Real {
     let face = AngleFace {
         has,
         phi: *phi,
         sigma,
+        set,
     };
     crate::energy::shell::shell_element::<D, MidedgeAngle, 21, 9, GN>(
         &MidedgeAngle(variant),
@@ -110,7 +136,8 @@ pub fn midedge_angle_face<D: FaceDensity, const GN: bool>(
 #[derive(Clone, Copy, Debug)]
 pub struct MidedgeAngle(pub AngleVariant);
 
-/// Per-face input: boundary flags, the three edge DOFs (rad) and the face's orientation signs.
+/// Per-face input: boundary flags, the three edge DOFs (rad), the face's orientation signs and
+/// the boundary edges whose mid-edge normal is set in space.
 #[derive(Clone, Copy, Debug)]
 pub struct AngleFace {
     /// Whether edge `i` has a neighbour.
@@ -119,6 +146,8 @@ pub struct AngleFace {
     pub phi: [Real; 3],
     /// The face's orientation sign `σ` on each edge.
     pub sigma: [Real; 3],
+    /// The set mid-edge normal of a boundary edge (a clamp, a symmetry plane), if any.
+    pub set: [Option<EdgeNormal>; 3],
 }
 
 /// Intermediate-variable derivatives kept for the Hessian contraction.
@@ -144,10 +173,16 @@ impl BendingModel<21, 9> for MidedgeAngle {
     #[inline(always)]
     fn face(&self, body: &Body, f: usize, nodes: &[usize], phi: &[Real]) -> AngleFace {
         let nv = body.num_vertices();
+        let e = [nodes[6] - nv, nodes[7] - nv, nodes[8] - nv];
         AngleFace {
             has: super::has_extra(nodes),
-            phi: [phi[nodes[6] - nv], phi[nodes[7] - nv], phi[nodes[8] - nv]],
+            phi: [phi[e[0]], phi[e[1]], phi[e[2]]],
             sigma: body.edge_sign[f],
+            set: if body.edge_normal.is_empty() {
+                [None; 3]
+            } else {
+                e.map(|e| body.edge_normal[e])
+            },
         }
     }
 
@@ -160,17 +195,37 @@ impl BendingModel<21, 9> for MidedgeAngle {
         grad: bool,
         hess: bool,
     ) -> BendingEval<21, AngleCache> {
-        let AngleFace { has, phi, sigma } = *face;
+        let AngleFace {
+            has,
+            phi,
+            sigma,
+            set,
+        } = *face;
         let xf = [x[0], x[1], x[2]];
         let a = first_fundamental_form(&xf);
         let nf = UnitNormal::new(&xf);
         let qs = AverageQs::new(&nf, x, has, hess);
+        // A set edge's `u` takes the average's `q̃` slot, with no rotation of its own.
+        let mut qt = qs.q;
+        let mut set_grad = [None; 3];
+        for i in 0..3 {
+            if let Some(en) = &set[i] {
+                let (u, g) = set_edge_u(en, &xf, i);
+                qt[i] = u;
+                set_grad[i] = Some(g);
+            }
+        }
         let mut q = SVec::<3>::zeros();
         let mut dh = [(SVec::<3>::zeros(), Mat3::zeros()); 3];
         let mut df = [(SVec::<3>::zeros(), Mat3::zeros()); 3];
         for i in 0..3 {
             let (h, gh, hh) = height_from_a(&a, i);
-            let (f, gf, hf) = edge_q(self.0, qs.q[i], h, sigma[i] * phi[i]);
+            let psi = if set[i].is_some() {
+                0.0
+            } else {
+                sigma[i] * phi[i]
+            };
+            let (f, gf, hf) = edge_q(self.0, qt[i], h, psi);
             q[i] = f;
             dh[i] = (gh, hh);
             df[i] = (gf, hf);
@@ -184,8 +239,16 @@ impl BendingModel<21, 9> for MidedgeAngle {
                 for c in 0..3 {
                     jq[(i, c)] = gf[1] * dh[i].0[c];
                 }
-                jq[(i, 3 + i)] = if has[i] { gf[0] } else { 0.0 };
-                jq[(i, 6 + i)] = gf[2] * sigma[i];
+                jq[(i, 3 + i)] = if has[i] || set[i].is_some() {
+                    gf[0]
+                } else {
+                    0.0
+                };
+                jq[(i, 6 + i)] = if set[i].is_some() {
+                    0.0
+                } else {
+                    gf[2] * sigma[i]
+                };
             }
             jy.fixed_view_mut::<3, 9>(0, 0)
                 .copy_from(&first_fundamental_form_jacobian(&xf));
@@ -195,6 +258,11 @@ impl BendingModel<21, 9> for MidedgeAngle {
                         for c in 0..3 {
                             jy[(3 + i, 3 * s + c)] = qs.grad[i][3 * l + c];
                         }
+                    }
+                }
+                if let Some(g) = &set_grad[i] {
+                    for c in 0..9 {
+                        jy[(3 + i, c)] = g[c];
                     }
                 }
                 jy[(6 + i, 18 + i)] = 1.0;
@@ -294,27 +362,34 @@ impl MidedgeAngle {
     fn add_y_hessian(
         &self,
         face: &AngleFace,
-        _: &[Vec3; 6],
+        x: &[Vec3; 6],
         ev: &BendingEval<21, AngleCache>,
         mut hy: SMat<9, 9>,
         lambda: Option<&Sym2>,
         set: bool,
         h: &mut SMat<21, 21>,
     ) {
-        let AngleFace { has, sigma, .. } = *face;
+        let AngleFace {
+            has,
+            sigma,
+            set: set_normal,
+            ..
+        } = *face;
         let c = &ev.cache;
         let mu = lambda.map(|l| b_from_q_matrix().transpose() * l);
         if let Some(mu) = &mu {
             for i in 0..3 {
                 let (gf, hf) = c.df[i];
                 let mut kmat = SMat::<3, 9>::zeros();
-                if has[i] {
+                if has[i] || set_normal[i].is_some() {
                     kmat[(0, 3 + i)] = 1.0;
                 }
                 for k in 0..3 {
                     kmat[(1, k)] = c.dh[i].0[k];
                 }
-                kmat[(2, 6 + i)] = sigma[i];
+                if set_normal[i].is_none() {
+                    kmat[(2, 6 + i)] = sigma[i];
+                }
                 hy += kmat.transpose() * hf * kmat * mu[i];
                 let mut aa = hy.fixed_view_mut::<3, 3>(0, 0);
                 aa += c.dh[i].1 * (mu[i] * gf[1]);
@@ -337,6 +412,14 @@ impl MidedgeAngle {
                 }
             }
             c.qs.add_hessians(&c.nf, has, [gy[3], gy[4], gy[5]], h);
+            // A set edge's `u`: its second derivative (zero for a fixed normal).
+            for i in 0..3 {
+                if let Some(en @ EdgeNormal::Plane { .. }) = &set_normal[i] {
+                    let xf = [x[0], x[1], x[2]];
+                    let mut dst = h.fixed_view_mut::<9, 9>(0, 0);
+                    dst += set_edge_u_hessian(en, &xf, i) * gy[3 + i];
+                }
+            }
         }
     }
 }

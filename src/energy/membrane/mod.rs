@@ -199,3 +199,79 @@ pub fn psd3(m: &Mat3) -> Mat3 {
     }
     out
 }
+
+/// The stretch λ* at which a thin sphere of `material` inflated by a gas reaches its pressure
+/// maximum (the limit point of pressure control), or `None` when its pressure rises
+/// monotonically (St Venant–Kirchhoff) or the law has no closed form here (Baraff–Witkin, the
+/// prism element). For an incompressible membrane in equibiaxial stretch λ (λ₃ = λ⁻²) the
+/// pressure is `p = (H/R) W′(λ)/λ²` with `W` per unit reference volume (Beatty 1987, "Topics in
+/// finite elasticity", §8), so up to a constant:
+///
+/// * neo-Hookean: `1/λ − 1/λ⁷` (λ* = 7^(1/6));
+/// * Mooney–Rivlin: `(c₁ + c₂λ²)(1/λ − 1/λ⁷)`;
+/// * Gent: `(1/λ − 1/λ⁷)/(1 − (2λ² + λ⁻⁴ − 3)/J_m)`.
+///
+/// The first local maximum on a scan of λ ∈ (1, 50] in steps of 1e-3, refined by golden
+/// section to 1e-10.
+pub fn thin_sphere_limit_stretch(
+    material: &crate::config::material::MembraneMaterial,
+) -> Option<Real> {
+    use crate::config::material::MembraneMaterial as M;
+    let base = |l: Real| 1.0 / l - l.powi(-7);
+    let p: Box<dyn Fn(Real) -> Real> = match *material {
+        M::NeoHookean => Box::new(base),
+        M::MooneyRivlin { c1, c2 } => Box::new(move |l| (c1 + c2 * l * l) * base(l)),
+        M::Gent { jm } => Box::new(move |l| {
+            let d = 1.0 - (2.0 * l * l + l.powi(-4) - 3.0) / jm;
+            if d > 0.0 {
+                base(l) / d
+            } else {
+                Real::INFINITY
+            }
+        }),
+        _ => return None,
+    };
+    let dl = 1e-3;
+    let mut l = 1.0 + dl;
+    while l < 50.0 {
+        let (a, b, c) = (p(l - dl), p(l), p(l + dl));
+        if !c.is_finite() {
+            return None;
+        }
+        if b > a && b >= c {
+            // Golden section on [l − dl, l + dl].
+            let g = (5f64.sqrt() - 1.0) / 2.0;
+            let (mut lo, mut hi) = (l - dl, l + dl);
+            while hi - lo > 1e-10 {
+                let (m1, m2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+                if p(m1) < p(m2) {
+                    lo = m1;
+                } else {
+                    hi = m2;
+                }
+            }
+            return Some(0.5 * (lo + hi));
+        }
+        l += dl;
+    }
+    None
+}
+
+#[cfg(test)]
+mod limit_tests {
+    use super::thin_sphere_limit_stretch;
+    use crate::config::material::MembraneMaterial as M;
+
+    #[test]
+    fn thin_sphere_limit_stretches_match_their_closed_forms() {
+        let nh = thin_sphere_limit_stretch(&M::NeoHookean).unwrap();
+        assert!((nh - 7f64.powf(1.0 / 6.0)).abs() < 1e-8, "{nh}");
+        // c₂/c₁ = 0.1: maximum at 1.47607 (and a minimum at 3.14262).
+        let mr = thin_sphere_limit_stretch(&M::MooneyRivlin { c1: 1.0, c2: 0.1 }).unwrap();
+        assert!((mr - 1.476070).abs() < 1e-6, "{mr}");
+        // Gent with J_m = 30: maximum near 1.445.
+        let g = thin_sphere_limit_stretch(&M::Gent { jm: 30.0 }).unwrap();
+        assert!((g - 1.445).abs() < 2e-3, "{g}");
+        assert_eq!(thin_sphere_limit_stretch(&M::Koiter), None);
+    }
+}
