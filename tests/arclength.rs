@@ -175,7 +175,9 @@ fn a_neo_hookean_balloon_is_traced_past_its_pressure_maximum() {
 /// `p = (4H/R₀)(c₁ + c₂λ²)(1/λ − 1/λ⁷)` rises to a maximum at λ = 1.4760, falls to a minimum at
 /// λ = 3.1426 and rises again. Under 16 kPa at dial 1 (above the maximum) arc length passes both
 /// and lands on dial 1 on the far, stable branch. Every frame within 0.5%, both turning points'
-/// pressures within 0.5% and stretches within 1% of the closed form.
+/// pressures within 0.5% and stretches within 1% of the closed form. A restart from a frame
+/// between the turning points reaches the same end (1e-8), and one from the last frame only
+/// solves the end again.
 #[test]
 fn a_mooney_rivlin_balloon_passes_its_maximum_and_its_minimum() {
     let d = tempfile::tempdir().unwrap();
@@ -213,6 +215,51 @@ fn a_mooney_rivlin_balloon_passes_its_maximum_and_its_minimum() {
         s["arc_length"]["negative_eigenvalues"], 0,
         "the far branch is stable"
     );
+    // A restart from a frame between the turning points continues the path: it passes the
+    // minimum and lands on the same end state.
+    let k = rows
+        .iter()
+        .position(|r| r["arc_length"] > 0.5 * (c[0].2 + c[1].2))
+        .unwrap();
+    let frame = format!("mr/frame_{k:05}.vtu");
+    shellsim(
+        &[
+            "mr.toml",
+            "s.vtk",
+            "--out",
+            "mr_restart",
+            "-q",
+            "--restart",
+            &frame,
+        ],
+        dir,
+    );
+    let s2 = summary(&dir.join("mr_restart"));
+    assert_eq!(s2["arc_length"]["end"], "dial 1", "{s2}");
+    let kinds: Vec<String> = critical(&s2).into_iter().map(|c| c.0).collect();
+    assert_eq!(kinds, ["load_minimum"], "{s2}");
+    let want = rows.last().unwrap()["gas_volume"];
+    let end = log(&dir.join("mr_restart")).last().unwrap()["gas_volume"];
+    assert!((end / want - 1.0).abs() < 1e-8, "{end} against {want}");
+    // A restart from the last frame (dial 1) is the end itself, solved again: no new path.
+    let last = format!("mr/frame_{:05}.vtu", rows.len() - 1);
+    shellsim(
+        &[
+            "mr.toml",
+            "s.vtk",
+            "--out",
+            "mr_end",
+            "-q",
+            "--restart",
+            &last,
+        ],
+        dir,
+    );
+    let s3 = summary(&dir.join("mr_end"));
+    assert_eq!(s3["arc_length"]["end"], "dial 1", "{s3}");
+    assert_eq!(s3["arc_length"]["steps"], 0, "{s3}");
+    let end = log(&dir.join("mr_end")).last().unwrap()["gas_volume"];
+    assert!((end / want - 1.0).abs() < 1e-8, "{end} against {want}");
 }
 
 /// The hinged cylindrical roof (Sze, Liu & Lo 2004, problem 3.8; from Sabir & Lock 1972):

@@ -461,6 +461,39 @@ pub(super) fn run_arc_length(
     let mut trial = state.clone();
     let mut inc = vec![0.0; n];
     let mut failure = None;
+    // A restart at dial 1: the end itself, solved again with these settings.
+    if lambda >= 1.0 {
+        let mut l1 = 1.0;
+        trial.copy_from(&state);
+        s.scene.body.prescribe(&mut trial.x, l1);
+        let (rep, got) = correct(s, &w, &state, lambda, &mut trial, &mut l1, Constraint::Dial)?;
+        match got {
+            Some(next) => {
+                state.copy_from(&trial);
+                at = next;
+                let pat = s.pattern();
+                let pot = s.potential(&pat, 1.0);
+                s.driver = driver_state(1.0, arc, psi, ds, rising, at.negative);
+                s.path_columns = path_columns(arc, at.negative, 0.0);
+                s.frame(writer, &pot, &state, &zeros, arc)?;
+                report.end = "dial 1".into();
+            }
+            None => {
+                report.end = "failed".into();
+                failure = Some(RunFailure::ArcLengthStep {
+                    min: min_step,
+                    dial: lambda,
+                    arc_length: arc,
+                    cause: rep.failure_or_unknown(),
+                    tolerance: s.config.newton.tol,
+                    force_scale: s.force_scale,
+                });
+            }
+        }
+        report.length = arc;
+        report.negative_eigenvalues = at.negative;
+        return finish(s, &state, 1.0, report, failure);
+    }
     let end = loop {
         if let Some(f) = interruption("dial", lambda) {
             failure = Some(f);
