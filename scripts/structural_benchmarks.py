@@ -45,29 +45,41 @@ def run(args, cwd):
     subprocess.run([BIN] + args, check=True, cwd=cwd, stdout=subprocess.DEVNULL)
 
 
-def cylinder_patch(path, radius, trange, yrange, n, m, drop):
-    """A cylinder patch about the y axis, angle θ in `trange` (from +z towards +x), y in
-    `yrange`, n × m quads split along alternating diagonals; z lowered by `drop` (legacy ASCII
-    VTK)."""
-    pts, tris = [], []
-    for j in range(m + 1):
-        for i in range(n + 1):
-            t = trange[0] + (trange[1] - trange[0]) * i / n
-            y = yrange[0] + (yrange[1] - yrange[0]) * j / m
-            pts.append((radius * math.sin(t), y, radius * math.cos(t) - drop))
+def grid_triangles(n, m):
+    """The triangles of an (n + 1) × (m + 1) grid of points (row-major), each quad split along
+    alternating diagonals."""
+    tris = []
     for j in range(m):
         for i in range(n):
             a = j * (n + 1) + i
             b, c, d = a + 1, a + n + 1, a + n + 2
             tris += [(a, b, d), (a, d, c)] if (i + j) % 2 == 0 else [(a, b, c), (b, d, c)]
+    return tris
+
+
+def write_vtk(path, title, pts, tris):
+    """Points and triangles as legacy ASCII VTK."""
     with open(path, "w") as f:
-        f.write("# vtk DataFile Version 3.0\npatch\nASCII\nDATASET POLYDATA\n")
+        f.write(f"# vtk DataFile Version 3.0\n{title}\nASCII\nDATASET POLYDATA\n")
         f.write(f"POINTS {len(pts)} double\n")
         for p in pts:
             f.write("%.17g %.17g %.17g\n" % p)
         f.write(f"POLYGONS {len(tris)} {4 * len(tris)}\n")
         for t in tris:
             f.write("3 %d %d %d\n" % t)
+
+
+def cylinder_patch(path, radius, trange, yrange, n, m, drop):
+    """A cylinder patch about the y axis, angle θ in `trange` (from +z towards +x), y in
+    `yrange`, n × m quads split along alternating diagonals; z lowered by `drop` (legacy ASCII
+    VTK)."""
+    pts = []
+    for j in range(m + 1):
+        for i in range(n + 1):
+            t = trange[0] + (trange[1] - trange[0]) * i / n
+            y = yrange[0] + (yrange[1] - yrange[0]) * j / m
+            pts.append((radius * math.sin(t), y, radius * math.cos(t) - drop))
+    write_vtk(path, "patch", pts, grid_triangles(n, m))
 
 
 def log(out):
@@ -284,26 +296,18 @@ inside = { min = [7.0, 7.0, -1e-6], max = [7.1, 7.1, 1e-6] }
 
 
 def hemisphere_quarter(path, n, r=10.0, hole=math.radians(18)):
-    pts, tris = [], []
+    """The quarter of the pinched hemisphere on an n × n grid of azimuth and polar angle,
+    oriented outward (legacy ASCII VTK)."""
+    pts = []
     for j in range(n + 1):
         for i in range(n + 1):
             al = hole + (math.pi / 2 - hole) * j / n
             be = (math.pi / 2) * i / n
             pts.append((r * math.sin(al) * math.cos(be), r * math.sin(al) * math.sin(be),
                         r * math.cos(al)))
-    for j in range(n):
-        for i in range(n):
-            a = j * (n + 1) + i
-            b, c, d = a + 1, a + n + 1, a + n + 2
-            tris += [(a, d, b), (a, c, d)] if (i + j) % 2 == 0 else [(a, c, b), (b, c, d)]
-    with open(path, "w") as f:
-        f.write("# vtk DataFile Version 3.0\nhemisphere\nASCII\nDATASET POLYDATA\n")
-        f.write(f"POINTS {len(pts)} double\n")
-        for p in pts:
-            f.write("%.17g %.17g %.17g\n" % p)
-        f.write(f"POLYGONS {len(tris)} {4 * len(tris)}\n")
-        for t in tris:
-            f.write("3 %d %d %d\n" % t)
+    # The grid's triangles reversed: the polar angle grows downwards.
+    tris = [(a, c, b) for (a, b, c) in grid_triangles(n, n)]
+    write_vtk(path, "hemisphere", pts, tris)
 
 
 def hemisphere(out, rows_out):

@@ -5,24 +5,9 @@
 //! load control on a monotone path, and bad input.
 
 mod common;
-use common::{cylinder_patch, run_status, shellsim};
+use common::{cylinder_patch, log_rows as log, run_status, shellsim};
 use std::collections::HashMap;
 use std::path::Path;
-
-/// `log.csv` as rows of named columns.
-fn log(out: &Path) -> Vec<HashMap<String, f64>> {
-    let text = std::fs::read_to_string(out.join("log.csv")).unwrap();
-    let mut lines = text.lines();
-    let head: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
-    lines
-        .map(|l| {
-            head.iter()
-                .cloned()
-                .zip(l.split(',').map(|v| v.parse::<f64>().unwrap()))
-                .collect()
-        })
-        .collect()
-}
 
 fn summary(out: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()

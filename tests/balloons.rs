@@ -5,27 +5,12 @@
 //! input (open, inward and non-manifold meshes, no gas, no volume, malformed shape files).
 
 mod common;
-use common::shellsim;
+use common::{log_rows as log, shellsim};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// `log.csv` as rows of named columns.
-fn log(out: &Path) -> Vec<std::collections::HashMap<String, f64>> {
-    let text = std::fs::read_to_string(out.join("log.csv")).unwrap();
-    let mut lines = text.lines();
-    let head: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
-    lines
-        .map(|l| {
-            head.iter()
-                .cloned()
-                .zip(l.split(',').map(|v| v.parse::<f64>().unwrap_or(f64::NAN)))
-                .collect()
-        })
-        .collect()
 }
 
 fn summary(out: &Path) -> serde_json::Value {

@@ -428,15 +428,7 @@ fn bad_symmetry_planes_are_refused() {
             &["constraints.symmetry[0]", "midedge_sin"],
         ),
     ];
-    for (settings, needles) in cases {
-        std::fs::write(dir.join("bad.toml"), settings).unwrap();
-        let (code, _, err) = run_status(&["bad.toml", "r.vtk", "--out", "obad", "-q"], dir);
-        assert_eq!(code, 2, "{settings}: {err}");
-        for n in needles {
-            assert!(err.contains(n), "{settings}: '{n}' not in: {err}");
-        }
-        assert!(!dir.join("obad").exists(), "a refused run wrote its folder");
-    }
+    refused(dir, &cases);
 }
 
 /// Bad supports: a selection of no vertex, no component, a component listed twice, an unknown
@@ -470,11 +462,17 @@ fn bad_supports_are_refused() {
             &["constraints.displacement[0]", "x component", "constraints.support"],
         ),
     ];
+    refused(dir, &cases);
+}
+
+/// Runs each of `cases` (settings, the texts its error must contain) on `dir/r.vtk`: exit 2,
+/// each text in the message, no panic, and no output folder.
+fn refused(dir: &Path, cases: &[(&str, &[&str])]) {
     for (settings, needles) in cases {
         std::fs::write(dir.join("bad.toml"), settings).unwrap();
         let (code, _, err) = run_status(&["bad.toml", "r.vtk", "--out", "obad", "-q"], dir);
         assert_eq!(code, 2, "{settings}: {err}");
-        for n in needles {
+        for n in needles.iter() {
             assert!(err.contains(n), "{settings}: '{n}' not in: {err}");
         }
         assert!(!err.contains("panicked"), "{err}");

@@ -309,21 +309,7 @@ impl<'a> Potential<'a> {
     /// body's scale, so that a load small against the sheet's stiffness is still solved to the
     /// tolerance relative to itself.
     pub fn load_scale(&self, x: &[Vec3], phi: &[Real]) -> Real {
-        let mut g = vec![0.0; self.pattern.n];
-        for (term, map) in self.terms.iter().zip(&self.pattern.maps) {
-            if term.applied_load() {
-                term.eval(
-                    self,
-                    map,
-                    x,
-                    phi,
-                    Want::Gradient,
-                    HessianProjection::None,
-                    &mut g,
-                    &mut [],
-                );
-            }
-        }
+        let mut g = self.gradient_of(x, phi, false, |t| t.applied_load());
         for &d in &self.body.pinned_dofs {
             g[d] = 0.0;
         }
@@ -340,25 +326,7 @@ impl<'a> Potential<'a> {
     /// to the faces and carry no moment of their own).
     pub fn reactions(&self, x: &[Vec3], phi: &[Real]) -> Vec<Vec3> {
         let nv = self.pattern.num_vertices;
-        let free = vec![false; self.node_fixed.len()];
-        let pot = Potential {
-            node_fixed: &free,
-            owned: None,
-            ..*self
-        };
-        let mut g = vec![0.0; self.pattern.n];
-        for (term, map) in self.terms.iter().zip(&self.pattern.maps) {
-            term.eval(
-                &pot,
-                map,
-                x,
-                phi,
-                Want::Gradient,
-                HessianProjection::None,
-                &mut g,
-                &mut [],
-            );
-        }
+        let g = self.gradient_of(x, phi, true, |_| true);
         let mut held = vec![[false; 3]; nv];
         for (v, h) in held.iter_mut().enumerate() {
             if self.node_fixed[v] {
@@ -383,15 +351,37 @@ impl<'a> Potential<'a> {
         if self.body.edge_normal.is_empty() {
             return Vec3::zeros();
         }
+        let g = self.gradient_of(x, phi, true, |t| t.name() == crate::energy::shell::NAME);
+        -x.iter()
+            .enumerate()
+            .map(|(v, p)| p.cross(&Vec3::new(g[3 * v], g[3 * v + 1], g[3 * v + 2])))
+            .sum::<Vec3>()
+    }
+
+    /// The gradient at `(x, phi)` (DOF order, `pattern.n` entries) of the terms that `keep`
+    /// selects: with nothing held when `nothing_held` (the held DOFs then carry the forces
+    /// the supports balance), else with this potential's held nodes. Pinned DOFs are not
+    /// zeroed.
+    fn gradient_of(
+        &self,
+        x: &[Vec3],
+        phi: &[Real],
+        nothing_held: bool,
+        keep: impl Fn(&dyn Term) -> bool,
+    ) -> Vec<Real> {
         let free = vec![false; self.node_fixed.len()];
-        let pot = Potential {
-            node_fixed: &free,
-            owned: None,
-            ..*self
+        let pot = if nothing_held {
+            Potential {
+                node_fixed: &free,
+                owned: None,
+                ..*self
+            }
+        } else {
+            *self
         };
         let mut g = vec![0.0; self.pattern.n];
         for (term, map) in self.terms.iter().zip(&self.pattern.maps) {
-            if term.name() == crate::energy::shell::NAME {
+            if keep(term.as_ref()) {
                 term.eval(
                     &pot,
                     map,
@@ -404,10 +394,7 @@ impl<'a> Potential<'a> {
                 );
             }
         }
-        -x.iter()
-            .enumerate()
-            .map(|(v, p)| p.cross(&Vec3::new(g[3 * v], g[3 * v + 1], g[3 * v + 2])))
-            .sum::<Vec3>()
+        g
     }
 
     /// Energies by term name at `(x, phi)` (each term's [`crate::energy::term::energies`]).

@@ -103,3 +103,19 @@ pub fn cylinder_patch(
     }
     std::fs::write(dir.join(name), s).unwrap();
 }
+
+/// `out/log.csv` as rows of named columns (a cell that is not a number reads as NaN).
+#[allow(dead_code)] // not every test crate reads logs
+pub fn log_rows(out: &Path) -> Vec<std::collections::HashMap<String, f64>> {
+    let text = std::fs::read_to_string(out.join("log.csv")).unwrap();
+    let mut lines = text.lines();
+    let head: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    lines
+        .map(|l| {
+            head.iter()
+                .cloned()
+                .zip(l.split(',').map(|v| v.parse::<f64>().unwrap_or(f64::NAN)))
+                .collect()
+        })
+        .collect()
+}

@@ -197,6 +197,27 @@ fn patch_face_derivatives_match_finite_differences() {
     }
 }
 
+/// The gradient and Hessian of `eval` at `v0` by central differences of its energy and its
+/// gradient (step `eps`), for the 21 DOFs of an edge-DOF face.
+fn central_differences_21<F>(eval: &F, v0: &SVec<21>, eps: Real) -> (SVec<21>, SMat<21, 21>)
+where
+    F: Fn(&SVec<21>, Option<&mut SVec<21>>, Option<&mut SMat<21, 21>>) -> Real,
+{
+    let mut gfd = SVec::<21>::zeros();
+    let mut hfd = SMat::<21, 21>::zeros();
+    for k in 0..21 {
+        let (mut vp, mut vm) = (*v0, *v0);
+        vp[k] += eps;
+        vm[k] -= eps;
+        let (mut gp, mut gm) = (SVec::<21>::zeros(), SVec::<21>::zeros());
+        let ep = eval(&vp, Some(&mut gp), None);
+        let em = eval(&vm, Some(&mut gm), None);
+        gfd[k] = (ep - em) / (2.0 * eps);
+        hfd.set_column(k, &((gp - gm) / (2.0 * eps)));
+    }
+    (gfd, hfd)
+}
+
 /// Mid-edge shell with edge DOFs (both variants, every boundary pattern): gradient and Hessian
 /// against central differences in all 21 DOFs; Gauss–Newton gradient equal to the exact one;
 /// the `sin` variant at φ = 0 equals the mid-edge average.
@@ -262,19 +283,7 @@ fn midedge_angle_derivatives_match_finite_differences() {
             ev.min() >= -1e-12 * ev.amax(),
             "trial {trial}: GN Hessian not PSD"
         );
-        let eps = 1e-6;
-        let mut gfd = SVec::<21>::zeros();
-        let mut hfd = SMat::<21, 21>::zeros();
-        for k in 0..21 {
-            let (mut vp, mut vm) = (v0, v0);
-            vp[k] += eps;
-            vm[k] -= eps;
-            let (mut gp, mut gm) = (SVec::<21>::zeros(), SVec::<21>::zeros());
-            let ep = eval(&vp, Some(&mut gp), None);
-            let em = eval(&vm, Some(&mut gm), None);
-            gfd[k] = (ep - em) / (2.0 * eps);
-            hfd.set_column(k, &((gp - gm) / (2.0 * eps)));
-        }
+        let (gfd, hfd) = central_differences_21(&eval, &v0, 1e-6);
         let ge = (g - gfd).amax() / g.amax();
         let he = (h - hfd).amax() / h.amax();
         assert!(
@@ -358,19 +367,7 @@ fn set_edge_normals_match_finite_differences() {
             g[18], 0.0,
             "trial {trial}: the set edge's own DOF does not enter"
         );
-        let eps = 1e-6;
-        let mut gfd = SVec::<21>::zeros();
-        let mut hfd = SMat::<21, 21>::zeros();
-        for k in 0..21 {
-            let (mut vp, mut vm) = (v0, v0);
-            vp[k] += eps;
-            vm[k] -= eps;
-            let (mut gp, mut gm) = (SVec::<21>::zeros(), SVec::<21>::zeros());
-            let ep = eval(&vp, Some(&mut gp), None);
-            let em = eval(&vm, Some(&mut gm), None);
-            gfd[k] = (ep - em) / (2.0 * eps);
-            hfd.set_column(k, &((gp - gm) / (2.0 * eps)));
-        }
+        let (gfd, hfd) = central_differences_21(&eval, &v0, 1e-6);
         let ge = (g - gfd).amax() / g.amax();
         let he = (h - hfd).amax() / h.amax();
         assert!(
