@@ -34,6 +34,7 @@ impl Pattern {
             &stencils,
         );
         p.pin(&scene.body.pinned_dofs);
+        p.pin_skew(&scene.body.skew_vertices());
         p
     }
 
@@ -73,6 +74,7 @@ impl Pattern {
             &stencils,
         );
         p.pin(&scene.body.pinned_dofs);
+        p.pin_skew(&scene.body.skew_vertices());
         Some(p)
     }
 }

@@ -654,6 +654,7 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
     crate::integrate::check_scene(&scene)?;
     crate::output::check_fields(&scene, &settings_path.display().to_string())?;
     crate::integrate::check_continuation(&scene, &settings_path.display().to_string())?;
+    crate::integrate::check_supports(&scene, &settings_path.display().to_string())?;
     crate::solve::newton::VERBOSE.store(cli.verbose, std::sync::atomic::Ordering::Relaxed);
     let restart = if cli.continue_series {
         Some(continue_from(&cli.out, cli.restart.as_ref())?)

@@ -75,21 +75,23 @@ const PLANES: &str = "[[constraints.support]]\ncomponents = [\"x\"]\n\
     [[constraints.support]]\ncomponents = [\"z\"]\n\
     inside = { min = [-2, -2, -1e-9], max = [2, 2, 1e-9] }\n";
 
-/// Runs a balloon of `material` under the gauge pressure `p` (at dial 1) by arc length; returns
-/// its log, summary, and the radius `R₀` of the sphere of its initial volume.
+/// Runs a balloon of `material` under the gauge pressure `p` (at dial 1) by arc length, held by
+/// `supports`; returns its log, summary, and the radius `R₀` of the sphere of its initial
+/// volume.
 fn balloon(
     dir: &Path,
     tag: &str,
     material: &str,
     p: f64,
     steps: usize,
+    supports: &str,
 ) -> (Vec<HashMap<String, f64>>, serde_json::Value, f64) {
     std::fs::write(
         dir.join(format!("{tag}.toml")),
         format!(
             "[material]\nbending = \"none\"\nthickness = 0.01\n{material}\n[gas]\n\
              control = \"pressure\"\npressure = {p}\n[solver]\ncontinuation = \"arc_length\"\n\
-             max_arc_length_steps = {steps}\n{PLANES}"
+             max_arc_length_steps = {steps}\n{supports}"
         ),
     )
     .unwrap();
@@ -123,6 +125,7 @@ fn a_neo_hookean_balloon_is_traced_past_its_pressure_maximum() {
         "model = \"neo_hookean\"\npoisson = 0.5\nyoung = 3e6",
         p,
         40,
+        PLANES,
     );
     assert_eq!(s["converged"], true, "{s}");
     assert_eq!(s["arc_length"]["end"], "steps");
@@ -156,6 +159,72 @@ fn a_neo_hookean_balloon_is_traced_past_its_pressure_maximum() {
     assert_eq!(rows.last().unwrap()["negative_eigenvalues"], 1.0);
 }
 
+/// The Mooney–Rivlin balloons' gauge pressure at dial 1 (Pa), above their maximum.
+const MR_PRESSURE: f64 = 1.6e4;
+
+/// A Mooney–Rivlin balloon (c₁ = 0.5 MPa, c₂ = 0.05 MPa, H = 0.01) under `MR_PRESSURE` at dial
+/// 1 by arc length (at most 200 steps) into `dir/tag`, held by `supports`, checked converged:
+/// its log, summary, initial radius R₀ and thin-sphere law `p(λ) = (4H/R₀)(c₁ + c₂λ²)(1/λ −
+/// 1/λ⁷)`.
+fn mooney_rivlin(
+    dir: &Path,
+    tag: &str,
+    supports: &str,
+) -> (
+    Vec<HashMap<String, f64>>,
+    serde_json::Value,
+    f64,
+    impl Fn(f64) -> f64,
+) {
+    let (c1, c2, h) = (5e5, 5e4, 0.01);
+    sphere(dir);
+    let (rows, s, r0) = balloon(
+        dir,
+        tag,
+        &format!("model = \"mooney_rivlin\"\nc1 = {c1}\nc2 = {c2}"),
+        MR_PRESSURE,
+        200,
+        supports,
+    );
+    assert_eq!(s["converged"], true, "{s}");
+    let law = move |l: f64| 4.0 * h / r0 * (c1 + c2 * l * l) * (1.0 / l - l.powi(-7));
+    (rows, s, r0, law)
+}
+
+/// The Mooney–Rivlin balloon of the next test with nothing held: the automatic statically
+/// determinate pins (A held, B on the line A₀B₀, C in the plane A₀B₀C₀) remove its six rigid
+/// motions and stay compatible with the inflation, so the path passes the maximum and the
+/// minimum and lands on dial 1 (λ ≈ 6.4), within 0.5% of the closed form. Pins along the
+/// coordinate axes forced a rigid spin that grew with the stretch: the path folded back at
+/// λ ≈ 1.58 and ran down to the unloaded state. The pins carry no reaction: below 1e-9 of the
+/// pressure's force on a half sphere, p π R₀², in every row.
+#[test]
+fn a_free_balloon_is_held_by_compatible_pins_through_both_turning_points() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let (rows, s, r0, law) = mooney_rivlin(dir, "free", "");
+    assert_eq!(s["arc_length"]["end"], "dial 1", "{s}");
+    let half = MR_PRESSURE * std::f64::consts::PI * r0 * r0;
+    let (mut worst, mut pin): (f64, f64) = (0.0, 0.0);
+    for r in &rows[1..] {
+        let l = stretch(&rows, r);
+        worst = worst.max((r["gas_pressure"] / law(l) - 1.0).abs());
+        for c in ["x", "y", "z"] {
+            pin = pin.max(r[&format!("reaction_force_rigid_pins_{c}")].abs());
+        }
+    }
+    let last = stretch(&rows, rows.last().unwrap());
+    println!(
+        "free balloon: worst {worst:.2e} out to λ = {last:.2}; largest pin force {pin:.2e} N \
+         against p π R₀² = {half:.3e} N"
+    );
+    assert!(worst < 5e-3, "{worst}");
+    assert!(last > 6.0, "the path went on: λ = {last}");
+    assert!(pin < 1e-9 * half, "{pin}");
+    let kinds: Vec<String> = critical(&s).into_iter().map(|c| c.0).collect();
+    assert_eq!(kinds, ["load_maximum", "load_minimum"], "{s}");
+}
+
 /// A Mooney–Rivlin balloon with c₂/c₁ = 0.1 (c₁ = 0.5 MPa): its thin-sphere pressure
 /// `p = (4H/R₀)(c₁ + c₂λ²)(1/λ − 1/λ⁷)` rises to a maximum at λ = 1.4760, falls to a minimum at
 /// λ = 3.1426 and rises again. Under 16 kPa at dial 1 (above the maximum) arc length passes both
@@ -167,19 +236,10 @@ fn a_neo_hookean_balloon_is_traced_past_its_pressure_maximum() {
 fn a_mooney_rivlin_balloon_passes_its_maximum_and_its_minimum() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    sphere(dir);
-    let (c1, c2, h, p) = (5e5, 5e4, 0.01, 1.6e4);
-    let (rows, s, r0) = balloon(
-        dir,
-        "mr",
-        &format!("model = \"mooney_rivlin\"\nc1 = {c1}\nc2 = {c2}"),
-        p,
-        200,
-    );
-    assert_eq!(s["converged"], true, "{s}");
+    let (rows, s, _, law) = mooney_rivlin(dir, "mr", PLANES);
+    let p = MR_PRESSURE;
     assert_eq!(s["arc_length"]["end"], "dial 1");
     assert_eq!(rows.last().unwrap()["dial"], 1.0, "lands exactly on dial 1");
-    let law = |l: f64| 4.0 * h / r0 * (c1 + c2 * l * l) * (1.0 / l - l.powi(-7));
     let worst = rows[1..]
         .iter()
         .map(|r| (r["gas_pressure"] / law(stretch(&rows, r)) - 1.0).abs())

@@ -333,8 +333,10 @@ fn gas_amount_equilibria_satisfy_the_gas_law_and_the_membrane_law() {
 }
 
 /// Under a prescribed pressure above the neo-Hookean limit the run stops (exit 1) naming the
-/// limit point and the material's own limit stretch (a Mooney–Rivlin balloon's too), never
-/// reporting a false equilibrium; below it, it converges on the rising branch.
+/// limit point and the material's own limit stretch, never reporting a false equilibrium;
+/// below it, it converges on the rising branch. A Mooney–Rivlin balloon, whose pressure rises
+/// again, stops at its own limit stretch in small steps, or lands on a true far-branch
+/// equilibrium.
 #[test]
 fn pressure_control_stops_at_the_limit_point() {
     let dir = tempfile::tempdir().unwrap();
@@ -369,14 +371,18 @@ fn pressure_control_stops_at_the_limit_point() {
     let sm = summary(&out);
     assert_eq!(sm["converged"], false);
     assert!(sm["reason"].as_str().unwrap().contains("volume"), "{sm}");
-    // A Mooney–Rivlin balloon (c₂/c₁ = 0.1) peaks later, at λ = 1.47607, and says so.
+    // A Mooney–Rivlin balloon (c₂/c₁ = 0.1) peaks later, at λ = 1.47607, and its pressure
+    // rises again past its minimum at λ = 3.14262: above the maximum there is an equilibrium
+    // on the far branch. Load control in small steps stops at the limit point and names the
+    // material's own limit stretch; in the default steps it may snap through to that far
+    // equilibrium, which must then be a true one: past the minimum, on the closed form.
+    let p_mr = 1.05 * 14906.2 / 0.9985;
     let mr = write(
         d,
         "mr.toml",
         &format!(
             "[material]\nbending = \"none\"\nthickness = 0.01\nmodel = \"mooney_rivlin\"\n\
-             c1 = 5e5\nc2 = 5e4\n[gas]\ncontrol = \"pressure\"\npressure = {}\n",
-            1.05 * 14906.2 / 0.9985
+             c1 = 5e5\nc2 = 5e4\n[gas]\ncontrol = \"pressure\"\npressure = {p_mr}\n"
         ),
     );
     let out = d.join("mr");
@@ -387,11 +393,41 @@ fn pressure_control_stops_at_the_limit_point() {
             "--out",
             out.to_str().unwrap(),
             "-q",
+            "--set",
+            "solver.continuation_step=0.01",
+            "--set",
+            "solver.max_continuation_step=0.01",
         ],
         d,
     );
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("peaks at the stretch 1.4761"), "{err}");
+    let out = d.join("mr_default");
+    let (code, err) = run(
+        &[
+            mr.to_str().unwrap(),
+            &mesh,
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+        ],
+        d,
+    );
+    if code == Some(0) {
+        let rows = log(&out);
+        let r0 = (3.0 * rows[0]["gas_volume"] / (4.0 * std::f64::consts::PI)).cbrt();
+        let l = (rows.last().unwrap()["gas_volume"] / rows[0]["gas_volume"]).cbrt();
+        let law = 4.0 * 0.01 / r0 * (5e5 + 5e4 * l * l) * (1.0 / l - l.powi(-7));
+        println!(
+            "Mooney–Rivlin above its maximum: snapped to λ = {l:.3}, p/law − 1 = {:.2e}",
+            p_mr / law - 1.0
+        );
+        assert!(l > 3.14262, "not on the far branch: λ {l}");
+        assert!((p_mr / law - 1.0).abs() < 5e-3, "not an equilibrium: λ {l}");
+    } else {
+        assert_eq!(code, Some(1), "{err}");
+        assert!(err.contains("peaks at the stretch 1.4761"), "{err}");
+    }
     // Below the limit: an equilibrium on the rising branch, λ < λ*.
     let out = d.join("below");
     shellsim(

@@ -4,13 +4,28 @@
 //! and the bad inputs of supports.
 
 mod common;
-use common::{cylinder_patch, run_status, shellsim};
+use common::{cylinder_patch, graded_cylinder_patch, run_status, shellsim};
 use shellsim::mesh::io::read_mesh;
+use shellsim::mesh::Mesh;
 use std::path::Path;
 
 fn summary(dir: &Path, out: &str) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join(out).join("summary.json")).unwrap())
         .unwrap()
+}
+
+/// Runs `dir/{m}.toml` on `dir/{m}.vtk` into `dir/{m}`, asserts that it converged, and returns
+/// its summary, the input mesh and the final frame.
+fn solved(dir: &Path, m: &str) -> (serde_json::Value, Mesh, Mesh) {
+    shellsim(
+        &[&format!("{m}.toml"), &format!("{m}.vtk"), "--out", m, "-q"],
+        dir,
+    );
+    let s = summary(dir, m);
+    assert_eq!(s["converged"], true, "{m}: {s}");
+    let mesh = read_mesh(&dir.join(format!("{m}.vtk"))).unwrap();
+    let frame = read_mesh(&dir.join(m).join(s["final_frame"].as_str().unwrap())).unwrap();
+    (s, mesh, frame)
 }
 
 fn rectangle(dir: &Path, lx: f64, ly: f64, edge: f64, jitter: &str, name: &str) {
@@ -315,14 +330,7 @@ fn a_quarter_model_with_symmetry_planes_equals_the_whole() {
     .unwrap();
     let mut w = Vec::new();
     for m in ["full", "quarter"] {
-        shellsim(
-            &[&format!("{m}.toml"), &format!("{m}.vtk"), "--out", m, "-q"],
-            dir,
-        );
-        let s = summary(dir, m);
-        assert_eq!(s["converged"], true, "{m}: {s}");
-        let mesh = read_mesh(&dir.join(format!("{m}.vtk"))).unwrap();
-        let frame = read_mesh(&dir.join(m).join(s["final_frame"].as_str().unwrap())).unwrap();
+        let (_, mesh, frame) = solved(dir, m);
         // The middle of a free edge: θ = 40°, y = 0.
         let v = (0..mesh.positions.len())
             .min_by(|&a, &b| {
@@ -341,6 +349,172 @@ fn a_quarter_model_with_symmetry_planes_equals_the_whole() {
     );
     assert!((w[0] / w[1] - 1.0).abs() < 1e-6, "{w:?}");
     assert!((w[0] / 0.3024 - 1.0).abs() < 0.05, "{w:?}");
+}
+
+/// A symmetry plane with an oblique normal: the quarter Scordelis–Lo roof of the previous test,
+/// rotated by 35° about the cylinder's axis (y) with its gravity, so that the plane x = 0
+/// becomes `(cos 35°, 0, −sin 35°)·x = 0` (given as `normal`); the diaphragm still holds the
+/// two components across the axis and the plane y = 0 is unchanged. Rotated back, every
+/// displacement must equal the axis-aligned model's to 1e-6 of the largest (both solved to
+/// 1e-10): the oblique plane holds the normal component and sets the boundary rotation exactly
+/// as the axis-aligned one. The supports' forces balance the weight to the residual the
+/// tolerance allows, and the oblique plane's reaction lies along its normal.
+#[test]
+fn an_oblique_symmetry_plane_equals_the_axis_aligned_one() {
+    use shellsim::math::{Mat3, Vec3};
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let (r, th) = (25.0f64, 40f64.to_radians());
+    cylinder_patch(dir, "quarter.vtk", r, (0.0, th), (0.0, 25.0), (12, 12), 0.0);
+    let (c, s) = (35f64.to_radians().cos(), 35f64.to_radians().sin());
+    let rot = Mat3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c);
+    let mut mesh = read_mesh(&dir.join("quarter.vtk")).unwrap();
+    for p in &mut mesh.positions {
+        *p = rot * *p;
+    }
+    shellsim::mesh::io::write_mesh(
+        &dir.join("rotated.vtk"),
+        &mesh,
+        shellsim::mesh::io::Format::VtkAscii,
+        "rotated",
+    )
+    .unwrap();
+    let (rho, h, g) = (360.0, 0.25, 0.001);
+    let gravity = rot * Vec3::new(0.0, 0.0, -g);
+    let n = rot * Vec3::x();
+    let common = format!(
+        "[material]\nthickness = {h}\nyoung = 4.32e8\npoisson = 0.0\ndensity = {rho}\n\
+         [solver]\ntolerance = 1e-10\n\
+         [[constraints.support]]\ncomponents = [\"x\", \"z\"]\n\
+         inside = {{ min = [-30, 24.999, -30], max = [30, 25.001, 30] }}\n\
+         [[constraints.symmetry]]\naxis = \"y\"\n"
+    );
+    std::fs::write(
+        dir.join("quarter.toml"),
+        format!(
+            "{common}[loads]\ngravity = [0, 0, {}]\n[[constraints.symmetry]]\nnormal = [1, 0, 0]\n",
+            -g
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("rotated.toml"),
+        format!(
+            "{common}[loads]\ngravity = [{}, {}, {}]\n\
+             [[constraints.symmetry]]\nnormal = [{}, {}, {}]\n",
+            gravity.x, gravity.y, gravity.z, n.x, n.y, n.z
+        ),
+    )
+    .unwrap();
+    let mut u = Vec::new();
+    for m in ["quarter", "rotated"] {
+        let (sm, mesh, frame) = solved(dir, m);
+        let back = if m == "rotated" {
+            rot.transpose()
+        } else {
+            Mat3::identity()
+        };
+        u.push(
+            (0..mesh.positions.len())
+                .map(|v| back * (frame.positions[v] - mesh.positions[v]))
+                .collect::<Vec<Vec3>>(),
+        );
+        {
+            let area: f64 = (0..mesh.faces.len()).map(|f| mesh.face_area(f)).sum();
+            let weight = (if m == "rotated" {
+                gravity
+            } else {
+                Vec3::new(0.0, 0.0, -g)
+            }) * (rho * h * area);
+            let total: Vec3 = sm["reactions"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|r| Vec3::from_fn(|k, _| r["force"][k].as_f64().unwrap()))
+                .sum();
+            let (fs, _) = reaction(&sm, "symmetry[1]");
+            let fs = Vec3::from(fs);
+            let n = back.transpose() * Vec3::x();
+            println!(
+                "oblique plane: reactions {total:?} against the weight {weight:?}; plane's \
+                 reaction {fs:?}"
+            );
+            // At the converged state the imbalance is the sum of the free DOFs' residuals,
+            // each below tolerance × force scale (a floor above round-off on this stiff shell).
+            let bound =
+                3.0 * mesh.positions.len() as f64 * 1e-10 * sm["force_scale"].as_f64().unwrap();
+            assert!((total + weight).norm() < bound, "{total:?}, {bound:e}");
+            assert!(
+                fs.norm() > 1e-3 * weight.norm(),
+                "the plane carries nothing: {fs:?}"
+            );
+            assert!(
+                fs.cross(&n).norm() < 1e-9 * fs.norm(),
+                "{fs:?} is not along {n:?}"
+            );
+        }
+    }
+    let big = u[0].iter().fold(0.0f64, |m, v| m.max(v.norm()));
+    let worst = u[0]
+        .iter()
+        .zip(&u[1])
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).norm()));
+    println!(
+        "oblique symmetry plane: largest displacement {big:.4e}, worst difference {worst:.2e}"
+    );
+    assert!(big > 1e-4, "{big}");
+    assert!(worst < 1e-6 * big, "{worst:e} of {big:e}");
+}
+
+/// The pinched cylinder with rigid diaphragms (MacNeal & Harder 1985): R = 300, L = 600,
+/// t = 3, E = 3e6, ν = 0.3, two opposite radial loads P at mid-length; reference deflection
+/// under a load 164.24 P/(E t) = 1.82488e-5 P. The octant model (θ from the load to 90°, y from
+/// mid-length to the diaphragm at y = 300) has symmetry planes x = 0, y = 0 and z = 0, the
+/// diaphragm holding x and z, and carries P/4 (P = 1000, a linear response). On a uniform 48²
+/// grid (4608 faces) the point load's singularity leaves +6.4%; grading the same grid toward
+/// the load (θ and y as the 1.35th power of the grid coordinate) brings it within 2%
+/// (measured +1.64%), as the benchmark target asks on at most ~5k faces.
+#[test]
+fn the_pinched_cylinder_octant_on_a_graded_grid_is_within_two_percent() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let n = 48;
+    let settings = "[material]\nthickness = 3.0\nyoung = 3e6\npoisson = 0.3\n\
+        [[loads.point]]\nforce = [0, 0, -250]\ninside = { min = [-1e-6, -1e-6, 299], max = [1e-6, 1e-6, 301] }\n\
+        [[constraints.support]]\ncomponents = [\"x\", \"z\"]\n\
+        inside = { min = [-400, 299.999, -400], max = [400, 300.001, 400] }\n\
+        [[constraints.symmetry]]\naxis = \"x\"\n[[constraints.symmetry]]\naxis = \"y\"\n\
+        [[constraints.symmetry]]\naxis = \"z\"\n";
+    let mut err = Vec::new();
+    for gamma in [1.0f64, 1.35] {
+        let m = format!("pc{gamma}");
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        graded_cylinder_patch(
+            dir,
+            &format!("{m}.vtk"),
+            300.0,
+            (0.0, half_pi),
+            (0.0, 300.0),
+            (n, n),
+            0.0,
+            gamma,
+        );
+        std::fs::write(dir.join(format!("{m}.toml")), settings).unwrap();
+        let (_, mesh, frame) = solved(dir, &m);
+        // The load point (θ = 0, y = 0) is vertex 0.
+        let w = (mesh.positions[0].z - frame.positions[0].z) / 1000.0;
+        err.push(w / 1.82488e-5 - 1.0);
+    }
+    println!(
+        "pinched cylinder octant, 4608 faces: uniform {:+.2}%, graded {:+.2}%",
+        100.0 * err[0],
+        100.0 * err[1]
+    );
+    assert!(err[1].abs() < 0.02, "{err:?}");
+    assert!(
+        err[0].abs() > 2.0 * err[1].abs(),
+        "grading should matter: {err:?}"
+    );
 }
 
 /// The pinched hemisphere with an 18° hole (MacNeal & Harder 1985): radius 10, t = 0.04,
@@ -411,14 +585,15 @@ fn the_pinched_hemisphere_quarter_matches_the_reference() {
     assert!((ua / ub - 1.0).abs() < 1e-4, "{ua} {ub}");
 }
 
-/// Bad symmetry planes: one that no vertex lies on, and one with a bending model that has no
-/// boundary rotation to set; each exit 2 naming the key.
+/// Bad symmetry planes: one that no vertex lies on (along an axis or oblique), one with a bending
+/// model that has no boundary rotation to set, both or neither of axis and normal, a zero
+/// normal, and a path on an oblique plane's vertices; each exit 2 naming the key.
 #[test]
 fn bad_symmetry_planes_are_refused() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
     rectangle(dir, 1.0, 0.5, 0.1, "0", "r.vtk");
-    let cases: [(&str, &[&str]); 2] = [
+    let cases: [(&str, &[&str]); 7] = [
         (
             "[[constraints.symmetry]]\naxis = \"x\"\nat = 0.123\n",
             &["constraints.symmetry[0]", "no vertex lies on the plane x = 0.123"],
@@ -427,18 +602,42 @@ fn bad_symmetry_planes_are_refused() {
             "[material]\nbending = \"patch_fit\"\n[[constraints.symmetry]]\naxis = \"x\"\nat = 0.5\n",
             &["constraints.symmetry[0]", "midedge_sin"],
         ),
+        (
+            "[[constraints.symmetry]]\naxis = \"x\"\nnormal = [1, 0, 0]\n",
+            &["constraints.symmetry[0]", "both axis and normal"],
+        ),
+        (
+            "[[constraints.symmetry]]\nat = 0.5\n",
+            &["constraints.symmetry[0]", "needs the plane's normal"],
+        ),
+        (
+            "[[constraints.symmetry]]\nnormal = [0, 0, 0]\n",
+            &["constraints.symmetry[0].normal", "non-zero"],
+        ),
+        (
+            "[[constraints.symmetry]]\nnormal = [3, 4, 0]\nat = 5\n",
+            &["constraints.symmetry[0]", "no vertex lies on the plane (0.6, 0.8, 0)·x = 5"],
+        ),
+        // The plane through the edge x = 0.5 at 45° to the sheet, and a path on that edge.
+        (
+            "[[constraints.symmetry]]\nnormal = [1, 0, 1]\nat = 0.3535533905932738\n\
+             [[constraints.displacement]]\ndisplacement = [0, 0.1, 0]\n\
+             inside = { min = [0.49, -1, -1], max = [1, 1, 1] }\n",
+            &["constraints.displacement[0]", "oblique symmetry plane"],
+        ),
     ];
     refused(dir, &cases);
 }
 
 /// Bad supports: a selection of no vertex, no component, a component listed twice, an unknown
-/// component, and a component both held and on a path, each exit 2 naming the key.
+/// component, a component both held and on a path, and supports that leave the sheet free to
+/// translate along a net load (the system would be singular), each exit 2 naming the key.
 #[test]
 fn bad_supports_are_refused() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
     rectangle(dir, 1.0, 0.5, 0.1, "0", "r.vtk");
-    let cases: [(&str, &[&str]); 5] = [
+    let cases: [(&str, &[&str]); 7] = [
         (
             "[[constraints.support]]\ncomponents = [\"x\"]\ninside = { min = [5, 5, 5], max = [6, 6, 6] }\n",
             &["constraints.support[0]", "selects no vertex"],
@@ -454,6 +653,17 @@ fn bad_supports_are_refused() {
         (
             "[[constraints.support]]\ncomponents = [\"w\"]\ntags = [1]\n",
             &["components", "w"],
+        ),
+        // Nothing holds the sheet, and a net load pushes it.
+        (
+            "[[loads.point]]\nforce = [0, 0, 1]\ninside = { min = [0.49, -1, -1], max = [1, 1, 1] }\n",
+            &["constraints", "free to translate along (0, 0, 1)", "net force of 1 N"],
+        ),
+        // A support that leaves a translation free along the load.
+        (
+            "[[constraints.support]]\ncomponents = [\"x\", \"z\"]\ninside = { min = [-1, -1, -1], max = [-0.49, 1, 1] }\n\
+             [[loads.traction]]\ntraction = [0, 2, 0]\ninside = { min = [0.49, -1, -1], max = [1, 1, 1] }\n",
+            &["constraints", "free to translate along (0, 1, 0)"],
         ),
         (
             "[[constraints.support]]\ncomponents = [\"x\"]\ninside = { min = [0.49, -1, -1], max = [1, 1, 1] }\n\

@@ -3,13 +3,14 @@
 //! and keeps no settings: the model ([`crate::model::Scene`]) adds the terms the settings
 //! enable.
 
+pub mod hold;
 mod lame;
 pub mod patch;
 pub mod select;
 
 pub use lame::Lame2d;
 
-use crate::math::{Real, Sym2, Vec3};
+use crate::math::{Mat3, Real, Sym2, Vec3};
 use crate::mesh::{Mesh, MeshError, Topology};
 use crate::rest::laws::GrowthInputs;
 use crate::rest::RestForms;
@@ -67,13 +68,22 @@ pub struct Body {
     /// edge-DOF bending models, [`crate::geometry::EdgeNormal`]); empty when none is.
     pub edge_normal: Vec<Option<crate::geometry::EdgeNormal>>,
     /// Position DOFs (`3v + k`) held at their current values while their vertex is otherwise
-    /// free: the components held by `[[constraints.support]]` and by partial paths; or, in
-    /// static mode with nothing held, the 6 that remove the rigid-body null space of the
-    /// Hessian (see [`rigid_pins`]).
+    /// free: the components held by `[[constraints.support]]`, by symmetry planes along an
+    /// axis and by partial paths, and the automatic rigid pins along an axis
+    /// ([`hold::rigid_pins`]); sorted. Vertices with a held direction off the axes are in
+    /// [`Body::skew`] instead.
     pub pinned_dofs: Vec<usize>,
     /// The position DOFs of [`Body::pinned_dofs`] that supports and partial paths hold (not
     /// the automatic rigid pins), sorted.
     pub held_dofs: Vec<usize>,
+    /// Vertices held along directions off the coordinate axes (oblique symmetry planes, the
+    /// automatic rigid pins), with the projector onto the directions they may move in
+    /// ([`hold::Skew`]), ascending.
+    pub skew: Vec<hold::Skew>,
+    /// The rigid motions that the supports (before the automatic pins) leave free: only the
+    /// translations among them under dead loads (gravity, point, traction, pressure, moment
+    /// loads), whose rotations the pins leave alone.
+    pub rigid: hold::RigidModes,
     /// Per-face inputs of the growth law.
     pub growth: GrowthInputs,
     /// Per face, the rest thickness at dial 1 over the reference thickness, when a growth law
@@ -125,6 +135,29 @@ fn positive_face_field(
 }
 
 impl Body {
+    /// The skew vertices ([`Body::skew`]), ascending.
+    pub fn skew_vertices(&self) -> Vec<usize> {
+        self.skew.iter().map(|s| s.vertex).collect()
+    }
+
+    /// The projector of skew vertex `v` ([`hold::Skew::free`]), `None` for any other node.
+    pub fn skew_projector(&self, v: usize) -> Option<Mat3> {
+        self.skew
+            .binary_search_by_key(&v, |s| s.vertex)
+            .ok()
+            .map(|i| self.skew[i].free)
+    }
+
+    /// Applies the skew vertices' projectors to a DOF vector (gradient, step, direction): the
+    /// components along the directions they hold become zero.
+    pub fn project_skew(&self, g: &mut [Real]) {
+        for s in &self.skew {
+            let d = 3 * s.vertex;
+            let p = s.free * Vec3::new(g[d], g[d + 1], g[d + 2]);
+            g[d..d + 3].copy_from_slice(p.as_slice());
+        }
+    }
+
     /// Validates the mesh and builds the body, in stages: the mesh and its topology, the
     /// material per face, the rest forms (reference, targets, growth), the masses, the supports,
     /// the checks that the problem is posed, and the ground. Errors name the file, field and
@@ -158,7 +191,8 @@ impl Body {
             clamped_edges,
             edge_normal,
             prescribed,
-            held_dofs,
+            mut comp,
+            mut dirs,
             mut groups,
         } = supports(&mesh, &topo, settings, &is_unused)?;
         let RestStage {
@@ -172,8 +206,10 @@ impl Body {
         }
         let mass = lumped_masses(&mesh, &thickness, m.density);
         // Free: no vertex that carries the sheet is held (unused vertices are held, inertly).
-        let free =
-            unused.len() < nv && (0..nv).all(|v| is_unused[v] || !fixed[v]) && held_dofs.is_empty();
+        let free = unused.len() < nv
+            && (0..nv).all(|v| is_unused[v] || !fixed[v])
+            && comp.iter().all(|c| *c == [false; 3])
+            && dirs.iter().all(|d| d.is_empty());
         check_posed(&mesh, settings, free)?;
         let ground = settings
             .contact
@@ -187,28 +223,50 @@ impl Body {
         } else {
             Vec::new()
         };
-        // Obstacles hold the sheet where they touch it: pins would carry their reaction.
-        let pinned_dofs = if free
-            && settings.obstacles.is_empty()
-            && settings.solver.mode == crate::settings::Mode::Static
-        {
-            let mut pins = rigid_pins(&mesh, &fixed);
-            // Dead loads are not invariant under rotations: pinning rotational DOFs would make
-            // the pins carry a reaction. Only the translation is pinned then (balanced loads are
-            // invariant under it); rotations the loads leave free get the solver's tiny shift.
-            if settings.loads.any_external() {
-                pins.truncate(3);
+        // The rigid motions the supports leave free. In statics without obstacles or a ground
+        // (which hold the sheet where they touch it, so pins would carry their reaction) they are
+        // removed by statically determinate pins. Dead loads are not invariant under
+        // rotations: pinning a rotation would make the pins carry a reaction. With loads only
+        // the free translations are pinned then (balanced loads are invariant under them);
+        // rotations the loads leave free get the solver's tiny shift.
+        let used: Vec<bool> = is_unused.iter().map(|&u| !u).collect();
+        let dead_loads =
+            settings.loads.any_external() || settings.loads.gravity.iter().any(|&g| g != 0.0);
+        let rigid = hold::free_modes(&mesh, &used, &fixed, &comp, &dirs, dead_loads);
+        let pinnable = settings.obstacles.is_empty()
+            && !settings.contact.enabled
+            && settings.solver.mode == crate::settings::Mode::Static;
+        let mut pin_dofs = Vec::new();
+        if pinnable && !rigid.modes.is_empty() {
+            let free_vertex: Vec<bool> = (0..nv).map(|v| used[v] && !fixed[v]).collect();
+            let pins = hold::rigid_pins(&mesh, &free_vertex, &rigid);
+            if !pins.is_empty() {
+                let gi = groups.len();
+                let mut group = SupportGroup {
+                    name: "rigid_pins".into(),
+                    dofs: Vec::new(),
+                    directions: Vec::new(),
+                };
+                for &(v, d) in &pins {
+                    match (0..3).find(|&k| d[k].abs() == 1.0) {
+                        Some(k) if !comp[v][k] => {
+                            comp[v][k] = true;
+                            group.dofs.push(3 * v + k);
+                            pin_dofs.push(3 * v + k);
+                        }
+                        _ => dirs[v].push((d, gi)),
+                    }
+                }
+                group.dofs.sort_unstable();
+                groups.push(group);
             }
-            let mut sorted = pins.clone();
-            sorted.sort_unstable();
-            groups.push(SupportGroup {
-                name: "rigid_pins".into(),
-                dofs: sorted,
-            });
-            pins
-        } else {
-            held_dofs.clone()
-        };
+        }
+        let hold::Final { pinned_dofs, skew } = hold::finalise(&fixed, &comp, &dirs, &mut groups);
+        let held_dofs: Vec<usize> = pinned_dofs
+            .iter()
+            .copied()
+            .filter(|d| !pin_dofs.contains(d))
+            .collect();
         let mean_edge = mesh.mean_edge_length();
         let eh = young
             .iter()
@@ -240,6 +298,8 @@ impl Body {
             edge_normal,
             pinned_dofs,
             held_dofs,
+            skew,
+            rigid,
             growth,
             grown_thickness,
             ground,
@@ -522,9 +582,12 @@ struct Supports {
     /// Vertices on prescribed paths, their displacement at dial 1 (m) and the components that
     /// follow it.
     prescribed: Vec<(usize, Vec3, [bool; 3])>,
-    /// The position DOFs (`3v + k`) held by component supports and partial paths, of vertices
-    /// not otherwise held, sorted.
-    held_dofs: Vec<usize>,
+    /// Per vertex, the coordinate components held by component supports, symmetry planes
+    /// along an axis and partial paths.
+    comp: Vec<[bool; 3]>,
+    /// Per vertex, the directions off the axes that oblique symmetry planes hold, with the
+    /// index of their support in `groups`.
+    dirs: Vec<Vec<hold::Held>>,
     /// Every support, with the DOFs it holds.
     groups: Vec<SupportGroup>,
 }
@@ -538,6 +601,10 @@ pub struct SupportGroup {
     pub name: String,
     /// The held DOFs, ascending.
     pub dofs: Vec<usize>,
+    /// The held directions off the coordinate axes, as (vertex, unit direction): an oblique
+    /// symmetry plane's, the automatic rigid pins', and every held component of a vertex that
+    /// also has one ([`hold::finalise`]).
+    pub directions: Vec<(usize, Vec3)>,
 }
 
 /// The supports of `[constraints]` on `mesh`, with the unused vertices held. Errors name the key
@@ -583,7 +650,12 @@ fn supports(
         d.sort_unstable();
         d.dedup();
         d.retain(|&k| !std::mem::replace(&mut claimed[k], true));
-        groups.push(SupportGroup { name, dofs: d });
+        groups.push(SupportGroup {
+            name,
+            dofs: d,
+            directions: Vec::new(),
+        });
+        groups.len() - 1
     };
     let all3 = |v: usize| 3 * v..3 * v + 3;
     if c.use_constraint_indicators {
@@ -713,18 +785,18 @@ fn supports(
     // Symmetry planes: the normal component held on the plane, and the boundary edges on it
     // keep their mid-edge normal in the plane.
     let tol = SYMMETRY_TOLERANCE * mesh.bbox_diagonal();
+    let mut dirs: Vec<Vec<hold::Held>> = vec![Vec::new(); nv];
     for (i, sy) in c.symmetry.iter().enumerate() {
         let what = format!("constraints.symmetry[{i}]");
-        let k = sy.axis.index();
-        let axis = ["x", "y", "z"][k];
+        let normal = sy.unit_normal();
+        let plane = sy.describe();
         let on: Vec<bool> = (0..nv)
-            .map(|v| !is_unused[v] && (mesh.positions[v][k] - sy.at).abs() <= tol)
+            .map(|v| !is_unused[v] && (normal.dot(&mesh.positions[v]) - sy.at).abs() <= tol)
             .collect();
         if !on.contains(&true) {
             return Err(mesh.invalid(format!(
-                "{what}: no vertex lies on the plane {axis} = {} (within {} m, 1e-9 of the \
+                "{what}: no vertex lies on the plane {plane} (within {} m, 1e-9 of the \
                  mesh's size); a symmetry plane cuts the model along its boundary",
-                crate::math::human(sy.at),
                 crate::math::human(tol)
             )));
         }
@@ -739,8 +811,6 @@ fn supports(
                  hold the normal component with [[constraints.support]] and model the whole"
             )));
         }
-        let mut normal = Vec3::zeros();
-        normal[k] = 1.0;
         let mut edges = 0usize;
         for (e, ends) in topo.edges.iter().enumerate() {
             if topo.edge_faces[e][1] != crate::mesh::topology::NONE || !on[ends[0]] || !on[ends[1]]
@@ -758,10 +828,9 @@ fn supports(
             let cos = t.dot(&nf);
             if cos.abs() < 0.1 {
                 return Err(mesh.invalid(format!(
-                    "{what}: face {f} meets the plane {axis} = {} at {:.1}° from the plane \
+                    "{what}: face {f} meets the plane {plane} at {:.1}° from the plane \
                      itself; a mirror-symmetric surface crosses its plane (at 90° in the \
                      limit of a fine mesh)",
-                    crate::math::human(sy.at),
                     cos.abs().asin().to_degrees()
                 )));
             }
@@ -776,19 +845,29 @@ fn supports(
         }
         if angle && edges == 0 {
             return Err(mesh.invalid(format!(
-                "{what}: no boundary edge lies on the plane {axis} = {}; a symmetry plane cuts \
-                 the model along its boundary",
-                crate::math::human(sy.at)
+                "{what}: no boundary edge lies on the plane {plane}; a symmetry plane cuts the \
+                 model along its boundary"
             )));
         }
         let list: Vec<usize> = (0..nv).filter(|&v| on[v]).collect();
-        for &v in &list {
-            comp[v][k] = true;
+        match sy.coordinate_axis() {
+            Some(axis) => {
+                let k = axis.index();
+                for &v in &list {
+                    comp[v][k] = true;
+                }
+                group(
+                    format!("symmetry[{i}]"),
+                    &mut list.iter().map(|&v| 3 * v + k),
+                );
+            }
+            None => {
+                let gi = group(format!("symmetry[{i}]"), &mut std::iter::empty());
+                for &v in &list {
+                    dirs[v].push((normal, gi));
+                }
+            }
         }
-        group(
-            format!("symmetry[{i}]"),
-            &mut list.iter().map(|&v| 3 * v + k),
-        );
     }
     let mut prescribed: Vec<(usize, Vec3, [bool; 3])> = Vec::new();
     for (i, pd) in c.displacement.iter().enumerate() {
@@ -800,6 +879,13 @@ fn supports(
                 return Err(mesh.invalid(format!(
                     "{what}: vertex {v} is already fixed or given another prescribed path; a \
                      vertex is either held, or moved along one path"
+                )));
+            }
+            if !dirs[v].is_empty() {
+                return Err(mesh.invalid(format!(
+                    "{what}: vertex {v} lies on an oblique symmetry plane \
+                     (constraints.symmetry), which holds its normal component; a vertex on \
+                     such a plane is not given a path"
                 )));
             }
             if let Some(k) = (0..3).find(|&k| mask[k] && comp[v][k]) {
@@ -830,20 +916,14 @@ fn supports(
             fixed[v] = true;
         }
     }
-    let held_dofs = (0..nv)
-        .filter(|&v| !fixed[v])
-        .flat_map(|v| {
-            let c = comp[v];
-            (0..3).filter(move |&k| c[k]).map(move |k| 3 * v + k)
-        })
-        .collect();
 
     Ok(Supports {
         fixed,
         clamped_edges,
         edge_normal,
         prescribed,
-        held_dofs,
+        comp,
+        dirs,
         groups,
     })
 }
@@ -1014,42 +1094,6 @@ fn check_moisture_regions(mesh: &Mesh, settings: &Settings) -> Result<(), MeshEr
         }
     }
     Ok(())
-}
-
-/// Six position DOFs whose fixing removes the rigid motions of a free sheet without
-/// constraining its shape: all of vertex A (nearest the centroid), the two coordinates of B
-/// (farthest from A) across the dominant direction of AB, and the coordinate of C (farthest from
-/// the line AB) along the dominant direction of the normal of ABC. In statics the energy is
-/// invariant under rigid motions, so the constrained minimum is an equilibrium of the free sheet:
-/// its gradient vanishes on the pinned DOFs too (they are transversal to the rigid motions).
-/// Without them the Hessian is singular and Newton needs a diagonal shift that slows the soft
-/// bending modes of thin shells to linear convergence.
-pub fn rigid_pins(mesh: &Mesh, unused: &[bool]) -> Vec<usize> {
-    let used: Vec<usize> = (0..mesh.positions.len()).filter(|&v| !unused[v]).collect();
-    if used.len() < 3 {
-        return Vec::new();
-    }
-    let p = &mesh.positions;
-    let c = used.iter().map(|&v| p[v]).sum::<Vec3>() / used.len() as Real;
-    let by = |f: &dyn Fn(usize) -> Real| {
-        used.iter()
-            .copied()
-            .max_by(|&u, &v| f(u).total_cmp(&f(v)).then(v.cmp(&u)))
-            .unwrap_or(used[0])
-    };
-    let a = by(&|v| -(p[v] - c).norm());
-    let b = by(&|v| (p[v] - p[a]).norm());
-    let ab = p[b] - p[a];
-    let cc = by(&|v| ab.cross(&(p[v] - p[a])).norm());
-    let n = ab.cross(&(p[cc] - p[a]));
-    if n.norm() <= 1e-12 * ab.norm_squared() {
-        return Vec::new();
-    }
-    let k_ab = ab.iamax();
-    let mut pins = vec![3 * a, 3 * a + 1, 3 * a + 2];
-    pins.extend((0..3).filter(|&k| k != k_ab).map(|k| 3 * b + k));
-    pins.push(3 * cc + n.iamax());
-    pins
 }
 
 /// What a contact penalty on the sheet's surfaces needs per vertex, and its defaults: the

@@ -38,15 +38,68 @@ pub struct Constraints {
     pub displacement: Vec<Prescribed>,
 }
 
-/// A symmetry plane normal to a coordinate axis.
+/// A symmetry plane `n̂ · x = at`, its normal given as a coordinate axis or as a vector.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Symmetry {
-    /// The plane's normal: `"x"`, `"y"` or `"z"`.
-    pub axis: Axis,
-    /// Where the plane cuts that axis (m, default: `0`).
+    /// The plane's normal as a coordinate axis: `"x"`, `"y"` or `"z"` (or give `normal`).
+    #[serde(default)]
+    pub axis: Option<Axis>,
+    /// The plane's normal as a vector, any length but zero (or give `axis`).
+    #[serde(default)]
+    pub normal: Option<[Real; 3]>,
+    /// The plane's signed distance from the origin along the unit normal (m, default: `0`):
+    /// with `axis`, where the plane cuts that axis.
     #[serde(default)]
     pub at: Real,
+}
+
+impl Symmetry {
+    /// The plane's unit normal (`axis` or `normal`, once validated).
+    pub fn unit_normal(&self) -> crate::math::Vec3 {
+        let mut n = crate::math::Vec3::zeros();
+        match (self.axis, self.normal) {
+            (Some(a), _) => n[a.index()] = 1.0,
+            (None, Some(v)) => n = crate::math::Vec3::from(v).normalize(),
+            (None, None) => {}
+        }
+        n
+    }
+
+    /// The coordinate axis the normal lies along (`axis`, or a `normal` with two zero
+    /// components), whose component the plane's vertices keep; `None` for an oblique plane.
+    pub fn coordinate_axis(&self) -> Option<Axis> {
+        match (self.axis, self.normal) {
+            (Some(a), _) => Some(a),
+            (None, Some(v)) => {
+                let nz: Vec<usize> = (0..3).filter(|&k| v[k] != 0.0).collect();
+                match nz[..] {
+                    [0] => Some(Axis::X),
+                    [1] => Some(Axis::Y),
+                    [2] => Some(Axis::Z),
+                    _ => None,
+                }
+            }
+            (None, None) => None,
+        }
+    }
+
+    /// A name for the plane in messages: `x = 0.5`, or `(0.6, 0.8, 0)·x = 1`.
+    pub fn describe(&self) -> String {
+        let at = crate::math::human(self.at);
+        match (self.axis, self.normal) {
+            (Some(a), _) => format!("{} = {at}", ["x", "y", "z"][a.index()]),
+            _ => {
+                let n = self.unit_normal();
+                format!(
+                    "({}, {}, {})·x = {at}",
+                    crate::math::human(n[0]),
+                    crate::math::human(n[1]),
+                    crate::math::human(n[2])
+                )
+            }
+        }
+    }
 }
 
 /// A Cartesian component of a vertex's position.
@@ -144,6 +197,30 @@ impl Constraints {
             ck.selection(&key, &sp.on)?;
         }
         for (i, sy) in cs.symmetry.iter().enumerate() {
+            let key = format!("constraints.symmetry[{i}]");
+            match (sy.axis, sy.normal) {
+                (Some(_), Some(_)) => {
+                    return ck.inv(&key, "gives both axis and normal; give one of them".into())
+                }
+                (None, None) => {
+                    return ck.inv(
+                        &key,
+                        "needs the plane's normal: axis (\"x\", \"y\" or \"z\") or normal \
+                         (a vector)"
+                            .into(),
+                    )
+                }
+                (None, Some(v)) => {
+                    let len = v.iter().map(|c| c * c).sum::<Real>().sqrt();
+                    if !(len.is_finite() && len > 0.0) {
+                        return ck.inv(
+                            &format!("{key}.normal"),
+                            format!("must be a finite, non-zero vector, got {}", vec_e(&v)),
+                        );
+                    }
+                }
+                (Some(_), None) => {}
+            }
             let max = crate::mesh::MAX_COORDINATE;
             if !(sy.at.is_finite() && sy.at.abs() <= max) {
                 return ck.inv(

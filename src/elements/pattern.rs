@@ -4,7 +4,7 @@
 //! terms; [`crate::assembly`] builds it for a scene.
 
 use super::{colour_blocks, morton_order, node_dofs, ElementMap, Scratch, Stencil, BLOCK};
-use crate::math::Vec3;
+use crate::math::{Mat3, Real, Vec3};
 use crate::mesh::topology::NONE;
 
 /// The Hessian's sparsity pattern and, per term, where its elements' entries go.
@@ -24,7 +24,22 @@ pub struct Pattern {
     pub maps: Vec<ElementMap>,
     /// Positions in the values of every entry in the row or column of a pinned DOF.
     pinned: Vec<usize>,
+    /// The stored blocks in the rows or columns of a skew vertex ([`Pattern::project_skew`]).
+    skew: Vec<SkewBlock>,
 }
+
+/// A stored block of the lower triangle between the rows of node `u` and the columns of node
+/// `v` (`u ≥ v`), one of them a skew vertex: the positions of its entries (row-major, up to
+/// 3 × 3, `NO_ENTRY` where the block has none: past a scalar node's one DOF, or above the
+/// diagonal of a diagonal block).
+#[derive(Clone, Debug)]
+struct SkewBlock {
+    u: u32,
+    v: u32,
+    pos: [[u32; 3]; 3],
+}
+
+const NO_ENTRY: u32 = u32::MAX;
 
 impl Pattern {
     /// Whether `other` has the same entries (the union of the stencils), so that a symbolic
@@ -140,6 +155,7 @@ impl Pattern {
             row_idx,
             maps,
             pinned: Vec::new(),
+            skew: Vec::new(),
         }
     }
 
@@ -154,6 +170,93 @@ impl Pattern {
             for k in self.col_ptr[col]..self.col_ptr[col + 1] {
                 if pinned[col] || pinned[self.row_idx[k]] {
                     self.pinned.push(k);
+                }
+            }
+        }
+    }
+
+    /// Records the stored blocks in the rows and columns of the vertices `skew` (ascending),
+    /// for [`Pattern::project_skew`].
+    pub fn pin_skew(&mut self, skew: &[usize]) {
+        self.skew.clear();
+        if skew.is_empty() {
+            return;
+        }
+        let nv = self.num_vertices;
+        let node = |d: usize| {
+            if d < 3 * nv {
+                (d / 3, d % 3)
+            } else {
+                (d - 2 * nv, 0)
+            }
+        };
+        let is_skew = |u: usize| u < nv && skew.binary_search(&u).is_ok();
+        let mut index: std::collections::HashMap<(usize, usize), usize> = Default::default();
+        for col in 0..self.n {
+            let (v, j) = node(col);
+            for k in self.col_ptr[col]..self.col_ptr[col + 1] {
+                let (u, i) = node(self.row_idx[k]);
+                if !(is_skew(u) || is_skew(v)) {
+                    continue;
+                }
+                let b = *index.entry((u, v)).or_insert_with(|| {
+                    self.skew.push(SkewBlock {
+                        u: u as u32,
+                        v: v as u32,
+                        pos: [[NO_ENTRY; 3]; 3],
+                    });
+                    self.skew.len() - 1
+                });
+                self.skew[b].pos[i][j] = k as u32;
+            }
+        }
+    }
+
+    /// Applies the skew vertices' projectors to the Hessian `values`: every stored block
+    /// `H_uv` becomes `T_u H_uv T_v`, `T` the projector `P` of a skew vertex (`proj`) and the
+    /// identity elsewhere, and a skew vertex's diagonal block gains `scale (I − P)`, so that its
+    /// held directions decouple with the pivot `scale`.
+    pub fn project_skew(
+        &self,
+        values: &mut [Real],
+        proj: &dyn Fn(usize) -> Option<Mat3>,
+        scale: Real,
+    ) {
+        for b in &self.skew {
+            let (u, v) = (b.u as usize, b.v as usize);
+            let mut m = Mat3::zeros();
+            for i in 0..3 {
+                for j in 0..3 {
+                    if b.pos[i][j] != NO_ENTRY {
+                        m[(i, j)] = values[b.pos[i][j] as usize];
+                    }
+                }
+            }
+            if u == v {
+                // The lower triangle of a symmetric block.
+                for i in 0..3 {
+                    for j in i + 1..3 {
+                        m[(i, j)] = m[(j, i)];
+                    }
+                }
+            }
+            let (pu, pv) = (proj(u), proj(v));
+            if let Some(p) = pu {
+                m = p * m;
+            }
+            if let Some(p) = pv {
+                m *= p;
+            }
+            if u == v {
+                if let Some(p) = pu {
+                    m += (Mat3::identity() - p) * scale;
+                }
+            }
+            for i in 0..3 {
+                for j in 0..3 {
+                    if b.pos[i][j] != NO_ENTRY {
+                        values[b.pos[i][j] as usize] = m[(i, j)];
+                    }
                 }
             }
         }

@@ -245,6 +245,7 @@ impl<'a> Potential<'a> {
             for &d in &sc.pinned_dofs {
                 grad[d] = 0.0;
             }
+            sc.project_skew(grad);
         }
         if want == Want::Hessian {
             for &k in self.pattern.pinned_entries() {
@@ -272,6 +273,8 @@ impl<'a> Potential<'a> {
             for &d in &sc.pinned_dofs {
                 values[self.pattern.diag(d)] = scale;
             }
+            self.pattern
+                .project_skew(values, &|u| sc.skew_projector(u), scale);
         }
         e
     }
@@ -301,6 +304,7 @@ impl<'a> Potential<'a> {
         for &d in &self.body.pinned_dofs {
             v[d] = 0.0;
         }
+        self.body.project_skew(v);
     }
 
     /// The applied loads' force scale at `(x, phi)` (N): the largest component of their forces
@@ -313,14 +317,25 @@ impl<'a> Potential<'a> {
         for &d in &self.body.pinned_dofs {
             g[d] = 0.0;
         }
+        self.body.project_skew(&mut g);
         g[..3 * self.pattern.num_vertices]
             .iter()
             .fold(0.0, |m: Real, v| m.max(v.abs()))
     }
 
+    /// The applied loads' forces at `(x, phi)` (N, DOF order): `−∂/∂x` of the load terms
+    /// ([`crate::energy::term::Term::applied_load`]) with nothing held.
+    pub fn applied_forces(&self, x: &[Vec3], phi: &[Real]) -> Vec<Real> {
+        let mut g = self.gradient_of(x, phi, true, |t| t.applied_load());
+        g.iter_mut().for_each(|v| *v = -*v);
+        g
+    }
+
     /// The support reactions at `(x, phi)`: per vertex, the force the supports exert on it (N),
     /// `∂Φ/∂x` evaluated with nothing held, on the held vertices and the held components of the
-    /// others ([`crate::body::Body::pinned_dofs`]), zero elsewhere. At an equilibrium the
+    /// others ([`crate::body::Body::pinned_dofs`]), its part along the held directions at a
+    /// skew vertex (`(I − P) ∂Φ/∂x`, [`crate::body::Body::skew`]), zero elsewhere. At an
+    /// equilibrium the
     /// reactions and the applied loads sum to zero (every term but the loads is invariant under
     /// translations), and so do their moments (the edge rotations a clamp holds are relative
     /// to the faces and carry no moment of their own).
@@ -336,9 +351,16 @@ impl<'a> Potential<'a> {
         for &d in &self.body.pinned_dofs {
             held[d / 3][d % 3] = true;
         }
-        (0..nv)
+        let mut r: Vec<Vec3> = (0..nv)
             .map(|v| Vec3::from_fn(|k, _| if held[v][k] { g[3 * v + k] } else { 0.0 }))
-            .collect()
+            .collect();
+        // A skew vertex: the part of its force along the directions it is held in.
+        for s in &self.body.skew {
+            let v = s.vertex;
+            let f = Vec3::new(g[3 * v], g[3 * v + 1], g[3 * v + 2]);
+            r[v] = f - s.free * f;
+        }
+        r
     }
 
     /// The couple (N·m, about the origin) that the supports exert through the boundary
@@ -360,8 +382,8 @@ impl<'a> Potential<'a> {
 
     /// The gradient at `(x, phi)` (DOF order, `pattern.n` entries) of the terms that `keep`
     /// selects: with nothing held when `nothing_held` (the held DOFs then carry the forces
-    /// the supports balance), else with this potential's held nodes. Pinned DOFs are not
-    /// zeroed.
+    /// the supports balance), else with this potential's held nodes. Pinned DOFs and skew
+    /// vertices' held directions are not zeroed.
     fn gradient_of(
         &self,
         x: &[Vec3],

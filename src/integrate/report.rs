@@ -422,15 +422,34 @@ pub fn reactions(pot: &Potential, state: &State) -> (Vec<Vec3>, Vec<Reaction>) {
         ..*pot
     };
     let r = pot.reactions(&state.x, &state.dofs);
+    // At a skew vertex, the reaction split among the supports' directions that hold it.
+    let mut split: std::collections::BTreeMap<usize, Vec<(usize, Vec3)>> = Default::default();
+    for (gi, g) in body.supports.iter().enumerate() {
+        for &(v, d) in &g.directions {
+            split.entry(v).or_default().push((gi, d));
+        }
+    }
+    let mut by_group: Vec<Vec<(usize, Vec3)>> = vec![Vec::new(); body.supports.len()];
+    for (&v, dirs) in &split {
+        let d: Vec<Vec3> = dirs.iter().map(|&(_, d)| d).collect();
+        for (&(gi, _), part) in dirs.iter().zip(crate::body::hold::split_reaction(r[v], &d)) {
+            by_group[gi].push((v, part));
+        }
+    }
     let totals = body
         .supports
         .iter()
-        .map(|g| {
+        .zip(&by_group)
+        .map(|(g, parts)| {
             let (mut f, mut m) = (Vec3::zeros(), Vec3::zeros());
             for &d in &g.dofs {
                 let (v, k) = (d / 3, d % 3);
                 let mut rv = Vec3::zeros();
                 rv[k] = r[v][k];
+                f += rv;
+                m += state.x[v].cross(&rv);
+            }
+            for &(v, rv) in parts {
                 f += rv;
                 m += state.x[v].cross(&rv);
             }

@@ -61,8 +61,16 @@ pub(super) fn run_static(
             break;
         }
         let (target, target_scale) = if dial < 1.0 {
-            let next = (dial + steps.step).min(1.0);
-            let hold = holds.iter().copied().find(|&h| h > dial && h < next);
+            // A step that ends within round-off of dial 1 or of a hold ends on it (ten steps
+            // of 0.1 sum to 0.9999999999999999), so that no extra step of 1e-16 follows.
+            let mut next = (dial + steps.step).min(1.0);
+            if 1.0 - next < DIAL_ROUND_OFF {
+                next = 1.0;
+            }
+            let hold = holds
+                .iter()
+                .copied()
+                .find(|&h| h > dial && h < next + DIAL_ROUND_OFF && h < 1.0);
             (hold.unwrap_or(next), scale)
         } else {
             (1.0, (scale * ratio).min(1.0))
@@ -218,5 +226,74 @@ pub(super) fn run_static(
     s.driver = super::DriverState::at_dial(dial, &steps);
     // The series' time of a static frame is its dial (a failed run's last frame included).
     s.frame(writer, &pot, &state, &zeros, dial)?;
+    Ok(())
+}
+
+/// How close a continuation step's end may come to dial 1 or a hold and be taken as it.
+const DIAL_ROUND_OFF: Real = 1e-12;
+
+/// Rejects a static scene whose supports leave it free to translate along a direction in which
+/// the loads at dial 1 have a net force: it has no equilibrium, and the automatic pins that
+/// remove the free motions ([`crate::body::hold::rigid_pins`]) would carry that force as a
+/// reaction. The net force `Σ fᵥ` along each free translation `t` must be below 1e-6 of
+/// `Σ |fᵥ|` (balanced loads cancel to round-off).
+pub fn check_supports(
+    scene: &crate::model::Scene,
+    settings_name: &str,
+) -> Result<(), crate::settings::SettingsError> {
+    let settings = &scene.settings;
+    let modes: Vec<Vec3> = scene
+        .body
+        .rigid
+        .modes
+        .iter()
+        .filter(|m| m.w == Vec3::zeros())
+        .map(|m| m.t)
+        .collect();
+    if settings.solver.mode != crate::settings::Mode::Static
+        || !settings.obstacles.is_empty()
+        || settings.contact.enabled
+        || modes.is_empty()
+    {
+        return Ok(());
+    }
+    let pattern = crate::assembly::Pattern::for_scene(scene);
+    let state = State::reference(scene);
+    let mut x = state.x.clone();
+    scene.body.prescribe(&mut x, 1.0);
+    let pot = crate::energy::Potential {
+        dial: 1.0,
+        gravity: Vec3::from(settings.loads.gravity),
+        states: &state.terms,
+        ..crate::energy::Potential::new(scene, &pattern)
+    };
+    let f = pot.applied_forces(&x, &state.dofs);
+    let nv = scene.body.num_vertices();
+    let force = |v: usize| Vec3::new(f[3 * v], f[3 * v + 1], f[3 * v + 2]);
+    let total: Vec3 = (0..nv).map(force).sum();
+    let size: Real = (0..nv).map(|v| force(v).norm()).sum();
+    for t in modes {
+        let along = total.dot(&t);
+        if along.abs() > 1e-6 * size {
+            let h = crate::math::human;
+            return Err(crate::settings::SettingsError::Invalid {
+                path: settings_name.to_string(),
+                key: "constraints".into(),
+                reason: format!(
+                    "the supports leave the sheet free to translate along ({}, {}, {}), and \
+                     the loads at dial 1 push it that way with a net force of {} N (of {} N \
+                     in all): a static scene has no equilibrium then, and the system is \
+                     singular. Hold vertices or components that carry it (constraint_indicators, \
+                     fix_tags, fix_boxes, [[constraints.support]]), balance the loads, or use \
+                     solver.mode = \"dynamic\"",
+                    h(t.x),
+                    h(t.y),
+                    h(t.z),
+                    h(along),
+                    h(size)
+                ),
+            });
+        }
+    }
     Ok(())
 }

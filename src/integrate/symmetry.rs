@@ -41,7 +41,8 @@ pub fn is_planar(scene: &Scene, x: &[Vec3]) -> bool {
 }
 
 /// Moves free vertices along their normals by `amp × u`, u uniform in [−1, 1) (seeded); the
-/// components a support holds ([`crate::body::Body::held_dofs`]) stay.
+/// components a support holds ([`crate::body::Body::held_dofs`]) stay, and so do the held
+/// directions of a skew vertex ([`crate::body::Body::skew`]).
 pub fn perturb(scene: &Scene, x: &mut [Vec3], amp: Real, seed: u64) {
     let normals = vertex_normals(scene, x);
     let mut free = vec![[true; 3]; x.len()];
@@ -52,9 +53,13 @@ pub fn perturb(scene: &Scene, x: &mut [Vec3], amp: Real, seed: u64) {
     for (v, p) in x.iter_mut().enumerate() {
         let u = rng.symmetric();
         if !scene.body.fixed[v] {
+            let step = match scene.body.skew_projector(v) {
+                Some(proj) => proj * normals[v],
+                None => normals[v],
+            };
             for k in 0..3 {
                 if free[v][k] {
-                    p[k] += normals[v][k] * (amp * u);
+                    p[k] += step[k] * (amp * u);
                 }
             }
         }

@@ -78,14 +78,38 @@ pub fn cylinder_patch(
     (n, m): (usize, usize),
     drop: f64,
 ) {
+    graded_cylinder_patch(dir, name, r, t, y, (n, m), drop, 1.0);
+}
+
+/// As [`cylinder_patch`], the grid graded toward `(t.0, y.0)` when `gamma` is not 1: θ and y
+/// vary as the `gamma`-th power of the grid coordinate.
+#[allow(clippy::too_many_arguments, dead_code)]
+pub fn graded_cylinder_patch(
+    dir: &Path,
+    name: &str,
+    r: f64,
+    t: (f64, f64),
+    y: (f64, f64),
+    (n, m): (usize, usize),
+    drop: f64,
+    gamma: f64,
+) {
     let mut s = format!(
         "# vtk DataFile Version 3.0\npatch\nASCII\nDATASET POLYDATA\nPOINTS {} double\n",
         (n + 1) * (m + 1)
     );
+    let at = |k: usize, of: usize| {
+        let u = k as f64 / of as f64;
+        if gamma == 1.0 {
+            u
+        } else {
+            u.powf(gamma)
+        }
+    };
     for j in 0..=m {
         for i in 0..=n {
-            let th = t.0 + (t.1 - t.0) * i as f64 / n as f64;
-            let yy = y.0 + (y.1 - y.0) * j as f64 / m as f64;
+            let th = t.0 + (t.1 - t.0) * at(i, n);
+            let yy = y.0 + (y.1 - y.0) * at(j, m);
             s += &format!("{} {} {}\n", r * th.sin(), yy, r * th.cos() - drop);
         }
     }

@@ -552,3 +552,105 @@ fn fused_explicit_step_gives_the_unfused_bits() {
         "the gradient vector was written"
     );
 }
+
+/// The skew vertices' projection on the stored lower triangle equals the dense
+/// `T H T + s (I − P)` (T block diagonal: P at skew vertices, I elsewhere) to round-off, on a
+/// pattern with vertex and scalar nodes, one skew vertex held along one direction and one along
+/// two, and random symmetric values.
+#[test]
+fn skew_projection_matches_the_dense_product() {
+    use shellsim::elements::Stencil;
+    use shellsim::math::Mat3;
+    let nv = 5;
+    let x: Vec<Vec3> = (0..nv).map(|i| Vec3::new(i as f64, 0.0, 0.0)).collect();
+    // Vertex triangles with one scalar node each (nodes 5, 6), and a vertex pair.
+    let st = Stencil {
+        slot_dofs: vec![3, 3, 3, 1],
+        nodes: vec![0, 1, 2, 5, 1, 3, 4, 6],
+        anchors: vec![x[1], x[3]],
+    };
+    let pair = Stencil {
+        slot_dofs: vec![3, 3],
+        nodes: vec![0, 4],
+        anchors: vec![x[2]],
+    };
+    let mut p = Pattern::build(&x, 2, &[st, pair]);
+    let n = p.n;
+    let mut rng = Rng::new(7);
+    let mut dense = vec![vec![0.0; n]; n];
+    let mut values = vec![0.0; p.nnz()];
+    for c in 0..n {
+        for k in p.col_ptr[c]..p.col_ptr[c + 1] {
+            let r = p.row_idx[k];
+            values[k] = rng.symmetric();
+            dense[r][c] = values[k];
+            dense[c][r] = values[k];
+        }
+    }
+    let unit = |v: Vec3| v.normalize();
+    let a = unit(Vec3::new(1.0, 2.0, -0.5));
+    let (b1, b2) = (
+        unit(Vec3::new(0.3, -1.0, 0.2)),
+        unit(Vec3::new(0.0, 0.2, 1.0)),
+    );
+    let b2 = unit(b2 - b1 * b1.dot(&b2));
+    let proj = |v: usize| match v {
+        1 => Some(Mat3::identity() - a * a.transpose()),
+        3 => Some(Mat3::identity() - b1 * b1.transpose() - b2 * b2.transpose()),
+        _ => None,
+    };
+    p.pin_skew(&[1, 3]);
+    let scale = 2.5;
+    p.project_skew(&mut values, &proj, scale);
+    // Dense T H T + s (I − P).
+    let mut t = vec![vec![0.0; n]; n];
+    for (i, row) in t.iter_mut().enumerate() {
+        row[i] = 1.0;
+    }
+    for v in [1, 3] {
+        let pv = proj(v).unwrap();
+        for i in 0..3 {
+            for j in 0..3 {
+                t[3 * v + i][3 * v + j] = pv[(i, j)];
+            }
+        }
+    }
+    let mul = |a: &Vec<Vec<f64>>, b: &Vec<Vec<f64>>| {
+        (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| (0..n).map(|k| a[i][k] * b[k][j]).sum())
+                    .collect()
+            })
+            .collect::<Vec<Vec<f64>>>()
+    };
+    let mut want = mul(&mul(&t, &dense), &t);
+    for v in [1, 3] {
+        let pv = proj(v).unwrap();
+        for i in 0..3 {
+            for j in 0..3 {
+                want[3 * v + i][3 * v + j] += scale * (Mat3::identity() - pv)[(i, j)];
+            }
+        }
+    }
+    let mut worst: f64 = 0.0;
+    for c in 0..n {
+        for k in p.col_ptr[c]..p.col_ptr[c + 1] {
+            worst = worst.max((values[k] - want[p.row_idx[k]][c]).abs());
+        }
+    }
+    assert!(worst < 1e-14, "{worst:e}");
+    // The held directions decouple: a held direction's row of T H T + s(I − P) is s times it.
+    let row: f64 = (0..n)
+        .map(|j| {
+            let e: f64 = (0..3).map(|i| a[i] * want[3 + i][j]).sum();
+            let expect = if (3..6).contains(&j) {
+                scale * a[j - 3]
+            } else {
+                0.0
+            };
+            (e - expect).abs()
+        })
+        .fold(0.0, f64::max);
+    assert!(row < 1e-14, "{row:e}");
+}

@@ -140,6 +140,14 @@ impl Step {
             return energy;
         }
         let (n, pinned) = (x.len(), &self.pinned);
+        let any_skew = !pot.body.skew.is_empty();
+        let skew = |u: usize| {
+            if any_skew {
+                pot.body.skew_projector(u)
+            } else {
+                None
+            }
+        };
         // The writes through `Disjoint` below rely on these.
         assert!(
             v.len() == n && self.next.len() == n && inv_m.len() == n && pinned.len() >= 3 * n,
@@ -171,7 +179,10 @@ impl Step {
                         0.0 + sums[at + k]
                     }
                 };
-                let f = Vec3::new(force(0), force(1), force(2));
+                let mut f = Vec3::new(force(0), force(1), force(2));
+                if let Some(p) = skew(u) {
+                    f = p * f;
+                }
                 at += 3;
                 let mut xu = old[u];
                 // SAFETY: each vertex is owned by one part, and only its part's hook writes
