@@ -757,6 +757,8 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
             cli.out.display()
         );
     }
+    // Everything the user waited for before the run: the run's wall time includes it.
+    scene.build_seconds = clock.elapsed().as_secs_f64();
     let ran = pool.install(|| {
         if cli.verbose {
             run(&scene, &mut writer, &mut Lines, threads, initial)

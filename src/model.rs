@@ -28,6 +28,10 @@ pub struct Scene {
     pub node_fixed: Vec<bool>,
     /// The stateful terms' states at the start of a run ([`crate::solve::State::terms`]).
     pub initial_states: TermStates,
+    /// The wall time spent before the run on reading the settings and the mesh, building this
+    /// scene and checking it (s): set by the command line, 0 otherwise. A run's `wall_seconds`
+    /// include it, and `summary.json`'s timing reports it as `build`.
+    pub build_seconds: crate::math::Real,
 }
 
 impl Scene {
@@ -53,6 +57,7 @@ impl Scene {
             globals,
             node_fixed,
             initial_states,
+            build_seconds: 0.0,
         })
     }
 

@@ -281,9 +281,16 @@ pub fn run(
     s.summary.final_frame = writer.last_frame();
     let t = &mut s.summary.timing;
     t.diffusion = s.summary.moisture_seconds;
+    t.build = scene.build_seconds;
     let n = t.newton;
     t.other = (s.summary.wall_seconds
-        - (n.assembly + n.factorisation + n.solve + n.line_search + t.diffusion + t.output))
+        - (t.build
+            + n.assembly
+            + n.factorisation
+            + n.solve
+            + n.line_search
+            + t.diffusion
+            + t.output))
         .max(0.0);
     s.summary.refuse_non_finite();
     writer.summary(&s.summary)?;

@@ -316,6 +316,9 @@ impl Summary {
 /// bookkeeping).
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
 pub struct Timing {
+    /// Reading the settings and the mesh, building the scene and checking it, before the run
+    /// ([`crate::model::Scene::build_seconds`]).
+    pub build: Real,
     /// Assembly, factorisation, solve and line search, summed over the Newton solves.
     #[serde(flatten)]
     pub newton: crate::solve::newton::NewtonTiming,

@@ -118,7 +118,12 @@ impl<'a> Solver<'a> {
             lin,
             ws,
             summary,
-            start: Instant::now(),
+            // The clock starts when the user started the run: the scene's build counts.
+            start: Instant::now()
+                .checked_sub(std::time::Duration::from_secs_f64(
+                    scene.build_seconds.clamp(0.0, 1e9),
+                ))
+                .unwrap_or_else(Instant::now),
             at_last_frame: Counters::default(),
             driver: DriverState::default(),
             reference: None,

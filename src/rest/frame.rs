@@ -72,6 +72,7 @@ pub fn pulled_back_targets(
     let nf = mesh.faces.len();
     let mut a = Vec::with_capacity(nf);
     let mut b = Vec::with_capacity(nf);
+    let size = mesh.bbox_diagonal();
     for f in 0..nf {
         let axy = abar_xy(f);
         if !(axy[0] > 0.0 && crate::math::sym_det(&axy) > 0.0) {
@@ -96,7 +97,6 @@ pub fn pulled_back_targets(
             )));
         }
         let bxy = bbar_xy(f);
-        let size = mesh.bbox_diagonal();
         if let Some(c) = [bxy[0], bxy[1], bxy[2]]
             .into_iter()
             .find(|c| !c.is_finite() || c.abs() * size > MAX_CURVATURE_TIMES_SIZE)
@@ -110,7 +110,7 @@ pub fn pulled_back_targets(
         }
         let t = reference_frame(mesh, f);
         a.push(pull_back(&t, &axy));
-        b.push(pull_back(&t, &bbar_xy(f)));
+        b.push(pull_back(&t, &bxy));
     }
     Ok((a, b))
 }
