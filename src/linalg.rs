@@ -18,11 +18,15 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, LdltRef, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
-    SymmetricOrdering,
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky,
+    SymbolicCholeskyRaw, SymmetricOrdering,
 };
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
+
+/// The size from which the factorisation is always supernodal (unknowns).
+pub const SUPERNODAL_FROM: usize = 1000;
 
 /// A failed factorisation or setup.
 #[derive(Debug, thiserror::Error)]
@@ -72,11 +76,23 @@ impl LinearSolver {
         row_idx: Vec<usize>,
     ) -> Result<Self, LinearError> {
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        // Supernodal from SUPERNODAL_FROM unknowns: faer's default flop-ratio threshold picks
+        // the simplicial factorisation for small systems, which measured slower on the shell
+        // Hessians of a few thousand unknowns (docs/solvers.md). The choice depends on the size
+        // alone, so results stay identical across runs.
+        let params = CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: if n >= SUPERNODAL_FROM {
+                SupernodalThreshold::FORCE_SUPERNODAL
+            } else {
+                SupernodalThreshold::AUTO
+            },
+            ..Default::default()
+        };
         let symbolic = factorize_symbolic_cholesky(
             pattern.as_ref(),
             Side::Lower,
             SymmetricOrdering::Amd,
-            Default::default(),
+            params,
         )
         .map_err(|e| LinearError::Setup(format!("{e:?}")))?;
         let req = StackReq::any_of(&[
