@@ -76,7 +76,7 @@ enum Constraint {
     Dial,
 }
 
-/// The DOF weights `W` (module doc), zero on the DOFs the solver does not move.
+/// The DOF weights `W` (module doc), zero on the held vertices and pinned DOFs.
 fn weights(s: &Solver) -> Vec<Real> {
     let pat = s.pattern();
     let body = &s.scene.body;
@@ -88,6 +88,11 @@ fn weights(s: &Solver) -> Vec<Real> {
         w[ne + k] = g.length;
     }
     s.potential(&pat, 0.0).mask_fixed(&mut w);
+    // A skew vertex keeps its weights: the vectors weighed are already projected onto its free
+    // directions, and the projection of the weights themselves is no mask.
+    for sk in &body.skew {
+        w[3 * sk.vertex..3 * sk.vertex + 3].fill(1.0);
+    }
     w
 }
 
