@@ -77,7 +77,6 @@ pub fn free_modes(
         / n_used as Real;
     let l = mesh.bbox_diagonal().max(Real::MIN_POSITIVE);
     let mut g = SMat::<6, 6>::zeros();
-    let axis = |k: usize| Vec3::from_fn(|i, _| if i == k { 1.0 } else { 0.0 });
     for v in (0..p.len()).filter(|&v| used[v]) {
         let mut add = |d: Vec3| {
             let a = row(d, p[v], c, l);
@@ -85,7 +84,7 @@ pub fn free_modes(
         };
         for (k, &held) in comp[v].iter().enumerate() {
             if fixed[v] || held {
-                add(axis(k));
+                add(Vec3::ith(k, 1.0));
             }
         }
         if !fixed[v] {
@@ -175,7 +174,7 @@ pub fn rigid_pins(mesh: &Mesh, free: &[bool], modes: &RigidModes) -> Vec<(usize,
     }
     let (n, abu) = (n.normalize(), ab.normalize());
     let u = n.cross(&abu);
-    let ax = |k: usize| Vec3::from_fn(|i, _| if i == k { 1.0 } else { 0.0 });
+    let ax = |k: usize| Vec3::ith(k, 1.0);
     let candidates = [
         (a, ax(0)),
         (a, ax(1)),
@@ -252,9 +251,7 @@ pub fn finalise(
             let d = 3 * v + k;
             if let Some(gi) = groups.iter().position(|g| g.dofs.binary_search(&d).is_ok()) {
                 groups[gi].dofs.retain(|&x| x != d);
-                let mut e = Vec3::zeros();
-                e[k] = 1.0;
-                all.push((e, gi));
+                all.push((Vec3::ith(k, 1.0), gi));
             }
         }
         all.extend(dirs[v].iter().copied());

@@ -342,16 +342,8 @@ pub fn check(scene: &Scene, settings_name: &str) -> Result<(), crate::settings::
     let pattern = crate::assembly::Pattern::for_scene(scene);
     let n = pattern.n;
     let state = State::reference(scene);
-    let gravity = Vec3::from(scene.settings.loads.gravity);
     let grad = |dial: Real| {
-        let mut x = state.x.clone();
-        scene.body.prescribe(&mut x, dial);
-        let pot = crate::energy::Potential {
-            dial,
-            gravity: gravity * dial,
-            states: &state.terms,
-            ..crate::energy::Potential::new(scene, &pattern)
-        };
+        let (x, pot) = super::statics::reference_potential(scene, &pattern, &state, dial);
         let mut g = vec![0.0; n];
         pot.eval(&x, &state.dofs, Want::Gradient, &mut g, &mut []);
         pot.mask_fixed(&mut g);

@@ -229,6 +229,27 @@ pub(super) fn run_static(
     Ok(())
 }
 
+/// The static potential at `dial` before a run (for the checks that need one): the reference
+/// state's positions with the prescribed paths at `dial`, and the potential with every load,
+/// gravity included, ramped to `dial` as the static driver ramps them, with `state`'s term
+/// states.
+pub(super) fn reference_potential<'p>(
+    scene: &'p crate::model::Scene,
+    pattern: &'p crate::assembly::Pattern,
+    state: &'p State,
+    dial: Real,
+) -> (Vec<Vec3>, crate::energy::Potential<'p>) {
+    let mut x = state.x.clone();
+    scene.body.prescribe(&mut x, dial);
+    let pot = crate::energy::Potential {
+        dial,
+        gravity: Vec3::from(scene.settings.loads.gravity) * dial,
+        states: &state.terms,
+        ..crate::energy::Potential::new(scene, pattern)
+    };
+    (x, pot)
+}
+
 /// How close a continuation step's end may come to dial 1 or a hold and be taken as it.
 const DIAL_ROUND_OFF: Real = 1e-12;
 
@@ -259,14 +280,7 @@ pub fn check_supports(
     }
     let pattern = crate::assembly::Pattern::for_scene(scene);
     let state = State::reference(scene);
-    let mut x = state.x.clone();
-    scene.body.prescribe(&mut x, 1.0);
-    let pot = crate::energy::Potential {
-        dial: 1.0,
-        gravity: Vec3::from(settings.loads.gravity),
-        states: &state.terms,
-        ..crate::energy::Potential::new(scene, &pattern)
-    };
+    let (x, pot) = reference_potential(scene, &pattern, &state, 1.0);
     let f = pot.applied_forces(&x, &state.dofs);
     let nv = scene.body.num_vertices();
     let force = |v: usize| Vec3::new(f[3 * v], f[3 * v + 1], f[3 * v + 2]);
