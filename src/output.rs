@@ -957,7 +957,17 @@ impl Writer {
             s.diffusion_direct_solves += n("diffusion_direct_solves");
             s.moisture_seconds += x("moisture_seconds");
             s.wall_seconds += x("wall_seconds");
+            if let Some(ls) = &mut s.linear_system {
+                let l = |k: &str| prev["linear_system"][k].as_u64().unwrap_or(0) as usize;
+                ls.factorisations += l("factorisations");
+                ls.failed_factorisations += l("failed_factorisations");
+                let steps = s.steps.max(1) as Real;
+                ls.factorisations_per_step = ls.factorisations as Real / steps;
+                ls.iterations_per_step = s.newton_iterations as Real / steps;
+            }
             let tm = &mut s.timing;
+            tm.build += t("build");
+            tm.analysis += t("analysis");
             tm.newton.assembly += t("assembly");
             tm.newton.factorisation += t("factorisation");
             tm.newton.solve += t("solve");

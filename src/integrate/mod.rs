@@ -285,6 +285,7 @@ pub fn run(
     let n = t.newton;
     t.other = (s.summary.wall_seconds
         - (t.build
+            + t.analysis
             + n.assembly
             + n.factorisation
             + n.solve
@@ -292,6 +293,7 @@ pub fn run(
             + t.diffusion
             + t.output))
         .max(0.0);
+    s.summary.linear_system = s.linear_system_report();
     s.summary.refuse_non_finite();
     writer.summary(&s.summary)?;
     Ok(s.summary)

@@ -231,6 +231,10 @@ pub struct Summary {
     pub warnings: Vec<String>,
     /// Where the wall time went (s).
     pub timing: Timing,
+    /// The mechanics' sparse linear system: its size, ordering, factor and factorisations
+    /// (left out in explicit runs, which factorise nothing).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub linear_system: Option<LinearSystemReport>,
     /// Explicit mode: its time step, time scales and cost.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub explicit: Option<ExplicitReport>,
@@ -247,6 +251,28 @@ pub struct Summary {
     /// Arc-length continuation: the path traced and its critical points.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub arc_length: Option<ArcLengthReport>,
+}
+
+/// The mechanics' sparse linear system (`summary.json`'s `linear_system`).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct LinearSystemReport {
+    /// Unknowns of the last pattern.
+    pub unknowns: usize,
+    /// Its fill-reducing ordering: `"amd"` or `"nested_dissection"`, the one with fewer flops.
+    pub ordering: String,
+    /// Non-zeros of the Cholesky factor L.
+    pub factor_nonzeros: usize,
+    /// Flops of one numeric factorisation (Σ over L's columns of the squared count).
+    pub factor_flops: Real,
+    /// Numeric factorisations over the run (all patterns), and of those the failed ones (a
+    /// non-positive pivot: an indefinite Hessian tried before its fallback).
+    pub factorisations: usize,
+    /// See `factorisations`.
+    pub failed_factorisations: usize,
+    /// Factorisations per accepted step.
+    pub factorisations_per_step: Real,
+    /// Newton iterations per accepted step.
+    pub iterations_per_step: Real,
 }
 
 /// What an arc-length run traced (`summary.json`'s `arc_length`).
@@ -319,6 +345,9 @@ pub struct Timing {
     /// Reading the settings and the mesh, building the scene and checking it, before the run
     /// ([`crate::model::Scene::build_seconds`]).
     pub build: Real,
+    /// The symbolic analysis of the sparse Hessian (the fill-reducing ordering, the elimination
+    /// tree and supernodes), once per sparsity pattern.
+    pub analysis: Real,
     /// Assembly, factorisation, solve and line search, summed over the Newton solves.
     #[serde(flatten)]
     pub newton: crate::solve::newton::NewtonTiming,

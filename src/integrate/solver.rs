@@ -47,6 +47,8 @@ pub(super) struct Solver<'a> {
     /// The run's controls, from the validated settings.
     pub(super) config: config::RunConfig,
     pub(super) lin: LinearSolver,
+    /// Factorisations of the linear solvers of earlier patterns.
+    pub(super) retired: crate::linalg::FactorCounts,
     pub(super) ws: Workspace,
     pub(super) summary: Summary,
     pub(super) start: Instant,
@@ -93,8 +95,15 @@ impl<'a> Solver<'a> {
         pattern: Pattern,
         threads: usize,
     ) -> Result<Self, RunError> {
-        let lin = LinearSolver::new(&pattern)?;
+        let mut lin = LinearSolver::new(&pattern)?;
         let ws = Workspace::new(&pattern);
+        // The implicit drivers factorise: the symbolic analysis (ordering, elimination tree)
+        // is timed on its own. The explicit driver never factorises and skips it.
+        let clock = Instant::now();
+        if scene.settings.solver.mode != Mode::Explicit {
+            lin.analyse()?;
+        }
+        let analysis = clock.elapsed().as_secs_f64();
         let changing = scene.terms.iter().any(|t| t.changing().is_some());
         let config = config::RunConfig::new(scene);
         let summary = Summary {
@@ -116,6 +125,7 @@ impl<'a> Solver<'a> {
             changing,
             config,
             lin,
+            retired: Default::default(),
             ws,
             summary,
             // The clock starts when the user started the run: the scene's build counts.
@@ -147,7 +157,27 @@ impl<'a> Solver<'a> {
             }
         }
         s.summary.force_scale = s.force_scale;
+        s.summary.timing.analysis = analysis;
         Ok(s)
+    }
+
+    /// The `linear_system` entry of the summary: the current pattern's system and the
+    /// factorisations of the whole run (`None` when nothing was factorised).
+    pub(super) fn linear_system_report(&self) -> Option<super::report::LinearSystemReport> {
+        let c = self.lin.counts();
+        let factorisations = c.factorisations + self.retired.factorisations;
+        let ordering = self.lin.ordering()?;
+        let steps = self.summary.steps.max(1) as Real;
+        Some(super::report::LinearSystemReport {
+            unknowns: self.lin.unknowns(),
+            ordering: ordering.name().into(),
+            factor_nonzeros: self.lin.factor_nnz(),
+            factor_flops: self.lin.factor_flops(),
+            factorisations,
+            failed_factorisations: c.failed + self.retired.failed,
+            factorisations_per_step: factorisations as Real / steps,
+            iterations_per_step: self.summary.newton_iterations as Real / steps,
+        })
     }
 
     /// The current pattern, for potentials to borrow.
@@ -167,7 +197,13 @@ impl<'a> Solver<'a> {
         };
         self.summary.element_changes += 1;
         if !p.same_union(&self.pattern) {
+            let c = self.lin.counts();
+            self.retired.factorisations += c.factorisations;
+            self.retired.failed += c.failed;
+            let clock = Instant::now();
             self.lin = LinearSolver::new(&p)?;
+            self.lin.analyse()?;
+            self.summary.timing.analysis += clock.elapsed().as_secs_f64();
             self.ws = Workspace::new(&p);
             self.summary.pattern_rebuilds += 1;
         }

@@ -1,0 +1,572 @@
+//! Sparse symmetric solves with faer's Cholesky, on any lower-triangular CSC pattern (the
+//! assembled Hessian's, the moisture diffusion's): LLᵀ for positive-definite matrices, and LDLᵀ
+//! (no pivoting) with its inertia for the symmetric indefinite ones that a dense low-rank term
+//! makes positive definite (an inflated balloon past its pressure limit point: the sparse part
+//! has one negative eigenvalue, the gas's rank-one stiffness removes it; see
+//! `solve::low_rank`).
+//!
+//! The symbolic factorisation (a fill-reducing ordering, the elimination tree, supernodes) is
+//! computed once per sparsity pattern, at the first factorisation; every Newton iteration only
+//! refactorises numerically. The ordering is AMD, or for large patterns the cheaper of AMD and
+//! METIS's nested dissection by the factorisation's flop count ([`ordering`]). Factorisation and
+//! solves run sequentially (`Par::Seq`) so the result never depends on the thread count.
+//!
+//! The inertia of an LDLᵀ factorisation is that of `D` (Sylvester's law: `P A Pᵀ = L D Lᵀ` is a
+//! congruence), read from the diagonal of the factor's storage (the first entry of each
+//! simplicial column, the diagonal of each supernode's block).
+
+pub mod ordering;
+
+use crate::math::Real;
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky,
+    SymbolicCholeskyRaw, SymmetricOrdering,
+};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::{Conj, MatMut, Par, Side};
+
+/// The size from which the factorisation is always supernodal (unknowns).
+pub const SUPERNODAL_FROM: usize = 1000;
+
+/// The size from which nested dissection is tried against AMD (unknowns). Below it METIS's
+/// ordering costs more than it saves: on a 6.8k-unknown balloon it cut the flops by 28% but not
+/// the factorisation's time, while the ordering took 5 ms; from 30k unknowns it saves 20% of
+/// every factorisation on closed surfaces (docs/solvers.md).
+pub const DISSECT_FROM: usize = 20_000;
+
+/// A fill-reducing ordering.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ordering {
+    /// faer's approximate minimum degree.
+    Amd,
+    /// METIS's multilevel nested dissection.
+    NestedDissection,
+}
+
+impl Ordering {
+    /// Its name in `summary.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Ordering::Amd => "amd",
+            Ordering::NestedDissection => "nested_dissection",
+        }
+    }
+}
+
+/// Flops of a numeric factorisation with this symbolic structure: Σ c² over the columns of L,
+/// c the column's count with the diagonal.
+fn symbolic_flops(symbolic: &SymbolicCholesky<usize>) -> f64 {
+    match symbolic.raw() {
+        SymbolicCholeskyRaw::Simplicial(s) => {
+            let cp = s.col_ptr();
+            ordering::cholesky_flops((0..s.nrows()).map(|j| cp[j + 1] - cp[j]))
+        }
+        SymbolicCholeskyRaw::Supernodal(s) => {
+            let begin = s.supernode_begin();
+            let end = s.supernode_end();
+            ordering::cholesky_flops((0..s.n_supernodes()).flat_map(|k| {
+                let ncols = end[k] - begin[k];
+                let nrows = ncols + s.supernode(k).pattern().len();
+                (0..ncols).map(move |j| nrows - j)
+            }))
+        }
+    }
+}
+
+/// A failed factorisation or setup.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum LinearError {
+    /// The matrix is not (numerically) positive definite.
+    #[error("matrix not positive definite (non-positive pivot at {index})")]
+    NonPositivePivot {
+        /// Pivot index (in the permuted order).
+        index: usize,
+    },
+    /// An LDLᵀ factorisation met an exactly zero pivot (the matrix is singular).
+    #[error("matrix singular (zero pivot at {index})")]
+    ZeroPivot {
+        /// Pivot index (in the permuted order).
+        index: usize,
+    },
+    /// faer could not build the symbolic structure (out of memory, bad pattern).
+    #[error("sparse Cholesky setup failed: {0}")]
+    Setup(String),
+}
+
+/// Which factorisation the solver holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    None,
+    Llt,
+    Ldlt,
+}
+
+/// The symbolic factorisation of a pattern, its ordering and the scratch memory of its numeric
+/// factorisations and solves.
+struct Analysis {
+    symbolic: SymbolicCholesky<usize>,
+    ordering: Ordering,
+    mem: MemBuffer,
+}
+
+/// A Cholesky solver bound to one sparsity pattern.
+pub struct LinearSolver {
+    pattern: SymbolicSparseColMat<usize>,
+    /// The symbolic analysis, made by the first factorisation (or [`Self::analyse`]): a scene
+    /// that never factorises (the explicit driver) never pays for it.
+    analysis: Option<Analysis>,
+    /// An ordering imposed by the caller (comparisons, benches); `None` chooses by flops.
+    imposed: Option<Ordering>,
+    l_values: Vec<Real>,
+    kind: Kind,
+    /// Negative pivots of the last factorisation (0 for Cholesky).
+    negative: usize,
+    /// Numeric factorisations attempted, and of those the ones that failed.
+    counts: FactorCounts,
+}
+
+/// How many numeric factorisations a solver attempted, and how many failed (a non-positive or
+/// zero pivot).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct FactorCounts {
+    /// Numeric factorisations attempted.
+    pub factorisations: usize,
+    /// Of those, the ones that failed.
+    pub failed: usize,
+}
+
+impl LinearSolver {
+    /// A solver for any lower-triangular CSC pattern (sorted rows, diagonal first). The
+    /// symbolic analysis waits for the first factorisation or [`Self::analyse`].
+    pub fn from_csc(
+        n: usize,
+        col_ptr: Vec<usize>,
+        row_idx: Vec<usize>,
+    ) -> Result<Self, LinearError> {
+        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        Ok(LinearSolver {
+            l_values: Vec::new(),
+            pattern,
+            analysis: None,
+            imposed: None,
+            kind: Kind::None,
+            negative: 0,
+            counts: FactorCounts::default(),
+        })
+    }
+
+    /// Imposes an ordering instead of choosing the cheaper one (for comparisons); before the
+    /// analysis. Nested dissection that fails still falls back to AMD.
+    pub fn with_ordering(mut self, ordering: Ordering) -> Self {
+        self.imposed = Some(ordering);
+        self.analysis = None;
+        self
+    }
+
+    /// The symbolic analysis (ordering, elimination tree, supernodes), once per pattern.
+    pub fn analyse(&mut self) -> Result<(), LinearError> {
+        self.analysis_mut().map(|_| ())
+    }
+
+    fn analysis_mut(&mut self) -> Result<&mut Analysis, LinearError> {
+        if self.analysis.is_none() {
+            let n = self.pattern.nrows();
+            // Supernodal from SUPERNODAL_FROM unknowns: faer's default flop-ratio threshold
+            // picks the simplicial factorisation for small systems, which measured slower on
+            // the shell Hessians of a few thousand unknowns (docs/solvers.md). The choice
+            // depends on the size alone, so results stay identical across runs.
+            let params = CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: if n >= SUPERNODAL_FROM {
+                    SupernodalThreshold::FORCE_SUPERNODAL
+                } else {
+                    SupernodalThreshold::AUTO
+                },
+                ..Default::default()
+            };
+            let (symbolic, ordering) = Self::symbolic(&self.pattern, params, self.imposed)?;
+            let req = StackReq::any_of(&[
+                symbolic.factorize_numeric_llt_scratch::<Real>(Par::Seq, Default::default()),
+                symbolic.factorize_numeric_ldlt_scratch::<Real>(Par::Seq, Default::default()),
+                symbolic.solve_in_place_scratch::<Real>(1, Par::Seq),
+            ]);
+            let mem = MemBuffer::try_new(req).map_err(|e| LinearError::Setup(format!("{e:?}")))?;
+            self.analysis = Some(Analysis {
+                symbolic,
+                ordering,
+                mem,
+            });
+        }
+        Ok(self.analysis.as_mut().expect("made above"))
+    }
+
+    /// The symbolic factorisation under the cheaper of AMD and nested dissection, by the flop
+    /// count of the factorisation ([`ordering::cholesky_flops`]); AMD on a tie, below
+    /// [`DISSECT_FROM`] unknowns, or when the dissection fails (with a warning on stderr).
+    fn symbolic(
+        pattern: &SymbolicSparseColMat<usize>,
+        params: CholeskySymbolicParams<'_>,
+        imposed: Option<Ordering>,
+    ) -> Result<(SymbolicCholesky<usize>, Ordering), LinearError> {
+        let setup = |e: faer::sparse::FaerError| LinearError::Setup(format!("{e:?}"));
+        let n = pattern.nrows();
+        let with = |perm: &[usize]| {
+            let inv = ordering::inverse(perm);
+            factorize_symbolic_cholesky(
+                pattern.as_ref(),
+                Side::Lower,
+                SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(perm, &inv, n)),
+                params,
+            )
+            .map_err(setup)
+        };
+        if imposed == Some(Ordering::Amd) || imposed.is_none() && n < DISSECT_FROM {
+            let amd = ordering::amd(pattern.as_ref()).map_err(setup)?;
+            return Ok((with(&amd)?, Ordering::Amd));
+        }
+        // The two orderings are independent and deterministic: computed side by side on the
+        // pool's threads (the result does not depend on how many there are).
+        let (amd, nd) = rayon::join(
+            || ordering::amd(pattern.as_ref()),
+            || ordering::nested_dissection(n, pattern.col_ptr(), pattern.row_idx()),
+        );
+        let amd = amd.map_err(setup)?;
+        let Some(nd) = nd else {
+            eprintln!(
+                "warning: nested dissection failed on a {n}-unknown pattern; ordering by AMD"
+            );
+            return Ok((with(&amd)?, Ordering::Amd));
+        };
+        if imposed == Some(Ordering::NestedDissection)
+            || ordering::flops_under(pattern.as_ref(), &nd.perm)
+                < ordering::flops_under(pattern.as_ref(), &amd)
+        {
+            Ok((with(&nd.perm)?, Ordering::NestedDissection))
+        } else {
+            Ok((with(&amd)?, Ordering::Amd))
+        }
+    }
+
+    /// The fill-reducing ordering the solver chose for its pattern (`None` before the
+    /// analysis).
+    pub fn ordering(&self) -> Option<Ordering> {
+        self.analysis.as_ref().map(|a| a.ordering)
+    }
+
+    /// Floating-point operations of one numeric factorisation (Σ over columns of L of the squared
+    /// column count; 0 before the analysis).
+    pub fn factor_flops(&self) -> f64 {
+        self.analysis
+            .as_ref()
+            .map_or(0.0, |a| symbolic_flops(&a.symbolic))
+    }
+
+    /// The numeric factorisations attempted so far, and the failed ones.
+    pub fn counts(&self) -> FactorCounts {
+        self.counts
+    }
+
+    /// Number of non-zeros in the factor L (0 before the analysis).
+    pub fn factor_nnz(&self) -> usize {
+        self.analysis.as_ref().map_or(0, |a| a.symbolic.len_val())
+    }
+
+    /// The number of unknowns.
+    pub fn unknowns(&self) -> usize {
+        self.pattern.nrows()
+    }
+
+    /// Numeric factorisation of the matrix with the pattern's structure and these values.
+    pub fn factor(&mut self, values: &[Real]) -> Result<(), LinearError> {
+        self.kind = Kind::None;
+        self.negative = 0;
+        let mut l = std::mem::take(&mut self.l_values);
+        let r = self.factor_to(values, &mut l);
+        self.l_values = l;
+        r?;
+        self.kind = Kind::Llt;
+        Ok(())
+    }
+
+    /// Numeric LDLᵀ factorisation (no pivoting) of a symmetric, possibly indefinite matrix with
+    /// the pattern's structure; returns its number of negative eigenvalues (the negative
+    /// pivots). An exactly zero pivot is an error. Without pivoting the factorisation is stable
+    /// for matrices that are positive definite up to a few directions, which is what it serves
+    /// (callers check their solves' results).
+    pub fn factor_indefinite(&mut self, values: &[Real]) -> Result<usize, LinearError> {
+        self.kind = Kind::None;
+        self.analyse()?;
+        self.counts.factorisations += 1;
+        let mut l = std::mem::take(&mut self.l_values);
+        let Some(an) = self.analysis.as_mut() else {
+            unreachable!("analysed above")
+        };
+        l.resize(an.symbolic.len_val(), 0.0);
+        let a = SparseColMatRef::new(self.pattern.as_ref(), values);
+        let stack = MemStack::new(&mut an.mem);
+        let r = an
+            .symbolic
+            .factorize_numeric_ldlt::<Real>(
+                &mut l,
+                a,
+                Side::Lower,
+                LdltRegularization::default(),
+                Par::Seq,
+                stack,
+                Default::default(),
+            )
+            .map(|_| ())
+            .map_err(|e| match e {
+                faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } => {
+                    LinearError::ZeroPivot { index }
+                }
+            });
+        self.l_values = l;
+        if r.is_err() {
+            self.counts.failed += 1;
+        }
+        r?;
+        let d = self.ldlt_diagonal();
+        if d.iter().any(|v| !v.is_finite()) {
+            self.counts.failed += 1;
+            return Err(LinearError::ZeroPivot {
+                index: d.iter().position(|v| !v.is_finite()).unwrap_or(0),
+            });
+        }
+        self.kind = Kind::Ldlt;
+        self.negative = d.iter().filter(|&&v| v < 0.0).count();
+        Ok(self.negative)
+    }
+
+    /// The pivots `D` of the last LDLᵀ factorisation, in the permuted order.
+    fn ldlt_diagonal(&self) -> Vec<Real> {
+        let l = &self.l_values;
+        let Some(an) = self.analysis.as_ref() else {
+            return Vec::new();
+        };
+        match an.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                // Each column stores its diagonal first.
+                let cp = s.col_ptr();
+                (0..s.nrows()).map(|j| l[cp[j]]).collect()
+            }
+            SymbolicCholeskyRaw::Supernodal(s) => {
+                let mut d = Vec::with_capacity(s.nrows());
+                let begin = s.supernode_begin();
+                let end = s.supernode_end();
+                let vp = s.col_ptr_for_val();
+                for k in 0..s.n_supernodes() {
+                    let ncols = end[k] - begin[k];
+                    let nrows = ncols + s.supernode(k).pattern().len();
+                    for j in 0..ncols {
+                        d.push(l[vp[k] + j * nrows + j]);
+                    }
+                }
+                d
+            }
+        }
+    }
+
+    /// Whether the symbolic factorisation is supernodal (larger matrices) rather than
+    /// simplicial (the two store the LDLᵀ pivots differently).
+    pub fn is_supernodal(&self) -> bool {
+        self.analysis
+            .as_ref()
+            .is_some_and(|a| matches!(a.symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_)))
+    }
+
+    /// Whether a factorisation is held (the last one succeeded).
+    pub fn is_factored(&self) -> bool {
+        self.kind != Kind::None
+    }
+
+    /// Whether the last factorisation was of an indefinite matrix (LDLᵀ with negative pivots).
+    pub fn is_indefinite(&self) -> bool {
+        self.kind == Kind::Ldlt && self.negative > 0
+    }
+
+    /// Numeric factorisation into caller-owned storage `l` (resized to [`Self::factor_nnz`]), to
+    /// keep several factors of one pattern (e.g. one per time step size) and solve with
+    /// [`Self::solve_with`].
+    pub fn factor_to(&mut self, values: &[Real], l: &mut Vec<Real>) -> Result<(), LinearError> {
+        self.analyse()?;
+        let Some(an) = self.analysis.as_mut() else {
+            unreachable!("analysed above")
+        };
+        l.resize(an.symbolic.len_val(), 0.0);
+        self.counts.factorisations += 1;
+        let a = SparseColMatRef::new(self.pattern.as_ref(), values);
+        let stack = MemStack::new(&mut an.mem);
+        let counts = &mut self.counts;
+        an.symbolic
+            .factorize_numeric_llt::<Real>(
+                l,
+                a,
+                Side::Lower,
+                LltRegularization::default(),
+                Par::Seq,
+                stack,
+                Default::default(),
+            )
+            .map_err(|e| {
+                counts.failed += 1;
+                match e {
+                    faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => {
+                        LinearError::NonPositivePivot { index }
+                    }
+                }
+            })?;
+        Ok(())
+    }
+
+    /// Solves `A x = rhs` in place with a factor made by [`Self::factor_to`].
+    pub fn solve_with(&mut self, l: &[Real], rhs: &mut [Real]) {
+        let n = rhs.len();
+        let Some(an) = self.analysis.as_mut() else {
+            panic!("solve before a factorisation")
+        };
+        let llt = LltRef::new(&an.symbolic, l);
+        let stack = MemStack::new(&mut an.mem);
+        llt.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(rhs, n, 1),
+            Par::Seq,
+            stack,
+        );
+    }
+
+    /// Solves `A x = rhs` in place with the last successful factorisation.
+    pub fn solve_in_place(&mut self, rhs: &mut [Real]) {
+        debug_assert!(
+            self.kind != Kind::None,
+            "solve before a successful factorisation"
+        );
+        let l = std::mem::take(&mut self.l_values);
+        if self.kind == Kind::Ldlt {
+            let n = rhs.len();
+            let Some(an) = self.analysis.as_mut() else {
+                panic!("solve before a factorisation")
+            };
+            let ldlt = LdltRef::new(&an.symbolic, &l);
+            let stack = MemStack::new(&mut an.mem);
+            ldlt.solve_in_place_with_conj(
+                Conj::No,
+                MatMut::from_column_major_slice_mut(rhs, n, 1),
+                Par::Seq,
+                stack,
+            );
+        } else {
+            self.solve_with(&l, rhs);
+        }
+        self.l_values = l;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The lower triangle of a k×k grid's 5-point Laplacian with 3 coupled unknowns per node,
+    /// plus `shift` on the diagonal (positive definite for shift > 0): (n, col_ptr, row_idx,
+    /// values).
+    fn grid(k: usize, shift: Real) -> (usize, Vec<usize>, Vec<usize>, Vec<Real>) {
+        let n = 3 * k * k;
+        let mut cols: Vec<Vec<(usize, Real)>> = vec![Vec::new(); n];
+        let node = |r: usize, c: usize| r * k + c;
+        for r in 0..k {
+            for c in 0..k {
+                let p = node(r, c);
+                let mut nb = Vec::new();
+                if c + 1 < k {
+                    nb.push(node(r, c + 1));
+                }
+                if r + 1 < k {
+                    nb.push(node(r + 1, c));
+                }
+                for a in 0..3 {
+                    let j = 3 * p + a;
+                    cols[j].push((j, 4.0 + shift));
+                    for b in a + 1..3 {
+                        cols[j].push((3 * p + b, 0.5));
+                    }
+                    for &q in &nb {
+                        for b in 0..3 {
+                            cols[j].push((3 * q + b, if a == b { -1.0 } else { -0.1 }));
+                        }
+                    }
+                }
+            }
+        }
+        let (mut cp, mut ri, mut v) = (vec![0], Vec::new(), Vec::new());
+        for mut c in cols {
+            c.sort_by_key(|e| e.0);
+            for (i, x) in c {
+                ri.push(i);
+                v.push(x);
+            }
+            cp.push(ri.len());
+        }
+        (n, cp, ri, v)
+    }
+
+    fn residual(n: usize, cp: &[usize], ri: &[usize], v: &[Real], x: &[Real], b: &[Real]) -> Real {
+        let mut r = b.to_vec();
+        for j in 0..n {
+            for k in cp[j]..cp[j + 1] {
+                let i = ri[k];
+                r[i] -= v[k] * x[j];
+                if i != j {
+                    r[j] -= v[k] * x[i];
+                }
+            }
+        }
+        r.iter().fold(0.0, |m, e| m.max(e.abs()))
+    }
+
+    #[test]
+    fn chooses_the_cheaper_ordering_and_solves_with_it() {
+        let (n, cp, ri, v) = grid(84, 0.5);
+        assert!(n >= DISSECT_FROM);
+        let b: Vec<Real> = (0..n).map(|i| ((i * 7919) % 101) as Real - 50.0).collect();
+        let mut flops = Vec::new();
+        for imposed in [None, Some(Ordering::Amd), Some(Ordering::NestedDissection)] {
+            let mut lin = LinearSolver::from_csc(n, cp.clone(), ri.clone()).expect("pattern");
+            if let Some(o) = imposed {
+                lin = lin.with_ordering(o);
+            }
+            lin.factor(&v).expect("positive definite");
+            let mut x = b.clone();
+            lin.solve_in_place(&mut x);
+            let r = residual(n, &cp, &ri, &v, &x, &b);
+            assert!(r < 1e-10 * 50.0, "{imposed:?}: residual {r}");
+            flops.push((lin.ordering(), lin.factor_flops()));
+        }
+        // On a planar grid nested dissection needs fewer flops than AMD, and is chosen.
+        assert!(flops[2].1 < flops[1].1, "{flops:?}");
+        assert_eq!(flops[0], flops[2]);
+        assert_eq!(flops[0].0, Some(Ordering::NestedDissection));
+    }
+
+    #[test]
+    fn small_systems_keep_amd_and_count_factorisations() {
+        let (n, cp, ri, v) = grid(10, 0.5);
+        let mut lin = LinearSolver::from_csc(n, cp, ri).expect("pattern");
+        assert_eq!(lin.ordering(), None, "no analysis before it is needed");
+        lin.factor(&v).expect("positive definite");
+        let mut bad = v.clone();
+        bad[0] = -1.0;
+        assert!(lin.factor(&bad).is_err());
+        assert_eq!(lin.ordering(), Some(Ordering::Amd));
+        assert_eq!(
+            lin.counts(),
+            FactorCounts {
+                factorisations: 2,
+                failed: 1
+            }
+        );
+    }
+}
