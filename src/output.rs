@@ -948,6 +948,7 @@ impl Writer {
             s.newton_iterations += n("newton_iterations");
             s.shifted_iterations += n("shifted_iterations");
             s.gauss_newton_iterations += n("gauss_newton_iterations");
+            s.chord_iterations += n("chord_iterations");
             s.indefinite_iterations += n("indefinite_iterations");
             s.saddle_escapes += n("saddle_escapes");
             s.diffusion_substeps += n("diffusion_substeps");

@@ -32,6 +32,7 @@ fn verbose_newton_lines_and_the_timing_breakdown() {
     let t = &s["timing"];
     let parts = [
         "build",
+        "analysis",
         "assembly",
         "factorisation",
         "solve",
@@ -53,6 +54,15 @@ fn verbose_newton_lines_and_the_timing_breakdown() {
     // The wall time counts from the start of the command: reading and building the scene too.
     assert!(t["build"].as_f64().unwrap() > 0.0, "{t}");
     assert!(t["output"].as_f64().unwrap() > 0.0, "{t}");
+    // A static run factorises: its ordering and symbolic factorisation are timed.
+    assert!(t["analysis"].as_f64().unwrap() > 0.0, "{t}");
+    let ls = &s["linear_system"];
+    assert!(ls["unknowns"].as_u64().unwrap() > 0, "{ls}");
+    assert_eq!(ls["ordering"], "amd", "{ls}");
+    assert!(
+        ls["factorisations"].as_u64().unwrap() >= s["newton_iterations"].as_u64().unwrap(),
+        "{ls}"
+    );
     // The parts are measured inside the wall time; `other` is the remainder.
     assert!(
         (sum - wall).abs() <= 1e-6 * wall.max(1.0),

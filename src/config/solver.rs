@@ -48,6 +48,10 @@ pub struct Solver {
     pub tolerance: Real,
     /// Newton iterations allowed per solve before the step is cut (default: `40`).
     pub max_newton_iterations: usize,
+    /// Dynamic mode: chord iterations, which solve with the factorisation of an earlier
+    /// iteration of the same time step while the residual at least halves per iteration
+    /// (default: `true`; `false` factorises every iteration).
+    pub chord: bool,
     /// Hessian used by Newton: `"adaptive"` (exact when it factorises, Gauss–Newton otherwise),
     /// `"none"` (exact + growing diagonal shift), `"gauss_newton"` (always), or per-element
     /// eigenvalue projection `"clamp_zero"` / `"abs"` (default: `"adaptive"`).
@@ -101,6 +105,7 @@ impl Default for Solver {
             mode: Mode::Static,
             tolerance: 1e-9,
             max_newton_iterations: 40,
+            chord: true,
             hessian_projection: HessianProjection::Adaptive,
             continuation_step: 1.0,
             min_continuation_step: 1e-4,

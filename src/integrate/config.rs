@@ -87,6 +87,9 @@ impl RunConfig {
                 tol: st.tolerance,
                 max_iter: st.max_newton_iterations,
                 projection: st.hessian_projection,
+                // Chord iterations in the implicit dynamics: the inertia keeps the Hessian
+                // close to the one last factorised.
+                chord: st.chord && st.mode == crate::settings::Mode::Dynamic,
             },
             symmetry_breaking: st.symmetry_breaking,
             seed: st.seed,
@@ -120,6 +123,7 @@ impl Default for NewtonOptions {
             tol: s.tolerance,
             max_iter: s.max_newton_iterations,
             projection: s.hessian_projection,
+            chord: false,
         }
     }
 }

@@ -181,6 +181,9 @@ pub struct Summary {
     pub shifted_iterations: usize,
     /// Newton iterations that fell back to the Gauss–Newton Hessian.
     pub gauss_newton_iterations: usize,
+    /// Newton iterations that solved with an earlier iteration's factorisation (chord
+    /// iterations of the implicit dynamics).
+    pub chord_iterations: usize,
     /// Newton iterations whose sparse Hessian part was indefinite and made positive definite
     /// by a dense low-rank part (an enclosed gas past a pressure limit point).
     pub indefinite_iterations: usize,

@@ -262,6 +262,7 @@ impl<'a> Solver<'a> {
         self.summary.newton_iterations += rep.iterations;
         self.summary.shifted_iterations += rep.shifted_iterations;
         self.summary.gauss_newton_iterations += rep.gauss_newton_iterations;
+        self.summary.chord_iterations += rep.chord_iterations;
         self.summary.indefinite_iterations += rep.indefinite_iterations;
         self.summary.residual = rep.residual;
         self.summary.timing.newton.add(&rep.timing);

@@ -148,6 +148,11 @@ pub fn nested_dissection(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> Opti
     let mut iperm = vec![0 as m::idx_t; ng];
     let mut sizes = [0 as m::idx_t; 3];
     let status: c_int;
+    // METIS keeps its random generator in global state, seeded at each call: calls are
+    // serialised so that concurrent ones (a sweep's scenes, parallel tests) cannot interleave
+    // their draws and each ordering stays a function of its pattern.
+    static METIS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _one_at_a_time = METIS.lock().unwrap_or_else(|e| e.into_inner());
     // SAFETY: the arrays are METIS's documented inputs for a graph of `ng` vertices: xadj has
     // ng + 1 offsets into adjncy, adjncy holds valid vertex numbers without self-loops (each
     // edge stored from both ends, as `adjacency` builds it), vwgt has ng positive weights; perm

@@ -22,6 +22,7 @@ use crate::linalg::LinearSolver;
 use crate::math::Real;
 
 /// The update vectors solved against the factor, and the capacitance matrix `S`.
+#[derive(Clone)]
 pub struct Woodbury {
     /// `A⁻¹ u_k`.
     ainv_u: Vec<Vec<Real>>,

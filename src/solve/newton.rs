@@ -28,7 +28,19 @@ pub struct NewtonOptions {
     pub max_iter: usize,
     /// Which Hessian each iteration factorises (`solver.hessian_projection`).
     pub projection: HessianProjection,
+    /// Chord (modified Newton) iterations: an iteration may solve with the factorisation of an
+    /// earlier iteration of the same solve while the residual keeps contracting by
+    /// [`CHORD_CONTRACTION`] per iteration (the implicit dynamics: the inertia's M/h² keeps the
+    /// Hessian close to the one factorised). `false`: every iteration factorises.
+    pub chord: bool,
 }
+
+/// The contraction ‖∇Φ‖ₖ₊₁ / ‖∇Φ‖ₖ a chord iteration must reach for the next one to reuse the
+/// factorisation again; a weaker one, a cut line search or a step that is not a descent
+/// direction makes the next iteration factorise afresh. A chord iteration costs an assembly,
+/// two triangular solves and a line search, about a fifth of a Newton iteration on the balloon
+/// (whose factorisation is 75% of an iteration), so one that halves the residual pays.
+pub const CHORD_CONTRACTION: Real = 0.5;
 
 /// What happened in one Newton solve.
 #[derive(Clone, Debug, Default)]
@@ -47,6 +59,8 @@ pub struct NewtonReport {
     pub shifted_iterations: usize,
     /// Iterations that fell back to the Gauss–Newton Hessian (adaptive mode).
     pub gauss_newton_iterations: usize,
+    /// Iterations that solved with an earlier iteration's factorisation (chord steps).
+    pub chord_iterations: usize,
     /// Iterations whose exact Hessian had an indefinite sparse part made positive definite by
     /// its low-rank part (an LDLᵀ factorisation; adaptive mode).
     pub indefinite_iterations: usize,
@@ -154,6 +168,7 @@ impl NewtonReport {
         self.max_shift = self.max_shift.max(later.max_shift);
         self.shifted_iterations += later.shifted_iterations;
         self.gauss_newton_iterations += later.gauss_newton_iterations;
+        self.chord_iterations += later.chord_iterations;
         self.indefinite_iterations += later.indefinite_iterations;
         self.line_search_cuts += later.line_search_cuts;
         self.timing.add(&later.timing);
@@ -183,6 +198,11 @@ pub struct Workspace {
     trial: State,
     /// Whether the last exact model needed LDLᵀ (its sparse part was indefinite).
     indefinite: bool,
+    /// The factorisation a chord iteration may reuse: the solver's factorisation count just
+    /// after it (any later factorisation replaced it).
+    chord_factor: Option<usize>,
+    /// The whole model of that factorisation (with its low-rank parts as they were).
+    chord_model: Option<super::low_rank::Woodbury>,
 }
 
 impl Workspace {
@@ -201,6 +221,8 @@ impl Workspace {
                 terms: Default::default(),
             },
             indefinite: false,
+            chord_factor: None,
+            chord_model: None,
         }
     }
 
@@ -337,6 +359,32 @@ pub fn is_positive_definite(
     }
 }
 
+/// Backtracking (Armijo) line search along `ws.step` from `state` (energy `e`, slope `slope`):
+/// the trial state in `ws.trial`, the step length, and whether it decreased Φ enough. Near
+/// convergence Φ changes at round-off level; a round-off slack keeps a tiny, correct step from
+/// being rejected.
+fn line_search(
+    pot: &Potential,
+    ws: &mut Workspace,
+    state: &State,
+    e: Real,
+    slope: Real,
+    rep: &mut NewtonReport,
+) -> (Real, bool) {
+    let slack = 1e-13 * e.abs().max(Real::MIN_POSITIVE);
+    let mut alpha = pot.step_bound(&ws.step);
+    for _ in 0..40 {
+        ws.trial.set_step(state, &ws.step, alpha);
+        let et = pot.eval(&ws.trial.x, &ws.trial.dofs, Want::Energy, &mut [], &mut []);
+        if et.is_finite() && et <= e + 1e-4 * alpha * slope + slack {
+            return (alpha, true);
+        }
+        alpha *= 0.5;
+        rep.line_search_cuts += 1;
+    }
+    (alpha, false)
+}
+
 /// Minimises `pot` from `state` (updated in place).
 pub fn newton(
     pot: &Potential,
@@ -350,6 +398,14 @@ pub fn newton(
     let mode = opts.projection;
     // Adaptive mode: whether this iteration tries the exact Hessian first.
     let mut try_exact = true;
+    // Chord iterations: whether the next iteration may reuse the held factorisation, and the
+    // residual the last chord iteration started from.
+    let mut chord_next = opts.chord;
+    let mut chord_from: Option<Real> = None;
+    // Each solve starts with a factorisation of its own: a step's result then depends on that
+    // step alone, and a run restarted from a frame repeats the uninterrupted one exactly.
+    ws.chord_factor = None;
+    ws.chord_model = None;
     loop {
         let mut projected = false;
         let first = match mode {
@@ -357,11 +413,22 @@ pub fn newton(
             HessianProjection::Adaptive => HessianProjection::None,
             m => m,
         };
+        // A chord iteration is expected when the last one (or a full Newton step) went well and
+        // the factorisation is still the held one: it needs no Hessian.
+        let chord_held = opts.chord
+            && ws.chord_factor == Some(lin.counts().factorisations)
+            && lin.is_factored()
+            && ws.chord_model.is_some();
+        let expect_chord = chord_next && chord_held;
         let clock = Instant::now();
-        let e = pot.eval_projected(
+        let mut e = pot.eval_projected(
             &state.x,
             &state.dofs,
-            Want::Hessian,
+            if expect_chord {
+                Want::Gradient
+            } else {
+                Want::Hessian
+            },
             first,
             &mut ws.grad,
             &mut ws.values,
@@ -384,9 +451,13 @@ pub fn newton(
             }
             return rep;
         }
-        if rep.iterations >= opts.max_iter {
+        // The limit counts iterations that factorised: a chord iteration halves the residual at
+        // least, or is followed by one that factorises. A run of chord iterations is bounded
+        // anyway, by the same limit again.
+        let newton_iterations = rep.iterations - rep.chord_iterations;
+        if newton_iterations >= opts.max_iter || rep.chord_iterations >= opts.max_iter.max(50) {
             rep.failure = Some(SolveError::NotConverged {
-                iterations: opts.max_iter,
+                iterations: rep.iterations,
                 residual: rep.residual,
             });
             return rep;
@@ -394,6 +465,70 @@ pub fn newton(
         if ws.values.iter().any(|v| !v.is_finite()) {
             rep.failure = Some(SolveError::NonFiniteHessian);
             return rep;
+        }
+        // A chord iteration reuses the held factorisation while the last one contracted the
+        // residual enough.
+        if let Some(r0) = chord_from.take() {
+            chord_next &= rep.residual <= CHORD_CONTRACTION * r0;
+        }
+        if expect_chord && chord_next {
+            let clock = Instant::now();
+            for (s, g) in ws.step.iter_mut().zip(&ws.grad) {
+                *s = -g;
+            }
+            let solved = ws
+                .chord_model
+                .as_ref()
+                .is_some_and(|wb| wb.solve_in_place(lin, &mut ws.step));
+            rep.timing.solve += clock.elapsed().as_secs_f64();
+            let slope: Real = ws.step.iter().zip(&ws.grad).map(|(d, g)| d * g).sum();
+            if solved && slope < 0.0 {
+                // Only the full step: a chord step that needs a line search is a sign that the
+                // old model no longer fits, and a fresh factorisation is cheaper than the cuts.
+                let clock = Instant::now();
+                let alpha = pot.step_bound(&ws.step).min(1.0);
+                ws.trial.set_step(state, &ws.step, alpha);
+                let et = pot.eval(&ws.trial.x, &ws.trial.dofs, Want::Energy, &mut [], &mut []);
+                let slack = 1e-13 * e.abs().max(Real::MIN_POSITIVE);
+                let accepted = alpha == 1.0 && et.is_finite() && et <= e + 1e-4 * slope + slack;
+                rep.timing.line_search += clock.elapsed().as_secs_f64();
+                if VERBOSE.load(std::sync::atomic::Ordering::Relaxed) {
+                    eprintln!(
+                        "newton {:>3}: energy {:+.9e} J  residual {}  chord  step {:.4}",
+                        rep.iterations,
+                        e,
+                        crate::math::human(rep.residual),
+                        alpha,
+                    );
+                }
+                if accepted {
+                    rep.iterations += 1;
+                    rep.chord_iterations += 1;
+                    state.copy_from(&ws.trial);
+                    chord_from = Some(rep.residual);
+                    chord_next = true;
+                    continue;
+                }
+            }
+            // Not a descent direction with the old model, or no decrease along it: this
+            // iteration factorises afresh.
+        }
+        if expect_chord {
+            // The Hessian was not assembled for the expected chord iteration.
+            let clock = Instant::now();
+            e = pot.eval_projected(
+                &state.x,
+                &state.dofs,
+                Want::Hessian,
+                first,
+                &mut ws.grad,
+                &mut ws.values,
+            );
+            rep.timing.assembly += clock.elapsed().as_secs_f64();
+            if ws.values.iter().any(|v| !v.is_finite()) {
+                rep.failure = Some(SolveError::NonFiniteHessian);
+                return rep;
+            }
         }
         let mut tau0 = if tau_prev > 1e-8 {
             tau_prev * 0.1
@@ -472,6 +607,7 @@ pub fn newton(
             }
         };
         rep.timing.factorisation += clock.elapsed().as_secs_f64();
+        ws.chord_factor = opts.chord.then(|| lin.counts().factorisations);
         let clock = Instant::now();
         tau_prev = tau;
         if tau > 0.0 {
@@ -485,6 +621,9 @@ pub fn newton(
             Some(wb) => wb,
             None => super::low_rank::Woodbury::new(lin, &lr),
         };
+        if opts.chord {
+            ws.chord_model = Some(wb.clone());
+        }
         if !wb.solve_in_place(lin, &mut ws.step) {
             rep.failure = Some(SolveError::LowRankSingular);
             return rep;
@@ -497,21 +636,7 @@ pub fn newton(
             rep.failure = Some(SolveError::NotDescent);
             return rep;
         }
-        // Backtracking line search. Near convergence Φ changes at round-off level; allow a
-        // round-off slack so that a tiny, correct step is not rejected.
-        let slack = 1e-13 * e.abs().max(Real::MIN_POSITIVE);
-        let mut alpha = pot.step_bound(&ws.step);
-        let mut accepted = false;
-        for _ in 0..40 {
-            ws.trial.set_step(state, &ws.step, alpha);
-            let et = pot.eval(&ws.trial.x, &ws.trial.dofs, Want::Energy, &mut [], &mut []);
-            if et.is_finite() && et <= e + 1e-4 * alpha * slope + slack {
-                accepted = true;
-                break;
-            }
-            alpha *= 0.5;
-            rep.line_search_cuts += 1;
-        }
+        let (alpha, accepted) = line_search(pot, ws, state, e, slope, &mut rep);
         rep.timing.line_search += clock.elapsed().as_secs_f64();
         if VERBOSE.load(std::sync::atomic::Ordering::Relaxed) {
             eprintln!(
@@ -540,5 +665,7 @@ pub fn newton(
         if mode == HessianProjection::Adaptive {
             try_exact = !projected || alpha == 1.0;
         }
+        // The first chord iteration after a fresh factorisation needs a full Newton step.
+        chord_next = opts.chord && alpha == 1.0;
     }
 }

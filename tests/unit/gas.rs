@@ -354,6 +354,7 @@ fn residuals(sc: &Scene, x0: &[Vec3], projection: HessianProjection, n: usize) -
                 tol: 1e-300,
                 max_iter: k,
                 projection,
+                chord: false,
             };
             newton(&pot, &mut lin, &mut ws, &mut st, opts).residual
         })
