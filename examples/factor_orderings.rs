@@ -1,6 +1,7 @@
 //! The sparse factorisation of one scene's Hessian under each fill-reducing ordering: unknowns,
-//! factor non-zeros, flops, the symbolic analysis and the numeric factorisation (best of
-//! `REPEATS`, orderings alternated so that a noisy machine treats them alike), one thread.
+//! factor non-zeros, flops, the symbolic analysis and the numeric factorisation and one solve
+//! (best of `REPEATS`, the variants alternated so that a noisy machine treats them alike), on
+//! one thread; and nested dissection split at its top separator on one and on two threads.
 //!
 //!     cargo run --release --example factor_orderings -- SETTINGS MESH [REPEATS]
 //!
@@ -35,38 +36,80 @@ fn main() -> anyhow::Result<()> {
     for i in 0..p.n {
         h[p.diag(i)] += mean;
     }
+    if let Some(d) = shellsim::linalg::ordering::nested_dissection(p.n, &p.col_ptr, &p.row_idx) {
+        println!(
+            "top-level dissection: halves of {} and {} unknowns, separator of {}",
+            d.sizes[0], d.sizes[1], d.sizes[2]
+        );
+    }
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
-    let orders = [Ordering::Amd, Ordering::NestedDissection];
+    let pool2 = rayon::ThreadPoolBuilder::new().num_threads(2).build()?;
+    let variants = [
+        ("amd", Ordering::Amd, false, 1),
+        ("nested_dissection", Ordering::NestedDissection, false, 1),
+        ("nd split, 1 thread", Ordering::NestedDissection, true, 1),
+        ("nd split, 2 threads", Ordering::NestedDissection, true, 2),
+    ];
     let mut solvers = Vec::new();
-    for o in orders {
-        let mut lin = LinearSolver::new(&p)?.with_ordering(o);
+    for (name, o, split, threads) in variants {
+        let mut lin =
+            LinearSolver::from_csc(p.n, p.col_ptr.clone(), p.row_idx.clone())?.with_ordering(o);
+        if split {
+            lin = lin.with_split();
+        }
         let t = Instant::now();
         lin.analyse()?;
-        solvers.push((lin, t.elapsed().as_secs_f64(), f64::INFINITY));
+        solvers.push((
+            name,
+            lin,
+            threads,
+            t.elapsed().as_secs_f64(),
+            f64::INFINITY,
+            f64::INFINITY,
+        ));
     }
-    pool.install(|| -> anyhow::Result<()> {
-        for _ in 0..repeats {
-            for s in solvers.iter_mut() {
+    let b: Vec<f64> = (0..p.n).map(|i| ((i * 7919) % 101) as f64 - 50.0).collect();
+    let mut x0: Option<Vec<f64>> = None;
+    for _ in 0..repeats {
+        for s in solvers.iter_mut() {
+            let p = if s.2 == 1 { &pool } else { &pool2 };
+            p.install(|| -> anyhow::Result<()> {
                 let t = Instant::now();
-                s.0.factor(&h)?;
-                s.2 = s.2.min(t.elapsed().as_secs_f64());
-            }
+                s.1.factor(&h)?;
+                s.4 = s.4.min(t.elapsed().as_secs_f64());
+                let mut x = b.clone();
+                let t = Instant::now();
+                s.1.solve_in_place(&mut x);
+                s.5 = s.5.min(t.elapsed().as_secs_f64());
+                let r = x0.get_or_insert_with(|| x.clone());
+                let d = r
+                    .iter()
+                    .zip(&x)
+                    .fold(0.0f64, |m, (a, c)| m.max((a - c).abs()));
+                let s0 = r.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+                anyhow::ensure!(
+                    d <= 1e-8 * s0,
+                    "{}: solution differs by {d:e} of {s0:e}",
+                    s.0
+                );
+                Ok(())
+            })?;
         }
-        Ok(())
-    })?;
+    }
     println!(
-        "{} faces, {} unknowns\nordering            factor_nnz   flops      analysis_ms  factor_ms",
+        "{} faces, {} unknowns\nvariant              factor_nnz   flops      analysis_ms  factor_ms  solve_ms",
         scene.body.num_faces(),
         p.n
     );
-    for (lin, analysis, factor) in &solvers {
+    for (name, lin, _, analysis, factor, solve) in &solvers {
         println!(
-            "{:<19} {:>10}  {:>9.3e}  {:>11.1}  {:>9.2}",
-            lin.ordering().map_or("-", |o| o.name()),
+            "{:<20} {:>10}  {:>9.3e}  {:>11.1}  {:>9.2}  {:>8.2}",
+            name,
             lin.factor_nnz(),
             lin.factor_flops(),
             1e3 * analysis,
-            1e3 * factor
+            1e3 * factor,
+            1e3 * solve
         );
     }
     Ok(())

@@ -16,6 +16,7 @@
 //! simplicial column, the diagonal of each supernode's block).
 
 pub mod ordering;
+mod split;
 
 use crate::math::Real;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -112,6 +113,10 @@ struct Analysis {
     symbolic: SymbolicCholesky<usize>,
     ordering: Ordering,
     mem: MemBuffer,
+    /// Under nested dissection, with [`LinearSolver::with_split`]: the factorisation split at
+    /// the top separator, its halves on two threads ([`split`]); `factor`, `factor_indefinite`
+    /// and `solve_in_place` use it.
+    split: Option<split::Split>,
 }
 
 /// A Cholesky solver bound to one sparsity pattern.
@@ -122,6 +127,8 @@ pub struct LinearSolver {
     analysis: Option<Analysis>,
     /// An ordering imposed by the caller (comparisons, benches); `None` chooses by flops.
     imposed: Option<Ordering>,
+    /// Whether a nested dissection's factorisation is split at its top separator.
+    split: bool,
     l_values: Vec<Real>,
     kind: Kind,
     /// Negative pivots of the last factorisation (0 for Cholesky).
@@ -154,6 +161,7 @@ impl LinearSolver {
             pattern,
             analysis: None,
             imposed: None,
+            split: false,
             kind: Kind::None,
             negative: 0,
             counts: FactorCounts::default(),
@@ -164,6 +172,16 @@ impl LinearSolver {
     /// analysis. Nested dissection that fails still falls back to AMD.
     pub fn with_ordering(mut self, ordering: Ordering) -> Self {
         self.imposed = Some(ordering);
+        self.analysis = None;
+        self
+    }
+
+    /// Splits the factorisation at the top separator when the ordering is nested dissection:
+    /// the two halves factorise and solve in parallel ([`split`]), and the result does not depend
+    /// on the thread count. Before the analysis. [`Self::factor_to`] and [`Self::solve_with`]
+    /// stay unsplit.
+    pub fn with_split(mut self) -> Self {
+        self.split = true;
         self.analysis = None;
         self
     }
@@ -188,7 +206,8 @@ impl LinearSolver {
                 },
                 ..Default::default()
             };
-            let (symbolic, ordering) = Self::symbolic(&self.pattern, params, self.imposed)?;
+            let (symbolic, ordering, split) =
+                Self::symbolic(&self.pattern, params, self.imposed, self.split)?;
             let req = StackReq::any_of(&[
                 symbolic.factorize_numeric_llt_scratch::<Real>(Par::Seq, Default::default()),
                 symbolic.factorize_numeric_ldlt_scratch::<Real>(Par::Seq, Default::default()),
@@ -199,19 +218,23 @@ impl LinearSolver {
                 symbolic,
                 ordering,
                 mem,
+                split,
             });
         }
         Ok(self.analysis.as_mut().expect("made above"))
     }
 
     /// The symbolic factorisation under the cheaper of AMD and nested dissection, by the flop
-    /// count of the factorisation ([`ordering::cholesky_flops`]); AMD on a tie, below
-    /// [`DISSECT_FROM`] unknowns, or when the dissection fails (with a warning on stderr).
+    /// count of the factorisation ([`ordering::cholesky_flops`]), or with `split` of its critical
+    /// path (the longer half and the separator, [`split::Split::critical_flops`]); AMD on a tie,
+    /// below [`DISSECT_FROM`] unknowns, or when the dissection fails (with a warning on stderr).
+    /// The choice depends on the pattern alone, never on the thread count.
     fn symbolic(
         pattern: &SymbolicSparseColMat<usize>,
         params: CholeskySymbolicParams<'_>,
         imposed: Option<Ordering>,
-    ) -> Result<(SymbolicCholesky<usize>, Ordering), LinearError> {
+        split: bool,
+    ) -> Result<(SymbolicCholesky<usize>, Ordering, Option<split::Split>), LinearError> {
         let setup = |e: faer::sparse::FaerError| LinearError::Setup(format!("{e:?}"));
         let n = pattern.nrows();
         let with = |perm: &[usize]| {
@@ -226,7 +249,7 @@ impl LinearSolver {
         };
         if imposed == Some(Ordering::Amd) || imposed.is_none() && n < DISSECT_FROM {
             let amd = ordering::amd(pattern.as_ref()).map_err(setup)?;
-            return Ok((with(&amd)?, Ordering::Amd));
+            return Ok((with(&amd)?, Ordering::Amd, None));
         }
         // The two orderings are independent and deterministic: computed side by side on the
         // pool's threads (the result does not depend on how many there are).
@@ -239,15 +262,26 @@ impl LinearSolver {
             eprintln!(
                 "warning: nested dissection failed on a {n}-unknown pattern; ordering by AMD"
             );
-            return Ok((with(&amd)?, Ordering::Amd));
+            return Ok((with(&amd)?, Ordering::Amd, None));
         };
+        let amd_flops = || ordering::flops_under(pattern.as_ref(), &amd);
+        if split {
+            // Split at the top separator, the cost is the longer half's factorisation and the
+            // separator's dense work, which the two threads do not share.
+            if let Some(sp) = split::Split::new(pattern, &nd)? {
+                if imposed == Some(Ordering::NestedDissection) || sp.critical_flops() < amd_flops()
+                {
+                    return Ok((with(&nd.perm)?, Ordering::NestedDissection, Some(sp)));
+                }
+                return Ok((with(&amd)?, Ordering::Amd, None));
+            }
+        }
         if imposed == Some(Ordering::NestedDissection)
-            || ordering::flops_under(pattern.as_ref(), &nd.perm)
-                < ordering::flops_under(pattern.as_ref(), &amd)
+            || ordering::flops_under(pattern.as_ref(), &nd.perm) < amd_flops()
         {
-            Ok((with(&nd.perm)?, Ordering::NestedDissection))
+            Ok((with(&nd.perm)?, Ordering::NestedDissection, None))
         } else {
-            Ok((with(&amd)?, Ordering::Amd))
+            Ok((with(&amd)?, Ordering::Amd, None))
         }
     }
 
@@ -270,9 +304,19 @@ impl LinearSolver {
         self.counts
     }
 
-    /// Number of non-zeros in the factor L (0 before the analysis).
+    /// Number of non-zeros in the factor L (0 before the analysis); split at the top
+    /// separator, those of the two halves' factors and of the dense separator.
     pub fn factor_nnz(&self) -> usize {
-        self.analysis.as_ref().map_or(0, |a| a.symbolic.len_val())
+        self.analysis.as_ref().map_or(0, |a| {
+            a.split
+                .as_ref()
+                .map_or(a.symbolic.len_val(), |s| s.factor_nnz())
+        })
+    }
+
+    /// Whether the factorisation is split at the top separator of a nested dissection.
+    pub fn is_split(&self) -> bool {
+        self.analysis.as_ref().is_some_and(|a| a.split.is_some())
     }
 
     /// The number of unknowns.
@@ -284,6 +328,16 @@ impl LinearSolver {
     pub fn factor(&mut self, values: &[Real]) -> Result<(), LinearError> {
         self.kind = Kind::None;
         self.negative = 0;
+        if let Some(sp) = self.analysis_mut()?.split.as_mut() {
+            let r = sp.factor(values, false);
+            self.counts.factorisations += 1;
+            if r.is_err() {
+                self.counts.failed += 1;
+            }
+            r?;
+            self.kind = Kind::Llt;
+            return Ok(());
+        }
         let mut l = std::mem::take(&mut self.l_values);
         let r = self.factor_to(values, &mut l);
         self.l_values = l;
@@ -299,7 +353,16 @@ impl LinearSolver {
     /// (callers check their solves' results).
     pub fn factor_indefinite(&mut self, values: &[Real]) -> Result<usize, LinearError> {
         self.kind = Kind::None;
-        self.analyse()?;
+        if let Some(sp) = self.analysis_mut()?.split.as_mut() {
+            let r = sp.factor(values, true);
+            self.counts.factorisations += 1;
+            if r.is_err() {
+                self.counts.failed += 1;
+            }
+            self.negative = r?;
+            self.kind = Kind::Ldlt;
+            return Ok(self.negative);
+        }
         self.counts.factorisations += 1;
         let mut l = std::mem::take(&mut self.l_values);
         let Some(an) = self.analysis.as_mut() else {
@@ -445,6 +508,10 @@ impl LinearSolver {
             self.kind != Kind::None,
             "solve before a successful factorisation"
         );
+        if let Some(sp) = self.analysis.as_ref().and_then(|a| a.split.as_ref()) {
+            sp.solve_in_place(rhs);
+            return;
+        }
         let l = std::mem::take(&mut self.l_values);
         if self.kind == Kind::Ldlt {
             let n = rhs.len();
@@ -549,6 +616,70 @@ mod tests {
         assert!(flops[2].1 < flops[1].1, "{flops:?}");
         assert_eq!(flops[0], flops[2]);
         assert_eq!(flops[0].0, Some(Ordering::NestedDissection));
+    }
+
+    #[test]
+    fn the_split_factorisation_solves_and_counts_negative_pivots_like_the_whole() {
+        let (n, cp, ri, v) = grid(84, 0.5);
+        let b: Vec<Real> = (0..n).map(|i| ((i * 7919) % 101) as Real - 50.0).collect();
+        let mut whole = LinearSolver::from_csc(n, cp.clone(), ri.clone()).expect("pattern");
+        let mut split = LinearSolver::from_csc(n, cp.clone(), ri.clone())
+            .expect("pattern")
+            .with_split();
+        whole.factor(&v).expect("positive definite");
+        split.factor(&v).expect("positive definite");
+        assert!(split.is_split() && !whole.is_split());
+        let (mut xw, mut xs) = (b.clone(), b.clone());
+        whole.solve_in_place(&mut xw);
+        split.solve_in_place(&mut xs);
+        let r = residual(n, &cp, &ri, &v, &xs, &b);
+        assert!(r < 1e-10 * 50.0, "split residual {r}");
+        let dx = xw
+            .iter()
+            .zip(&xs)
+            .fold(0.0, |m: Real, (a, c)| m.max((a - c).abs()));
+        let xmax = xw.iter().fold(0.0, |m: Real, a| m.max(a.abs()));
+        assert!(dx <= 1e-12 * xmax, "{dx} of {xmax}");
+        // Shifted into indefiniteness: the same inertia and solution by LDLᵀ (the shift keeps
+        // clear of the spectrum, so no pivot is near zero), and LLᵀ refuses it.
+        let mut ind = v.clone();
+        for j in 0..n {
+            ind[cp[j]] -= 1.2;
+        }
+        let nw = whole.factor_indefinite(&ind).expect("no zero pivot");
+        let ns = split.factor_indefinite(&ind).expect("no zero pivot");
+        assert!(nw > 0);
+        assert_eq!(nw, ns);
+        let (mut xw, mut xs) = (b.clone(), b.clone());
+        whole.solve_in_place(&mut xw);
+        split.solve_in_place(&mut xs);
+        let r = residual(n, &cp, &ri, &ind, &xs, &b);
+        let xmax = xs.iter().fold(0.0, |m: Real, a| m.max(a.abs()));
+        assert!(
+            r < 1e-9 * 50.0 * xmax.max(1.0),
+            "indefinite split residual {r}"
+        );
+        assert!(split.factor(&ind).is_err());
+        // Bitwise the same on one thread as on two.
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let mut x1 = b.clone();
+        one.install(|| {
+            split.factor(&v).expect("positive definite");
+            split.solve_in_place(&mut x1);
+        });
+        let two = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let mut x2 = b.clone();
+        two.install(|| {
+            split.factor(&v).expect("positive definite");
+            split.solve_in_place(&mut x2);
+        });
+        assert!(x1.iter().zip(&x2).all(|(a, c)| a.to_bits() == c.to_bits()));
     }
 
     #[test]

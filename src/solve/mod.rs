@@ -15,6 +15,8 @@ pub use state::State;
 impl LinearSolver {
     /// Symbolic analysis of an assembled sparsity pattern, done once per pattern.
     pub fn new(p: &crate::assembly::Pattern) -> Result<Self, LinearError> {
-        Self::from_csc(p.n, p.col_ptr.clone(), p.row_idx.clone())
+        // The Hessian's factorisation is split at the top separator when nested dissection is
+        // chosen: its halves run on two threads.
+        Ok(Self::from_csc(p.n, p.col_ptr.clone(), p.row_idx.clone())?.with_split())
     }
 }
