@@ -268,10 +268,13 @@ impl LinearSolver {
         if split {
             // Split at the top separator, the cost is the longer half's factorisation and the
             // separator's dense work, which the two threads do not share.
-            if let Some(sp) = split::Split::new(pattern, &nd)? {
+            // The split and the whole symbolic factorisation side by side (the latter serves
+            // the unsplit solves, `factor_to`).
+            let (sp, whole) = rayon::join(|| split::Split::new(pattern, &nd), || with(&nd.perm));
+            if let Some(sp) = sp? {
                 if imposed == Some(Ordering::NestedDissection) || sp.critical_flops() < amd_flops()
                 {
-                    return Ok((with(&nd.perm)?, Ordering::NestedDissection, Some(sp)));
+                    return Ok((whole?, Ordering::NestedDissection, Some(sp)));
                 }
                 return Ok((with(&amd)?, Ordering::Amd, None));
             }

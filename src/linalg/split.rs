@@ -362,7 +362,8 @@ impl Split {
             let map: Vec<usize> = d.perm[range].iter().chain(&sep).copied().collect();
             Half::new(a, map, nh)
         };
-        let halves = [half(0..n0)?, half(n0..n0 + n1)?];
+        let (h0, h1) = rayon::join(|| half(0..n0), || half(n0..n0 + n1));
+        let halves = [h0?, h1?];
         let mut spos = vec![usize::MAX; a.nrows()];
         for (k, &g) in sep.iter().enumerate() {
             spos[g] = k;
