@@ -87,9 +87,13 @@ impl RunConfig {
                 tol: st.tolerance,
                 max_iter: st.max_newton_iterations,
                 projection: st.hessian_projection,
-                // Chord iterations in the implicit dynamics: the inertia keeps the Hessian
-                // close to the one last factorised.
-                chord: st.chord && st.mode == crate::settings::Mode::Dynamic,
+                // Chord iterations in the implicit dynamics with a fixed time step: the inertia
+                // keeps the Hessian close to the one last factorised. An adaptive step grows
+                // after easy steps as counted in Newton iterations, which chord iterations
+                // would change: there, every iteration factorises.
+                chord: st.chord
+                    && st.mode == crate::settings::Mode::Dynamic
+                    && s.time.dt_max <= s.time.dt,
             },
             symmetry_breaking: st.symmetry_breaking,
             seed: st.seed,

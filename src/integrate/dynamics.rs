@@ -337,8 +337,7 @@ pub(super) fn run_dynamic(
         let calm = moisture
             .as_ref()
             .is_none_or(|m| m.change <= 0.5 * cf.moisture_max_change);
-        // The step's difficulty is the iterations that factorised: chord iterations are cheap.
-        steps.accepted(rep.iterations - rep.chord_iterations, calm);
+        steps.accepted(rep.iterations, calm);
         progress.update(
             t / tm.end,
             &format!(
