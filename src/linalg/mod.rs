@@ -99,6 +99,61 @@ pub enum LinearError {
     Setup(String),
 }
 
+impl From<faer::linalg::cholesky::llt::factor::LltError> for LinearError {
+    fn from(e: faer::linalg::cholesky::llt::factor::LltError) -> Self {
+        match e {
+            faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => {
+                LinearError::NonPositivePivot { index }
+            }
+        }
+    }
+}
+
+impl From<faer::linalg::cholesky::ldlt::factor::LdltError> for LinearError {
+    fn from(e: faer::linalg::cholesky::ldlt::factor::LdltError) -> Self {
+        match e {
+            faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } => {
+                LinearError::ZeroPivot { index }
+            }
+        }
+    }
+}
+
+/// faer's numeric factorisation of `a` (lower triangle) into `l` under `symbolic`: LDLᵀ without
+/// pivoting when `ldlt`, LLᵀ otherwise; sequential, with the scratch `mem`. Shared by the whole
+/// and the split factorisations.
+fn factorize_numeric(
+    symbolic: &SymbolicCholesky<usize>,
+    l: &mut [Real],
+    a: SparseColMatRef<'_, usize, Real>,
+    ldlt: bool,
+    mem: &mut MemBuffer,
+) -> Result<(), LinearError> {
+    let stack = MemStack::new(mem);
+    if ldlt {
+        symbolic.factorize_numeric_ldlt::<Real>(
+            l,
+            a,
+            Side::Lower,
+            LdltRegularization::default(),
+            Par::Seq,
+            stack,
+            Default::default(),
+        )?;
+    } else {
+        symbolic.factorize_numeric_llt::<Real>(
+            l,
+            a,
+            Side::Lower,
+            LltRegularization::default(),
+            Par::Seq,
+            stack,
+            Default::default(),
+        )?;
+    }
+    Ok(())
+}
+
 /// Which factorisation the solver holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Kind {
@@ -267,9 +322,8 @@ impl LinearSolver {
         let amd_flops = || ordering::flops_under(pattern.as_ref(), &amd);
         if split {
             // Split at the top separator, the cost is the longer half's factorisation and the
-            // separator's dense work, which the two threads do not share.
-            // The split and the whole symbolic factorisation side by side (the latter serves
-            // the unsplit solves, `factor_to`).
+            // separator's dense work, which the two threads do not share. The split and the
+            // whole symbolic factorisation (for the unsplit `factor_to`) are built side by side.
             let (sp, whole) = rayon::join(|| split::Split::new(pattern, &nd), || with(&nd.perm));
             if let Some(sp) = sp? {
                 if imposed == Some(Ordering::NestedDissection) || sp.critical_flops() < amd_flops()
@@ -331,22 +385,40 @@ impl LinearSolver {
     pub fn factor(&mut self, values: &[Real]) -> Result<(), LinearError> {
         self.kind = Kind::None;
         self.negative = 0;
-        if let Some(sp) = self.analysis_mut()?.split.as_mut() {
-            let r = sp.factor(values, false);
-            self.counts.factorisations += 1;
-            if r.is_err() {
-                self.counts.failed += 1;
-            }
-            r?;
-            self.kind = Kind::Llt;
-            return Ok(());
-        }
-        let mut l = std::mem::take(&mut self.l_values);
-        let r = self.factor_to(values, &mut l);
-        self.l_values = l;
-        r?;
+        let r = if let Some(sp) = self.analysis_mut()?.split.as_mut() {
+            sp.factor(values, false).map(|_| ())
+        } else {
+            let mut l = std::mem::take(&mut self.l_values);
+            let r = self.numeric_into(values, &mut l, false);
+            self.l_values = l;
+            r
+        };
+        self.tally(r)?;
         self.kind = Kind::Llt;
         Ok(())
+    }
+
+    /// Counts a factorisation attempt and whether it failed, passing its result on.
+    fn tally<T>(&mut self, r: Result<T, LinearError>) -> Result<T, LinearError> {
+        self.counts.factorisations += 1;
+        self.counts.failed += usize::from(r.is_err());
+        r
+    }
+
+    /// The unsplit numeric factorisation into `l` (resized to the factor), not counted.
+    fn numeric_into(
+        &mut self,
+        values: &[Real],
+        l: &mut Vec<Real>,
+        ldlt: bool,
+    ) -> Result<(), LinearError> {
+        self.analyse()?;
+        let Some(an) = self.analysis.as_mut() else {
+            unreachable!("analysed above")
+        };
+        l.resize(an.symbolic.len_val(), 0.0);
+        let a = SparseColMatRef::new(self.pattern.as_ref(), values);
+        factorize_numeric(&an.symbolic, l, a, ldlt, &mut an.mem)
     }
 
     /// Numeric LDLᵀ factorisation (no pivoting) of a symmetric, possibly indefinite matrix with
@@ -356,55 +428,22 @@ impl LinearSolver {
     /// (callers check their solves' results).
     pub fn factor_indefinite(&mut self, values: &[Real]) -> Result<usize, LinearError> {
         self.kind = Kind::None;
-        if let Some(sp) = self.analysis_mut()?.split.as_mut() {
-            let r = sp.factor(values, true);
-            self.counts.factorisations += 1;
-            if r.is_err() {
-                self.counts.failed += 1;
-            }
-            self.negative = r?;
-            self.kind = Kind::Ldlt;
-            return Ok(self.negative);
-        }
-        self.counts.factorisations += 1;
-        let mut l = std::mem::take(&mut self.l_values);
-        let Some(an) = self.analysis.as_mut() else {
-            unreachable!("analysed above")
-        };
-        l.resize(an.symbolic.len_val(), 0.0);
-        let a = SparseColMatRef::new(self.pattern.as_ref(), values);
-        let stack = MemStack::new(&mut an.mem);
-        let r = an
-            .symbolic
-            .factorize_numeric_ldlt::<Real>(
-                &mut l,
-                a,
-                Side::Lower,
-                LdltRegularization::default(),
-                Par::Seq,
-                stack,
-                Default::default(),
-            )
-            .map(|_| ())
-            .map_err(|e| match e {
-                faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } => {
-                    LinearError::ZeroPivot { index }
+        let r = if let Some(sp) = self.analysis_mut()?.split.as_mut() {
+            sp.factor(values, true)
+        } else {
+            let mut l = std::mem::take(&mut self.l_values);
+            let r = self.numeric_into(values, &mut l, true);
+            self.l_values = l;
+            r.and_then(|()| {
+                let d = self.ldlt_diagonal();
+                match d.iter().position(|v| !v.is_finite()) {
+                    Some(index) => Err(LinearError::ZeroPivot { index }),
+                    None => Ok(d.iter().filter(|&&v| v < 0.0).count()),
                 }
-            });
-        self.l_values = l;
-        if r.is_err() {
-            self.counts.failed += 1;
-        }
-        r?;
-        let d = self.ldlt_diagonal();
-        if d.iter().any(|v| !v.is_finite()) {
-            self.counts.failed += 1;
-            return Err(LinearError::ZeroPivot {
-                index: d.iter().position(|v| !v.is_finite()).unwrap_or(0),
-            });
-        }
+            })
+        };
+        self.negative = self.tally(r)?;
         self.kind = Kind::Ldlt;
-        self.negative = d.iter().filter(|&&v| v < 0.0).count();
         Ok(self.negative)
     }
 
@@ -459,34 +498,8 @@ impl LinearSolver {
     /// keep several factors of one pattern (e.g. one per time step size) and solve with
     /// [`Self::solve_with`].
     pub fn factor_to(&mut self, values: &[Real], l: &mut Vec<Real>) -> Result<(), LinearError> {
-        self.analyse()?;
-        let Some(an) = self.analysis.as_mut() else {
-            unreachable!("analysed above")
-        };
-        l.resize(an.symbolic.len_val(), 0.0);
-        self.counts.factorisations += 1;
-        let a = SparseColMatRef::new(self.pattern.as_ref(), values);
-        let stack = MemStack::new(&mut an.mem);
-        let counts = &mut self.counts;
-        an.symbolic
-            .factorize_numeric_llt::<Real>(
-                l,
-                a,
-                Side::Lower,
-                LltRegularization::default(),
-                Par::Seq,
-                stack,
-                Default::default(),
-            )
-            .map_err(|e| {
-                counts.failed += 1;
-                match e {
-                    faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => {
-                        LinearError::NonPositivePivot { index }
-                    }
-                }
-            })?;
-        Ok(())
+        let r = self.numeric_into(values, l, false);
+        self.tally(r)
     }
 
     /// Solves `A x = rhs` in place with a factor made by [`Self::factor_to`].

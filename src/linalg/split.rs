@@ -182,40 +182,7 @@ impl Half {
             *v = a[e];
         }
         let m = SparseColMatRef::new(self.pattern.as_ref(), &self.values);
-        let stack = MemStack::new(&mut self.mem);
-        if ldlt {
-            self.symbolic
-                .factorize_numeric_ldlt::<Real>(
-                    &mut self.l,
-                    m,
-                    Side::Lower,
-                    LdltRegularization::default(),
-                    Par::Seq,
-                    stack,
-                    Default::default(),
-                )
-                .map_err(|e| match e {
-                    faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } => {
-                        LinearError::ZeroPivot { index }
-                    }
-                })?;
-        } else {
-            self.symbolic
-                .factorize_numeric_llt::<Real>(
-                    &mut self.l,
-                    m,
-                    Side::Lower,
-                    LltRegularization::default(),
-                    Par::Seq,
-                    stack,
-                    Default::default(),
-                )
-                .map_err(|e| match e {
-                    faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => {
-                        LinearError::NonPositivePivot { index }
-                    }
-                })?;
-        }
+        super::factorize_numeric(&self.symbolic, &mut self.l, m, ldlt, &mut self.mem)?;
         // L_c (and D_c) of the trailing block, then S_h = L_c D_c L_cᵀ.
         let nh = self.nh;
         let ns = self.map.len() - nh;
@@ -443,12 +410,7 @@ impl Split {
                 par,
                 MemStack::new(&mut mem),
                 Default::default(),
-            )
-            .map_err(|e| match e {
-                faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index } => {
-                    LinearError::ZeroPivot { index }
-                }
-            })?;
+            )?;
             let d: Vec<Real> = (0..ns).map(|k| self.s[(k, k)]).collect();
             if d.iter().any(|v| !v.is_finite()) {
                 return Err(LinearError::ZeroPivot { index: 0 });
@@ -469,12 +431,7 @@ impl Split {
                 par,
                 MemStack::new(&mut mem),
                 Default::default(),
-            )
-            .map_err(|e| match e {
-                faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => {
-                    LinearError::NonPositivePivot { index }
-                }
-            })?;
+            )?;
             0
         };
         Ok(negative)

@@ -198,10 +198,8 @@ pub struct Workspace {
     trial: State,
     /// Whether the last exact model needed LDLᵀ (its sparse part was indefinite).
     indefinite: bool,
-    /// The factorisation a chord iteration may reuse: the solver's factorisation count just
-    /// after it (any later factorisation replaced it).
-    chord_factor: Option<usize>,
-    /// The whole model of that factorisation (with its low-rank parts as they were).
+    /// The model a chord iteration may reuse: the held factorisation with its low-rank parts as
+    /// they were; cleared before any other factorisation replaces it.
     chord_model: Option<super::low_rank::Woodbury>,
 }
 
@@ -221,7 +219,6 @@ impl Workspace {
                 terms: Default::default(),
             },
             indefinite: false,
-            chord_factor: None,
             chord_model: None,
         }
     }
@@ -371,18 +368,31 @@ fn line_search(
     slope: Real,
     rep: &mut NewtonReport,
 ) -> (Real, bool) {
-    let slack = 1e-13 * e.abs().max(Real::MIN_POSITIVE);
     let mut alpha = pot.step_bound(&ws.step);
     for _ in 0..40 {
-        ws.trial.set_step(state, &ws.step, alpha);
-        let et = pot.eval(&ws.trial.x, &ws.trial.dofs, Want::Energy, &mut [], &mut []);
-        if et.is_finite() && et <= e + 1e-4 * alpha * slope + slack {
+        if sufficient_decrease(pot, ws, state, e, slope, alpha) {
             return (alpha, true);
         }
         alpha *= 0.5;
         rep.line_search_cuts += 1;
     }
     (alpha, false)
+}
+
+/// Whether the step of length `alpha` along `ws.step` (set into `ws.trial`) decreases Φ from `e`
+/// enough (Armijo, 1e-4 of the slope), within a round-off slack of 1e-13 |Φ|.
+fn sufficient_decrease(
+    pot: &Potential,
+    ws: &mut Workspace,
+    state: &State,
+    e: Real,
+    slope: Real,
+    alpha: Real,
+) -> bool {
+    let slack = 1e-13 * e.abs().max(Real::MIN_POSITIVE);
+    ws.trial.set_step(state, &ws.step, alpha);
+    let et = pot.eval(&ws.trial.x, &ws.trial.dofs, Want::Energy, &mut [], &mut []);
+    et.is_finite() && et <= e + 1e-4 * alpha * slope + slack
 }
 
 /// Minimises `pot` from `state` (updated in place).
@@ -404,7 +414,6 @@ pub fn newton(
     let mut chord_from: Option<Real> = None;
     // Each solve starts with a factorisation of its own: a step's result then depends on that
     // step alone, and a run restarted from a frame repeats the uninterrupted one exactly.
-    ws.chord_factor = None;
     ws.chord_model = None;
     loop {
         let mut projected = false;
@@ -414,12 +423,8 @@ pub fn newton(
             m => m,
         };
         // A chord iteration is expected when the last one (or a full Newton step) went well and
-        // the factorisation is still the held one: it needs no Hessian.
-        let chord_held = opts.chord
-            && ws.chord_factor == Some(lin.counts().factorisations)
-            && lin.is_factored()
-            && ws.chord_model.is_some();
-        let expect_chord = chord_next && chord_held;
+        // a model is held: it needs no Hessian.
+        let expect_chord = chord_next && ws.chord_model.is_some();
         let clock = Instant::now();
         let mut e = pot.eval_projected(
             &state.x,
@@ -452,8 +457,8 @@ pub fn newton(
             return rep;
         }
         // The limit counts iterations that factorised: a chord iteration halves the residual at
-        // least, or is followed by one that factorises. A run of chord iterations is bounded
-        // anyway, by the same limit again.
+        // least, or is followed by one that factorises. Chord iterations have their own bound,
+        // the same limit or 50, whichever is larger.
         let newton_iterations = rep.iterations - rep.chord_iterations;
         if newton_iterations >= opts.max_iter || rep.chord_iterations >= opts.max_iter.max(50) {
             rep.failure = Some(SolveError::NotConverged {
@@ -487,10 +492,7 @@ pub fn newton(
                 // old model no longer fits, and a fresh factorisation is cheaper than the cuts.
                 let clock = Instant::now();
                 let alpha = pot.step_bound(&ws.step).min(1.0);
-                ws.trial.set_step(state, &ws.step, alpha);
-                let et = pot.eval(&ws.trial.x, &ws.trial.dofs, Want::Energy, &mut [], &mut []);
-                let slack = 1e-13 * e.abs().max(Real::MIN_POSITIVE);
-                let accepted = alpha == 1.0 && et.is_finite() && et <= e + 1e-4 * slope + slack;
+                let accepted = alpha == 1.0 && sufficient_decrease(pot, ws, state, e, slope, alpha);
                 rep.timing.line_search += clock.elapsed().as_secs_f64();
                 if VERBOSE.load(std::sync::atomic::Ordering::Relaxed) {
                     eprintln!(
@@ -513,6 +515,7 @@ pub fn newton(
             // Not a descent direction with the old model, or no decrease along it: this
             // iteration factorises afresh.
         }
+        ws.chord_model = None;
         if expect_chord {
             // The Hessian was not assembled for the expected chord iteration.
             let clock = Instant::now();
@@ -607,7 +610,6 @@ pub fn newton(
             }
         };
         rep.timing.factorisation += clock.elapsed().as_secs_f64();
-        ws.chord_factor = opts.chord.then(|| lin.counts().factorisations);
         let clock = Instant::now();
         tau_prev = tau;
         if tau > 0.0 {
