@@ -237,34 +237,49 @@ impl Half {
         Ok(())
     }
 
-    /// The forward sweep of the leading columns on `x` (local; the separator rows start at 0
-    /// and end holding `−L_3h y_h`; LDLᵀ: then divided by the leading pivots).
+    /// The forward sweep of the leading columns on `x`, `k` local vectors one after another
+    /// (the separator rows start at 0 and end holding `−L_3h y_h`; LDLᵀ: then divided by the
+    /// leading pivots).
+    ///
+    /// Per supernode (columns `b..e`, below them the rows `pattern`), column-major values: the
+    /// triangular solve on `x[b..e]` by columns (contiguous updates), then `t = L_below x[b..e]`
+    /// accumulated column by column into a dense buffer and scattered once, `x[pattern] −= t`.
+    /// Each supernode serves all `k` vectors while its values are in cache: the sweep is bound by
+    /// reading the factor, so k right-hand sides cost little more than one.
     fn forward(&self, x: &mut [Real], ldlt: bool) {
-        let nh = self.nh;
+        let (nh, nl) = (self.nh, self.map.len());
         let l = &self.l;
         let SymbolicCholeskyRaw::Supernodal(s) = self.symbolic.raw() else {
             unreachable!("the halves are supernodal")
         };
         let (begin, end, vp) = (s.supernode_begin(), s.supernode_end(), s.col_ptr_for_val());
+        let mut t: Vec<Real> = Vec::new();
         for k in 0..s.n_supernodes() {
             if begin[k] >= nh {
                 break;
             }
-            let ncols = end[k] - begin[k];
+            let (b, ncols) = (begin[k], end[k] - begin[k]);
             let pattern = s.supernode(k).pattern();
             let nrows = ncols + pattern.len();
-            for jj in 0..ncols.min(nh - begin[k]) {
-                let col = &l[vp[k] + jj * nrows..vp[k] + (jj + 1) * nrows];
-                let j = begin[k] + jj;
-                if !ldlt {
-                    x[j] /= col[jj];
+            let nc = ncols.min(nh - b);
+            let block = &l[vp[k]..vp[k] + ncols * nrows];
+            for x in x.chunks_exact_mut(nl) {
+                let xs = &mut x[b..b + ncols];
+                for jj in 0..nc {
+                    let col = &block[jj * nrows..jj * nrows + ncols];
+                    if !ldlt {
+                        xs[jj] /= col[jj];
+                    }
+                    let xj = xs[jj];
+                    axpy(&mut xs[jj + 1..], &col[jj + 1..], -xj);
                 }
-                let xj = x[j];
-                for (ii, v) in col.iter().enumerate().take(ncols).skip(jj + 1) {
-                    x[begin[k] + ii] -= v * xj;
+                t.clear();
+                t.resize(pattern.len(), 0.0);
+                for jj in 0..nc {
+                    axpy(&mut t, &block[jj * nrows + ncols..(jj + 1) * nrows], xs[jj]);
                 }
-                for (&row, v) in pattern.iter().zip(&col[ncols..]) {
-                    x[row] -= v * xj;
+                for (&row, v) in pattern.iter().zip(&t) {
+                    x[row] -= v;
                 }
             }
         }
@@ -275,42 +290,87 @@ impl Half {
                 for jj in 0..ncols {
                     let j = begin[k] + jj;
                     if j < nh {
-                        x[j] /= l[vp[k] + jj * nrows + jj];
+                        let d = l[vp[k] + jj * nrows + jj];
+                        for x in x.chunks_exact_mut(nl) {
+                            x[j] /= d;
+                        }
                     }
                 }
             }
         }
     }
 
-    /// The backward sweep of the leading columns on `x` (separator rows hold x3).
+    /// The backward sweep of the leading columns on `k` local vectors (separator rows hold x3).
+    ///
+    /// Per supernode, last first: `x[pattern]` gathered into a dense buffer, then each column's
+    /// `x_j = (x_j − L_belowᵀ t − L_blockᵀ x[j+1..e]) / L_jj` by contiguous dot products.
     fn backward(&self, x: &mut [Real], ldlt: bool) {
-        let nh = self.nh;
+        let (nh, nl) = (self.nh, self.map.len());
         let l = &self.l;
         let SymbolicCholeskyRaw::Supernodal(s) = self.symbolic.raw() else {
             unreachable!("the halves are supernodal")
         };
         let (begin, end, vp) = (s.supernode_begin(), s.supernode_end(), s.col_ptr_for_val());
+        let mut t: Vec<Real> = Vec::new();
         for k in (0..s.n_supernodes()).rev() {
             if begin[k] >= nh {
                 continue;
             }
-            let ncols = end[k] - begin[k];
+            let (b, ncols) = (begin[k], end[k] - begin[k]);
             let pattern = s.supernode(k).pattern();
             let nrows = ncols + pattern.len();
-            for jj in (0..ncols.min(nh - begin[k])).rev() {
-                let col = &l[vp[k] + jj * nrows..vp[k] + (jj + 1) * nrows];
-                let j = begin[k] + jj;
-                let mut acc = x[j];
-                for (ii, v) in col.iter().enumerate().take(ncols).skip(jj + 1) {
-                    acc -= v * x[begin[k] + ii];
+            let nc = ncols.min(nh - b);
+            let block = &l[vp[k]..vp[k] + ncols * nrows];
+            for x in x.chunks_exact_mut(nl) {
+                t.clear();
+                t.extend(pattern.iter().map(|&row| x[row]));
+                let xs = &mut x[b..b + ncols];
+                for jj in (0..nc).rev() {
+                    let col = &block[jj * nrows..(jj + 1) * nrows];
+                    let acc =
+                        xs[jj] - dot(&col[ncols..], &t) - dot(&col[jj + 1..ncols], &xs[jj + 1..]);
+                    xs[jj] = if ldlt { acc } else { acc / col[jj] };
                 }
-                for (&row, v) in pattern.iter().zip(&col[ncols..]) {
-                    acc -= v * x[row];
-                }
-                x[j] = if ldlt { acc } else { acc / col[jj] };
             }
         }
     }
+}
+
+/// `y += a x`, four lanes at a time (the order of each entry's operations is fixed).
+fn axpy(y: &mut [Real], x: &[Real], a: Real) {
+    let n = y.len().min(x.len());
+    let (y, x) = (&mut y[..n], &x[..n]);
+    let mut yc = y.chunks_exact_mut(4);
+    let mut xc = x.chunks_exact(4);
+    for (yy, xx) in (&mut yc).zip(&mut xc) {
+        yy[0] += a * xx[0];
+        yy[1] += a * xx[1];
+        yy[2] += a * xx[2];
+        yy[3] += a * xx[3];
+    }
+    for (yy, xx) in yc.into_remainder().iter_mut().zip(xc.remainder()) {
+        *yy += a * xx;
+    }
+}
+
+/// `Σ a_i b_i` with four partial sums (a fixed order, so the same on any thread).
+fn dot(a: &[Real], b: &[Real]) -> Real {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0; 4];
+    let mut ac = a.chunks_exact(4);
+    let mut bc = b.chunks_exact(4);
+    for (x, y) in (&mut ac).zip(&mut bc) {
+        acc[0] += x[0] * y[0];
+        acc[1] += x[1] * y[1];
+        acc[2] += x[2] * y[2];
+        acc[3] += x[3] * y[3];
+    }
+    let mut tail = 0.0;
+    for (x, y) in ac.remainder().iter().zip(bc.remainder()) {
+        tail += x * y;
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
 impl Split {
@@ -437,56 +497,70 @@ impl Split {
         Ok(negative)
     }
 
-    /// Solves `A x = rhs` in place with the last factorisation.
+    /// Solves `A X = B` in place with the last factorisation, `rhs` holding the columns of B
+    /// one after another (its length a multiple of n).
     pub(super) fn solve_in_place(&self, rhs: &mut [Real]) {
         let ldlt = self.ldlt;
         let ns = self.sep.len();
+        let n = self.halves[0].nh + self.halves[1].nh + ns;
+        let nrhs = rhs.len() / n;
         let local = |h: &Half| {
-            let mut x = vec![0.0; h.map.len()];
-            for k in 0..h.nh {
-                x[k] = rhs[h.map[k]];
+            let nl = h.map.len();
+            let mut x = vec![0.0; nl * nrhs];
+            for (x, b) in x.chunks_exact_mut(nl).zip(rhs.chunks_exact(n)) {
+                for k in 0..h.nh {
+                    x[k] = b[h.map[k]];
+                }
             }
             h.forward(&mut x, ldlt);
             x
         };
         let [h0, h1] = &self.halves;
         let (mut x0, mut x1) = rayon::join(|| local(h0), || local(h1));
-        // r3 = b3 − L31 y1 − L32 y2, then x3 = S⁻¹ r3 by the dense factor.
-        let mut x3: Vec<Real> = (0..ns)
-            .map(|k| rhs[self.sep[k]] + x0[h0.nh + k] + x1[h1.nh + k])
-            .collect();
+        let (nl0, nl1) = (h0.map.len(), h1.map.len());
         let s = &self.s;
-        for j in 0..ns {
-            if !ldlt {
-                x3[j] /= s[(j, j)];
+        let mut x3s = Vec::with_capacity(nrhs * ns);
+        for r in 0..nrhs {
+            // r3 = b3 − L31 y1 − L32 y2, then x3 = S⁻¹ r3 by the dense factor.
+            let b = &rhs[r * n..(r + 1) * n];
+            let mut x3: Vec<Real> = (0..ns)
+                .map(|k| b[self.sep[k]] + x0[r * nl0 + h0.nh + k] + x1[r * nl1 + h1.nh + k])
+                .collect();
+            for j in 0..ns {
+                if !ldlt {
+                    x3[j] /= s[(j, j)];
+                }
+                let xj = x3[j];
+                for i in j + 1..ns {
+                    x3[i] -= s[(i, j)] * xj;
+                }
             }
-            let xj = x3[j];
-            for i in j + 1..ns {
-                x3[i] -= s[(i, j)] * xj;
+            if ldlt {
+                for (j, v) in x3.iter_mut().enumerate() {
+                    *v /= s[(j, j)];
+                }
             }
+            for j in (0..ns).rev() {
+                let mut acc = x3[j];
+                for i in j + 1..ns {
+                    acc -= s[(i, j)] * x3[i];
+                }
+                x3[j] = if ldlt { acc } else { acc / s[(j, j)] };
+            }
+            x0[r * nl0 + h0.nh..(r + 1) * nl0].copy_from_slice(&x3);
+            x1[r * nl1 + h1.nh..(r + 1) * nl1].copy_from_slice(&x3);
+            x3s.extend_from_slice(&x3);
         }
-        if ldlt {
-            for (j, v) in x3.iter_mut().enumerate() {
-                *v /= s[(j, j)];
-            }
-        }
-        for j in (0..ns).rev() {
-            let mut acc = x3[j];
-            for i in j + 1..ns {
-                acc -= s[(i, j)] * x3[i];
-            }
-            x3[j] = if ldlt { acc } else { acc / s[(j, j)] };
-        }
-        x0[h0.nh..].copy_from_slice(&x3);
-        x1[h1.nh..].copy_from_slice(&x3);
         rayon::join(|| h0.backward(&mut x0, ldlt), || h1.backward(&mut x1, ldlt));
-        for (h, x) in [(h0, &x0), (h1, &x1)] {
-            for k in 0..h.nh {
-                rhs[h.map[k]] = x[k];
+        for (r, b) in rhs.chunks_exact_mut(n).enumerate() {
+            for (h, x) in [(h0, &x0[r * nl0..]), (h1, &x1[r * nl1..])] {
+                for k in 0..h.nh {
+                    b[h.map[k]] = x[k];
+                }
             }
-        }
-        for (k, &g) in self.sep.iter().enumerate() {
-            rhs[g] = x3[k];
+            for (k, &g) in self.sep.iter().enumerate() {
+                b[g] = x3s[r * ns + k];
+            }
         }
     }
 }
