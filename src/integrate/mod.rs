@@ -209,6 +209,7 @@ pub fn run(
     // what the frame gives.
     let driver = driver.filter(|d| d.mode == s.summary.mode);
     if let Some(d) = &driver {
+        s.ws.set_model_hints(d.model_hints);
         for t in scene.terms.iter() {
             if let (Some(s), Some(v)) = (t.stateful(), d.terms.get(t.name())) {
                 s.check_state(v)

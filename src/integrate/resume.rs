@@ -47,6 +47,13 @@ pub struct DriverState {
     pub globals: Vec<Real>,
     /// Their velocities (dynamics).
     pub global_velocities: Vec<Real>,
+    /// The dynamic driver's last change of velocity per unit time (m/s², x, y, z per vertex,
+    /// then the global DOFs'), which its Newton start extrapolates with; absent before the
+    /// first step.
+    pub acceleration: Option<Vec<Real>>,
+    /// What Newton's last solves learnt about the Hessian ([`crate::solve::newton::Workspace::model_hints`]):
+    /// whether its last exact model needed LDLᵀ, and whether it was rejected.
+    pub model_hints: [bool; 2],
     /// The frame is the reference state of a planar start, which the run perturbs right after
     /// writing it (the symmetry breaking): a restart from it perturbs it the same way.
     pub perturb_pending: bool,

@@ -352,6 +352,7 @@ impl<'a> Solver<'a> {
         let mut driver = self.driver.clone();
         driver.mode = self.summary.mode.clone();
         driver.perturb_pending = reference.is_some();
+        driver.model_hints = self.ws.model_hints();
         driver.globals = state.dofs[self.scene.body.num_edge_dofs()..].to_vec();
         for (name, own) in state.terms.iter() {
             if !own.is_empty() {
@@ -444,6 +445,13 @@ impl<'a> Solver<'a> {
         // One factorisation of H + 1e-9·mean|diag|·I, with the dense low-rank part through
         // the inertia (an indefinite sparse part is fine when the whole is positive definite).
         let lr = pot.low_rank(x, phi);
-        crate::solve::newton::is_positive_definite(&mut self.lin, &pot, &values, &lr, 1e-9)
+        let stable =
+            crate::solve::newton::is_positive_definite(&mut self.lin, &pot, &values, &lr, 1e-9);
+        if !stable {
+            // The solve that follows (from a perturbed state) starts without an exact model
+            // known to fail.
+            self.ws.note_not_positive_definite();
+        }
+        stable
     }
 }

@@ -37,16 +37,38 @@ pub struct Woodbury {
 impl Woodbury {
     /// Prepares the update on a factorised `lin` (k extra solves).
     pub fn new(lin: &mut LinearSolver, parts: &[LowRank]) -> Self {
+        Self::new_with(lin, parts, None)
+    }
+
+    /// As [`Self::new`], solving `A r = r` in place in the same pass over the factor (one
+    /// multi-vector solve: the sweeps are bound by reading the factor); [`Self::correct`] then
+    /// finishes `(A + UCUᵀ)⁻¹ r`.
+    pub fn new_with(lin: &mut LinearSolver, parts: &[LowRank], r: Option<&mut [Real]>) -> Self {
         let kept: Vec<&LowRank> = parts.iter().filter(|p| p.c != 0.0).collect();
         let k = kept.len();
-        let ainv_u: Vec<Vec<Real>> = kept
-            .iter()
-            .map(|p| {
-                let mut v = p.u.clone();
-                lin.solve_in_place(&mut v);
-                v
-            })
-            .collect();
+        let ainv_u: Vec<Vec<Real>> = match (k, r) {
+            (0, Some(r)) => {
+                lin.solve_in_place(r);
+                Vec::new()
+            }
+            (0, None) => Vec::new(),
+            (_, r) => {
+                let n = kept[0].u.len();
+                let mut block: Vec<Real> = kept.iter().flat_map(|p| p.u.iter().copied()).collect();
+                if let Some(r) = &r {
+                    block.extend_from_slice(r);
+                }
+                lin.solve_in_place(&mut block);
+                if let Some(r) = r {
+                    r.copy_from_slice(&block[k * n..]);
+                }
+                block
+                    .chunks_exact(n)
+                    .take(k)
+                    .map(<[Real]>::to_vec)
+                    .collect()
+            }
+        };
         let mut s = vec![0.0; k * k];
         for i in 0..k {
             for j in 0..k {
@@ -71,6 +93,12 @@ impl Woodbury {
     /// singular (the whole matrix is).
     pub fn solve_in_place(&self, lin: &mut LinearSolver, r: &mut [Real]) -> bool {
         lin.solve_in_place(r);
+        self.correct(r)
+    }
+
+    /// Turns `A⁻¹ r` (solved already, e.g. by [`Self::new_with`]) into `(A + UCUᵀ)⁻¹ r` in
+    /// place. Returns false if `S` is singular.
+    pub fn correct(&self, r: &mut [Real]) -> bool {
         let k = self.c.len();
         if k == 0 {
             return true;

@@ -198,6 +198,10 @@ pub struct Workspace {
     trial: State,
     /// Whether the last exact model needed LDLᵀ (its sparse part was indefinite).
     indefinite: bool,
+    /// Whether the last exact model tried was rejected (the Hessian was not positive definite):
+    /// the next solve then starts with the Gauss–Newton model instead of a failed
+    /// factorisation, and tries the exact one again in its second iteration.
+    exact_rejected: bool,
     /// The model a chord iteration may reuse: the held factorisation with its low-rank parts as
     /// they were; cleared before any other factorisation replaces it.
     chord_model: Option<super::low_rank::Woodbury>,
@@ -219,8 +223,27 @@ impl Workspace {
                 terms: Default::default(),
             },
             indefinite: false,
+            exact_rejected: false,
             chord_model: None,
         }
+    }
+
+    /// What the last solves learnt about the Hessian, which the next solve's first model
+    /// follows: whether the last exact model needed LDLᵀ, and whether it was rejected. A frame
+    /// records them so that a restart repeats the uninterrupted run exactly.
+    pub fn model_hints(&self) -> [bool; 2] {
+        [self.indefinite, self.exact_rejected]
+    }
+
+    /// Records that the Hessian was found not positive definite outside a solve (a stability
+    /// test): the next solve starts with the Gauss–Newton model.
+    pub fn note_not_positive_definite(&mut self) {
+        self.exact_rejected = true;
+    }
+
+    /// Restores [`Self::model_hints`].
+    pub fn set_model_hints(&mut self, hints: [bool; 2]) {
+        [self.indefinite, self.exact_rejected] = hints;
     }
 
     /// The gradient of the last evaluation.
@@ -306,19 +329,46 @@ fn exact_model_from(
     tau_max: Real,
     indefinite_first: bool,
 ) -> Option<(Real, super::low_rank::Woodbury)> {
+    exact_model_solving(
+        lin,
+        pot,
+        values,
+        shifted,
+        lr,
+        tau_max,
+        indefinite_first,
+        None,
+    )
+}
+
+/// [`exact_model_from`], solving `A r = r` (the sparse part) in the same pass over the factor
+/// as the low-rank vectors when a model is accepted (`r` is then ready for
+/// [`super::low_rank::Woodbury::correct`]; otherwise it is left changed).
+#[allow(clippy::too_many_arguments)]
+fn exact_model_solving(
+    lin: &mut LinearSolver,
+    pot: &Potential,
+    values: &[Real],
+    shifted: &mut [Real],
+    lr: &[crate::energy::term::LowRank],
+    tau_max: Real,
+    indefinite_first: bool,
+    mut r: Option<&mut [Real]>,
+) -> Option<(Real, super::low_rank::Woodbury)> {
+    use super::low_rank::Woodbury;
     // LDLᵀ of the unshifted sparse part, accepted when the whole is positive definite.
-    let by_ldlt = |lin: &mut LinearSolver| {
+    let by_ldlt = |lin: &mut LinearSolver, r: Option<&mut [Real]>| {
         let negative = lin.factor_indefinite(values).ok()?;
-        let wb = super::low_rank::Woodbury::new(lin, lr);
+        let wb = Woodbury::new_with(lin, lr, r);
         (wb.negative_eigenvalues(negative) == Some(0)).then_some((0.0, wb))
     };
     if indefinite_first && !lr.is_empty() {
-        if let Some(m) = by_ldlt(lin) {
+        if let Some(m) = by_ldlt(lin, r.as_deref_mut()) {
             return Some(m);
         }
     }
     if let Some(t) = factor_with_shift_upto(lin, pot, values, shifted, tau_max, tau_max) {
-        let wb = super::low_rank::Woodbury::new(lin, lr);
+        let wb = Woodbury::new_with(lin, lr, r);
         if wb.keeps_positive_definite() {
             return Some((t, wb));
         }
@@ -327,7 +377,7 @@ fn exact_model_from(
     if lr.is_empty() {
         return None;
     }
-    by_ldlt(lin)
+    by_ldlt(lin, r)
 }
 
 /// Whether the whole Hessian (sparse `values` + low-rank `lr`) shifted by `δ·mean|diag|`
@@ -406,8 +456,10 @@ pub fn newton(
     let mut rep = NewtonReport::default();
     let mut tau_prev: Real = 0.0;
     let mode = opts.projection;
-    // Adaptive mode: whether this iteration tries the exact Hessian first.
-    let mut try_exact = true;
+    // Adaptive mode: whether this iteration tries the exact Hessian first. Not the first
+    // iteration when the last one tried, in an earlier solve, was rejected; the second does.
+    let mut try_exact = !ws.exact_rejected;
+    let mut hinted = ws.exact_rejected;
     // Chord iterations: whether the next iteration may reuse the held factorisation, and the
     // residual the last chord iteration started from.
     let mut chord_next = opts.chord;
@@ -552,7 +604,10 @@ pub fn newton(
             // definite (LDLᵀ and the inertia). If it is genuinely indefinite, use the
             // Gauss–Newton Hessian instead.
             let exact = if try_exact {
-                exact_model_from(
+                for (s, g) in ws.step.iter_mut().zip(&ws.grad) {
+                    *s = -g;
+                }
+                exact_model_solving(
                     lin,
                     pot,
                     &ws.values,
@@ -560,6 +615,7 @@ pub fn newton(
                     &lr,
                     tau0.min(1e-8),
                     ws.indefinite,
+                    Some(&mut ws.step),
                 )
             } else {
                 None
@@ -569,6 +625,7 @@ pub fn newton(
                     factored = true;
                     tau0 = t;
                     model = Some(wb);
+                    ws.exact_rejected = false;
                     ws.indefinite = lin.is_indefinite();
                     if ws.indefinite {
                         rep.indefinite_iterations += 1;
@@ -577,7 +634,11 @@ pub fn newton(
                 None => {
                     if try_exact {
                         // The assembled exact Hessian is indefinite; `first` was already
-                        // Gauss–Newton otherwise.
+                        // Gauss–Newton otherwise. With a low-rank part, its sparse part's LDLᵀ
+                        // is the last factorisation when that was indefinite too: the next
+                        // exact attempt starts there.
+                        ws.exact_rejected = true;
+                        ws.indefinite = !lr.is_empty() && lin.is_indefinite();
                         let c = Instant::now();
                         pot.eval_projected(
                             &state.x,
@@ -616,17 +677,21 @@ pub fn newton(
             rep.shifted_iterations += 1;
             rep.max_shift = rep.max_shift.max(tau);
         }
-        for (s, g) in ws.step.iter_mut().zip(&ws.grad) {
-            *s = -g;
-        }
+        // The step: `A⁻¹(−g)` was solved with the low-rank vectors (by the accepted exact
+        // model, or here), and the low-rank correction finishes it.
         let wb = match model {
             Some(wb) => wb,
-            None => super::low_rank::Woodbury::new(lin, &lr),
+            None => {
+                for (s, g) in ws.step.iter_mut().zip(&ws.grad) {
+                    *s = -g;
+                }
+                super::low_rank::Woodbury::new_with(lin, &lr, Some(&mut ws.step))
+            }
         };
         if opts.chord {
             ws.chord_model = Some(wb.clone());
         }
-        if !wb.solve_in_place(lin, &mut ws.step) {
+        if !wb.correct(&mut ws.step) {
             rep.failure = Some(SolveError::LowRankSingular);
             return rep;
         }
@@ -665,7 +730,8 @@ pub fn newton(
         }
         state.copy_from(&ws.trial);
         if mode == HessianProjection::Adaptive {
-            try_exact = !projected || alpha == 1.0;
+            try_exact = !projected || alpha == 1.0 || hinted;
+            hinted = false;
         }
         // The first chord iteration after a fresh factorisation needs a full Newton step.
         chord_next = opts.chord && alpha == 1.0;

@@ -698,3 +698,48 @@ fn projected_hessian_matches_the_projected_gradient() {
     println!("projected Hessian against the projected gradient: {worst:.2e}");
     assert!(worst < 1e-6, "{worst:e}");
 }
+
+/// A rejected exact model is remembered: the next solve from the same state starts with the
+/// Gauss–Newton model without the failed factorisations, and takes the same step.
+#[test]
+fn a_rejected_exact_model_is_not_retried_by_the_next_solve() {
+    let sc = balloon(2, "[gas]\ncontrol = \"amount\"\namount = 6e4\n");
+    let p = Pattern::for_scene(&sc);
+    let pot = Potential::new(&sc, &p);
+    // Crushed to 70%: the compressed membrane's exact Hessian is indefinite.
+    let x0 = inflated(&sc, 0.7, 1e-3, 3);
+    let opts = NewtonOptions {
+        tol: 1e-300,
+        max_iter: 1,
+        projection: HessianProjection::Adaptive,
+        chord: false,
+    };
+    let one_iteration = |ws: &mut shellsim::solve::newton::Workspace| {
+        let mut lin = LinearSolver::new(&p).unwrap();
+        let mut st = State {
+            x: x0.clone(),
+            dofs: Vec::new(),
+            terms: sc.initial_states.clone(),
+        };
+        let rep = newton(&pot, &mut lin, ws, &mut st, opts);
+        (rep, lin.counts(), st.x)
+    };
+    let mut ws = shellsim::solve::newton::Workspace::new(&p);
+    assert_eq!(ws.model_hints(), [false, false]);
+    let (first, c1, x1) = one_iteration(&mut ws);
+    assert_eq!(first.gauss_newton_iterations, 1, "{first:?}");
+    assert!(
+        c1.failed >= 1,
+        "the exact model was tried and refused: {c1:?}"
+    );
+    assert!(ws.model_hints()[1], "{:?}", ws.model_hints());
+    let (second, c2, x2) = one_iteration(&mut ws);
+    assert_eq!(second.gauss_newton_iterations, 1, "{second:?}");
+    assert_eq!(c2.failed, 0, "{c2:?}");
+    assert_eq!(c2.factorisations, 1, "{c2:?}");
+    // The same Gauss–Newton step either way.
+    assert!(x1
+        .iter()
+        .zip(&x2)
+        .all(|(a, b)| (0..3).all(|k| a[k].to_bits() == b[k].to_bits())));
+}
