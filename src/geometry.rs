@@ -293,12 +293,27 @@ impl AverageQs {
     /// Evaluates every edge of a face; Hessians only with `hess`.
     #[inline]
     pub fn new(nf: &UnitNormal, x: &[Vec3; 6], has: [bool; 3], hess: bool) -> Self {
-        let mut out = AverageQs {
+        let mut out = Self::zeros();
+        out.fill(nf, x, has, hess);
+        out
+    }
+
+    /// All zero (no edge).
+    #[inline]
+    pub fn zeros() -> Self {
+        AverageQs {
             q: [0.0; 3],
             grad: [SVec::<12>::zeros(); 3],
             hess: [SMat::<12, 12>::zeros(); 3],
             dnf: [Vec3::zeros(); 3],
-        };
+        }
+    }
+
+    /// [`Self::new`] in place, on a value from [`Self::zeros`] (an edge without a neighbour
+    /// keeps its zeros; the Hessians are written only with `hess`): a kernel that keeps the
+    /// result in a larger value fills it there instead of copying 3.5 kB in.
+    #[inline(always)]
+    pub fn fill(&mut self, nf: &UnitNormal, x: &[Vec3; 6], has: [bool; 3], hess: bool) {
         for i in 0..3 {
             if !has[i] {
                 continue;
@@ -309,13 +324,12 @@ impl AverageQs {
                 [i, j, k],
                 &[x[i], x[j], x[k]],
                 &x[3 + i],
-                hess.then_some(&mut out.hess[i]),
+                hess.then_some(&mut self.hess[i]),
             );
-            out.q[i] = eq.q;
-            out.grad[i] = eq.grad;
-            out.dnf[i] = f;
+            self.q[i] = eq.q;
+            self.grad[i] = eq.grad;
+            self.dnf[i] = f;
         }
-        out
     }
 
     /// Adds `Σ_i μ_i ∇²q_i` to the position block (the first 18 rows and columns) of an element

@@ -307,34 +307,36 @@ impl LinearSolver {
             return Ok((with(&amd)?, Ordering::Amd, None));
         }
         // The two orderings are independent and deterministic: computed side by side on the
-        // pool's threads (the result does not depend on how many there are).
+        // pool's threads (the result does not depend on how many there are), AMD's flop count
+        // with it (METIS takes longer).
         let (amd, nd) = rayon::join(
-            || ordering::amd(pattern.as_ref()),
+            || {
+                ordering::amd(pattern.as_ref())
+                    .map(|p| (ordering::flops_under(pattern.as_ref(), &p), p))
+            },
             || ordering::nested_dissection(n, pattern.col_ptr(), pattern.row_idx()),
         );
-        let amd = amd.map_err(setup)?;
+        let (amd_flops, amd) = amd.map_err(setup)?;
         let Some(nd) = nd else {
             eprintln!(
                 "warning: nested dissection failed on a {n}-unknown pattern; ordering by AMD"
             );
             return Ok((with(&amd)?, Ordering::Amd, None));
         };
-        let amd_flops = || ordering::flops_under(pattern.as_ref(), &amd);
         if split {
             // Split at the top separator, the cost is the longer half's factorisation and the
             // separator's dense work, which the two threads do not share. The split and the
             // whole symbolic factorisation (for the unsplit `factor_to`) are built side by side.
             let (sp, whole) = rayon::join(|| split::Split::new(pattern, &nd), || with(&nd.perm));
             if let Some(sp) = sp? {
-                if imposed == Some(Ordering::NestedDissection) || sp.critical_flops() < amd_flops()
-                {
+                if imposed == Some(Ordering::NestedDissection) || sp.critical_flops() < amd_flops {
                     return Ok((whole?, Ordering::NestedDissection, Some(sp)));
                 }
                 return Ok((with(&amd)?, Ordering::Amd, None));
             }
         }
         if imposed == Some(Ordering::NestedDissection)
-            || ordering::flops_under(pattern.as_ref(), &nd.perm) < amd_flops()
+            || ordering::flops_under(pattern.as_ref(), &nd.perm) < amd_flops
         {
             Ok((with(&nd.perm)?, Ordering::NestedDissection, None))
         } else {
