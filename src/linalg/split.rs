@@ -142,14 +142,28 @@ impl Half {
             }
             col_ptr.push(row_idx.len());
         }
+        // The symbolic factorisation in the local order as it stands (`Identity`), which faer
+        // reads from the upper triangle: the transposed pattern. The numeric factorisation then
+        // takes the gathered lower triangle as it is, without permuting a copy of it first.
+        let mut upper_cols: Vec<Vec<usize>> = vec![Vec::new(); m];
+        for c in 0..m {
+            for &r in &row_idx[col_ptr[c]..col_ptr[c + 1]] {
+                upper_cols[r].push(c);
+            }
+        }
+        let mut up_ptr = Vec::with_capacity(m + 1);
+        let mut up_idx = Vec::with_capacity(row_idx.len());
+        up_ptr.push(0);
+        for c in upper_cols {
+            up_idx.extend(c);
+            up_ptr.push(up_idx.len());
+        }
+        let upper = SymbolicSparseColMat::new_checked(m, m, up_ptr, None, up_idx);
         let pattern = SymbolicSparseColMat::new_checked(m, m, col_ptr, None, row_idx);
-        // The identity as a custom ordering: faer's `Identity` takes the pattern's stored
-        // triangle as the upper one, which a lower-triangular pattern is not.
-        let identity: Vec<usize> = (0..m).collect();
         let symbolic = factorize_symbolic_cholesky(
-            pattern.as_ref(),
-            Side::Lower,
-            SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(&identity, &identity, m)),
+            upper.as_ref(),
+            Side::Upper,
+            SymmetricOrdering::Identity,
             CholeskySymbolicParams {
                 supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
                 ..Default::default()
