@@ -98,7 +98,6 @@ pub(super) fn run_dynamic(
         }
         acc.copy_from_slice(a);
     }
-    let extrapolate = tm.dt_max <= tm.dt && sc.settings.obstacles.is_empty();
     let mut trial = state.clone();
     let damping = tm.damping > 0.0;
     let (mut a_prev, mut b_prev) = if damping {
@@ -149,6 +148,8 @@ pub(super) fn run_dynamic(
     }
     // Friction: the lagged normal forces, carried from step to step.
     let obstacles = !sc.settings.obstacles.is_empty();
+    // With a fixed step and no obstacle, Newton starts from the extrapolation (see `acc`).
+    let extrapolate = tm.dt_max <= tm.dt && !obstacles;
     let mut lag = FrictionLag::new(sc, &state.x, dial_now, cf.slip_speed);
     // With friction, the last accepted step (its start, its start's dial, its length): frames
     // report the friction forces of that step. The first frame reports none.

@@ -692,24 +692,19 @@ mod tests {
         );
         assert!(split.factor(&ind).is_err());
         // Bitwise the same on one thread as on two.
-        let one = rayon::ThreadPoolBuilder::new()
-            .num_threads(1)
-            .build()
-            .unwrap();
-        let mut x1 = b.clone();
-        one.install(|| {
-            split.factor(&v).expect("positive definite");
-            split.solve_in_place(&mut x1);
-        });
-        let two = rayon::ThreadPoolBuilder::new()
-            .num_threads(2)
-            .build()
-            .unwrap();
-        let mut x2 = b.clone();
-        two.install(|| {
-            split.factor(&v).expect("positive definite");
-            split.solve_in_place(&mut x2);
-        });
+        let mut on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut x = b.clone();
+            pool.install(|| {
+                split.factor(&v).expect("positive definite");
+                split.solve_in_place(&mut x);
+            });
+            x
+        };
+        let (x1, x2) = (on(1), on(2));
         assert!(x1.iter().zip(&x2).all(|(a, c)| a.to_bits() == c.to_bits()));
     }
 

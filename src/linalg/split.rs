@@ -69,6 +69,8 @@ pub(super) struct Split {
     a33: Vec<(usize, usize, usize)>,
     /// The dense factor of S (lower; LDLᵀ: unit L below, D on the diagonal).
     s: Mat<Real>,
+    /// Scratch of S's dense LLᵀ or LDLᵀ, allocated once.
+    dense_mem: MemBuffer,
     ldlt: bool,
 }
 
@@ -422,11 +424,18 @@ impl Split {
                 }
             }
         }
+        use faer::linalg::cholesky::{ldlt, llt};
+        let dense_mem = MemBuffer::try_new(StackReq::any_of(&[
+            ldlt::factor::cholesky_in_place_scratch::<Real>(ns, Par::Seq, Default::default()),
+            llt::factor::cholesky_in_place_scratch::<Real>(ns, Par::Seq, Default::default()),
+        ]))
+        .map_err(|e| LinearError::Setup(format!("{e:?}")))?;
         Ok(Some(Split {
             halves,
             sep,
             a33,
             s: Mat::zeros(ns, ns),
+            dense_mem,
             ldlt: false,
         }))
     }
@@ -468,21 +477,13 @@ impl Split {
         for &(r, c, e) in &self.a33 {
             self.s[(r, c)] -= a[e];
         }
-        let par = Par::Seq;
+        let stack = MemStack::new(&mut self.dense_mem);
         let negative = if ldlt {
-            let mut mem = MemBuffer::try_new(
-                faer::linalg::cholesky::ldlt::factor::cholesky_in_place_scratch::<Real>(
-                    ns,
-                    par,
-                    Default::default(),
-                ),
-            )
-            .map_err(|e| LinearError::Setup(format!("{e:?}")))?;
             faer::linalg::cholesky::ldlt::factor::cholesky_in_place(
                 self.s.as_mut(),
                 LdltRegularization::default(),
-                par,
-                MemStack::new(&mut mem),
+                Par::Seq,
+                stack,
                 Default::default(),
             )?;
             let d: Vec<Real> = (0..ns).map(|k| self.s[(k, k)]).collect();
@@ -491,19 +492,11 @@ impl Split {
             }
             d.iter().filter(|&&v| v < 0.0).count() + h0.negative + h1.negative
         } else {
-            let mut mem = MemBuffer::try_new(
-                faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<Real>(
-                    ns,
-                    par,
-                    Default::default(),
-                ),
-            )
-            .map_err(|e| LinearError::Setup(format!("{e:?}")))?;
             faer::linalg::cholesky::llt::factor::cholesky_in_place(
                 self.s.as_mut(),
                 LltRegularization::default(),
-                par,
-                MemStack::new(&mut mem),
+                Par::Seq,
+                stack,
                 Default::default(),
             )?;
             0

@@ -246,6 +246,13 @@ impl Workspace {
         [self.indefinite, self.exact_rejected] = hints;
     }
 
+    /// `step = −∇Φ`, the right-hand side of every model's solve.
+    fn step_from_gradient(&mut self) {
+        for (s, g) in self.step.iter_mut().zip(&self.grad) {
+            *s = -g;
+        }
+    }
+
     /// The gradient of the last evaluation.
     pub fn gradient(&self) -> &[Real] {
         &self.grad
@@ -315,37 +322,16 @@ pub fn exact_model(
     lr: &[crate::energy::term::LowRank],
     tau_max: Real,
 ) -> Option<(Real, super::low_rank::Woodbury)> {
-    exact_model_from(lin, pot, values, shifted, lr, tau_max, false)
+    exact_model_from(lin, pot, values, shifted, lr, tau_max, false, None)
 }
 
 /// [`exact_model`], trying LDLᵀ first when `indefinite_first` (the previous iteration's sparse
-/// part was indefinite: one factorisation instead of a failed Cholesky and an LDLᵀ).
-fn exact_model_from(
-    lin: &mut LinearSolver,
-    pot: &Potential,
-    values: &[Real],
-    shifted: &mut [Real],
-    lr: &[crate::energy::term::LowRank],
-    tau_max: Real,
-    indefinite_first: bool,
-) -> Option<(Real, super::low_rank::Woodbury)> {
-    exact_model_solving(
-        lin,
-        pot,
-        values,
-        shifted,
-        lr,
-        tau_max,
-        indefinite_first,
-        None,
-    )
-}
-
-/// [`exact_model_from`], solving `A r = r` (the sparse part) in the same pass over the factor
-/// as the low-rank vectors when a model is accepted (`r` is then ready for
-/// [`super::low_rank::Woodbury::correct`]; otherwise it is left changed).
+/// part was indefinite: one factorisation instead of a failed Cholesky and an LDLᵀ), and
+/// solving `A r = r` (the sparse part) in the same pass over the factor as the low-rank vectors
+/// when a model is accepted (`r` is then ready for [`super::low_rank::Woodbury::correct`];
+/// otherwise it is left changed).
 #[allow(clippy::too_many_arguments)]
-fn exact_model_solving(
+fn exact_model_from(
     lin: &mut LinearSolver,
     pot: &Potential,
     values: &[Real],
@@ -530,9 +516,7 @@ pub fn newton(
         }
         if expect_chord && chord_next {
             let clock = Instant::now();
-            for (s, g) in ws.step.iter_mut().zip(&ws.grad) {
-                *s = -g;
-            }
+            ws.step_from_gradient();
             let solved = ws
                 .chord_model
                 .as_ref()
@@ -604,10 +588,8 @@ pub fn newton(
             // definite (LDLᵀ and the inertia). If it is genuinely indefinite, use the
             // Gauss–Newton Hessian instead.
             let exact = if try_exact {
-                for (s, g) in ws.step.iter_mut().zip(&ws.grad) {
-                    *s = -g;
-                }
-                exact_model_solving(
+                ws.step_from_gradient();
+                exact_model_from(
                     lin,
                     pot,
                     &ws.values,
@@ -682,9 +664,7 @@ pub fn newton(
         let wb = match model {
             Some(wb) => wb,
             None => {
-                for (s, g) in ws.step.iter_mut().zip(&ws.grad) {
-                    *s = -g;
-                }
+                ws.step_from_gradient();
                 super::low_rank::Woodbury::new_with(lin, &lr, Some(&mut ws.step))
             }
         };
