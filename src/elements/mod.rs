@@ -165,9 +165,26 @@ impl Clone for Scratch {
     }
 }
 
-/// Elements per block: large enough for cache locality and cheap scheduling, small enough that
-/// a colour holds many blocks.
+/// Most elements per block: large enough for cache locality and cheap scheduling.
 pub const BLOCK: usize = 256;
+
+/// Fewest elements per block: below this, rayon's scheduling (about a microsecond per block)
+/// would no longer be small against the block's work (16 shell faces take about 60 µs).
+pub const MIN_BLOCK: usize = 16;
+
+/// Blocks a term's elements are cut into at least, when [`MIN_BLOCK`] allows: a greedy
+/// colouring of a surface mesh's blocks takes 4–8 colours, and each colour must still hold
+/// several blocks per thread, or a small mesh (a 1000-face strip in 4 blocks of 256 has one
+/// block per colour) assembles on one core.
+pub const MIN_BLOCKS: usize = 64;
+
+/// Elements per block for a term of `ne` elements: `⌈ne / MIN_BLOCKS⌉` within
+/// [`MIN_BLOCK`]..=[`BLOCK`]. It depends on the mesh only, never on the thread count, so the
+/// order in which an entry receives its contributions (colour by colour, block by block) is
+/// the same for any number of threads.
+pub fn block_size(ne: usize) -> usize {
+    ne.div_ceil(MIN_BLOCKS).clamp(MIN_BLOCK, BLOCK)
+}
 
 /// First DOF and number of DOFs of node `u` when nodes below `nv` are vertices.
 #[inline(always)]

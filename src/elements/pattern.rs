@@ -3,7 +3,7 @@
 //! and the colouring of its element blocks). Built from stencils alone, so it sits below the
 //! terms; [`crate::assembly`] builds it for a scene.
 
-use super::{colour_blocks, morton_order, node_dofs, ElementMap, Scratch, Stencil, BLOCK};
+use super::{block_size, colour_blocks, morton_order, node_dofs, ElementMap, Scratch, Stencil};
 use crate::math::{Mat3, Real, Vec3};
 use crate::mesh::topology::NONE;
 
@@ -125,7 +125,7 @@ impl Pattern {
                 }
                 let morton = morton_order(&st.anchors, positions);
                 let blocks: Vec<Vec<usize>> = morton
-                    .chunks(BLOCK)
+                    .chunks(block_size(morton.len()))
                     .map(|c| {
                         let mut b: Vec<usize> = c.iter().map(|&e| e as usize).collect();
                         b.sort_unstable();

@@ -654,3 +654,37 @@ fn skew_projection_matches_the_dense_product() {
         .fold(0.0, f64::max);
     assert!(row < 1e-14, "{row:e}");
 }
+
+/// The best 2-thread speed-up the colouring allows: each colour runs its blocks in parallel and
+/// waits for its largest, so a colour of total work `T` and largest block `B` takes at least
+/// `max(B, T/2)` (work counted in elements).
+fn two_thread_bound(colours: &[Vec<Vec<usize>>]) -> f64 {
+    let (mut serial, mut parallel) = (0usize, 0.0f64);
+    for blocks in colours {
+        let total: usize = blocks.iter().map(Vec::len).sum();
+        let largest = blocks.iter().map(Vec::len).max().unwrap_or(0);
+        serial += total;
+        parallel += (largest as f64).max(total as f64 / 2.0);
+    }
+    serial as f64 / parallel
+}
+
+/// A small, long mesh still assembles on both cores: the paper walker's 60 × 8 mm strip of 960
+/// faces (fixed blocks of 256 faces gave it 4 blocks, one per colour, and a bound of 1.0), and
+/// a 5000-face square. The bound is what the colouring permits; the walker's measured
+/// assembly speed-up is in docs/speed.md.
+#[test]
+fn small_meshes_colour_into_enough_blocks_for_two_threads() {
+    let strip = shellsim::mesh::io::read_mesh(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/meshes/paper_walker.vtk"
+    )))
+    .unwrap();
+    let sc = Scene::build(strip, Settings::from_str_with("", "test", &[]).unwrap()).unwrap();
+    let p = pattern(&sc);
+    let bound = two_thread_bound(p.colours());
+    assert!(bound >= 1.8, "walker strip: 2-thread bound {bound:.2}");
+    let sc = scene_with_edge("", None, 0.02);
+    let bound = two_thread_bound(pattern(&sc).colours());
+    assert!(bound >= 1.9, "5000-face square: 2-thread bound {bound:.2}");
+}
