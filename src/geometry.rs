@@ -230,31 +230,51 @@ pub fn midedge_average_q(
         let fnf_nf = -k;
         let fnf_ng = -(u * w.transpose()) / s3 - k;
         let fng_ng = -(w * u.transpose()) / s3 - (u * w.transpose()) / s3 - k;
-        // J (9×12): rows [w; Nf; Ng].
-        let mut jac = SMat::<9, 12>::zeros();
-        for c in 0..3 {
-            jac[(c, c)] = -1.0;
-            jac[(c, 3 + c)] = 1.0;
+        // H = Jᵀ F'' J with J (9×12, rows [w; Nf; Ng], columns the slots [v_i, v_j, v_k, p])
+        // block-sparse: w = v_j − v_i has −I, +I at slots 0, 1; N_f has `jnf` at slots 0–2;
+        // N_g has `jng` at slots 1–3. Column block b: M_b = F'' J_b (three 3×3 row blocks),
+        // then H_ab = Σ_r J_raᵀ M_rb over the blocks present, for a ≤ b, mirrored: 33 products
+        // of 3×3 matrices instead of the dense 9×12 products' 84.
+        let wcoef: [Real; 4] = [-1.0, 1.0, 0.0, 0.0];
+        let fblk = [Some(jnf[0]), Some(jnf[1]), Some(jnf[2]), None];
+        let gblk = [
+            None,
+            Some(ng_data.dn[2]),
+            Some(ng_data.dn[1]),
+            Some(ng_data.dn[0]),
+        ];
+        let (fnf_w, fng_w, fng_nf) = (fw_nf.transpose(), fw_ng.transpose(), fnf_ng.transpose());
+        let mut m = [[Mat3::zeros(); 3]; 4];
+        for b in 0..4 {
+            let (mut mw, mut mf, mut mg) = (Mat3::zeros(), fnf_w * wcoef[b], fng_w * wcoef[b]);
+            if let Some(f) = &fblk[b] {
+                mw += fw_nf * f;
+                mf += fnf_nf * f;
+                mg += fng_nf * f;
+            }
+            if let Some(g) = &gblk[b] {
+                mw += fw_ng * g;
+                mf += fnf_ng * g;
+                mg += fng_ng * g;
+            }
+            m[b] = [mw, mf, mg];
         }
-        for (a, j) in jnf.iter().enumerate() {
-            jac.fixed_view_mut::<3, 3>(3, 3 * a).copy_from(j);
+        for (b, [mw, mf, mg]) in m.iter().enumerate() {
+            for a in 0..=b {
+                let mut blk = mw * wcoef[a];
+                if let Some(f) = &fblk[a] {
+                    blk += f.transpose() * mf;
+                }
+                if let Some(g) = &gblk[a] {
+                    blk += g.transpose() * mg;
+                }
+                h.fixed_view_mut::<3, 3>(3 * a, 3 * b).copy_from(&blk);
+                if a != b {
+                    h.fixed_view_mut::<3, 3>(3 * b, 3 * a)
+                        .copy_from(&blk.transpose());
+                }
+            }
         }
-        for (slot, j) in &jng {
-            jac.fixed_view_mut::<3, 3>(6, 3 * slot).copy_from(j);
-        }
-        let mut hf = SMat::<9, 9>::zeros();
-        hf.fixed_view_mut::<3, 3>(0, 3).copy_from(&fw_nf);
-        hf.fixed_view_mut::<3, 3>(3, 0)
-            .copy_from(&fw_nf.transpose());
-        hf.fixed_view_mut::<3, 3>(0, 6).copy_from(&fw_ng);
-        hf.fixed_view_mut::<3, 3>(6, 0)
-            .copy_from(&fw_ng.transpose());
-        hf.fixed_view_mut::<3, 3>(3, 3).copy_from(&fnf_nf);
-        hf.fixed_view_mut::<3, 3>(3, 6).copy_from(&fnf_ng);
-        hf.fixed_view_mut::<3, 3>(6, 3)
-            .copy_from(&fnf_ng.transpose());
-        hf.fixed_view_mut::<3, 3>(6, 6).copy_from(&fng_ng);
-        *h = jac.transpose() * hf * jac;
         // Ng second derivative contracted with ∂F/∂Ng, over [p, v_k, v_j] → local [3, 2, 1].
         let hg = ng_data.hessian_contract(&f_ng);
         let map = [3usize, 2, 1];

@@ -353,6 +353,59 @@ impl BendingModel<21, 9> for MidedgeAngle {
     }
 }
 
+/// `h = Jyᵀ hy Jy` (with `set`) or `h += Jyᵀ hy Jy`, through the block structure of `Jy`
+/// (9×21, [`BendingModel::eval`]): the rows of `a` and `q̃` reach the face's 9 vertex DOFs
+/// (`F`, 6×9), row `q̃_i` also the 3 DOFs of the far vertex `p_i` (`g_i`, a 3-vector), and row
+/// `φ_i` is the unit vector of DOF `18 + i`. With `U = hy Jy` (9×21): `U_F = hy[:, 0..6] F`,
+/// `U_{p_i} = hy[:, 3+i] g_iᵀ`, `U_{φ_i} = hy[:, 6+i]`; then `H_F = Fᵀ U[0..6]`,
+/// `H_{p_i} = g_i U[3+i]`, `H_{φ_i} = U[6+i]`. About 1.9k multiply-adds against the dense
+/// products' 5.7k.
+#[inline(always)]
+fn jy_congruence(jy: &SMat<9, 21>, hy: &SMat<9, 9>, set: bool, h: &mut SMat<21, 21>) {
+    let f = jy.fixed_view::<6, 9>(0, 0).into_owned();
+    let g: [Vec3; 3] = std::array::from_fn(|i| {
+        Vec3::new(
+            jy[(3 + i, 9 + 3 * i)],
+            jy[(3 + i, 10 + 3 * i)],
+            jy[(3 + i, 11 + 3 * i)],
+        )
+    });
+    let mut u = SMat::<9, 21>::zeros();
+    u.fixed_view_mut::<9, 9>(0, 0)
+        .copy_from(&(hy.fixed_view::<9, 6>(0, 0) * f));
+    for i in 0..3 {
+        for r in 0..9 {
+            let w = hy[(r, 3 + i)];
+            for k in 0..3 {
+                u[(r, 9 + 3 * i + k)] = w * g[i][k];
+            }
+            u[(r, 18 + i)] = hy[(r, 6 + i)];
+        }
+    }
+    let top = f.transpose() * u.fixed_view::<6, 21>(0, 0);
+    if set {
+        h.fixed_view_mut::<9, 21>(0, 0).copy_from(&top);
+    } else {
+        let mut dst = h.fixed_view_mut::<9, 21>(0, 0);
+        dst += top;
+    }
+    for i in 0..3 {
+        for col in 0..21 {
+            let w = u[(3 + i, col)];
+            for k in 0..3 {
+                let e = &mut h[(9 + 3 * i + k, col)];
+                *e = if set { g[i][k] * w } else { *e + g[i][k] * w };
+            }
+            let e = &mut h[(18 + i, col)];
+            *e = if set {
+                u[(6 + i, col)]
+            } else {
+                *e + u[(6 + i, col)]
+            };
+        }
+    }
+}
+
 impl MidedgeAngle {
     /// Adds (or, with `set`, assigns) `Jyᵀ (hy + Σ_i μ_i (Kᵢᵀ F_i'' Kᵢ + F_i,h ∇²_a h_i)) Jy`
     /// and, with `lambda`, adds the second-derivative terms of `a` and `q̃` contracted with
@@ -395,12 +448,7 @@ impl MidedgeAngle {
                 aa += c.dh[i].1 * (mu[i] * gf[1]);
             }
         }
-        if set {
-            // Written straight into `h`: no 21×21 temporary to copy.
-            (c.jy.transpose() * hy).mul_to(&c.jy, h);
-        } else {
-            *h += c.jy.transpose() * hy * c.jy;
-        }
+        jy_congruence(&c.jy, &hy, set, h);
         if let Some(mu) = &mu {
             let gy = c.jq.transpose() * mu;
             let pat = first_fundamental_form_hessian_pattern(&Sym2::new(gy[0], gy[1], gy[2]));
