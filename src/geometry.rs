@@ -236,13 +236,14 @@ pub fn midedge_average_q(
         // then H_ab = Σ_r J_raᵀ M_rb over the blocks present, for a ≤ b, mirrored: 33 products
         // of 3×3 matrices instead of the dense 9×12 products' 84.
         let wcoef: [Real; 4] = [-1.0, 1.0, 0.0, 0.0];
-        let fblk = [Some(jnf[0]), Some(jnf[1]), Some(jnf[2]), None];
-        let gblk = [
-            None,
-            Some(ng_data.dn[2]),
-            Some(ng_data.dn[1]),
-            Some(ng_data.dn[0]),
-        ];
+        let mut fblk: [Option<Mat3>; 4] = [None; 4];
+        for (a, j) in jnf.iter().enumerate() {
+            fblk[a] = Some(*j);
+        }
+        let mut gblk: [Option<Mat3>; 4] = [None; 4];
+        for &(slot, j) in &jng {
+            gblk[slot] = Some(j);
+        }
         let (fnf_w, fng_w, fng_nf) = (fw_nf.transpose(), fw_ng.transpose(), fnf_ng.transpose());
         let mut m = [[Mat3::zeros(); 3]; 4];
         for b in 0..4 {

@@ -169,7 +169,7 @@ impl Clone for Scratch {
 pub const BLOCK: usize = 256;
 
 /// Fewest elements per block: below this, rayon's scheduling (about a microsecond per block)
-/// would no longer be small against the block's work (16 shell faces take about 60 µs).
+/// would no longer be small against the block's work (16 shell faces with edge DOFs take about 50 µs).
 pub const MIN_BLOCK: usize = 16;
 
 /// Blocks a term's elements are cut into at least, when [`MIN_BLOCK`] allows: a greedy
