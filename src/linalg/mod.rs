@@ -162,12 +162,56 @@ enum Kind {
     Ldlt,
 }
 
-/// The symbolic factorisation of a pattern, its ordering and the scratch memory of its numeric
-/// factorisations and solves.
-struct Analysis {
+/// The unsplit symbolic factorisation of a pattern under its ordering, with the scratch memory
+/// of its numeric factorisations and solves.
+struct Whole {
     symbolic: SymbolicCholesky<usize>,
-    ordering: Ordering,
     mem: MemBuffer,
+}
+
+impl Whole {
+    /// The symbolic factorisation of the lower-triangular `pattern` under `perm` (new position
+    /// → unknown). Supernodal from [`SUPERNODAL_FROM`] unknowns: faer's default flop-ratio
+    /// threshold picks the simplicial factorisation for small systems, which measured slower on
+    /// the shell Hessians of a few thousand unknowns (docs/solvers.md). The choice depends on
+    /// the size alone, so results stay identical across runs.
+    fn new(pattern: &SymbolicSparseColMat<usize>, perm: &[usize]) -> Result<Self, LinearError> {
+        let n = pattern.nrows();
+        let params = CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: if n >= SUPERNODAL_FROM {
+                SupernodalThreshold::FORCE_SUPERNODAL
+            } else {
+                SupernodalThreshold::AUTO
+            },
+            ..Default::default()
+        };
+        let inv = ordering::inverse(perm);
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.as_ref(),
+            Side::Lower,
+            SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(perm, &inv, n)),
+            params,
+        )
+        .map_err(|e| LinearError::Setup(format!("{e:?}")))?;
+        let req = StackReq::any_of(&[
+            symbolic.factorize_numeric_llt_scratch::<Real>(Par::Seq, Default::default()),
+            symbolic.factorize_numeric_ldlt_scratch::<Real>(Par::Seq, Default::default()),
+            symbolic.solve_in_place_scratch::<Real>(1, Par::Seq),
+        ]);
+        let mem = MemBuffer::try_new(req).map_err(|e| LinearError::Setup(format!("{e:?}")))?;
+        Ok(Whole { symbolic, mem })
+    }
+}
+
+/// The analysis of a pattern: its ordering and symbolic factorisation.
+struct Analysis {
+    ordering: Ordering,
+    /// The ordering's permutation: new position → unknown.
+    perm: Vec<usize>,
+    /// The unsplit symbolic factorisation. Made with the analysis, except under the split,
+    /// whose factorisations and solves do not use it: there the first [`LinearSolver::factor_to`]
+    /// makes it (on a shell's Hessian, never).
+    whole: Option<Whole>,
     /// Under nested dissection, with [`LinearSolver::with_split`]: the factorisation split at
     /// the top separator, its halves on two threads ([`split`]); `factor`, `factor_indefinite`
     /// and `solve_in_place` use it.
@@ -248,35 +292,19 @@ impl LinearSolver {
 
     fn analysis_mut(&mut self) -> Result<&mut Analysis, LinearError> {
         if self.analysis.is_none() {
-            let n = self.pattern.nrows();
-            // Supernodal from SUPERNODAL_FROM unknowns: faer's default flop-ratio threshold
-            // picks the simplicial factorisation for small systems, which measured slower on
-            // the shell Hessians of a few thousand unknowns (docs/solvers.md). The choice
-            // depends on the size alone, so results stay identical across runs.
-            let params = CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: if n >= SUPERNODAL_FROM {
-                    SupernodalThreshold::FORCE_SUPERNODAL
-                } else {
-                    SupernodalThreshold::AUTO
-                },
-                ..Default::default()
-            };
-            let (symbolic, ordering, split) =
-                Self::symbolic(&self.pattern, params, self.imposed, self.split)?;
-            let req = StackReq::any_of(&[
-                symbolic.factorize_numeric_llt_scratch::<Real>(Par::Seq, Default::default()),
-                symbolic.factorize_numeric_ldlt_scratch::<Real>(Par::Seq, Default::default()),
-                symbolic.solve_in_place_scratch::<Real>(1, Par::Seq),
-            ]);
-            let mem = MemBuffer::try_new(req).map_err(|e| LinearError::Setup(format!("{e:?}")))?;
-            self.analysis = Some(Analysis {
-                symbolic,
-                ordering,
-                mem,
-                split,
-            });
+            self.analysis = Some(Self::symbolic(&self.pattern, self.imposed, self.split)?);
         }
         Ok(self.analysis.as_mut().expect("made above"))
+    }
+
+    /// The unsplit symbolic factorisation, made on first use under the split.
+    fn whole_mut(&mut self) -> Result<&mut Whole, LinearError> {
+        self.analyse()?;
+        let an = self.analysis.as_mut().expect("analysed above");
+        if an.whole.is_none() {
+            an.whole = Some(Whole::new(&self.pattern, &an.perm)?);
+        }
+        Ok(an.whole.as_mut().expect("made above"))
     }
 
     /// The symbolic factorisation under the cheaper of AMD and nested dissection, by the flop
@@ -286,25 +314,22 @@ impl LinearSolver {
     /// The choice depends on the pattern alone, never on the thread count.
     fn symbolic(
         pattern: &SymbolicSparseColMat<usize>,
-        params: CholeskySymbolicParams<'_>,
         imposed: Option<Ordering>,
         split: bool,
-    ) -> Result<(SymbolicCholesky<usize>, Ordering, Option<split::Split>), LinearError> {
+    ) -> Result<Analysis, LinearError> {
         let setup = |e: faer::sparse::FaerError| LinearError::Setup(format!("{e:?}"));
         let n = pattern.nrows();
-        let with = |perm: &[usize]| {
-            let inv = ordering::inverse(perm);
-            factorize_symbolic_cholesky(
-                pattern.as_ref(),
-                Side::Lower,
-                SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(perm, &inv, n)),
-                params,
-            )
-            .map_err(setup)
+        let whole = |perm: Vec<usize>, ordering: Ordering| {
+            Ok(Analysis {
+                whole: Some(Whole::new(pattern, &perm)?),
+                ordering,
+                perm,
+                split: None,
+            })
         };
         if imposed == Some(Ordering::Amd) || imposed.is_none() && n < DISSECT_FROM {
             let amd = ordering::amd(pattern.as_ref()).map_err(setup)?;
-            return Ok((with(&amd)?, Ordering::Amd, None));
+            return whole(amd, Ordering::Amd);
         }
         // The two orderings are independent and deterministic: computed side by side on the
         // pool's threads (the result does not depend on how many there are), AMD's flop count
@@ -321,26 +346,29 @@ impl LinearSolver {
             eprintln!(
                 "warning: nested dissection failed on a {n}-unknown pattern; ordering by AMD"
             );
-            return Ok((with(&amd)?, Ordering::Amd, None));
+            return whole(amd, Ordering::Amd);
         };
         if split {
             // Split at the top separator, the cost is the longer half's factorisation and the
-            // separator's dense work, which the two threads do not share. The split and the
-            // whole symbolic factorisation (for the unsplit `factor_to`) are built side by side.
-            let (sp, whole) = rayon::join(|| split::Split::new(pattern, &nd), || with(&nd.perm));
-            if let Some(sp) = sp? {
+            // separator's dense work, which the two threads do not share.
+            if let Some(sp) = split::Split::new(pattern, &nd)? {
                 if imposed == Some(Ordering::NestedDissection) || sp.critical_flops() < amd_flops {
-                    return Ok((whole?, Ordering::NestedDissection, Some(sp)));
+                    return Ok(Analysis {
+                        ordering: Ordering::NestedDissection,
+                        perm: nd.perm,
+                        whole: None,
+                        split: Some(sp),
+                    });
                 }
-                return Ok((with(&amd)?, Ordering::Amd, None));
+                return whole(amd, Ordering::Amd);
             }
         }
         if imposed == Some(Ordering::NestedDissection)
             || ordering::flops_under(pattern.as_ref(), &nd.perm) < amd_flops
         {
-            Ok((with(&nd.perm)?, Ordering::NestedDissection, None))
+            whole(nd.perm, Ordering::NestedDissection)
         } else {
-            Ok((with(&amd)?, Ordering::Amd, None))
+            whole(amd, Ordering::Amd)
         }
     }
 
@@ -351,11 +379,17 @@ impl LinearSolver {
     }
 
     /// Floating-point operations of one numeric factorisation (Σ over columns of L of the squared
-    /// column count; 0 before the analysis).
+    /// column count; 0 before the analysis). Split at the top separator, those it performs: the
+    /// two halves, each with the separator's trailing block, and the separator's dense
+    /// factorisation.
     pub fn factor_flops(&self) -> f64 {
         self.analysis
             .as_ref()
-            .map_or(0.0, |a| symbolic_flops(&a.symbolic))
+            .map_or(0.0, |a| match (&a.split, &a.whole) {
+                (Some(sp), _) => sp.flops(),
+                (None, Some(w)) => symbolic_flops(&w.symbolic),
+                (None, None) => 0.0,
+            })
     }
 
     /// The numeric factorisations attempted so far, and the failed ones.
@@ -369,7 +403,9 @@ impl LinearSolver {
         self.analysis.as_ref().map_or(0, |a| {
             a.split
                 .as_ref()
-                .map_or(a.symbolic.len_val(), |s| s.factor_nnz())
+                .map(|s| s.factor_nnz())
+                .or(a.whole.as_ref().map(|w| w.symbolic.len_val()))
+                .unwrap_or(0)
         })
     }
 
@@ -414,13 +450,15 @@ impl LinearSolver {
         l: &mut Vec<Real>,
         ldlt: bool,
     ) -> Result<(), LinearError> {
-        self.analyse()?;
-        let Some(an) = self.analysis.as_mut() else {
-            unreachable!("analysed above")
-        };
-        l.resize(an.symbolic.len_val(), 0.0);
+        self.whole_mut()?;
+        let w = self
+            .analysis
+            .as_mut()
+            .and_then(|an| an.whole.as_mut())
+            .expect("made above");
+        l.resize(w.symbolic.len_val(), 0.0);
         let a = SparseColMatRef::new(self.pattern.as_ref(), values);
-        factorize_numeric(&an.symbolic, l, a, ldlt, &mut an.mem)
+        factorize_numeric(&w.symbolic, l, a, ldlt, &mut w.mem)
     }
 
     /// Numeric LDLᵀ factorisation (no pivoting) of a symmetric, possibly indefinite matrix with
@@ -452,10 +490,10 @@ impl LinearSolver {
     /// The pivots `D` of the last LDLᵀ factorisation, in the permuted order.
     fn ldlt_diagonal(&self) -> Vec<Real> {
         let l = &self.l_values;
-        let Some(an) = self.analysis.as_ref() else {
+        let Some(w) = self.analysis.as_ref().and_then(|an| an.whole.as_ref()) else {
             return Vec::new();
         };
-        match an.symbolic.raw() {
+        match w.symbolic.raw() {
             SymbolicCholeskyRaw::Simplicial(s) => {
                 // Each column stores its diagonal first.
                 let cp = s.col_ptr();
@@ -479,11 +517,14 @@ impl LinearSolver {
     }
 
     /// Whether the symbolic factorisation is supernodal (larger matrices) rather than
-    /// simplicial (the two store the LDLᵀ pivots differently).
+    /// simplicial (the two store the LDLᵀ pivots differently). The split's halves are.
     pub fn is_supernodal(&self) -> bool {
-        self.analysis
-            .as_ref()
-            .is_some_and(|a| matches!(a.symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_)))
+        self.analysis.as_ref().is_some_and(|a| {
+            a.split.is_some()
+                || a.whole
+                    .as_ref()
+                    .is_some_and(|w| matches!(w.symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_)))
+        })
     }
 
     /// Whether a factorisation is held (the last one succeeded).
@@ -507,11 +548,11 @@ impl LinearSolver {
     /// Solves `A x = rhs` in place with a factor made by [`Self::factor_to`].
     pub fn solve_with(&mut self, l: &[Real], rhs: &mut [Real]) {
         let n = rhs.len();
-        let Some(an) = self.analysis.as_mut() else {
+        let Some(w) = self.analysis.as_mut().and_then(|an| an.whole.as_mut()) else {
             panic!("solve before a factorisation")
         };
-        let llt = LltRef::new(&an.symbolic, l);
-        let stack = MemStack::new(&mut an.mem);
+        let llt = LltRef::new(&w.symbolic, l);
+        let stack = MemStack::new(&mut w.mem);
         llt.solve_in_place_with_conj(
             Conj::No,
             MatMut::from_column_major_slice_mut(rhs, n, 1),
@@ -531,7 +572,7 @@ impl LinearSolver {
         let Some(an) = self.analysis.as_mut() else {
             panic!("solve before a factorisation")
         };
-        let n = an.symbolic.nrows();
+        let n = self.pattern.nrows();
         assert!(
             n > 0 && rhs.len().is_multiple_of(n),
             "right-hand sides of length {} for {n} unknowns",
@@ -541,20 +582,23 @@ impl LinearSolver {
             sp.solve_in_place(rhs);
             return;
         }
+        let Some(w) = an.whole.as_mut() else {
+            panic!("solve before a factorisation")
+        };
         let k = rhs.len() / n;
-        let mut wide = (k > 1)
-            .then(|| MemBuffer::new(an.symbolic.solve_in_place_scratch::<Real>(k, Par::Seq)));
-        let stack = MemStack::new(wide.as_mut().unwrap_or(&mut an.mem));
+        let mut wide =
+            (k > 1).then(|| MemBuffer::new(w.symbolic.solve_in_place_scratch::<Real>(k, Par::Seq)));
+        let stack = MemStack::new(wide.as_mut().unwrap_or(&mut w.mem));
         let rhs = MatMut::from_column_major_slice_mut(rhs, n, k);
         if self.kind == Kind::Ldlt {
-            LdltRef::new(&an.symbolic, &self.l_values).solve_in_place_with_conj(
+            LdltRef::new(&w.symbolic, &self.l_values).solve_in_place_with_conj(
                 Conj::No,
                 rhs,
                 Par::Seq,
                 stack,
             );
         } else {
-            LltRef::new(&an.symbolic, &self.l_values).solve_in_place_with_conj(
+            LltRef::new(&w.symbolic, &self.l_values).solve_in_place_with_conj(
                 Conj::No,
                 rhs,
                 Par::Seq,
@@ -706,6 +750,57 @@ mod tests {
         };
         let (x1, x2) = (on(1), on(2));
         assert!(x1.iter().zip(&x2).all(|(a, c)| a.to_bits() == c.to_bits()));
+    }
+
+    #[test]
+    fn the_split_makes_its_unsplit_factor_on_first_use_and_counts_its_own_flops() {
+        let (n, cp, ri, v) = grid(84, 0.5);
+        let b: Vec<Real> = (0..n).map(|i| ((i * 7919) % 101) as Real - 50.0).collect();
+        let mut split = LinearSolver::from_csc(n, cp.clone(), ri.clone())
+            .expect("pattern")
+            .with_split()
+            .with_ordering(Ordering::NestedDissection);
+        split.analyse().expect("analysis");
+        assert!(split.is_split() && split.is_supernodal());
+        let an = split.analysis.as_ref().expect("analysed");
+        assert!(
+            an.whole.is_none(),
+            "the split needs no unsplit symbolic factorisation"
+        );
+        // The flops it performs: more than the unsplit factorisation's under the same order
+        // (the separator's dense work is done three times over), less than twice as many.
+        let sp = an.split.as_ref().expect("split");
+        let unsplit = ordering::flops_under(split.pattern.as_ref(), &an.perm);
+        let f = split.factor_flops();
+        assert_eq!(f, sp.flops());
+        assert!(f > unsplit && f < 2.0 * unsplit, "{f} against {unsplit}");
+        // factor_to and solve_with stay unsplit, and agree with the split solve.
+        split.factor(&v).expect("positive definite");
+        let mut xs = b.clone();
+        split.solve_in_place(&mut xs);
+        let mut l = Vec::new();
+        split.factor_to(&v, &mut l).expect("positive definite");
+        assert_eq!(
+            l.len(),
+            split
+                .analysis
+                .as_ref()
+                .and_then(|a| a.whole.as_ref())
+                .expect("made")
+                .symbolic
+                .len_val()
+        );
+        let mut xw = b.clone();
+        split.solve_with(&l, &mut xw);
+        let r = residual(n, &cp, &ri, &v, &xw, &b);
+        assert!(r < 1e-10 * 50.0, "unsplit residual {r}");
+        let dx = xw
+            .iter()
+            .zip(&xs)
+            .fold(0.0, |m: Real, (a, c)| m.max((a - c).abs()));
+        let xmax = xw.iter().fold(0.0, |m: Real, a| m.max(a.abs()));
+        assert!(dx <= 1e-12 * xmax, "{dx} of {xmax}");
+        assert_eq!(split.counts().factorisations, 2);
     }
 
     #[test]

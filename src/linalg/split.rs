@@ -117,49 +117,66 @@ impl Half {
         for (k, &g) in map.iter().enumerate() {
             local[g] = k;
         }
-        let mut cols: Vec<Vec<(usize, usize)>> = vec![Vec::new(); m];
-        for j in 0..a.ncols() {
-            let lj = local[j];
-            if lj == usize::MAX {
-                continue;
-            }
-            for e in a.col_ptr()[j]..a.col_ptr()[j + 1] {
-                let li = local[a.row_idx()[e]];
-                if li == usize::MAX {
-                    continue;
-                }
-                let (r, c) = if li >= lj { (li, lj) } else { (lj, li) };
-                cols[c].push((r, e));
+        // The local lower triangle by two counting sorts, with no per-column lists and no
+        // sorting: the entries bucketed by local row, then by local column taking the rows in
+        // increasing order, which leaves every column's rows sorted. `gather` follows each
+        // entry to its place in the original values.
+        let (cp, ri, local) = (a.col_ptr(), a.row_idx(), &local);
+        let entries = || {
+            map.iter().flat_map(move |&j| {
+                let lj = local[j];
+                (cp[j]..cp[j + 1]).filter_map(move |e| {
+                    let li = local[ri[e]];
+                    (li != usize::MAX).then(|| (li.max(lj), li.min(lj), e))
+                })
+            })
+        };
+        let mut row_ptr = vec![0usize; m + 1];
+        for (r, _, _) in entries() {
+            row_ptr[r + 1] += 1;
+        }
+        for k in 0..m {
+            row_ptr[k + 1] += row_ptr[k];
+        }
+        let nnz = row_ptr[m];
+        // By rows: (column, original entry).
+        let mut by_row = vec![(0usize, 0usize); nnz];
+        let mut next = row_ptr.clone();
+        for (r, c, e) in entries() {
+            by_row[next[r]] = (c, e);
+            next[r] += 1;
+        }
+        let mut col_ptr = vec![0usize; m + 1];
+        for &(c, _) in &by_row {
+            col_ptr[c + 1] += 1;
+        }
+        for k in 0..m {
+            col_ptr[k + 1] += col_ptr[k];
+        }
+        let mut row_idx = vec![0usize; nnz];
+        let mut gather = vec![0usize; nnz];
+        let mut next = col_ptr.clone();
+        for r in 0..m {
+            for &(c, e) in &by_row[row_ptr[r]..row_ptr[r + 1]] {
+                row_idx[next[c]] = r;
+                gather[next[c]] = e;
+                next[c] += 1;
             }
         }
-        let mut col_ptr = Vec::with_capacity(m + 1);
-        let mut row_idx = Vec::new();
-        let mut gather = Vec::new();
-        col_ptr.push(0);
-        for mut c in cols {
-            c.sort_unstable();
-            for (r, e) in c {
-                row_idx.push(r);
-                gather.push(e);
-            }
-            col_ptr.push(row_idx.len());
-        }
+        drop(by_row);
         // The symbolic factorisation in the local order as it stands (`Identity`), which faer
-        // reads from the upper triangle: the transposed pattern. The numeric factorisation then
-        // takes the gathered lower triangle as it is, without permuting a copy of it first.
-        let mut upper_cols: Vec<Vec<usize>> = vec![Vec::new(); m];
+        // reads from the upper triangle: the transposed pattern, the lower one by rows (again
+        // sorted, taking the columns in increasing order). The numeric factorisation then takes
+        // the gathered lower triangle as it is, without permuting a copy of it first.
+        let mut up_idx = vec![0usize; nnz];
+        let mut next = row_ptr.clone();
         for c in 0..m {
             for &r in &row_idx[col_ptr[c]..col_ptr[c + 1]] {
-                upper_cols[r].push(c);
+                up_idx[next[r]] = c;
+                next[r] += 1;
             }
         }
-        let mut up_ptr = Vec::with_capacity(m + 1);
-        let mut up_idx = Vec::with_capacity(row_idx.len());
-        up_ptr.push(0);
-        for c in upper_cols {
-            up_idx.extend(c);
-            up_ptr.push(up_idx.len());
-        }
+        let up_ptr = row_ptr;
         let upper = SymbolicSparseColMat::new_checked(m, m, up_ptr, None, up_idx);
         let pattern = SymbolicSparseColMat::new_checked(m, m, col_ptr, None, row_idx);
         let symbolic = factorize_symbolic_cholesky(
@@ -451,6 +468,18 @@ impl Split {
             .map(|h| super::symbolic_flops(&h.symbolic))
             .fold(0.0, f64::max);
         halves + 2.0 * ns * ns * ns / 3.0
+    }
+
+    /// Flops of one factorisation as the split performs it: the two halves (each with the
+    /// separator's trailing block, Σ c² over their columns) and the separator's dense
+    /// factorisation (Σ c² over its columns, about ns³/3).
+    pub(super) fn flops(&self) -> f64 {
+        let ns = self.sep.len();
+        self.halves
+            .iter()
+            .map(|h| super::symbolic_flops(&h.symbolic))
+            .sum::<f64>()
+            + super::ordering::cholesky_flops((1..=ns).rev())
     }
 
     /// Non-zeros of the two halves' factors and the dense separator's lower triangle.
