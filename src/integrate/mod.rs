@@ -46,7 +46,6 @@ use failure::interruption;
 use resume::Resume;
 use solver::Solver;
 
-use crate::assembly::Pattern;
 use crate::math::Real;
 use crate::model::Scene;
 use crate::settings::{Continuation, Mode};
@@ -200,7 +199,7 @@ pub fn run(
     threads: usize,
     initial: Option<InitialState>,
 ) -> Result<Summary, RunError> {
-    let mut s = Solver::new(scene, Pattern::for_scene(scene), threads)?;
+    let mut s = Solver::new(scene, threads)?;
     let (mut state, v, start, dial, driver) = match initial {
         Some(st) => (st.state, st.v, Some(st.time), st.dial, st.driver),
         None => (State::reference(scene), None, None, None, None),

@@ -348,8 +348,8 @@ pub struct Timing {
     /// Reading the settings and the mesh, building the scene and checking it, before the run
     /// ([`crate::model::Scene::build_seconds`]).
     pub build: Real,
-    /// The symbolic analysis of the sparse Hessian (the fill-reducing ordering, the elimination
-    /// tree and supernodes), once per sparsity pattern.
+    /// The sparse Hessian's sparsity pattern and its symbolic analysis (the fill-reducing
+    /// ordering, the elimination tree and supernodes), once per pattern (implicit modes).
     pub analysis: Real,
     /// Assembly, factorisation, solve and line search, summed over the Newton solves.
     #[serde(flatten)]

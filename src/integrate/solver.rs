@@ -90,20 +90,30 @@ impl Counters {
 }
 
 impl<'a> Solver<'a> {
-    pub(super) fn new(
-        scene: &'a Scene,
-        pattern: Pattern,
-        threads: usize,
-    ) -> Result<Self, RunError> {
+    /// The solver of `scene` on `threads` threads. The run's clock starts when the user
+    /// started the command (the scene's build counts), so that `wall_seconds` also holds the
+    /// Hessian's sparsity pattern and its analysis made here.
+    pub(super) fn new(scene: &'a Scene, threads: usize) -> Result<Self, RunError> {
+        let start = Instant::now()
+            .checked_sub(std::time::Duration::from_secs_f64(
+                scene.build_seconds.clamp(0.0, 1e9),
+            ))
+            .unwrap_or_else(Instant::now);
+        // The implicit drivers factorise: the sparsity pattern and its symbolic analysis
+        // (ordering, elimination tree) are timed together as `analysis`. The explicit driver
+        // never factorises and skips the analysis; its pattern's time counts as `other`.
+        let clock = Instant::now();
+        let pattern = Pattern::for_scene(scene);
         let mut lin = LinearSolver::new(&pattern)?;
         let ws = Workspace::new(&pattern);
-        // The implicit drivers factorise: the symbolic analysis (ordering, elimination tree)
-        // is timed on its own. The explicit driver never factorises and skips it.
-        let clock = Instant::now();
         if scene.settings.solver.mode != Mode::Explicit {
             lin.analyse()?;
         }
-        let analysis = clock.elapsed().as_secs_f64();
+        let analysis = if scene.settings.solver.mode != Mode::Explicit {
+            clock.elapsed().as_secs_f64()
+        } else {
+            0.0
+        };
         let changing = scene.terms.iter().any(|t| t.changing().is_some());
         let config = config::RunConfig::new(scene);
         let summary = Summary {
@@ -128,12 +138,7 @@ impl<'a> Solver<'a> {
             retired: Default::default(),
             ws,
             summary,
-            // The clock starts when the user started the run: the scene's build counts.
-            start: Instant::now()
-                .checked_sub(std::time::Duration::from_secs_f64(
-                    scene.build_seconds.clamp(0.0, 1e9),
-                ))
-                .unwrap_or_else(Instant::now),
+            start,
             at_last_frame: Counters::default(),
             driver: DriverState::default(),
             reference: None,
@@ -441,17 +446,59 @@ impl<'a> Solver<'a> {
         let pot = self.potential_at(&pattern, dial, state);
         let mut values = vec![0.0; pattern.nnz()];
         let mut g = vec![0.0; pattern.n];
+        // Timed with the Newton solves' assembly and factorisation.
+        let clock = Instant::now();
         pot.eval(x, phi, Want::Hessian, &mut g, &mut values);
+        let lr = pot.low_rank(x, phi);
+        self.summary.timing.newton.assembly += clock.elapsed().as_secs_f64();
         // One factorisation of H + 1e-9·mean|diag|·I, with the dense low-rank part through
         // the inertia (an indefinite sparse part is fine when the whole is positive definite).
-        let lr = pot.low_rank(x, phi);
+        let clock = Instant::now();
         let stable =
             crate::solve::newton::is_positive_definite(&mut self.lin, &pot, &values, &lr, 1e-9);
+        self.summary.timing.newton.factorisation += clock.elapsed().as_secs_f64();
         if !stable {
             // The solve that follows (from a perturbed state) starts without an exact model
             // known to fail.
             self.ws.note_not_positive_definite();
         }
         stable
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Solver;
+    use crate::mesh::generate::{rectangle, Spacing};
+    use crate::{Scene, Settings};
+    use std::time::{Duration, Instant};
+
+    /// The run's clock covers what the solver's construction does (the Hessian's pattern and
+    /// its analysis) and the scene's build before it: `wall_seconds` is what the user waited.
+    #[test]
+    fn the_run_clock_starts_before_the_pattern_and_the_analysis() {
+        let mesh = rectangle(-0.5, -0.5, 1.0, 1.0, 0.25, Spacing::default());
+        let settings = Settings::from_str_with(
+            "[rest]\ntarget = \"uniform\"\nbbar = [1.0, 0.0, 0.0]\n",
+            "clock",
+            &[],
+        )
+        .unwrap();
+        let mut scene = Scene::build(mesh, settings).unwrap();
+        scene.build_seconds = 0.25;
+        let before = Instant::now();
+        let s = Solver::new(&scene, 1).unwrap();
+        let took = before.elapsed();
+        assert!(s.summary.timing.analysis > 0.0);
+        // The clock started a build's length before the construction began: what is missing
+        // from the 0.25 s is the moment before the clock was read, not the construction (a
+        // clock read at its end would miss all of `took`).
+        let lead = before.saturating_duration_since(s.start);
+        let missing = Duration::from_secs_f64(0.25).saturating_sub(lead);
+        assert!(
+            missing < took / 4,
+            "missing {missing:?} of a {took:?} construction"
+        );
+        assert!(lead <= Duration::from_secs_f64(0.25), "{lead:?}");
     }
 }
