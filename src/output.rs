@@ -949,6 +949,7 @@ impl Writer {
             s.shifted_iterations += n("shifted_iterations");
             s.gauss_newton_iterations += n("gauss_newton_iterations");
             s.chord_iterations += n("chord_iterations");
+            s.gradient_only_checks += n("gradient_only_checks");
             s.indefinite_iterations += n("indefinite_iterations");
             s.saddle_escapes += n("saddle_escapes");
             s.diffusion_substeps += n("diffusion_substeps");

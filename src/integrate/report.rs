@@ -184,6 +184,9 @@ pub struct Summary {
     /// Newton iterations that solved with an earlier iteration's factorisation (chord
     /// iterations of the implicit dynamics).
     pub chord_iterations: usize,
+    /// Checks of convergence made with the gradient alone, the residual predicted below the
+    /// tolerance (a converged one ends its solve without assembling the Hessian).
+    pub gradient_only_checks: usize,
     /// Newton iterations whose sparse Hessian part was indefinite and made positive definite
     /// by a dense low-rank part (an enclosed gas past a pressure limit point).
     pub indefinite_iterations: usize,

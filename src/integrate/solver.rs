@@ -268,6 +268,7 @@ impl<'a> Solver<'a> {
         self.summary.shifted_iterations += rep.shifted_iterations;
         self.summary.gauss_newton_iterations += rep.gauss_newton_iterations;
         self.summary.chord_iterations += rep.chord_iterations;
+        self.summary.gradient_only_checks += rep.gradient_only_checks;
         self.summary.indefinite_iterations += rep.indefinite_iterations;
         self.summary.residual = rep.residual;
         self.summary.timing.newton.add(&rep.timing);

@@ -743,3 +743,62 @@ fn a_rejected_exact_model_is_not_retried_by_the_next_solve() {
         .zip(&x2)
         .all(|(a, b)| (0..3).all(|k| a[k].to_bits() == b[k].to_bits())));
 }
+
+/// A Newton solve that converges quadratically ends with an evaluation of the gradient alone:
+/// the residual predicted from the last full step's rate is below the tolerance, so the
+/// Hessian is not assembled for the check that ends the solve. The check tells the truth (an
+/// independent gradient at the result meets the tolerance), and a solve whose prediction
+/// misses still converges to the same state as the other (the Hessian is then assembled).
+#[test]
+fn a_predicted_convergence_is_checked_without_the_hessian() {
+    let sc = balloon(2, "[gas]\ncontrol = \"amount\"\namount = 6e4\n");
+    let p = Pattern::for_scene(&sc);
+    let pot = Potential::new(&sc, &p);
+    let mut lin = LinearSolver::new(&p).unwrap();
+    let mut ws = shellsim::solve::newton::Workspace::new(&p);
+    let state = |x: Vec<Vec3>| State {
+        x,
+        dofs: Vec::new(),
+        terms: sc.initial_states.clone(),
+    };
+    let mut st = state(inflated(&sc, 1.2, 0.0, 1));
+    let opts = NewtonOptions::default();
+    let rep = newton(&pot, &mut lin, &mut ws, &mut st, opts);
+    assert!(rep.converged, "{rep:?}");
+    let mut rng = Rng::new(8);
+    let x0: Vec<Vec3> =
+        st.x.iter()
+            .map(|p| p * 1.01 + Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * 1e-3)
+            .collect();
+    let mut a = state(x0.clone());
+    let rep = newton(&pot, &mut lin, &mut ws, &mut a, opts);
+    assert!(rep.converged, "{rep:?}");
+    assert_eq!(rep.gradient_only_checks, 1, "{rep:?}");
+    let mut g = vec![0.0; p.n];
+    pot.eval(&a.x, &a.dofs, Want::Gradient, &mut g, &mut []);
+    assert!(pot.residual(&g) <= opts.tol, "{}", pot.residual(&g));
+    assert_eq!(pot.residual(&g).to_bits(), rep.residual.to_bits());
+    // Stopping one iteration short and going on from there: the second solve has no history
+    // to predict from, assembles the Hessian for every check, and lands on the same bits.
+    let mut b = state(x0);
+    let short = newton(
+        &pot,
+        &mut lin,
+        &mut ws,
+        &mut b,
+        NewtonOptions {
+            max_iter: rep.iterations - 1,
+            ..opts
+        },
+    );
+    assert!(
+        !short.converged && short.gradient_only_checks <= 1,
+        "{short:?}"
+    );
+    let rest = newton(&pot, &mut lin, &mut ws, &mut b, opts);
+    assert!(rest.converged && rest.gradient_only_checks == 0, "{rest:?}");
+    assert!(a.x.iter().zip(&b.x).all(|(p, q)| p
+        .iter()
+        .zip(q.iter())
+        .all(|(u, v)| u.to_bits() == v.to_bits())));
+}
