@@ -1777,6 +1777,38 @@ fn static_runs_report_the_dial() {
     assert_eq!(series.last().unwrap().0, dial);
 }
 
+/// The membrane continuation goes straight to the true stretching weight once a raised weight
+/// needed no Newton iteration (the membrane is at its rest metric: the programmed cone is
+/// isometric to the flat sheet), and the cone it ends on is the exact one to the mesh's error.
+#[test]
+fn membrane_continuation_ends_after_a_raise_that_needs_no_iteration() {
+    let d = tmp();
+    let p = d.path();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let settings = root.join("settings/gcm_cone.toml").display().to_string();
+    let mesh = root
+        .join("meshes/gcm_cone_jittered.vtk")
+        .display()
+        .to_string();
+    let r = run(&[&settings, &mesh, "--out", "o", "-v"], p);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let lines: Vec<&str> = r.stderr.lines().collect();
+    let steps: Vec<usize> = (0..lines.len())
+        .filter(|&i| lines[i].starts_with("continuation"))
+        .collect();
+    // The first continuation step at dial 1 whose solve converged at its first evaluation.
+    let free = steps
+        .iter()
+        .position(|&i| i > 0 && lines[i - 1].starts_with("newton   0:"))
+        .unwrap_or_else(|| panic!("no raise without iterations: {}", r.stderr));
+    assert_eq!(free + 2, steps.len(), "{}", r.stderr);
+    let e = run(&["error", "gcm_cone", "o/frame_00001.vtu"], p);
+    assert_eq!(e.code, 0, "{}", e.stderr);
+    let v: serde_json::Value = serde_json::from_str(&e.stdout).unwrap();
+    let rel = v["rms_error_rel"].as_f64().unwrap();
+    assert!(rel < 2e-4, "{v}");
+}
+
 /// Frames keep the input's corner order even where the scene starts a sliver at a wider
 /// corner, with the per-corner `edge_angles` in that order too, and a restart reads them back.
 #[test]

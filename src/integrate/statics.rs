@@ -115,7 +115,12 @@ pub(super) fn run_static(
                 steps.accepted(rep.iterations, true);
             } else {
                 scale = target_scale;
-                if grow {
+                if rep.iterations == 0 {
+                    // The raised weight changed nothing the tolerance sees: the membrane is at
+                    // its rest metric, and the rest of the way is one step (halved like any
+                    // other if it fails).
+                    ratio = ratio.max(1.0 / scale);
+                } else if grow {
                     ratio = (ratio * ratio).min(1e3);
                 }
             }
