@@ -1736,12 +1736,7 @@ fn static_runs_report_the_dial() {
     // A run that fails part-way (two Newton iterations allowed per step, no membrane
     // continuation: it stops at dial 1/64 on the GCM cone): its last row, its last series
     // entry and the summary agree on the dial.
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let settings = root.join("settings/gcm_cone.toml").display().to_string();
-    let mesh = root
-        .join("meshes/gcm_cone_jittered.vtk")
-        .display()
-        .to_string();
+    let (settings, mesh) = gcm_cone_scene();
     let r = run(
         &[
             &settings,
@@ -1777,6 +1772,16 @@ fn static_runs_report_the_dial() {
     assert_eq!(series.last().unwrap().0, dial);
 }
 
+/// The repository's GCM cone scene: its settings file and its jittered 842-face mesh.
+fn gcm_cone_scene() -> (String, String) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let path = |rel: &str| root.join(rel).display().to_string();
+    (
+        path("settings/gcm_cone.toml"),
+        path("meshes/gcm_cone_jittered.vtk"),
+    )
+}
+
 /// The membrane continuation goes straight to the true stretching weight once a raised weight
 /// needed no Newton iteration (the membrane is at its rest metric: the programmed cone is
 /// isometric to the flat sheet), and the cone it ends on is the exact one to the mesh's error.
@@ -1784,12 +1789,7 @@ fn static_runs_report_the_dial() {
 fn membrane_continuation_ends_after_a_raise_that_needs_no_iteration() {
     let d = tmp();
     let p = d.path();
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let settings = root.join("settings/gcm_cone.toml").display().to_string();
-    let mesh = root
-        .join("meshes/gcm_cone_jittered.vtk")
-        .display()
-        .to_string();
+    let (settings, mesh) = gcm_cone_scene();
     let r = run(&[&settings, &mesh, "--out", "o", "-v"], p);
     assert_eq!(r.code, 0, "{}", r.stderr);
     let lines: Vec<&str> = r.stderr.lines().collect();

@@ -106,10 +106,8 @@ impl<'a> Solver<'a> {
         let pattern = Pattern::for_scene(scene);
         let mut lin = LinearSolver::new(&pattern)?;
         let ws = Workspace::new(&pattern);
-        if scene.settings.solver.mode != Mode::Explicit {
-            lin.analyse()?;
-        }
         let analysis = if scene.settings.solver.mode != Mode::Explicit {
+            lin.analyse()?;
             clock.elapsed().as_secs_f64()
         } else {
             0.0

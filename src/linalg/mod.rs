@@ -297,16 +297,6 @@ impl LinearSolver {
         Ok(self.analysis.as_mut().expect("made above"))
     }
 
-    /// The unsplit symbolic factorisation, made on first use under the split.
-    fn whole_mut(&mut self) -> Result<&mut Whole, LinearError> {
-        self.analyse()?;
-        let an = self.analysis.as_mut().expect("analysed above");
-        if an.whole.is_none() {
-            an.whole = Some(Whole::new(&self.pattern, &an.perm)?);
-        }
-        Ok(an.whole.as_mut().expect("made above"))
-    }
-
     /// The symbolic factorisation under the cheaper of AMD and nested dissection, by the flop
     /// count of the factorisation ([`ordering::cholesky_flops`]), or with `split` of its critical
     /// path (the longer half and the separator, [`split::Split::critical_flops`]); AMD on a tie,
@@ -450,12 +440,13 @@ impl LinearSolver {
         l: &mut Vec<Real>,
         ldlt: bool,
     ) -> Result<(), LinearError> {
-        self.whole_mut()?;
-        let w = self
-            .analysis
-            .as_mut()
-            .and_then(|an| an.whole.as_mut())
-            .expect("made above");
+        self.analyse()?;
+        let an = self.analysis.as_mut().expect("analysed above");
+        // The unsplit symbolic factorisation, made on first use under the split.
+        if an.whole.is_none() {
+            an.whole = Some(Whole::new(&self.pattern, &an.perm)?);
+        }
+        let w = an.whole.as_mut().expect("made above");
         l.resize(w.symbolic.len_val(), 0.0);
         let a = SparseColMatRef::new(self.pattern.as_ref(), values);
         factorize_numeric(&w.symbolic, l, a, ldlt, &mut w.mem)
@@ -669,6 +660,16 @@ mod tests {
         r.iter().fold(0.0, |m, e| m.max(e.abs()))
     }
 
+    /// Asserts that `y` agrees with `x` entry by entry to `tol` × x's largest entry.
+    fn assert_agree(x: &[Real], y: &[Real], tol: Real, what: &str) {
+        let xmax = x.iter().fold(0.0, |m: Real, a| m.max(a.abs()));
+        let d = x
+            .iter()
+            .zip(y)
+            .fold(0.0, |m: Real, (a, c)| m.max((a - c).abs()));
+        assert!(d <= tol * xmax, "{what}: {d} of {xmax}");
+    }
+
     #[test]
     fn chooses_the_cheaper_ordering_and_solves_with_it() {
         let (n, cp, ri, v) = grid(84, 0.5);
@@ -709,12 +710,7 @@ mod tests {
         split.solve_in_place(&mut xs);
         let r = residual(n, &cp, &ri, &v, &xs, &b);
         assert!(r < 1e-10 * 50.0, "split residual {r}");
-        let dx = xw
-            .iter()
-            .zip(&xs)
-            .fold(0.0, |m: Real, (a, c)| m.max((a - c).abs()));
-        let xmax = xw.iter().fold(0.0, |m: Real, a| m.max(a.abs()));
-        assert!(dx <= 1e-12 * xmax, "{dx} of {xmax}");
+        assert_agree(&xw, &xs, 1e-12, "split against whole");
         // Shifted into indefiniteness: the same inertia and solution by LDLᵀ (the shift keeps
         // clear of the spectrum, so no pivot is near zero), and LLᵀ refuses it.
         let mut ind = v.clone();
@@ -794,12 +790,7 @@ mod tests {
         split.solve_with(&l, &mut xw);
         let r = residual(n, &cp, &ri, &v, &xw, &b);
         assert!(r < 1e-10 * 50.0, "unsplit residual {r}");
-        let dx = xw
-            .iter()
-            .zip(&xs)
-            .fold(0.0, |m: Real, (a, c)| m.max((a - c).abs()));
-        let xmax = xw.iter().fold(0.0, |m: Real, a| m.max(a.abs()));
-        assert!(dx <= 1e-12 * xmax, "{dx} of {xmax}");
+        assert_agree(&xw, &xs, 1e-12, "split against whole");
         assert_eq!(split.counts().factorisations, 2);
     }
 
@@ -845,12 +836,7 @@ mod tests {
                     // towards its spectrum.
                     let tol = if indefinite { 1e-10 } else { 1e-12 };
                     for (x, y) in [(&x1, y1), (&x2, y2)] {
-                        let xmax = x.iter().fold(0.0, |m: Real, a| m.max(a.abs()));
-                        let d = x
-                            .iter()
-                            .zip(y)
-                            .fold(0.0, |m: Real, (a, c)| m.max((a - c).abs()));
-                        assert!(d <= tol * xmax, "{indefinite}: {d} of {xmax}");
+                        assert_agree(x, y, tol, &format!("indefinite {indefinite}"));
                     }
                 }
             }

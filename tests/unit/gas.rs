@@ -361,29 +361,33 @@ fn residuals(sc: &Scene, x0: &[Vec3], projection: HessianProjection, n: usize) -
         .collect()
 }
 
-/// Near an equilibrium of the gas-controlled balloon, Newton with the exact Hessian (sparse +
-/// rank-one) converges quadratically; without the rank-one part it converges only linearly, and
-/// with the seed's tangent (the rank-one part without the follower part, Eq. 16) too.
-#[test]
-fn newton_is_quadratic_with_the_rank_one_part() {
-    let sc = balloon(2, "[gas]\ncontrol = \"amount\"\namount = 6e4\n");
-    // The equilibrium, then a perturbation of it.
-    let p = Pattern::for_scene(&sc);
-    let pot = Potential::new(&sc, &p);
+/// The gas-controlled balloon's equilibrium (solved from a 20% inflation), scaled by 1.01 and
+/// perturbed by 1e-3 per coordinate: a start near it.
+fn near_equilibrium(sc: &Scene) -> Vec<Vec3> {
+    let p = Pattern::for_scene(sc);
+    let pot = Potential::new(sc, &p);
     let mut lin = LinearSolver::new(&p).unwrap();
     let mut ws = shellsim::solve::newton::Workspace::new(&p);
     let mut st = State {
-        x: inflated(&sc, 1.2, 0.0, 1),
+        x: inflated(sc, 1.2, 0.0, 1),
         dofs: Vec::new(),
         terms: sc.initial_states.clone(),
     };
     let rep = newton(&pot, &mut lin, &mut ws, &mut st, NewtonOptions::default());
     assert!(rep.converged, "{rep:?}");
     let mut rng = Rng::new(8);
-    let x0: Vec<Vec3> =
-        st.x.iter()
-            .map(|p| p * 1.01 + Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * 1e-3)
-            .collect();
+    st.x.iter()
+        .map(|p| p * 1.01 + Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * 1e-3)
+        .collect()
+}
+
+/// Near an equilibrium of the gas-controlled balloon, Newton with the exact Hessian (sparse +
+/// rank-one) converges quadratically; without the rank-one part it converges only linearly, and
+/// with the seed's tangent (the rank-one part without the follower part, Eq. 16) too.
+#[test]
+fn newton_is_quadratic_with_the_rank_one_part() {
+    let sc = balloon(2, "[gas]\ncontrol = \"amount\"\namount = 6e4\n");
+    let x0 = near_equilibrium(&sc);
     let exact = residuals(&sc, &x0, HessianProjection::None, 5);
     let seed = residuals(&sc, &x0, HessianProjection::GaussNewton, 5);
     let mut without = sc.clone();
@@ -761,15 +765,8 @@ fn a_predicted_convergence_is_checked_without_the_hessian() {
         dofs: Vec::new(),
         terms: sc.initial_states.clone(),
     };
-    let mut st = state(inflated(&sc, 1.2, 0.0, 1));
     let opts = NewtonOptions::default();
-    let rep = newton(&pot, &mut lin, &mut ws, &mut st, opts);
-    assert!(rep.converged, "{rep:?}");
-    let mut rng = Rng::new(8);
-    let x0: Vec<Vec3> =
-        st.x.iter()
-            .map(|p| p * 1.01 + Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * 1e-3)
-            .collect();
+    let x0 = near_equilibrium(&sc);
     let mut a = state(x0.clone());
     let rep = newton(&pot, &mut lin, &mut ws, &mut a, opts);
     assert!(rep.converged, "{rep:?}");
