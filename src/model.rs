@@ -93,6 +93,7 @@ impl<'a> Potential<'a> {
             frozen: None,
             owned: None,
             force_scale: scene.body.force_scale,
+            taken_at: &[],
             states: &scene.initial_states,
         }
     }

@@ -95,6 +95,8 @@ pub struct Settings {
     pub gas: Gas,
     /// Ground contact with friction.
     pub contact: Contact,
+    /// Contact of the sheet with itself and between sheets.
+    pub self_contact: crate::config::self_contact::SelfContact,
     /// Two horizontal glass slides squeezing the sheet (MorphoShell's).
     pub slides: Slides,
     /// Rigid obstacles (`[[obstacles]]`), fixed or moved with the dial.
@@ -232,6 +234,7 @@ impl Settings {
         self.loads.validate()?;
         self.gas.validate()?;
         self.contact.validate()?;
+        self.self_contact.validate(mode)?;
         for (i, o) in self.obstacles.iter().enumerate() {
             o.validate(i, mode)?;
         }

@@ -16,6 +16,8 @@ mod gas;
 mod geometry;
 #[path = "unit/io.rs"]
 mod io;
+#[path = "unit/self_contact.rs"]
+mod self_contact;
 #[path = "unit/settings.rs"]
 mod settings;
 #[path = "unit/shapes.rs"]

@@ -41,6 +41,7 @@ pub mod obstacle;
 pub mod output;
 pub mod rest;
 pub mod selection;
+pub mod self_contact;
 pub mod shell;
 pub mod slides;
 pub mod solver;

@@ -33,6 +33,7 @@ pub mod obstacles;
 pub mod potential;
 pub use crate::elements::projection;
 pub mod registry;
+pub mod self_contact;
 pub mod shell;
 pub mod slides;
 pub mod stiffening;

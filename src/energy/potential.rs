@@ -106,6 +106,9 @@ pub struct Potential<'a> {
     /// The force scale F of the residual (N): the body's, `max(E h) × mean edge`, or in
     /// statics the applied loads' when smaller ([`Potential::load_scale`]).
     pub force_scale: Real,
+    /// The positions at which the elements of the terms whose elements change were gathered
+    /// (empty: no bound on the motion from them); the driver's solver sets them.
+    pub taken_at: &'a [Vec3],
     /// The stateful terms' states the potential is evaluated with ([`crate::solve::State::terms`]): the
     /// scene's initial states unless a driver sets its own.
     pub states: &'a TermStates,
@@ -199,11 +202,13 @@ impl<'a> Potential<'a> {
         gx.max(gp / self.body.mean_edge).max(gg) / f
     }
 
-    /// The largest fraction of a Newton step `step` (DOF order) that moves no global DOF by more
-    /// than its [`crate::energy::term::GlobalDof::max_step`] (1 when none would).
-    pub fn step_bound(&self, step: &[Real]) -> Real {
+    /// The largest fraction of a Newton step `step` (DOF order) from the positions `x` that
+    /// moves no global DOF by more than its [`crate::energy::term::GlobalDof::max_step`] and
+    /// that every term bounding the steps allows ([`crate::energy::term::StepLimit`]; 1 when
+    /// none would bound it), and whether a term asks to gather its elements again first.
+    pub fn step_bound(&self, x: &[Vec3], step: &[Real]) -> crate::energy::term::StepBound {
         let ne = 3 * self.pattern.num_vertices + self.body.num_edge_dofs();
-        step[ne..]
+        let globals = step[ne..]
             .iter()
             .zip(self.globals)
             .fold(1.0, |a: Real, (d, g)| {
@@ -212,7 +217,30 @@ impl<'a> Potential<'a> {
                 } else {
                     a
                 }
-            })
+            });
+        self.terms
+            .iter()
+            .zip(&self.pattern.maps)
+            .filter_map(|(t, map)| Some(t.step_limit()?.max_fraction(self, map, x, step)))
+            .fold(
+                crate::energy::term::StepBound {
+                    fraction: globals,
+                    regather: false,
+                },
+                |a, b| crate::energy::term::StepBound {
+                    fraction: a.fraction.min(b.fraction),
+                    regather: a.regather || b.regather,
+                },
+            )
+    }
+
+    /// Whether every term that bounds the steps admits the positions `x`
+    /// ([`crate::energy::term::StepLimit::admits`]).
+    pub fn admits(&self, x: &[Vec3]) -> bool {
+        self.terms
+            .iter()
+            .zip(&self.pattern.maps)
+            .all(|(t, map)| t.step_limit().is_none_or(|l| l.admits(self, map, x)))
     }
 
     /// As [`Potential::eval`], with the element Hessians projected as `projection` says.

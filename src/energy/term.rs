@@ -156,6 +156,42 @@ pub trait Term: Send + Sync {
     fn explicit(&self) -> Option<&dyn ExplicitHooks> {
         None
     }
+
+    /// A term that bounds every Newton step and checks every trial state (contact by
+    /// continuous collision detection) declares it here (default: none).
+    fn step_limit(&self) -> Option<&dyn StepLimit> {
+        None
+    }
+}
+
+/// How far a Newton step may go ([`StepLimit::max_fraction`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepBound {
+    /// The largest fraction of the step allowed, in `[0, 1]`.
+    pub fraction: Real,
+    /// Whether the term's elements, gathered again at the step's start, would allow a
+    /// markedly longer step: a vertex has used up the room it had from where they were
+    /// gathered. Newton then stops, and the driver gathers them again and goes on.
+    pub regather: bool,
+}
+
+/// The capability of a term that bounds the Newton steps: the line search starts from the
+/// largest fraction of the step every such term allows, and accepts no trial state a term
+/// does not admit (it halves the step instead).
+pub trait StepLimit {
+    /// The largest fraction in `[0, 1]` of `step` (DOF order) from the positions `x` that the
+    /// term allows (every state on the segment is admissible), and whether gathering its
+    /// elements again at `x` would allow a longer one.
+    fn max_fraction(
+        &self,
+        pot: &Potential,
+        map: &ElementMap,
+        x: &[Vec3],
+        step: &[Real],
+    ) -> StepBound;
+
+    /// Whether the term admits the positions `x` (the static check of a trial state).
+    fn admits(&self, pot: &Potential, map: &ElementMap, x: &[Vec3]) -> bool;
 }
 
 /// The capability of a term that reports more than its energy under its name.

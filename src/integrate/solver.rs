@@ -32,6 +32,9 @@ pub(super) fn apply_inverse(
 /// Multiplier updates allowed per solve (see [`Solver::solve`]).
 pub(super) const MAX_UPDATES: usize = 50;
 
+/// The most times one solve gathers the contact pairs again ([`SolveError::Regather`]).
+const MAX_REGATHERS: usize = 100;
+
 /// The smallest static force scale, relative to the body's `max(E h) × mean edge`: with the
 /// default tolerance 1e-9, a residual of 1e-13 of the body's scale, 25× the round-off floor
 /// measured on a cantilever whose load is 6e-7 of its membrane stiffness.
@@ -44,6 +47,9 @@ pub(super) struct Solver<'a> {
     pub(super) pattern: std::sync::Arc<Pattern>,
     /// Whether some term's elements change during the run.
     pub(super) changing: bool,
+    /// The positions at which the changing terms' elements were last gathered (empty when no
+    /// term's elements change): such a term bounds each Newton step's motion from them.
+    pub(super) taken_at: Vec<Vec3>,
     /// The run's controls, from the validated settings.
     pub(super) config: config::RunConfig,
     pub(super) lin: LinearSolver,
@@ -130,6 +136,11 @@ impl<'a> Solver<'a> {
         let mut s = Solver {
             scene,
             pattern: std::sync::Arc::new(pattern),
+            taken_at: if changing {
+                scene.body.mesh.positions.clone()
+            } else {
+                Vec::new()
+            },
             changing,
             config,
             lin,
@@ -195,6 +206,8 @@ impl<'a> Solver<'a> {
         if !self.changing {
             return Ok(false);
         }
+        // The elements are taken at this state: the motion bound starts here.
+        self.taken_at.clone_from(&state.x);
         let Some(p) = self.pattern.refreshed(self.scene, &state.x, &state.dofs) else {
             return Ok(false);
         };
@@ -283,23 +296,39 @@ impl<'a> Solver<'a> {
         state: &mut State,
         opts: NewtonOptions,
     ) -> NewtonReport {
-        assert!(
-            std::ptr::eq(pot.pattern, &*self.pattern),
-            "a potential on a replaced pattern was solved"
-        );
         let mut total = NewtonReport::default();
-        for _ in 0..MAX_UPDATES {
+        let mut regathers = 0;
+        let mut updates = 0;
+        while updates < MAX_UPDATES {
+            // The solver's current pattern: a term that gathered its elements again within
+            // this solve replaced the one the caller's potential was made on.
+            let pat = self.pattern();
             let terms = state.terms.clone();
+            let taken = self.taken_at.clone();
             let pot = &Potential {
                 states: &terms,
+                pattern: &pat,
+                taken_at: &taken,
                 ..*pot
             };
             let rep = newton(pot, &mut self.lin, &mut self.ws, state, opts);
             self.record(&rep);
             total.absorb(&rep);
+            if matches!(rep.failure, Some(SolveError::Regather)) && regathers < MAX_REGATHERS {
+                // A vertex would leave the reach of the contact pairs: gather them at this
+                // iterate and go on from it.
+                regathers += 1;
+                total.failure = None;
+                if self.refresh(state).is_err() {
+                    total.failure = Some(SolveError::Factor);
+                    return total;
+                }
+                continue;
+            }
             if !rep.converged {
                 return total;
             }
+            updates += 1;
             if !self.scene.terms.iter().any(|t| t.updates().is_some()) {
                 return total;
             }

@@ -112,6 +112,10 @@ pub enum SolveError {
     /// The Hessian has NaN or infinite entries.
     #[error("non-finite Hessian")]
     NonFiniteHessian,
+    /// A vertex would leave the region in which a term's elements (contact pairs) were
+    /// gathered: the driver gathers them again at the current iterate and goes on.
+    #[error("a vertex would leave the reach of the contact pairs gathered for this step")]
+    Regather,
     /// The iteration limit was reached.
     #[error(
         "no convergence in {iterations} Newton iterations (residual {})",
@@ -407,9 +411,14 @@ fn line_search(
     state: &State,
     e: Real,
     slope: Real,
+    bound: Real,
     rep: &mut NewtonReport,
 ) -> (Real, bool) {
-    let mut alpha = pot.step_bound(&ws.step);
+    let mut alpha = bound;
+    if alpha.is_nan() || alpha <= 0.0 {
+        // A term allows no motion along this step (a contact pair at its minimum distance).
+        return (0.0, false);
+    }
     for _ in 0..40 {
         if sufficient_decrease(pot, ws, state, e, slope, alpha) {
             return (alpha, true);
@@ -433,7 +442,7 @@ fn sufficient_decrease(
     let slack = 1e-13 * e.abs().max(Real::MIN_POSITIVE);
     ws.trial.set_step(state, &ws.step, alpha);
     let et = pot.eval(&ws.trial.x, &ws.trial.dofs, Want::Energy, &mut [], &mut []);
-    et.is_finite() && et <= e + 1e-4 * alpha * slope + slack
+    et.is_finite() && et <= e + 1e-4 * alpha * slope + slack && pot.admits(&ws.trial.x)
 }
 
 /// Minimises `pot` from `state` (updated in place).
@@ -545,7 +554,7 @@ pub fn newton(
                 // Only the full step: a chord step that needs a line search is a sign that the
                 // old model no longer fits, and a fresh factorisation is cheaper than the cuts.
                 let clock = Instant::now();
-                let alpha = pot.step_bound(&ws.step).min(1.0);
+                let alpha = pot.step_bound(&state.x, &ws.step).fraction.min(1.0);
                 let accepted = alpha == 1.0 && sufficient_decrease(pot, ws, state, e, slope, alpha);
                 rep.timing.line_search += clock.elapsed().as_secs_f64();
                 if VERBOSE.load(std::sync::atomic::Ordering::Relaxed) {
@@ -702,7 +711,13 @@ pub fn newton(
             rep.failure = Some(SolveError::NotDescent);
             return rep;
         }
-        let (alpha, accepted) = line_search(pot, ws, state, e, slope, &mut rep);
+        let bound = pot.step_bound(&state.x, &ws.step);
+        if bound.regather {
+            rep.timing.line_search += clock.elapsed().as_secs_f64();
+            rep.failure = Some(SolveError::Regather);
+            return rep;
+        }
+        let (alpha, accepted) = line_search(pot, ws, state, e, slope, bound.fraction, &mut rep);
         rep.timing.line_search += clock.elapsed().as_secs_f64();
         if VERBOSE.load(std::sync::atomic::Ordering::Relaxed) {
             eprintln!(

@@ -34,6 +34,10 @@
 //! Units: positions m, k Pa/m, δ and ε m, λ N, energies J. DOF order: the 3 coordinates of each
 //! vertex (the ground acts on vertices only; edge DOFs are untouched).
 
+pub mod broad;
+pub mod ccd;
+pub mod distance;
+
 use crate::math::{Real, Vec3};
 
 /// The ground plane and its contact law.

@@ -1,0 +1,192 @@
+#!/usr/bin/env python3
+"""Independent check of a self-contact run: no two faces intersect and no two mid-surfaces
+come closer than a floor, in every frame.
+
+    contact_check.py REFERENCE_MESH OUT_DIR --exclusion R [--floor D] [--json FILE]
+
+Reads the reference mesh and every frame of OUT_DIR with VTK's own readers, and, brute force
+over every pair of faces that share no vertex (numpy, none of shellsim's code):
+
+* intersection: an edge of one face crossing the other face (segment–triangle test, both ways);
+* the minimum distance between the two faces: the smallest of the six vertex–face and nine
+  edge–edge distances, computed here by projecting and clamping.
+
+Pairs closer than R in the reference mesh (measured the same way) are excluded, as shellsim
+excludes them. Prints one line per frame and a JSON summary (the smallest distance over all
+frames and pairs, its frame and faces, and the number of intersecting pairs); exits 1 when a
+pair intersects or comes below --floor.
+"""
+
+import argparse
+import glob
+import json
+import os
+import sys
+
+import numpy as np
+import vtk
+from vtk.util.numpy_support import vtk_to_numpy
+
+
+def read(path):
+    if path.endswith(".vtu"):
+        r = vtk.vtkXMLUnstructuredGridReader()
+    else:
+        r = vtk.vtkGenericDataObjectReader()
+    r.SetFileName(path)
+    r.Update()
+    out = r.GetOutput()
+    pts = vtk_to_numpy(out.GetPoints().GetData()).astype(float)
+    faces = []
+    for c in range(out.GetNumberOfCells()):
+        ids = out.GetCell(c).GetPointIds()
+        faces.append([ids.GetId(k) for k in range(ids.GetNumberOfIds())])
+    return pts, np.array(faces, dtype=np.int64)
+
+
+def point_segment(p, a, b):
+    """Distances from points p to segments a-b (arrays of shape (n, 3))."""
+    e = b - a
+    l2 = np.einsum("ij,ij->i", e, e)
+    t = np.where(l2 > 0, np.einsum("ij,ij->i", p - a, e) / np.where(l2 > 0, l2, 1), 0)
+    t = np.clip(t, 0, 1)
+    return np.linalg.norm(p - (a + t[:, None] * e), axis=1)
+
+
+def point_triangle(p, a, b, c):
+    e1, e2, r = b - a, c - a, p - a
+    m11 = np.einsum("ij,ij->i", e1, e1)
+    m12 = np.einsum("ij,ij->i", e1, e2)
+    m22 = np.einsum("ij,ij->i", e2, e2)
+    r1 = np.einsum("ij,ij->i", e1, r)
+    r2 = np.einsum("ij,ij->i", e2, r)
+    det = m11 * m22 - m12 * m12
+    ok = det > 1e-14 * m11 * m22
+    sd = np.where(ok, det, 1)
+    u = (r1 * m22 - m12 * r2) / sd
+    v = (m11 * r2 - m12 * r1) / sd
+    inside = ok & (u >= 0) & (v >= 0) & (u + v <= 1)
+    q = a + u[:, None] * e1 + v[:, None] * e2
+    d_in = np.linalg.norm(p - q, axis=1)
+    d_out = np.minimum(
+        np.minimum(point_segment(p, a, b), point_segment(p, b, c)), point_segment(p, c, a)
+    )
+    return np.where(inside, d_in, d_out)
+
+
+def segment_segment(a, b, c, d):
+    u, v, w = b - a, d - c, a - c
+    uu = np.einsum("ij,ij->i", u, u)
+    vv = np.einsum("ij,ij->i", v, v)
+    uv = np.einsum("ij,ij->i", u, v)
+    uw = np.einsum("ij,ij->i", u, w)
+    vw = np.einsum("ij,ij->i", v, w)
+    det = uu * vv - uv * uv
+    ok = det > 1e-14 * uu * vv
+    sd = np.where(ok, det, 1)
+    s = (uv * vw - vv * uw) / sd
+    t = (uu * vw - uv * uw) / sd
+    inside = ok & (s > 0) & (s < 1) & (t > 0) & (t < 1)
+    d_in = np.linalg.norm(w + s[:, None] * u - t[:, None] * v, axis=1)
+    d_out = np.minimum(
+        np.minimum(point_segment(a, c, d), point_segment(b, c, d)),
+        np.minimum(point_segment(c, a, b), point_segment(d, a, b)),
+    )
+    return np.where(inside, d_in, d_out)
+
+
+def segment_crosses(p, q, a, b, c):
+    """Whether segments p-q cross triangles a-b-c (proper crossings, Möller–Trumbore)."""
+    e1, e2, d = b - a, c - a, q - p
+    h = np.cross(d, e2)
+    det = np.einsum("ij,ij->i", e1, h)
+    ok = np.abs(det) > 1e-300
+    f = 1 / np.where(ok, det, 1)
+    s = p - a
+    u = f * np.einsum("ij,ij->i", s, h)
+    qv = np.cross(s, e1)
+    v = f * np.einsum("ij,ij->i", d, qv)
+    t = f * np.einsum("ij,ij->i", e2, qv)
+    return ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= 0) & (t <= 1)
+
+
+def pair_distances(x, faces, i, j):
+    fi, fj = faces[i], faces[j]
+    d = np.full(len(i), np.inf)
+    for k in range(3):
+        d = np.minimum(d, point_triangle(x[fi[:, k]], x[fj[:, 0]], x[fj[:, 1]], x[fj[:, 2]]))
+        d = np.minimum(d, point_triangle(x[fj[:, k]], x[fi[:, 0]], x[fi[:, 1]], x[fi[:, 2]]))
+        for m in range(3):
+            d = np.minimum(
+                d,
+                segment_segment(
+                    x[fi[:, k]], x[fi[:, (k + 1) % 3]], x[fj[:, m]], x[fj[:, (m + 1) % 3]]
+                ),
+            )
+    return d
+
+
+def crossings(x, faces, i, j):
+    fi, fj = faces[i], faces[j]
+    hit = np.zeros(len(i), dtype=bool)
+    for k in range(3):
+        a, b = (k, (k + 1) % 3)
+        hit |= segment_crosses(x[fi[:, a]], x[fi[:, b]], x[fj[:, 0]], x[fj[:, 1]], x[fj[:, 2]])
+        hit |= segment_crosses(x[fj[:, a]], x[fj[:, b]], x[fi[:, 0]], x[fi[:, 1]], x[fi[:, 2]])
+    return hit
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("reference")
+    ap.add_argument("out")
+    ap.add_argument("--exclusion", type=float, required=True)
+    ap.add_argument("--floor", type=float, default=0.0)
+    ap.add_argument("--json")
+    a = ap.parse_args()
+    x0, faces = read(a.reference)
+    n = len(faces)
+    i, j = np.triu_indices(n, 1)
+    shared = np.zeros(len(i), dtype=bool)
+    for k in range(3):
+        for m in range(3):
+            shared |= faces[i, k] == faces[j, m]
+    i, j = i[~shared], j[~shared]
+    keep = pair_distances(x0, faces, i, j) >= a.exclusion
+    i, j = i[keep], j[keep]
+    frames = sorted(glob.glob(os.path.join(a.out, "frame_*.vtu")))
+    if not frames:
+        print(f"{a.out}: no frames", file=sys.stderr)
+        return 2
+    best = (np.inf, None, None)
+    crossing = 0
+    for fr in frames:
+        x, fs = read(fr)
+        if not np.array_equal(fs, faces):
+            print(f"{fr}: the faces differ from the reference mesh's", file=sys.stderr)
+            return 2
+        d = pair_distances(x, faces, i, j)
+        k = int(np.argmin(d)) if len(d) else None
+        c = int(crossings(x, faces, i, j).sum()) if len(i) else 0
+        crossing += c
+        if k is not None and d[k] < best[0]:
+            best = (float(d[k]), os.path.basename(fr), (int(i[k]), int(j[k])))
+        dmin = float(d[k]) if k is not None else float("inf")
+        print(f"{os.path.basename(fr)}: min distance {dmin:.6g}, crossing pairs {c}")
+    summary = {
+        "pairs": int(len(i)),
+        "frames": len(frames),
+        "min_distance": best[0],
+        "min_frame": best[1],
+        "min_faces": best[2],
+        "crossing_pairs": crossing,
+    }
+    print(json.dumps(summary))
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(summary, f)
+    return 1 if crossing or best[0] < a.floor else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

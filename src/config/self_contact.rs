@@ -1,0 +1,133 @@
+//! `[self_contact]`: contact of the sheet with itself and between sheets, with the sheets'
+//! thickness as the offset.
+
+use super::solver::Mode;
+use super::values::{Auto, AutoOr};
+use super::{Check, Invalid};
+use crate::math::Real;
+use serde::{Deserialize, Serialize};
+
+/// `[self_contact]`: the sheet's surfaces never pass through each other or another sheet's;
+/// mid-surfaces stay an offset apart (see `crate::energy::self_contact`).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SelfContact {
+    /// Build the contact (default `false`).
+    pub enabled: bool,
+    /// The offset ξ between mid-surfaces in contact (m). `"auto"`: the mean of the two sides'
+    /// thicknesses, `(h_a + h_b)/2` (default); a number: that offset for every pair (a contact
+    /// thickness apart from the material's).
+    pub offset: AutoOr,
+    /// Penalty stiffness k: contact pressure per unit penetration into the offset (Pa/m).
+    /// `"auto"`: the area-weighted mean of E/h (default), as for the ground.
+    pub stiffness: AutoOr,
+    /// Smoothing length δ of the penalty (m). `"auto"`: h/100 (default).
+    pub smoothing: AutoOr,
+    /// Pairs closer than this along the reference surface never touch (m). `"auto"`:
+    /// `2 (ξ + δ)` with the largest offset (default).
+    pub exclusion: AutoOr,
+    /// How far beyond the offset pairs are gathered at the start of a step (m); a vertex
+    /// moves at most half of it within the step. `"auto"`: the largest offset (default).
+    pub halo: AutoOr,
+    /// The smallest distance two mid-surfaces may come to, as a fraction of their offset
+    /// (default `0.1`): no step takes a pair closer.
+    pub min_separation: Real,
+}
+
+impl Default for SelfContact {
+    fn default() -> Self {
+        SelfContact {
+            enabled: false,
+            offset: AutoOr::Auto(Auto::Auto),
+            stiffness: AutoOr::Auto(Auto::Auto),
+            smoothing: AutoOr::Auto(Auto::Auto),
+            exclusion: AutoOr::Auto(Auto::Auto),
+            halo: AutoOr::Auto(Auto::Auto),
+            min_separation: 0.1,
+        }
+    }
+}
+
+impl SelfContact {
+    /// Validates `[self_contact]` when enabled: positive lengths and stiffness, a minimum
+    /// separation in (0, 0.9], and a mode that bounds its steps (not explicit).
+    pub fn validate(&self, mode: Mode) -> Result<(), Invalid> {
+        let ck = Check;
+        if !self.enabled {
+            return Ok(());
+        }
+        if mode == Mode::Explicit {
+            return ck.inv(
+                "self_contact.enabled",
+                "self-contact bounds every Newton step by continuous collision detection; \
+                 explicit mode has no Newton step to bound. Use solver.mode = \"static\" or \
+                 \"dynamic\""
+                    .into(),
+            );
+        }
+        for (key, v) in [
+            ("self_contact.offset", self.offset),
+            ("self_contact.stiffness", self.stiffness),
+            ("self_contact.smoothing", self.smoothing),
+            ("self_contact.exclusion", self.exclusion),
+            ("self_contact.halo", self.halo),
+        ] {
+            if let AutoOr::Value(x) = v {
+                ck.pos(key, x)?;
+            }
+        }
+        let s = self.min_separation;
+        if !(s > 0.0 && s <= 0.9) {
+            return ck.inv(
+                "self_contact.min_separation",
+                format!(
+                    "must be in (0, 0.9] (a fraction of the offset), got {}",
+                    crate::math::human(s)
+                ),
+            );
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Disabled checks nothing; enabled needs positive values, a separation fraction in
+    /// (0, 0.9], and an implicit mode.
+    #[test]
+    fn enabled_self_contact_needs_positive_values_and_an_implicit_mode() {
+        let off = SelfContact {
+            offset: AutoOr::Value(-1.0),
+            ..Default::default()
+        };
+        assert!(off.validate(Mode::Explicit).is_ok());
+        let on = SelfContact {
+            enabled: true,
+            ..Default::default()
+        };
+        assert!(on.validate(Mode::Static).is_ok());
+        assert!(on.validate(Mode::Dynamic).is_ok());
+        let e = on.validate(Mode::Explicit).unwrap_err();
+        assert_eq!(e.key, "self_contact.enabled");
+        let bad = SelfContact {
+            halo: AutoOr::Value(0.0),
+            ..on.clone()
+        };
+        assert_eq!(
+            bad.validate(Mode::Static).unwrap_err().key,
+            "self_contact.halo"
+        );
+        for s in [0.0, 0.95, Real::NAN] {
+            let bad = SelfContact {
+                min_separation: s,
+                ..on.clone()
+            };
+            assert_eq!(
+                bad.validate(Mode::Static).unwrap_err().key,
+                "self_contact.min_separation"
+            );
+        }
+    }
+}

@@ -1,0 +1,241 @@
+//! The broad phase: every point–triangle and edge–edge pair of a surface whose primitives'
+//! axis-aligned boxes, inflated by a radius, overlap — the candidates that the exact distance
+//! then filters.
+//!
+//! A uniform grid: each face's (each edge's) box, inflated by the radius, is listed under every
+//! cell it overlaps, in a table sorted by cell (and primitive, so the table is the same on any
+//! thread count); each vertex looks up the one cell it lies in, each edge the cells its own box
+//! overlaps. The cell is the largest inflated box's longest side (so a box spans at most two
+//! cells per axis), unless the grid would then be finer than 2²⁰ cells per axis. Build and
+//! queries are linear in the number of primitives for meshes of even size; the queries run in
+//! parallel, one result list per primitive, concatenated in primitive order.
+//!
+//! Units: positions and radius m.
+
+use crate::math::{Real, Vec3};
+use rayon::prelude::*;
+
+/// Cells per axis at most (the key packs three 21-bit coordinates).
+const MAX_CELLS: Real = (1u64 << 20) as Real;
+
+/// An axis-aligned box.
+#[derive(Clone, Copy, Debug)]
+struct Aabb {
+    min: Vec3,
+    max: Vec3,
+}
+
+impl Aabb {
+    fn of(points: impl Iterator<Item = Vec3>, inflate: Real) -> Aabb {
+        let (mut min, mut max) = (Vec3::repeat(Real::INFINITY), Vec3::repeat(-Real::INFINITY));
+        for p in points {
+            min = min.inf(&p);
+            max = max.sup(&p);
+        }
+        Aabb {
+            min: min.add_scalar(-inflate),
+            max: max.add_scalar(inflate),
+        }
+    }
+    fn overlaps(&self, o: &Aabb) -> bool {
+        (0..3).all(|k| self.min[k] <= o.max[k] && o.min[k] <= self.max[k])
+    }
+    fn contains(&self, p: &Vec3) -> bool {
+        (0..3).all(|k| self.min[k] <= p[k] && p[k] <= self.max[k])
+    }
+}
+
+/// The grid: origin, cell size, and the sorted (cell key, primitive) table.
+struct Grid {
+    origin: Vec3,
+    cell: Real,
+    table: Vec<(u64, u32)>,
+}
+
+impl Grid {
+    fn coord(&self, p: &Vec3) -> [u64; 3] {
+        std::array::from_fn(|k| {
+            (((p[k] - self.origin[k]) / self.cell).floor().max(0.0) as u64).min((1 << 21) - 1)
+        })
+    }
+    fn key(c: [u64; 3]) -> u64 {
+        (c[0] << 42) | (c[1] << 21) | c[2]
+    }
+    /// The grid over `boxes`, each listed under every cell it overlaps.
+    fn new(boxes: &[Aabb]) -> Grid {
+        let (mut lo, mut hi) = (Vec3::repeat(Real::INFINITY), Vec3::repeat(-Real::INFINITY));
+        let mut side: Real = 0.0;
+        for b in boxes {
+            lo = lo.inf(&b.min);
+            hi = hi.sup(&b.max);
+            side = side.max((b.max - b.min).max());
+        }
+        let extent = (hi - lo).max();
+        let cell = side.max(extent / MAX_CELLS).max(Real::MIN_POSITIVE);
+        let mut g = Grid {
+            origin: lo,
+            cell,
+            table: Vec::new(),
+        };
+        let per: Vec<Vec<(u64, u32)>> = boxes
+            .par_iter()
+            .enumerate()
+            .map(|(i, b)| {
+                let mut out = Vec::with_capacity(8);
+                g.cells(b, |k| out.push((k, i as u32)));
+                out
+            })
+            .collect();
+        g.table = per.into_iter().flatten().collect();
+        g.table.par_sort_unstable();
+        g
+    }
+    /// Calls `f` with the key of every cell `b` overlaps.
+    fn cells(&self, b: &Aabb, mut f: impl FnMut(u64)) {
+        let (a, z) = (self.coord(&b.min), self.coord(&b.max));
+        for i in a[0]..=z[0] {
+            for j in a[1]..=z[1] {
+                for k in a[2]..=z[2] {
+                    f(Self::key([i, j, k]));
+                }
+            }
+        }
+    }
+    /// The primitives listed under cell `key`.
+    fn at(&self, key: u64) -> &[(u64, u32)] {
+        let lo = self.table.partition_point(|e| e.0 < key);
+        let hi = self.table.partition_point(|e| e.0 <= key);
+        &self.table[lo..hi]
+    }
+}
+
+/// Vertex `p` and face `f` whose face box, inflated by `radius`, contains `x[p]`, with `p` not a
+/// vertex of `f`: sorted by vertex, then face.
+pub fn point_triangle(x: &[Vec3], faces: &[[usize; 3]], radius: Real) -> Vec<(u32, u32)> {
+    if faces.is_empty() {
+        return Vec::new();
+    }
+    let boxes: Vec<Aabb> = faces
+        .par_iter()
+        .map(|f| Aabb::of(f.iter().map(|&v| x[v]), radius))
+        .collect();
+    let grid = Grid::new(&boxes);
+    let per: Vec<Vec<(u32, u32)>> = (0..x.len())
+        .into_par_iter()
+        .map(|p| {
+            let mut out: Vec<(u32, u32)> = grid
+                .at(Grid::key(grid.coord(&x[p])))
+                .iter()
+                .map(|e| e.1)
+                .filter(|&f| !faces[f as usize].contains(&p) && boxes[f as usize].contains(&x[p]))
+                .map(|f| (p as u32, f))
+                .collect();
+            out.sort_unstable();
+            out
+        })
+        .collect();
+    per.into_iter().flatten().collect()
+}
+
+/// Edge pairs `(a, b)`, `a < b`, sharing no vertex, whose boxes inflated by `radius` overlap:
+/// sorted.
+pub fn edge_edge(x: &[Vec3], edges: &[[usize; 2]], radius: Real) -> Vec<(u32, u32)> {
+    if edges.is_empty() {
+        return Vec::new();
+    }
+    let inflated: Vec<Aabb> = edges
+        .par_iter()
+        .map(|e| Aabb::of(e.iter().map(|&v| x[v]), radius))
+        .collect();
+    let grid = Grid::new(&inflated);
+    let per: Vec<Vec<(u32, u32)>> = (0..edges.len())
+        .into_par_iter()
+        .map(|a| {
+            let own = Aabb::of(edges[a].iter().map(|&v| x[v]), 0.0);
+            let mut out = Vec::new();
+            grid.cells(&own, |k| {
+                for &(_, b) in grid.at(k) {
+                    let bu = b as usize;
+                    if bu > a
+                        && !edges[bu].iter().any(|v| edges[a].contains(v))
+                        && inflated[bu].overlaps(&own)
+                    {
+                        out.push((a as u32, b));
+                    }
+                }
+            });
+            out.sort_unstable();
+            out.dedup();
+            out
+        })
+        .collect();
+    per.into_iter().flatten().collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::distance;
+
+    /// Two random triangle soups: the grid finds exactly the pairs a brute-force loop over all
+    /// pairs finds with the same box test (so every pair within the radius is among them).
+    #[test]
+    fn the_grid_finds_what_brute_force_finds() {
+        let mut seed = 0x853c49e6748fea9bu64;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as Real / (1u64 << 53) as Real
+        };
+        let n = 300;
+        let x: Vec<Vec3> = (0..n)
+            .map(|_| Vec3::new(rnd(), rnd(), rnd() * 0.3))
+            .collect();
+        let faces: Vec<[usize; 3]> = (0..200)
+            .map(|i| [i % n, (i * 7 + 3) % n, (i * 13 + 5) % n])
+            .filter(|f| f[0] != f[1] && f[1] != f[2] && f[0] != f[2])
+            .collect();
+        let edges: Vec<[usize; 2]> = faces
+            .iter()
+            .flat_map(|f| [[f[0], f[1]], [f[1], f[2]]])
+            .collect();
+        let r = 0.03;
+        let boxes: Vec<Aabb> = faces
+            .iter()
+            .map(|f| Aabb::of(f.iter().map(|&v| x[v]), r))
+            .collect();
+        let mut brute = Vec::new();
+        for (p, xp) in x.iter().enumerate() {
+            for (f, b) in boxes.iter().enumerate() {
+                if !faces[f].contains(&p) && b.contains(xp) {
+                    brute.push((p as u32, f as u32));
+                }
+            }
+        }
+        assert_eq!(point_triangle(&x, &faces, r), brute);
+        // Every vertex–face pair within r is a candidate.
+        for p in 0..n {
+            for (f, t) in faces.iter().enumerate() {
+                if t.contains(&p) {
+                    continue;
+                }
+                let q = [x[p], x[t[0]], x[t[1]], x[t[2]]];
+                if distance::point_triangle(&q).d2 < r * r {
+                    assert!(brute.contains(&(p as u32, f as u32)));
+                }
+            }
+        }
+        let mut brute = Vec::new();
+        for a in 0..edges.len() {
+            let own = Aabb::of(edges[a].iter().map(|&v| x[v]), 0.0);
+            for b in a + 1..edges.len() {
+                let ib = Aabb::of(edges[b].iter().map(|&v| x[v]), r);
+                if !edges[b].iter().any(|v| edges[a].contains(v)) && ib.overlaps(&own) {
+                    brute.push((a as u32, b as u32));
+                }
+            }
+        }
+        assert_eq!(edge_edge(&x, &edges, r), brute);
+    }
+}

@@ -1,0 +1,673 @@
+//! Contact of the sheet with itself and between sheets (`[self_contact]`): mid-surfaces stay an
+//! offset apart, and no step ever carries one surface through another.
+//!
+//! **Pairs.** Every vertex with every face not incident to it (point–triangle), and every edge
+//! with every edge sharing no vertex (edge–edge), measured by their exact distance `d`
+//! ([`crate::contact::distance`]). The offset between mid-surfaces is
+//! `ξ = (h_a + h_b)/2`, the mean of the two sides' thicknesses (a vertex's thickness is its
+//! faces' area-weighted mean, a triangle's or an edge's the mean of its vertices'), or one
+//! `offset` for every pair.
+//!
+//! **Normal law: a smoothed penalty with a physical stiffness.** Each vertex presses on the
+//! closest point of the surface on either side of it (the side is the sign of `(x_p − q)·n_p`,
+//! `q` the closest point, `n_p` the vertex's area-weighted normal): of the point–triangle pairs
+//! of vertex `p`, only the nearest on each side carries energy,
+//!
+//! `E_p = k (A_p/2) ψ(ξ − d)`,
+//!
+//! with `A_p` the vertex's reference area, `k` the stiffness (Pa/m) and `ψ` the ground's C²
+//! penalty with smoothing δ ([`crate::contact::penalty`]). Both sheets of a contact press with
+//! half their area, so two flat sheets pressed by a pressure σ sink into their offset by the
+//! ground's closed form, `√(2δσ/k)` below `kδ/2` and `σ/k + δ/2` beyond, on any mesh: the
+//! stiffness converges under refinement. The closest point of a surface is a continuous function of
+//! the vertex, so the energy is C¹ where a vertex slides from one face to the next.
+//!
+//! **Edge–edge pairs** carry the contact where no vertex is near a face (two creases crossing).
+//! They act only inside half the offset, `E = m(c) k w ψ(ξ/2 − d)`, `w` a quarter of the mean
+//! of the four vertex areas, `m` IPC's mollifier of nearly parallel edges
+//! ([`crate::contact::distance::mollifier`]): on a flat contact they are idle and the pressure
+//! is the vertex law's alone.
+//!
+//! **The guarantee.** No step takes a pair closer than `s ξ` (`min_separation` s, default 0.1):
+//! every Newton step is bounded by additive CCD over the pairs ([`crate::contact::ccd`]) and
+//! every trial state is checked before the line search accepts it. The pairs are gathered once
+//! per step (at the step's start, when the pattern is refreshed), all those within `ξ + halo`;
+//! within the step each vertex moves at most `halo/2` from where they were gathered, so no
+//! pair outside the list can come within `ξ`.
+//!
+//! **Exclusion.** Pairs within the exclusion radius `R` of each other on the reference sheet,
+//! measured both in space and along its edges (the graph distance, at most `2R` plus two edge
+//! lengths), never touch: without it a mesh finer than its thickness would be in contact
+//! with itself at rest. `R` defaults to `2 (ξ + δ)`. An arc of that length comes within the
+//! offset of its own start only when bent to a radius below about `0.53 (ξ + δ)`: folds
+//! tighter than about half the thickness cannot self-contact, and Kirchhoff–Love shells cannot
+//! represent them anyway. Reference pairs that are close in space but far along the sheet are
+//! separate layers: closer than their offset, they are an error naming the faces.
+//!
+//! Units: positions m, k Pa/m, δ, ξ, R m, A m², energies J. DOF order per pair: the four
+//! points' coordinates, point–triangle `(p, t₂, t₁, t₀)` with `t₀ < t₁ < t₂`, edge–edge
+//! `(a, b, c, d)` with `a < b`, `c < d` (the order of the last two slots tells the kinds apart).
+
+use super::term::{StepBound, StepLimit, Term};
+use crate::body::Body;
+use crate::contact::{broad, ccd, distance, penalty};
+use crate::elements::Stencil;
+use crate::elements::{assemble_elements, ElementMap, Want};
+use crate::energy::term::ChangingElements;
+use crate::energy::{HessianProjection, Potential};
+use crate::math::{Real, SMat, SVec, Vec3};
+use crate::mesh::MeshError;
+use rayon::prelude::*;
+
+/// The mollifier's threshold as a fraction of the product of the squared rest lengths
+/// (Li et al. 2020, §4.3).
+const MOLLIFIER: Real = 1e-3;
+
+/// The contact of a sheet with itself and with other sheets of the mesh.
+pub struct SelfContact {
+    /// The mesh's faces.
+    faces: Vec<[usize; 3]>,
+    /// The mesh's edges `(a, b)`, `a < b`.
+    edges: Vec<[usize; 2]>,
+    /// Reference positions (the mollifier's rest lengths).
+    rest: Vec<Vec3>,
+    /// Thickness per vertex (m), or the fixed offset in every entry.
+    thickness: Vec<Real>,
+    /// Reference area per vertex (m²).
+    area: Vec<Real>,
+    /// Penalty stiffness k (Pa/m).
+    pub stiffness: Real,
+    /// Smoothing length δ (m).
+    pub smoothing: Real,
+    /// The largest offset (m).
+    pub xi_max: Real,
+    /// How far beyond the offset pairs are gathered (m).
+    pub halo: Real,
+    /// The exclusion radius (m).
+    pub exclusion: Real,
+    /// The smallest distance as a fraction of the offset.
+    pub min_separation: Real,
+    /// Excluded point–triangle pairs `p << 32 | f`, sorted.
+    excluded_pt: Vec<u64>,
+    /// Excluded edge–edge pairs `a << 32 | b` (edge indices, `a < b`), sorted.
+    excluded_ee: Vec<u64>,
+}
+
+/// Whether the element with these four nodes is a point–triangle pair (module doc: the order
+/// of the last two slots).
+#[inline]
+fn is_point_triangle(nodes: &[usize]) -> bool {
+    nodes[2] > nodes[3]
+}
+
+/// The four positions of an element.
+#[inline]
+fn points(x: &[Vec3], nodes: &[usize]) -> [Vec3; 4] {
+    std::array::from_fn(|i| x[nodes[i]])
+}
+
+impl SelfContact {
+    /// The offset of the pair with these nodes (m).
+    #[inline]
+    fn offset(&self, nodes: &[usize]) -> Real {
+        let h = &self.thickness;
+        if is_point_triangle(nodes) {
+            0.5 * (h[nodes[0]] + (h[nodes[1]] + h[nodes[2]] + h[nodes[3]]) / 3.0)
+        } else {
+            0.25 * (h[nodes[0]] + h[nodes[1]] + h[nodes[2]] + h[nodes[3]])
+        }
+    }
+
+    /// The closest points of an element at `x`.
+    #[inline]
+    fn closest(&self, x: &[Vec3; 4], nodes: &[usize]) -> distance::Closest {
+        if is_point_triangle(nodes) {
+            distance::point_triangle(x)
+        } else {
+            distance::edge_edge(x)
+        }
+    }
+
+    /// The pairs within `radius` (beyond each pair's offset) at `x`, not excluded: the
+    /// stencil, point–triangle pairs first (module doc for the slot order).
+    fn pairs(&self, x: &[Vec3], beyond: Real) -> Stencil {
+        let reach = self.xi_max + beyond;
+        let pt = broad::point_triangle(x, &self.faces, reach);
+        let ee = broad::edge_edge(x, &self.edges, reach);
+        let pt: Vec<[usize; 4]> = pt
+            .par_iter()
+            .filter(|&&(p, f)| {
+                self.excluded_pt
+                    .binary_search(&((p as u64) << 32 | f as u64))
+                    .is_err()
+            })
+            .map(|&(p, f)| {
+                let mut t = self.faces[f as usize];
+                t.sort_unstable();
+                [p as usize, t[2], t[1], t[0]]
+            })
+            .filter(|n| {
+                let d2 = distance::point_triangle(&points(x, n)).d2;
+                d2 < (self.offset(n) + beyond).powi(2)
+            })
+            .collect();
+        let ee: Vec<[usize; 4]> = ee
+            .par_iter()
+            .filter(|&&(a, b)| {
+                self.excluded_ee
+                    .binary_search(&((a as u64) << 32 | b as u64))
+                    .is_err()
+            })
+            .map(|&(a, b)| {
+                let (ea, eb) = (self.edges[a as usize], self.edges[b as usize]);
+                [ea[0], ea[1], eb[0], eb[1]]
+            })
+            .filter(|n| {
+                let d2 = distance::edge_edge(&points(x, n)).d2;
+                d2 < (self.offset(n) + beyond).powi(2)
+            })
+            .collect();
+        let mut st = Stencil {
+            slot_dofs: vec![3; 4],
+            nodes: Vec::with_capacity(4 * (pt.len() + ee.len())),
+            anchors: Vec::with_capacity(pt.len() + ee.len()),
+        };
+        for n in pt.iter().chain(&ee) {
+            st.nodes.extend_from_slice(n);
+            st.anchors.push(points(x, n).iter().sum::<Vec3>() / 4.0);
+        }
+        st
+    }
+
+    /// Area-weighted vertex normals at `x` (unnormalised: only their direction is used).
+    fn vertex_normals(&self, x: &[Vec3]) -> Vec<Vec3> {
+        let mut n = vec![Vec3::zeros(); x.len()];
+        for f in &self.faces {
+            let c = (x[f[1]] - x[f[0]]).cross(&(x[f[2]] - x[f[0]]));
+            for &v in f {
+                n[v] += c;
+            }
+        }
+        n
+    }
+
+    /// Per element of `map`, whether it carries energy at `x`: every edge–edge pair, and of
+    /// each vertex's point–triangle pairs the nearest on each side (module doc; ties go to the
+    /// first in element order).
+    fn active(&self, map: &ElementMap, x: &[Vec3]) -> Vec<bool> {
+        let nodes = &map.nodes;
+        let ne = nodes.len() / 4;
+        let normals = self.vertex_normals(x);
+        let measured: Vec<Option<(usize, bool, Real)>> = (0..ne)
+            .into_par_iter()
+            .map(|e| {
+                let n = &nodes[4 * e..4 * e + 4];
+                if !is_point_triangle(n) {
+                    return None;
+                }
+                let y = points(x, n);
+                let cl = distance::point_triangle(&y);
+                let r = y[0] * cl.c[0] + y[1] * cl.c[1] + y[2] * cl.c[2] + y[3] * cl.c[3];
+                Some((n[0], r.dot(&normals[n[0]]) >= 0.0, cl.d2))
+            })
+            .collect();
+        let mut active = vec![true; ne];
+        // Point–triangle elements come sorted by vertex: one run per vertex.
+        let mut e = 0;
+        while e < ne {
+            let Some((p, _, _)) = measured[e] else {
+                e += 1;
+                continue;
+            };
+            let mut end = e;
+            let mut best: [Option<(Real, usize)>; 2] = [None, None];
+            while end < ne {
+                match measured[end] {
+                    Some((q, side, d2)) if q == p => {
+                        let b = &mut best[usize::from(side)];
+                        if b.is_none_or(|(bd, _)| d2 < bd) {
+                            *b = Some((d2, end));
+                        }
+                        end += 1;
+                    }
+                    _ => break,
+                }
+            }
+            for (k, a) in active[e..end].iter_mut().enumerate() {
+                *a = best.iter().any(|b| b.is_some_and(|(_, i)| i == e + k));
+            }
+            e = end;
+        }
+        active
+    }
+
+    /// Energy, gradient and Hessian of one active element (module doc).
+    fn element(
+        &self,
+        nodes: &[usize],
+        x: &[Vec3],
+        grad: Option<&mut SVec<12>>,
+        hess: Option<&mut SMat<12, 12>>,
+    ) -> Real {
+        let y = points(x, nodes);
+        let pt = is_point_triangle(nodes);
+        let xi = self.offset(nodes);
+        let (reach, weight) = if pt {
+            (xi, 0.5 * self.area[nodes[0]])
+        } else {
+            let a = &self.area;
+            (
+                0.5 * xi,
+                0.0625 * (a[nodes[0]] + a[nodes[1]] + a[nodes[2]] + a[nodes[3]]),
+            )
+        };
+        let cl = self.closest(&y, nodes);
+        let zero = |g: Option<&mut SVec<12>>, h: Option<&mut SMat<12, 12>>| {
+            if let Some(g) = g {
+                g.fill(0.0);
+            }
+            if let Some(h) = h {
+                h.fill(0.0);
+            }
+            0.0
+        };
+        if cl.d2 >= reach * reach || cl.d2 <= 0.0 {
+            return zero(grad, hess);
+        }
+        let d = cl.d2.sqrt();
+        let w = self.stiffness * weight;
+        let (psi, dpsi, ddpsi) = penalty(reach - d, self.smoothing);
+        // The mollifier of nearly parallel edges: (m, m′, m″) where it is below 1.
+        let mollifier = if pt {
+            None
+        } else {
+            let r = &self.rest;
+            let eps = MOLLIFIER
+                * (r[nodes[1]] - r[nodes[0]]).norm_squared()
+                * (r[nodes[3]] - r[nodes[2]]).norm_squared();
+            let (c, _) = distance::cross_squared(&y, None);
+            (c < eps).then(|| distance::mollifier(c, eps))
+        };
+        let m = mollifier.map_or(1.0, |(m, _, _)| m);
+        let energy = m * w * psi;
+        if grad.is_none() && hess.is_none() {
+            return energy;
+        }
+        let want_h = hess.is_some();
+        let mut h2 = SMat::<12, 12>::zeros();
+        let g2 = distance::derivatives(&y, &cl, want_h.then_some(&mut h2));
+        // ∇d = ∇d²/(2d); E₀ = wψ(reach − d): ∇E₀ = −wψ′∇d.
+        let gd = g2 / (2.0 * d);
+        let g0 = gd * (-w * dpsi);
+        // E = m E₀: ∇E = m∇E₀ + E₀∇m, ∇²E = m∇²E₀ + ∇m∇E₀ᵀ + ∇E₀∇mᵀ + E₀∇²m, with
+        // ∇m = m′∇c and ∇²m = m″∇c∇cᵀ + m′∇²c.
+        let mut hc = SMat::<12, 12>::zeros();
+        let gc = mollifier.map(|_| distance::cross_squared(&y, want_h.then_some(&mut hc)).1);
+        if let Some(g) = grad {
+            *g = g0 * m;
+            if let (Some((_, dm, _)), Some(gc)) = (mollifier, &gc) {
+                *g += gc * (dm * w * psi);
+            }
+        }
+        if let Some(h) = hess {
+            // ∇²d = ∇²d²/(2d) − ∇d ∇dᵀ/d; ∇²E₀ = w(ψ″∇d∇dᵀ − ψ′∇²d).
+            let hd = h2 / (2.0 * d) - gd * gd.transpose() / d;
+            *h = (gd * gd.transpose() * ddpsi - hd * dpsi) * (w * m);
+            if let (Some((_, dm, ddm)), Some(gc)) = (mollifier, &gc) {
+                let gm = gc * dm;
+                *h += gm * g0.transpose()
+                    + g0 * gm.transpose()
+                    + (gc * gc.transpose() * ddm + hc * dm) * (w * psi);
+            }
+        }
+        energy
+    }
+}
+
+impl ChangingElements for SelfContact {
+    fn stencil_at(&self, _: &Body, x: &[Vec3], _: &[Real]) -> Stencil {
+        self.pairs(x, self.halo)
+    }
+}
+
+impl StepLimit for SelfContact {
+    /// The smallest of: each vertex's room within half the halo of where the pairs were
+    /// gathered, and each pair's additive CCD fraction to `s ξ`. Gathering again pays when
+    /// the room left is below half of what a fresh gathering would give (capped at the whole
+    /// step).
+    fn max_fraction(
+        &self,
+        pot: &Potential,
+        map: &ElementMap,
+        x: &[Vec3],
+        step: &[Real],
+    ) -> StepBound {
+        let dx = |v: usize| Vec3::new(step[3 * v], step[3 * v + 1], step[3 * v + 2]);
+        let taken = pot.taken_at;
+        let half = 0.5 * self.halo;
+        let fraction = |room: Real, l: Real| {
+            if room <= 0.0 {
+                0.0
+            } else if l > room {
+                room / l
+            } else {
+                1.0
+            }
+        };
+        let (room, fresh) = if taken.len() == x.len() {
+            (0..x.len())
+                .into_par_iter()
+                .map(|v| {
+                    let l = dx(v).norm();
+                    (
+                        fraction(half - (x[v] - taken[v]).norm(), l),
+                        fraction(half, l),
+                    )
+                })
+                .reduce(|| (1.0, 1.0), |a, b| (a.0.min(b.0), a.1.min(b.1)))
+        } else {
+            (1.0, 1.0)
+        };
+        if room < 0.5 * fresh {
+            return StepBound {
+                fraction: room,
+                regather: true,
+            };
+        }
+        let nodes = &map.nodes;
+        let ccd = (0..nodes.len() / 4)
+            .into_par_iter()
+            .map(|e| {
+                let n = &nodes[4 * e..4 * e + 4];
+                let d: [Vec3; 4] = std::array::from_fn(|i| dx(n[i]));
+                let d_min = self.min_separation * self.offset(n);
+                ccd::safe_fraction(&points(x, n), &d, is_point_triangle(n), d_min, room)
+            })
+            .reduce(|| room, Real::min);
+        StepBound {
+            fraction: ccd,
+            regather: false,
+        }
+    }
+
+    /// Every pair at least `s ξ` apart.
+    fn admits(&self, _: &Potential, map: &ElementMap, x: &[Vec3]) -> bool {
+        let nodes = &map.nodes;
+        (0..nodes.len() / 4).into_par_iter().all(|e| {
+            let n = &nodes[4 * e..4 * e + 4];
+            let d_min = self.min_separation * self.offset(n);
+            self.closest(&points(x, n), n).d2 >= d_min * d_min
+        })
+    }
+}
+
+impl Term for SelfContact {
+    fn name(&self) -> &'static str {
+        "self_contact"
+    }
+    fn stencil(&self, body: &Body) -> Stencil {
+        self.pairs(&body.mesh.positions, self.halo)
+    }
+    fn changing(&self) -> Option<&dyn ChangingElements> {
+        Some(self)
+    }
+    fn step_limit(&self) -> Option<&dyn StepLimit> {
+        Some(self)
+    }
+    fn eval(
+        &self,
+        pot: &Potential,
+        map: &ElementMap,
+        x: &[Vec3],
+        _phi: &[Real],
+        want: Want,
+        projection: HessianProjection,
+        grad: &mut [Real],
+        values: &mut [Real],
+    ) -> Real {
+        if map.nodes.is_empty() {
+            return 0.0;
+        }
+        let active = self.active(map, x);
+        assemble_elements::<12, 4, _>(
+            map,
+            |e, nodes, g, h| {
+                if active[e] {
+                    self.element(nodes, x, g, h)
+                } else {
+                    if let Some(g) = g {
+                        g.fill(0.0);
+                    }
+                    if let Some(h) = h {
+                        h.fill(0.0);
+                    }
+                    0.0
+                }
+            },
+            pot.node_fixed,
+            projection,
+            want,
+            grad,
+            values,
+            &pot.pattern.col_ptr,
+        )
+    }
+}
+
+/// The term of `[self_contact]` on `body`, or `None` when disabled.
+pub fn term(
+    body: &Body,
+    c: &crate::config::self_contact::SelfContact,
+) -> Result<Option<Box<dyn Term>>, MeshError> {
+    if !c.enabled {
+        return Ok(None);
+    }
+    let mesh = &body.mesh;
+    let ca = crate::body::ContactAreas::of(mesh, &body.thickness, &body.young);
+    let thickness: Vec<Real> = match c.offset {
+        crate::config::values::AutoOr::Value(xi) => vec![xi; mesh.positions.len()],
+        _ => ca.half_thickness.iter().map(|h| 2.0 * h).collect(),
+    };
+    let xi_max = thickness.iter().copied().fold(0.0, Real::max);
+    let smoothing = c.smoothing.or(ca.h_mean / 100.0);
+    let mut edges: Vec<[usize; 2]> = body
+        .topo
+        .edges
+        .iter()
+        .map(|e| [e[0].min(e[1]), e[0].max(e[1])])
+        .collect();
+    edges.sort_unstable();
+    let mut sc = SelfContact {
+        faces: mesh.faces.clone(),
+        edges,
+        rest: mesh.positions.clone(),
+        thickness,
+        area: ca.area,
+        stiffness: c.stiffness.or(ca.e_over_h),
+        smoothing,
+        xi_max,
+        halo: c.halo.or(xi_max),
+        exclusion: c.exclusion.or(2.0 * (xi_max + smoothing)),
+        min_separation: c.min_separation,
+        excluded_pt: Vec::new(),
+        excluded_ee: Vec::new(),
+    };
+    exclude(&mut sc, body)?;
+    Ok(Some(Box::new(sc)))
+}
+
+/// Fills the exclusion lists (module doc) and checks the reference state: a pair close in
+/// space but far along the sheet and closer than its offset is an error naming its faces.
+fn exclude(sc: &mut SelfContact, body: &Body) -> Result<(), MeshError> {
+    let x = &body.mesh.positions;
+    let r = sc.exclusion;
+    let longest = sc
+        .edges
+        .iter()
+        .map(|e| (x[e[1]] - x[e[0]]).norm())
+        .fold(0.0, Real::max);
+    let graph = 2.0 * r + 2.0 * longest;
+    let adjacency = Adjacency::new(x.len(), &sc.edges, x);
+    // Point–triangle pairs within r in space, grouped by vertex.
+    let pt = broad::point_triangle(x, &sc.faces, r);
+    let pt: Vec<(u32, u32, Real)> = pt
+        .into_par_iter()
+        .filter_map(|(p, f)| {
+            let t = sc.faces[f as usize];
+            let d2 = distance::point_triangle(&[x[p as usize], x[t[0]], x[t[1]], x[t[2]]]).d2;
+            (d2 < r * r).then_some((p, f, d2.sqrt()))
+        })
+        .collect();
+    let ee = broad::edge_edge(x, &sc.edges, r);
+    let ee: Vec<(u32, u32, Real)> = ee
+        .into_par_iter()
+        .filter_map(|(a, b)| {
+            let (ea, eb) = (sc.edges[a as usize], sc.edges[b as usize]);
+            let d2 = distance::edge_edge(&[x[ea[0]], x[ea[1]], x[eb[0]], x[eb[1]]]).d2;
+            (d2 < r * r).then_some((a, b, d2.sqrt()))
+        })
+        .collect();
+    // For each source vertex, the vertices within the graph radius.
+    let near = |from: usize, reach: Real, targets: &[usize]| -> bool {
+        adjacency.within(from, reach, targets)
+    };
+    let pt_flags: Vec<bool> = pt
+        .par_iter()
+        .map(|&(p, f, _)| near(p as usize, graph, &sc.faces[f as usize]))
+        .collect();
+    let ee_flags: Vec<bool> = ee
+        .par_iter()
+        .map(|&(a, b, _)| {
+            let (ea, eb) = (sc.edges[a as usize], sc.edges[b as usize]);
+            near(ea[0], graph + longest, &eb)
+        })
+        .collect();
+    for (&(p, f, d), &close) in pt.iter().zip(&pt_flags) {
+        if close {
+            sc.excluded_pt.push((p as u64) << 32 | f as u64);
+        } else {
+            let mut t = sc.faces[f as usize];
+            t.sort_unstable();
+            let n = [p as usize, t[2], t[1], t[0]];
+            if d < sc.offset(&n) {
+                return Err(body.mesh.invalid(format!(
+                    "self_contact: vertex {p} and face {f} are {} apart in the reference \
+                     state, closer than their offset {} though far apart along the sheet: \
+                     separate the layers, or set self_contact.offset smaller",
+                    crate::math::human(d),
+                    crate::math::human(sc.offset(&n)),
+                )));
+            }
+        }
+    }
+    for (&(a, b, d), &close) in ee.iter().zip(&ee_flags) {
+        if close {
+            sc.excluded_ee.push((a as u64) << 32 | b as u64);
+        } else {
+            let (ea, eb) = (sc.edges[a as usize], sc.edges[b as usize]);
+            let n = [ea[0], ea[1], eb[0], eb[1]];
+            if d < sc.offset(&n) {
+                return Err(body.mesh.invalid(format!(
+                    "self_contact: edges {}–{} and {}–{} are {} apart in the reference state, \
+                     closer than their offset {} though far apart along the sheet: separate \
+                     the layers, or set self_contact.offset smaller",
+                    ea[0],
+                    ea[1],
+                    eb[0],
+                    eb[1],
+                    crate::math::human(d),
+                    crate::math::human(sc.offset(&n)),
+                )));
+            }
+        }
+    }
+    sc.excluded_pt.sort_unstable();
+    sc.excluded_ee.sort_unstable();
+    // Pairs not excluded that are within the offset at rest: the exclusion radius is too small
+    // for this mesh and offset.
+    let reach = sc.pairs(x, 0.0);
+    if let Some(n) = reach.nodes.chunks(4).next() {
+        let d = sc.closest(&points(x, n), n).d2.sqrt();
+        return Err(body.mesh.invalid(format!(
+            "self_contact: the pair of vertices {:?} is {} apart at rest, within its offset {}, \
+             yet not excluded: raise self_contact.exclusion to at least {} (or refine the mesh, \
+             or set a smaller self_contact.offset)",
+            n,
+            crate::math::human(d),
+            crate::math::human(sc.offset(n)),
+            crate::math::human(2.0 * sc.offset(n) + longest),
+        )));
+    }
+    Ok(())
+}
+
+/// The mesh's edge graph with reference edge lengths, for bounded Dijkstra searches.
+struct Adjacency {
+    start: Vec<usize>,
+    next: Vec<(usize, Real)>,
+}
+
+impl Adjacency {
+    fn new(nv: usize, edges: &[[usize; 2]], x: &[Vec3]) -> Adjacency {
+        let mut count = vec![0usize; nv + 1];
+        for e in edges {
+            count[e[0] + 1] += 1;
+            count[e[1] + 1] += 1;
+        }
+        for i in 0..nv {
+            count[i + 1] += count[i];
+        }
+        let mut fill = count.clone();
+        let mut next = vec![(0, 0.0); count[nv]];
+        for e in edges {
+            let l = (x[e[1]] - x[e[0]]).norm();
+            next[fill[e[0]]] = (e[1], l);
+            fill[e[0]] += 1;
+            next[fill[e[1]]] = (e[0], l);
+            fill[e[1]] += 1;
+        }
+        Adjacency { start: count, next }
+    }
+
+    /// Whether any of `targets` is within graph distance `reach` of `from`.
+    fn within(&self, from: usize, reach: Real, targets: &[usize]) -> bool {
+        if targets.contains(&from) {
+            return true;
+        }
+        let mut dist: std::collections::HashMap<usize, Real> = std::collections::HashMap::new();
+        let mut heap = std::collections::BinaryHeap::new();
+        dist.insert(from, 0.0);
+        heap.push(std::cmp::Reverse((Ordered(0.0), from)));
+        while let Some(std::cmp::Reverse((Ordered(d), v))) = heap.pop() {
+            if dist.get(&v).is_some_and(|&dv| d > dv) {
+                continue;
+            }
+            if targets.contains(&v) {
+                return true;
+            }
+            for &(u, l) in &self.next[self.start[v]..self.start[v + 1]] {
+                let du = d + l;
+                if du <= reach && dist.get(&u).is_none_or(|&old| du < old) {
+                    dist.insert(u, du);
+                    heap.push(std::cmp::Reverse((Ordered(du), u)));
+                }
+            }
+        }
+        false
+    }
+}
+
+/// A finite real with a total order, for the heap.
+#[derive(Clone, Copy, PartialEq)]
+struct Ordered(Real);
+impl Eq for Ordered {}
+impl PartialOrd for Ordered {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Ordered {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&o.0)
+    }
+}
