@@ -126,3 +126,174 @@ fn a_strip_rolled_past_a_full_turn_winds_onto_itself_a_thickness_apart() {
         }
     }
 }
+
+/// Squares of side `side` (edges about `edge`, jittered, each its own seed) with their corners
+/// at `corners`, flat, written as one mesh `name` in `dir`.
+fn sheets_mesh(dir: &Path, name: &str, side: f64, edge: f64, corners: &[(f64, f64, f64)]) {
+    use shellsim::mesh::generate::{rectangle, Spacing};
+    let mut mesh = shellsim::mesh::Mesh::default();
+    for (k, &(x0, y0, z0)) in corners.iter().enumerate() {
+        let m = rectangle(
+            x0,
+            y0,
+            side,
+            side,
+            edge,
+            Spacing {
+                jitter: 0.2,
+                seed: 5 + k as u64,
+                ..Default::default()
+            },
+        );
+        let base = mesh.positions.len();
+        mesh.positions.extend(
+            m.positions
+                .iter()
+                .map(|p| shellsim::math::Vec3::new(p.x, p.y, z0)),
+        );
+        mesh.faces.extend(
+            m.faces
+                .iter()
+                .map(|f| [f[0] + base, f[1] + base, f[2] + base]),
+        );
+    }
+    shellsim::mesh::io::write_mesh(
+        &dir.join(name),
+        &mesh,
+        shellsim::mesh::io::Format::Vtk,
+        name,
+    )
+    .unwrap();
+}
+
+/// Three 5 cm squares (h = 1 mm, E = 1 MPa, ρ = 1000 kg/m³) stacked a thickness apart under a
+/// gravity of 1000 m/s²: the bottom one held, the others free to move up and down. Each
+/// interface carries the weight above it, σ = ρ h g per sheet (1 and 2 kPa), below the
+/// penalty's kδ/2 = 5 kPa (k = E/h, δ = h/100): its closed-form penetration into the offset is
+/// √(2δσ/k), 4.47 µm and 6.32 µm. Measured as the offset less the mean distance between the
+/// sheets: 0.42% and 0.46% below (the pressure varies a little over the jittered meshes, and
+/// the mean of the square root is below the square root of the mean); asserted within 1%. The
+/// pairs' normal forces sum to the weights above the two interfaces (measured to 1.6e-9), the
+/// frames' mean contact pressure on each sheet is the weight pressure on its sides (to 3e-9),
+/// and the held sheet's support carries all three sheets, all asserted to 1e-6.
+#[test]
+fn a_stack_of_sheets_sinks_into_its_offset_by_the_closed_form() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let (h, e, rho, g, side) = (1e-3, 1e6, 1000.0, 1000.0, 0.05);
+    let sheets: Vec<(f64, f64, f64)> = (0..3).map(|k| (0.0, 0.0, k as f64 * 1.001 * h)).collect();
+    sheets_mesh(dir, "stack.vtk", side, 0.01, &sheets);
+    let settings = format!(
+        "[material]\nyoung = {e}\nthickness = {h}\ndensity = {rho}\n\
+         [loads]\ngravity = [0, 0, -{g}]\n\
+         [constraints]\nfix_boxes = [{{ min = [-1, -1, -1e-4], max = [1, 1, 1e-4] }}]\n\
+         [[constraints.support]]\ncomponents = [\"x\", \"y\"]\n\
+         inside = {{ min = [-1, -1, 5e-4], max = [1, 1, 1] }}\n\
+         [self_contact]\nenabled = true\n"
+    );
+    std::fs::write(dir.join("stack.toml"), settings).unwrap();
+    shellsim(&["stack.toml", "stack.vtk", "--out", "out", "-q"], dir);
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(s["converged"], true, "{s}");
+    // The contact carries the weight above each interface: one sheet's and two sheets', and
+    // the held sheet's support the weight of all three.
+    let w1 = rho * h * g * side * side;
+    let last = log_rows(&dir.join("out")).pop().unwrap();
+    let carried = last["self_contact_force"];
+    println!(
+        "contact force {carried} N, weights above the interfaces {} N",
+        3.0 * w1
+    );
+    assert!((carried - 3.0 * w1).abs() < 1e-6 * 3.0 * w1, "{carried}");
+    let held = s["reactions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["support"] == "fix_boxes[0]")
+        .unwrap_or_else(|| panic!("{}", s["reactions"]))["force"][2]
+        .as_f64()
+        .unwrap();
+    assert!((held - 3.0 * w1).abs() < 1e-6 * 3.0 * w1, "{held}");
+    let frames = common::finite_frames(&dir.join("out"), "vtu", "stack");
+    let x = &frames.last().unwrap().positions;
+    // The frames' contact pressure, per sheet (area-weighted): the top sheet is pressed from
+    // below by its weight's pressure, the middle one from both sides (σ + 2σ), the held one
+    // by 2σ.
+    let fm = frames.last().unwrap();
+    let pressure = &fm.face_fields["contact_pressure"].data;
+    let nf = fm.faces.len() / 3;
+    for (k, expected) in [(0, 2.0), (1, 3.0), (2, 1.0)] {
+        let (mut pa, mut a) = (0.0, 0.0);
+        for f in k * nf..(k + 1) * nf {
+            let area = fm.face_area(f);
+            pa += pressure[f] * area;
+            a += area;
+        }
+        let sigma = expected * rho * h * g;
+        println!(
+            "sheet {k}: mean contact pressure {} Pa, expected {sigma} Pa",
+            pa / a
+        );
+        assert!(
+            (pa / a - sigma).abs() < 1e-6 * sigma,
+            "sheet {k}: {}",
+            pa / a
+        );
+    }
+    let n = x.len() / 3;
+    let mean_z = |k: usize| x[k * n..(k + 1) * n].iter().map(|p| p.z).sum::<f64>() / n as f64;
+    let (k_pen, delta) = (e / h, h / 100.0);
+    for (upper, carried) in [(1, 2.0), (2, 1.0)] {
+        let sigma = carried * rho * h * g;
+        let exact = (2.0 * delta * sigma / k_pen).sqrt();
+        let p = h - (mean_z(upper) - mean_z(upper - 1));
+        println!("interface under sheet {upper}: penetration {p:.6e}, closed form {exact:.6e}");
+        assert!((p - exact).abs() < 0.01 * exact, "{p} vs {exact}");
+    }
+}
+
+/// A square dropped from 1 cm onto a held one, shifted so that it overhangs an edge, in
+/// dynamic mode: it lands at 0.44 m/s, bounces and settles over the edge. No frame has
+/// crossing faces or two mid-surfaces closer than the minimum separation (a tenth of the
+/// offset): checked by the independent script. Measured: the closest approach 0.607 mm of the
+/// 1 mm offset, at the impact, where the edges of the tilted sheet cross the held sheet's
+/// edge (edge–edge pairs press only inside half the offset).
+#[test]
+fn a_dropped_sheet_lands_on_another_without_crossing_it() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let h = 1e-3;
+    sheets_mesh(
+        dir,
+        "drop.vtk",
+        0.05,
+        0.01,
+        &[(0.0, 0.0, 0.0), (0.003, 0.002, 0.01)],
+    );
+    std::fs::write(
+        dir.join("drop.toml"),
+        format!(
+            "[material]\nyoung = 1e6\nthickness = {h}\ndensity = 1000\n\
+             [solver]\nmode = \"dynamic\"\n\
+             [time]\nend = 0.3\ndt = 1e-3\noutput_interval = 0.01\n\
+             [loads]\ngravity = [0, 0, -9.81]\n\
+             [constraints]\nfix_boxes = [{{ min = [-1, -1, -1e-4], max = [1, 1, 1e-4] }}]\n\
+             [self_contact]\nenabled = true\n"
+        ),
+    )
+    .unwrap();
+    shellsim(&["drop.toml", "drop.vtk", "--out", "out", "-q"], dir);
+    let last = log_rows(&dir.join("out")).pop().unwrap();
+    assert!(
+        last["self_contact_pairs"] > 0.0,
+        "the sheet rests on the other"
+    );
+    let c = check(dir, "drop.vtk", "out", 2.0 * (h + h / 100.0));
+    println!("dropped sheet: {c}");
+    assert_eq!(c["crossing_pairs"], 0, "{c}");
+    assert_eq!(c["frames"], 31);
+    let dmin = c["min_distance"].as_f64().unwrap();
+    assert!(dmin >= 0.1 * h && dmin < h, "{dmin}");
+}

@@ -48,7 +48,7 @@
 //! points' coordinates, point–triangle `(p, t₂, t₁, t₀)` with `t₀ < t₁ < t₂`, edge–edge
 //! `(a, b, c, d)` with `a < b`, `c < d` (the order of the last two slots tells the kinds apart).
 
-use super::term::{StepBound, StepLimit, Term};
+use super::term::{Reports, StepBound, StepLimit, Term};
 use crate::body::Body;
 use crate::contact::{broad, ccd, distance, penalty};
 use crate::elements::Stencil;
@@ -116,6 +116,35 @@ impl SelfContact {
         } else {
             0.25 * (h[nodes[0]] + h[nodes[1]] + h[nodes[2]] + h[nodes[3]])
         }
+    }
+
+    /// The distance below which a pair presses (the offset for a point–triangle pair, half
+    /// of it for an edge–edge pair) and its area weight (m²): half the vertex's area, or a
+    /// quarter of the mean of the four vertex areas (module doc).
+    #[inline]
+    fn law(&self, nodes: &[usize]) -> (Real, Real) {
+        let xi = self.offset(nodes);
+        let a = &self.area;
+        if is_point_triangle(nodes) {
+            (xi, 0.5 * a[nodes[0]])
+        } else {
+            (
+                0.5 * xi,
+                0.0625 * (a[nodes[0]] + a[nodes[1]] + a[nodes[2]] + a[nodes[3]]),
+            )
+        }
+    }
+
+    /// The mollifier `(m, m′, m″)` of an edge–edge pair at `y` where it is below 1 (nearly
+    /// parallel edges), `None` elsewhere.
+    #[inline]
+    fn mollifier(&self, nodes: &[usize], y: &[Vec3; 4]) -> Option<(Real, Real, Real)> {
+        let r = &self.rest;
+        let eps = MOLLIFIER
+            * (r[nodes[1]] - r[nodes[0]]).norm_squared()
+            * (r[nodes[3]] - r[nodes[2]]).norm_squared();
+        let (c, _) = distance::cross_squared(y, None);
+        (c < eps).then(|| distance::mollifier(c, eps))
     }
 
     /// The closest points of an element at `x`.
@@ -251,16 +280,7 @@ impl SelfContact {
     ) -> Real {
         let y = points(x, nodes);
         let pt = is_point_triangle(nodes);
-        let xi = self.offset(nodes);
-        let (reach, weight) = if pt {
-            (xi, 0.5 * self.area[nodes[0]])
-        } else {
-            let a = &self.area;
-            (
-                0.5 * xi,
-                0.0625 * (a[nodes[0]] + a[nodes[1]] + a[nodes[2]] + a[nodes[3]]),
-            )
-        };
+        let (reach, weight) = self.law(nodes);
         let cl = self.closest(&y, nodes);
         let zero = |g: Option<&mut SVec<12>>, h: Option<&mut SMat<12, 12>>| {
             if let Some(g) = g {
@@ -277,17 +297,7 @@ impl SelfContact {
         let d = cl.d2.sqrt();
         let w = self.stiffness * weight;
         let (psi, dpsi, ddpsi) = penalty(reach - d, self.smoothing);
-        // The mollifier of nearly parallel edges: (m, m′, m″) where it is below 1.
-        let mollifier = if pt {
-            None
-        } else {
-            let r = &self.rest;
-            let eps = MOLLIFIER
-                * (r[nodes[1]] - r[nodes[0]]).norm_squared()
-                * (r[nodes[3]] - r[nodes[2]]).norm_squared();
-            let (c, _) = distance::cross_squared(&y, None);
-            (c < eps).then(|| distance::mollifier(c, eps))
-        };
+        let mollifier = if pt { None } else { self.mollifier(nodes, &y) };
         let m = mollifier.map_or(1.0, |(m, _, _)| m);
         let energy = m * w * psi;
         if grad.is_none() && hess.is_none() {
@@ -321,6 +331,118 @@ impl SelfContact {
             }
         }
         energy
+    }
+}
+
+impl SelfContact {
+    /// The normal force `λ = m k w ψ′` (N) of every pair of `map` that carries energy at
+    /// `x`, with its closest points' coefficients (module doc).
+    fn forces(&self, map: &ElementMap, x: &[Vec3]) -> Vec<(usize, Real, [Real; 4])> {
+        let nodes = &map.nodes;
+        let active = self.active(map, x);
+        (0..nodes.len() / 4)
+            .into_par_iter()
+            .filter(|&e| active[e])
+            .filter_map(|e| {
+                let n = &nodes[4 * e..4 * e + 4];
+                let y = points(x, n);
+                let cl = self.closest(&y, n);
+                let (reach, weight) = self.law(n);
+                let d = cl.d2.sqrt();
+                if d >= reach || d <= 0.0 {
+                    return None;
+                }
+                let m = if is_point_triangle(n) {
+                    1.0
+                } else {
+                    self.mollifier(n, &y).map_or(1.0, |(m, _, _)| m)
+                };
+                let dpsi = penalty(reach - d, self.smoothing).1;
+                Some((e, m * self.stiffness * weight * dpsi, cl.c))
+            })
+            .collect()
+    }
+
+    /// This term's element map in `pot`'s pattern.
+    fn map<'p>(&self, pot: &Potential<'p>) -> Option<&'p ElementMap> {
+        let i = pot.terms.iter().position(|t| t.name() == self.name())?;
+        pot.pattern.maps.get(i)
+    }
+}
+
+impl Reports for SelfContact {
+    /// `self_contact_pairs`: the pairs that press; `self_contact_gap`: the smallest distance
+    /// of a gathered pair over its offset (the gathering's reach over the offset when none
+    /// was gathered); `self_contact_force`: the sum of the pairs' normal forces (N).
+    fn observables(&self, pot: &Potential, x: &[Vec3], _phi: &[Real]) -> Vec<(String, Real)> {
+        let Some(map) = self.map(pot) else {
+            return Vec::new();
+        };
+        let forces = self.forces(map, x);
+        let gap = map
+            .nodes
+            .par_chunks(4)
+            .map(|n| self.closest(&points(x, n), n).d2.sqrt() / self.offset(n))
+            .reduce(
+                || 1.0 + self.halo / self.xi_max.max(Real::MIN_POSITIVE),
+                Real::min,
+            );
+        vec![
+            ("self_contact_pairs".into(), forces.len() as Real),
+            ("self_contact_gap".into(), gap),
+            (
+                "self_contact_force".into(),
+                forces.iter().map(|f| f.1).sum(),
+            ),
+        ]
+    }
+
+    /// `contact_pressure` (Pa): per face, the mean over its vertices of the normal force the
+    /// pairs put on the vertex (shared by the closest points' coefficients) over its area;
+    /// `contact_gap` (m): per face, the smallest `d − ξ` of the gathered pairs that involve one
+    /// of its vertices (the halo where none does).
+    fn face_fields(&self, pot: &Potential, x: &[Vec3], _phi: &[Real]) -> Vec<(String, Vec<Real>)> {
+        let Some(map) = self.map(pot) else {
+            return Vec::new();
+        };
+        let nv = x.len();
+        let mut force = vec![0.0; nv];
+        for (e, lambda, c) in self.forces(map, x) {
+            for (k, ci) in c.iter().enumerate() {
+                force[map.nodes[4 * e + k]] += lambda * ci.abs();
+            }
+        }
+        let mut gap = vec![self.halo; nv];
+        for n in map.nodes.chunks(4) {
+            let g = self.closest(&points(x, n), n).d2.sqrt() - self.offset(n);
+            for &v in n {
+                gap[v] = gap[v].min(g);
+            }
+        }
+        let per_face =
+            |f: &[usize; 3], per: &dyn Fn(usize) -> Real| (per(f[0]) + per(f[1]) + per(f[2])) / 3.0;
+        let pressure = self
+            .faces
+            .iter()
+            .map(|f| {
+                per_face(f, &|v| {
+                    if self.area[v] > 0.0 {
+                        force[v] / self.area[v]
+                    } else {
+                        0.0
+                    }
+                })
+            })
+            .collect();
+        let face_gap = self
+            .faces
+            .iter()
+            .map(|f| gap[f[0]].min(gap[f[1]]).min(gap[f[2]]))
+            .collect();
+        vec![
+            ("contact_pressure".into(), pressure),
+            ("contact_gap".into(), face_gap),
+        ]
     }
 }
 
@@ -412,6 +534,9 @@ impl Term for SelfContact {
         Some(self)
     }
     fn step_limit(&self) -> Option<&dyn StepLimit> {
+        Some(self)
+    }
+    fn reports(&self) -> Option<&dyn Reports> {
         Some(self)
     }
     fn eval(

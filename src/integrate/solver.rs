@@ -462,9 +462,33 @@ impl<'a> Solver<'a> {
             .eval(&s.x, &s.dofs, Want::Energy, &mut [], &mut [])
         };
         let ep = e(&predicted);
-        if ep.is_finite() && ep < e(state) {
-            state.copy_from(&predicted);
+        if !(ep.is_finite() && ep < e(state)) {
+            return;
         }
+        // A term that bounds the steps (contact) must allow the whole prediction: it is a step
+        // like Newton's, and may not carry the sheet through itself.
+        if self.scene.terms.iter().any(|t| t.step_limit().is_some()) {
+            let nx = 3 * state.x.len();
+            let mut step = vec![0.0; nx + state.dofs.len()];
+            for (v, (a, b)) in state.x.iter().zip(&predicted.x).enumerate() {
+                for k in 0..3 {
+                    step[3 * v + k] = b[k] - a[k];
+                }
+            }
+            for (i, (a, b)) in state.dofs.iter().zip(&predicted.dofs).enumerate() {
+                step[nx + i] = b - a;
+            }
+            let bound = Potential {
+                states: &state.terms,
+                taken_at: &self.taken_at,
+                ..*pot
+            }
+            .step_bound(&state.x, &step);
+            if bound.regather || bound.fraction < 1.0 {
+                return;
+            }
+        }
+        state.copy_from(&predicted);
     }
 
     /// Tests `H + δI ≻ 0` at `state` (see module doc).
