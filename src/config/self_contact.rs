@@ -26,8 +26,8 @@ pub struct SelfContact {
     /// Pairs closer than this along the reference surface never touch (m). `"auto"`:
     /// `2 (ξ + δ)` with the largest offset (default).
     pub exclusion: AutoOr,
-    /// How far beyond the offset pairs are gathered at the start of a step (m); a vertex
-    /// moves at most half of it within the step. `"auto"`: the largest offset (default).
+    /// How far beyond the offset pairs are gathered into the Hessian's pattern at the start
+    /// of a step (m). `"auto"`: the largest offset (default).
     pub halo: AutoOr,
     /// The smallest distance two mid-surfaces may come to, as a fraction of their offset
     /// (default `0.1`): no step takes a pair closer.

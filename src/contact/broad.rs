@@ -40,6 +40,7 @@ impl Aabb {
     fn overlaps(&self, o: &Aabb) -> bool {
         (0..3).all(|k| self.min[k] <= o.max[k] && o.min[k] <= self.max[k])
     }
+    #[cfg(test)]
     fn contains(&self, p: &Vec3) -> bool {
         (0..3).all(|k| self.min[k] <= p[k] && p[k] <= self.max[k])
     }
@@ -87,7 +88,12 @@ impl Grid {
             })
             .collect();
         g.table = per.into_iter().flatten().collect();
-        g.table.par_sort_unstable();
+        // Rayon's sort pays only on large tables.
+        if g.table.len() > 1 << 16 {
+            g.table.par_sort_unstable();
+        } else {
+            g.table.sort_unstable();
+        }
         g
     }
     /// Calls `f` with the key of every cell `b` overlaps.
@@ -109,49 +115,71 @@ impl Grid {
     }
 }
 
-/// Vertex `p` and face `f` whose face box, inflated by `radius`, contains `x[p]`, with `p` not a
-/// vertex of `f`: sorted by vertex, then face.
-pub fn point_triangle(x: &[Vec3], faces: &[[usize; 3]], radius: Real) -> Vec<(u32, u32)> {
+/// The box of the vertices `v` at `x` and, when given, at `to` (the end of a step: the box
+/// then holds the straight paths from one to the other), inflated by `inflate`.
+#[inline]
+fn span(v: &[usize], x: &[Vec3], to: Option<&[Vec3]>, inflate: Real) -> Aabb {
+    match to {
+        None => Aabb::of(v.iter().map(|&i| x[i]), inflate),
+        Some(t) => Aabb::of(
+            v.iter().map(|&i| x[i]).chain(v.iter().map(|&i| t[i])),
+            inflate,
+        ),
+    }
+}
+
+/// Vertex `p` and face `f`, `p` not a vertex of `f`, whose boxes overlap, the face's inflated
+/// by `radius`. The boxes hold the positions `x` and, when given, `to`: every pair that can
+/// come within `radius` on the straight paths from one to the other. Sorted by vertex, then
+/// face.
+pub fn point_triangle(
+    x: &[Vec3],
+    to: Option<&[Vec3]>,
+    faces: &[[usize; 3]],
+    radius: Real,
+) -> Vec<(u32, u32)> {
     if faces.is_empty() {
         return Vec::new();
     }
-    let boxes: Vec<Aabb> = faces
-        .par_iter()
-        .map(|f| Aabb::of(f.iter().map(|&v| x[v]), radius))
-        .collect();
+    let boxes: Vec<Aabb> = faces.par_iter().map(|f| span(f, x, to, radius)).collect();
     let grid = Grid::new(&boxes);
     let per: Vec<Vec<(u32, u32)>> = (0..x.len())
         .into_par_iter()
         .map(|p| {
-            let mut out: Vec<(u32, u32)> = grid
-                .at(Grid::key(grid.coord(&x[p])))
-                .iter()
-                .map(|e| e.1)
-                .filter(|&f| !faces[f as usize].contains(&p) && boxes[f as usize].contains(&x[p]))
-                .map(|f| (p as u32, f))
-                .collect();
+            let own = span(&[p], x, to, 0.0);
+            let mut out = Vec::new();
+            grid.cells(&own, |k| {
+                for &(_, f) in grid.at(k) {
+                    if !faces[f as usize].contains(&p) && boxes[f as usize].overlaps(&own) {
+                        out.push((p as u32, f));
+                    }
+                }
+            });
             out.sort_unstable();
+            out.dedup();
             out
         })
         .collect();
     per.into_iter().flatten().collect()
 }
 
-/// Edge pairs `(a, b)`, `a < b`, sharing no vertex, whose boxes inflated by `radius` overlap:
-/// sorted.
-pub fn edge_edge(x: &[Vec3], edges: &[[usize; 2]], radius: Real) -> Vec<(u32, u32)> {
+/// Edge pairs `(a, b)`, `a < b`, sharing no vertex, whose boxes (one inflated by `radius`)
+/// overlap, the boxes holding `x` and, when given, `to` as in [`point_triangle`]: sorted.
+pub fn edge_edge(
+    x: &[Vec3],
+    to: Option<&[Vec3]>,
+    edges: &[[usize; 2]],
+    radius: Real,
+) -> Vec<(u32, u32)> {
     if edges.is_empty() {
         return Vec::new();
     }
-    let inflated: Vec<Aabb> = edges
-        .par_iter()
-        .map(|e| Aabb::of(e.iter().map(|&v| x[v]), radius))
-        .collect();
+    let inflated: Vec<Aabb> = edges.par_iter().map(|e| span(e, x, to, radius)).collect();
     let grid = Grid::new(&inflated);
     let per: Vec<Vec<(u32, u32)>> = (0..edges.len())
         .into_par_iter()
         .map(|a| {
-            let own = Aabb::of(edges[a].iter().map(|&v| x[v]), 0.0);
+            let own = span(&edges[a], x, to, 0.0);
             let mut out = Vec::new();
             grid.cells(&own, |k| {
                 for &(_, b) in grid.at(k) {
@@ -213,7 +241,7 @@ mod tests {
                 }
             }
         }
-        assert_eq!(point_triangle(&x, &faces, r), brute);
+        assert_eq!(point_triangle(&x, None, &faces, r), brute);
         // Every vertex–face pair within r is a candidate.
         for p in 0..n {
             for (f, t) in faces.iter().enumerate() {
@@ -236,6 +264,38 @@ mod tests {
                 }
             }
         }
-        assert_eq!(edge_edge(&x, &edges, r), brute);
+        assert_eq!(edge_edge(&x, None, &edges, r), brute);
+        // Swept: the boxes hold both ends of a random motion.
+        let to: Vec<Vec3> = x
+            .iter()
+            .map(|p| p + Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.1)
+            .collect();
+        let sw = |v: &[usize], inflate: Real| {
+            Aabb::of(
+                v.iter().map(|&i| x[i]).chain(v.iter().map(|&i| to[i])),
+                inflate,
+            )
+        };
+        let mut brute = Vec::new();
+        for p in 0..n {
+            let own = sw(&[p], 0.0);
+            for (f, t) in faces.iter().enumerate() {
+                if !t.contains(&p) && sw(t, r).overlaps(&own) {
+                    brute.push((p as u32, f as u32));
+                }
+            }
+        }
+        assert_eq!(point_triangle(&x, Some(&to), &faces, r), brute);
+        let mut brute = Vec::new();
+        for a in 0..edges.len() {
+            let own = sw(&edges[a], 0.0);
+            for b in a + 1..edges.len() {
+                if !edges[b].iter().any(|v| edges[a].contains(v)) && sw(&edges[b], r).overlaps(&own)
+                {
+                    brute.push((a as u32, b as u32));
+                }
+            }
+        }
+        assert_eq!(edge_edge(&x, Some(&to), &edges, r), brute);
     }
 }

@@ -38,6 +38,33 @@ pub fn safe_fraction(x: &[Vec3; 4], dx: &[Vec3; 4], pt: bool, d_min: Real, max: 
     } else {
         n[0].max(n[1]) + n[2].max(n[3])
     };
+    // A lower bound of the distance first, from the primitives' boxes: most pairs the broad
+    // phase hands over are too far apart for their relative motion, and need no exact
+    // distance.
+    let (a, b): (&[Vec3], &[Vec3]) = if pt {
+        (&x[..1], &x[1..])
+    } else {
+        (&x[..2], &x[2..])
+    };
+    let gap = (0..3)
+        .map(|k| {
+            let (alo, ahi) = a
+                .iter()
+                .fold((Real::INFINITY, -Real::INFINITY), |(l, h), p| {
+                    (l.min(p[k]), h.max(p[k]))
+                });
+            let (blo, bhi) = b
+                .iter()
+                .fold((Real::INFINITY, -Real::INFINITY), |(l, h), p| {
+                    (l.min(p[k]), h.max(p[k]))
+                });
+            (blo - ahi).max(alo - bhi).max(0.0)
+        })
+        .fold(0.0, |s: Real, g| s + g * g)
+        .sqrt();
+    if l * max <= (gap - d_min) * (1.0 - STOP) {
+        return max;
+    }
     let dist = |t: Real| -> Real {
         let y: [Vec3; 4] = std::array::from_fn(|i| x[i] + dx[i] * t);
         if pt {

@@ -107,7 +107,8 @@ pub struct Potential<'a> {
     /// statics the applied loads' when smaller ([`Potential::load_scale`]).
     pub force_scale: Real,
     /// The positions at which the elements of the terms whose elements change were gathered
-    /// (empty: no bound on the motion from them); the driver's solver sets them.
+    /// (the driver's solver sets them; empty: the positions evaluated): a contact term tells
+    /// there which pairs it gathered.
     pub taken_at: &'a [Vec3],
     /// The stateful terms' states the potential is evaluated with ([`crate::solve::State::terms`]): the
     /// scene's initial states unless a driver sets its own.

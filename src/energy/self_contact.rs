@@ -30,10 +30,12 @@
 //!
 //! **The guarantee.** No step takes a pair closer than `s ξ` (`min_separation` s, default 0.1):
 //! every Newton step is bounded by additive CCD over the pairs ([`crate::contact::ccd`]) and
-//! every trial state is checked before the line search accepts it. The pairs are gathered once
-//! per step (at the step's start, when the pattern is refreshed), all those within `ξ + halo`;
-//! within the step each vertex moves at most `halo/2` from where they were gathered, so no
-//! pair outside the list can come within `ξ`.
+//! every trial state is checked before the line search accepts it. The pairs are gathered into
+//! the Hessian's pattern once per step (at the step's start, when the pattern is refreshed),
+//! all those within `ξ + halo`. Every Newton step also runs the broad phase over the boxes of
+//! the straight paths: a pair that was not gathered may not come within its offset, where its
+//! law would begin (CCD to `ξ`). When such a pair limits the step and is within reach, the pairs
+//! are gathered again at the current iterate (a new pattern), and Newton goes on.
 //!
 //! **Exclusion.** Pairs within the exclusion radius `R` of each other on the reference sheet,
 //! measured both in space and along its edges (the graph distance, at most `2R` plus two edge
@@ -161,8 +163,8 @@ impl SelfContact {
     /// stencil, point–triangle pairs first (module doc for the slot order).
     fn pairs(&self, x: &[Vec3], beyond: Real) -> Stencil {
         let reach = self.xi_max + beyond;
-        let pt = broad::point_triangle(x, &self.faces, reach);
-        let ee = broad::edge_edge(x, &self.edges, reach);
+        let pt = broad::point_triangle(x, None, &self.faces, reach);
+        let ee = broad::edge_edge(x, None, &self.edges, reach);
         let pt: Vec<[usize; 4]> = pt
             .par_iter()
             .filter(|&&(p, f)| {
@@ -453,10 +455,12 @@ impl ChangingElements for SelfContact {
 }
 
 impl StepLimit for SelfContact {
-    /// The smallest of: each vertex's room within half the halo of where the pairs were
-    /// gathered, and each pair's additive CCD fraction to `s ξ`. Gathering again pays when
-    /// the room left is below half of what a fresh gathering would give (capped at the whole
-    /// step).
+    /// The smallest of each gathered pair's additive CCD fraction to `s ξ`, and of each other
+    /// pair's fraction to its offset `ξ`, where its law would begin: a pair that was not
+    /// gathered may not press within the step. The others are found by the broad phase over
+    /// the boxes of the straight paths, inflated by the largest offset. When one of them would
+    /// enter its offset and is within the gathering's reach now, gathering again at `x` adds it
+    /// and allows the longer step.
     fn max_fraction(
         &self,
         pot: &Potential,
@@ -465,49 +469,73 @@ impl StepLimit for SelfContact {
         step: &[Real],
     ) -> StepBound {
         let dx = |v: usize| Vec3::new(step[3 * v], step[3 * v + 1], step[3 * v + 2]);
-        let taken = pot.taken_at;
-        let half = 0.5 * self.halo;
-        let fraction = |room: Real, l: Real| {
-            if room <= 0.0 {
-                0.0
-            } else if l > room {
-                room / l
-            } else {
-                1.0
-            }
-        };
-        let (room, fresh) = if taken.len() == x.len() {
-            (0..x.len())
-                .into_par_iter()
-                .map(|v| {
-                    let l = dx(v).norm();
-                    (
-                        fraction(half - (x[v] - taken[v]).norm(), l),
-                        fraction(half, l),
-                    )
-                })
-                .reduce(|| (1.0, 1.0), |a, b| (a.0.min(b.0), a.1.min(b.1)))
-        } else {
-            (1.0, 1.0)
-        };
-        if room < 0.5 * fresh {
-            return StepBound {
-                fraction: room,
-                regather: true,
-            };
-        }
         let nodes = &map.nodes;
-        let ccd = (0..nodes.len() / 4)
+        let gathered = (0..nodes.len() / 4)
             .into_par_iter()
             .map(|e| {
                 let n = &nodes[4 * e..4 * e + 4];
                 let d: [Vec3; 4] = std::array::from_fn(|i| dx(n[i]));
                 let d_min = self.min_separation * self.offset(n);
-                ccd::safe_fraction(&points(x, n), &d, is_point_triangle(n), d_min, room)
+                ccd::safe_fraction(&points(x, n), &d, is_point_triangle(n), d_min, 1.0)
             })
-            .reduce(|| room, Real::min);
+            .reduce(|| 1.0, Real::min);
+        // The pairs not gathered: where the pairs were gathered (the solver's positions, or `x`
+        // outside a solve), they were farther apart than their offset and the halo.
+        let taken = if pot.taken_at.len() == x.len() {
+            pot.taken_at
+        } else {
+            x
+        };
+        let to: Vec<Vec3> = (0..x.len()).map(|v| x[v] + dx(v)).collect();
+        let pt = broad::point_triangle(x, Some(&to), &self.faces, self.xi_max);
+        let ee = broad::edge_edge(x, Some(&to), &self.edges, self.xi_max);
+        let others = pt
+            .par_iter()
+            .filter(|&&(p, f)| {
+                self.excluded_pt
+                    .binary_search(&((p as u64) << 32 | f as u64))
+                    .is_err()
+            })
+            .map(|&(p, f)| {
+                let mut t = self.faces[f as usize];
+                t.sort_unstable();
+                [p as usize, t[2], t[1], t[0]]
+            })
+            .chain(
+                ee.par_iter()
+                    .filter(|&&(a, b)| {
+                        self.excluded_ee
+                            .binary_search(&((a as u64) << 32 | b as u64))
+                            .is_err()
+                    })
+                    .map(|&(a, b)| {
+                        let (ea, eb) = (self.edges[a as usize], self.edges[b as usize]);
+                        [ea[0], ea[1], eb[0], eb[1]]
+                    }),
+            )
+            .map(|n| {
+                let d: [Vec3; 4] = std::array::from_fn(|i| dx(n[i]));
+                let y = points(x, &n);
+                let xi = self.offset(&n);
+                let t = ccd::safe_fraction(&y, &d, is_point_triangle(&n), xi, 1.0);
+                // The gathering's own test (`pairs`): those within reach were gathered, and
+                // answer to the bound above.
+                if t >= 1.0 || self.closest(&points(taken, &n), &n).d2 < (xi + self.halo).powi(2) {
+                    return (1.0, false);
+                }
+                // Within reach now: gathering again would add it.
+                (t, self.closest(&y, &n).d2 < (xi + self.halo).powi(2))
+            })
+            .reduce(|| (1.0, false), |a, b| (a.0.min(b.0), a.1 || b.1));
+        let moved = !std::ptr::eq(taken, x) && taken != x;
+        if others.0 < gathered && others.1 && moved {
+            return StepBound {
+                fraction: others.0,
+                regather: true,
+            };
+        }
         StepBound {
-            fraction: ccd,
+            fraction: gathered.min(others.0),
             regather: false,
         }
     }
@@ -634,7 +662,7 @@ fn exclude(sc: &mut SelfContact, body: &Body) -> Result<(), MeshError> {
     let graph = 2.0 * r + 2.0 * longest;
     let adjacency = Adjacency::new(x.len(), &sc.edges, x);
     // Point–triangle pairs within r in space, grouped by vertex.
-    let pt = broad::point_triangle(x, &sc.faces, r);
+    let pt = broad::point_triangle(x, None, &sc.faces, r);
     let pt: Vec<(u32, u32, Real)> = pt
         .into_par_iter()
         .filter_map(|(p, f)| {
@@ -643,7 +671,7 @@ fn exclude(sc: &mut SelfContact, body: &Body) -> Result<(), MeshError> {
             (d2 < r * r).then_some((p, f, d2.sqrt()))
         })
         .collect();
-    let ee = broad::edge_edge(x, &sc.edges, r);
+    let ee = broad::edge_edge(x, None, &sc.edges, r);
     let ee: Vec<(u32, u32, Real)> = ee
         .into_par_iter()
         .filter_map(|(a, b)| {

@@ -148,11 +148,8 @@ pub(super) fn run_dynamic(
     }
     // Friction: the lagged normal forces, carried from step to step.
     let obstacles = !sc.settings.obstacles.is_empty();
-    // Self-contact bounds every Newton step from the step's start: Newton starts there, since
-    // a prediction could carry the sheet through itself unchecked.
-    let bounded = sc.terms.iter().any(|t| t.step_limit().is_some());
     // With a fixed step and no obstacle, Newton starts from the extrapolation (see `acc`).
-    let extrapolate = tm.dt_max <= tm.dt && !obstacles && !bounded;
+    let extrapolate = tm.dt_max <= tm.dt && !obstacles;
     let mut lag = FrictionLag::new(sc, &state.x, dial_now, cf.slip_speed);
     // With friction, the last accepted step (its start, its start's dial, its length): frames
     // report the friction forces of that step. The first frame reports none.
@@ -190,7 +187,7 @@ pub(super) fn run_dynamic(
         // Vertices on prescribed paths are fixed: their inertia is not assembled, so the
         // prediction can carry their prescribed position into every trial.
         sc.body.prescribe(&mut xhat, dial);
-        if obstacles || bounded {
+        if obstacles {
             // Newton starts from the last state, not the prediction: the prediction of a sheet
             // falling onto an obstacle lies deep inside it, where the penalty's curvature and
             // the friction's lagged normals make the first iterations wander.
@@ -214,6 +211,16 @@ pub(super) fn run_dynamic(
         if extrapolate {
             for (k, a) in acc[3 * n..].iter().enumerate() {
                 trial.dofs[ne + k] += a * h * h;
+            }
+        }
+        // With self-contact a predicted start is a step like Newton's: Newton starts from the
+        // step's start when the contact does not allow all of it.
+        if !obstacles {
+            let pat = s.pattern();
+            let pot = s.potential(&pat, dial);
+            if !s.allows(&pot, &state, &trial.x, &trial.dofs) {
+                trial.x.copy_from_slice(&state.x);
+                sc.body.prescribe(&mut trial.x, dial);
             }
         }
         let moisture_clock = Instant::now();

@@ -48,7 +48,7 @@ pub(super) struct Solver<'a> {
     /// Whether some term's elements change during the run.
     pub(super) changing: bool,
     /// The positions at which the changing terms' elements were last gathered (empty when no
-    /// term's elements change): such a term bounds each Newton step's motion from them.
+    /// term's elements change): a contact term tells there which pairs it gathered.
     pub(super) taken_at: Vec<Vec3>,
     /// The run's controls, from the validated settings.
     pub(super) config: config::RunConfig,
@@ -467,28 +467,42 @@ impl<'a> Solver<'a> {
         }
         // A term that bounds the steps (contact) must allow the whole prediction: it is a step
         // like Newton's, and may not carry the sheet through itself.
-        if self.scene.terms.iter().any(|t| t.step_limit().is_some()) {
-            let nx = 3 * state.x.len();
-            let mut step = vec![0.0; nx + state.dofs.len()];
-            for (v, (a, b)) in state.x.iter().zip(&predicted.x).enumerate() {
-                for k in 0..3 {
-                    step[3 * v + k] = b[k] - a[k];
-                }
-            }
-            for (i, (a, b)) in state.dofs.iter().zip(&predicted.dofs).enumerate() {
-                step[nx + i] = b - a;
-            }
-            let bound = Potential {
-                states: &state.terms,
-                taken_at: &self.taken_at,
-                ..*pot
-            }
-            .step_bound(&state.x, &step);
-            if bound.regather || bound.fraction < 1.0 {
-                return;
+        if self.allows(pot, state, &predicted.x, &predicted.dofs) {
+            state.copy_from(&predicted);
+        }
+    }
+
+    /// Whether the terms that bound the steps ([`crate::energy::term::StepLimit`], contact)
+    /// allow the whole straight step from `from` to `(to, to_dofs)` under `pot` (always, when
+    /// no term bounds the steps): a predicted start is such a step, and may not carry the sheet
+    /// through itself.
+    pub(super) fn allows(
+        &self,
+        pot: &Potential,
+        from: &State,
+        to: &[Vec3],
+        to_dofs: &[Real],
+    ) -> bool {
+        if !self.scene.terms.iter().any(|t| t.step_limit().is_some()) {
+            return true;
+        }
+        let nx = 3 * from.x.len();
+        let mut step = vec![0.0; nx + from.dofs.len()];
+        for (v, (a, b)) in from.x.iter().zip(to).enumerate() {
+            for k in 0..3 {
+                step[3 * v + k] = b[k] - a[k];
             }
         }
-        state.copy_from(&predicted);
+        for (i, (a, b)) in from.dofs.iter().zip(to_dofs).enumerate() {
+            step[nx + i] = b - a;
+        }
+        let bound = Potential {
+            states: &from.terms,
+            taken_at: &self.taken_at,
+            ..*pot
+        }
+        .step_bound(&from.x, &step);
+        !bound.regather && bound.fraction >= 1.0
     }
 
     /// Tests `H + δI ≻ 0` at `state` (see module doc).
