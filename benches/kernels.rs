@@ -2,7 +2,9 @@
 //! assembly of ~100k faces on 1 and 2 threads, and one Newton iteration (assemble + numeric
 //! Cholesky + solve) on ~5k and ~20k-face meshes for every bending model, with the assembly and
 //! the factorisation also timed apart; the moisture step; and a balloon frame at the size of
-//! seed 002's Table 1 (`balloon`).
+//! seed 002's Table 1 (`balloon`); self-contact between two sheets pressed together
+//! (`self_contact`: the term's Hessian per pressing pair, the CCD step bound, and one Newton
+//! iteration of the same scene).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use shellsim::assembly::{Pattern, Want};
@@ -685,8 +687,111 @@ fn frame_write(c: &mut Criterion) {
     let _ = pot;
 }
 
+/// Two square sheets of side 1 (h = 2 mm, edges `edge`), the upper one `gap` above the lower
+/// at the evaluated state and 1.5 offsets above in the reference mesh; the scene, the pattern
+/// with the pairs gathered at that state, and the state.
+fn two_sheets(edge: f64, gap: f64) -> (Scene, Pattern, Vec<Vec3>) {
+    let h = 0.002;
+    let mut mesh = shellsim::mesh::Mesh::default();
+    for (k, z) in [(0u64, 0.0), (1, 1.5 * h)] {
+        let m = rectangle(
+            0.0,
+            0.0,
+            1.0,
+            1.0,
+            edge,
+            Spacing {
+                jitter: 0.2,
+                seed: 3 + k,
+                ..Default::default()
+            },
+        );
+        let base = mesh.positions.len();
+        mesh.positions
+            .extend(m.positions.iter().map(|p| Vec3::new(p.x, p.y, z)));
+        mesh.faces.extend(
+            m.faces
+                .iter()
+                .map(|f| [f[0] + base, f[1] + base, f[2] + base]),
+        );
+    }
+    let n0 = mesh.positions.len() / 2;
+    let s = format!(
+        "[material]\nthickness = {h}\n[self_contact]\nenabled = true\n\
+         [constraints]\nfix_boxes = [{{ min = [-1, -1, -1], max = [2, 2, 1e-4] }}]\n"
+    );
+    let sc = Scene::build(mesh, Settings::from_str_with(&s, "bench", &[]).unwrap()).unwrap();
+    let mut x = sc.body.mesh.positions.clone();
+    let mut rng = Rng::new(7);
+    for p in &mut x[n0..] {
+        p.z = gap + 1e-2 * gap * rng.symmetric();
+    }
+    let phi = vec![0.0; sc.num_scalar_dofs()];
+    let p = Pattern::for_scene(&sc)
+        .refreshed(&sc, &x, &phi)
+        .expect("the pressed sheets have pairs");
+    (sc, p, x)
+}
+
+/// Self-contact of two sheets pressed into their offset (every vertex of both presses): the
+/// term's energy, gradient and Hessian (throughput: pressing pairs), the CCD step bound of a
+/// random step of a tenth of the offset, and one Newton iteration (assembly of every term,
+/// numeric Cholesky, solve) of the same scene.
+fn self_contact(c: &mut Criterion) {
+    let mut g = c.benchmark_group("self_contact");
+    g.sample_size(10);
+    for edge in [1.0 / 50.0, 1.0 / 100.0] {
+        let (sc, p, x) = two_sheets(edge, 0.0018);
+        let i = (0..sc.terms.len())
+            .find(|&i| sc.terms[i].name() == "self_contact")
+            .unwrap();
+        let pot = potential(&sc, &p);
+        let phi = vec![0.0; sc.num_scalar_dofs()];
+        let (mut gr, mut h) = (vec![0.0; p.n], vec![0.0; p.nnz()]);
+        let pairs = p.maps[i].nodes.len() / 4;
+        let nf = sc.body.num_faces();
+        let term = &sc.terms[i];
+        g.throughput(Throughput::Elements(pairs as u64));
+        g.bench_function(BenchmarkId::new("term_hessian_per_pair", nf), |b| {
+            b.iter(|| {
+                term.eval(
+                    &pot,
+                    &p.maps[i],
+                    &x,
+                    &phi,
+                    Want::Hessian,
+                    shellsim::energy::HessianProjection::None,
+                    &mut gr,
+                    &mut h,
+                )
+            })
+        });
+        let mut rng = Rng::new(11);
+        let step: Vec<f64> = (0..p.n).map(|_| 2e-4 * rng.symmetric()).collect();
+        g.bench_function(BenchmarkId::new("ccd_step_bound_per_pair", nf), |b| {
+            b.iter(|| black_box(pot.step_bound(&x, &step).fraction))
+        });
+        g.throughput(Throughput::Elements(1));
+        let mut lin = LinearSolver::new(&p).unwrap();
+        g.bench_function(BenchmarkId::new("newton_iteration", nf), |b| {
+            b.iter(|| {
+                pot.eval(&x, &phi, Want::Hessian, &mut gr, &mut h);
+                for k in 0..p.n {
+                    h[p.diag(k)] += 1e-6;
+                }
+                lin.factor(&h).unwrap();
+                let mut rhs = gr.clone();
+                lin.solve_in_place(&mut rhs);
+                black_box(rhs[0])
+            })
+        });
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
+    self_contact,
     explicit_step,
     frame_write,
     kernel,
