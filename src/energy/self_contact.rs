@@ -272,11 +272,13 @@ impl SelfContact {
         active
     }
 
-    /// Energy, gradient and Hessian of one active element (module doc).
+    /// Energy, gradient and Hessian of one active element (module doc); with `gauss_newton`
+    /// the Hessian is the positive semi-definite model `m w ψ″ ∇d ∇dᵀ`.
     fn element(
         &self,
         nodes: &[usize],
         x: &[Vec3],
+        gauss_newton: bool,
         grad: Option<&mut SVec<12>>,
         hess: Option<&mut SMat<12, 12>>,
     ) -> Real {
@@ -322,6 +324,13 @@ impl SelfContact {
             }
         }
         if let Some(h) = hess {
+            if gauss_newton {
+                // The Gauss–Newton model: the penalty's curvature along the distance alone,
+                // m w ψ″ ∇d ∇dᵀ, positive semi-definite (the distance's own curvature and the
+                // mollifier's derivatives are left out).
+                *h = gd * gd.transpose() * (ddpsi * w * m);
+                return energy;
+            }
             // ∇²d = ∇²d²/(2d) − ∇d ∇dᵀ/d; ∇²E₀ = w(ψ″∇d∇dᵀ − ψ′∇²d).
             let hd = h2 / (2.0 * d) - gd * gd.transpose() / d;
             *h = (gd * gd.transpose() * ddpsi - hd * dpsi) * (w * m);
@@ -582,11 +591,12 @@ impl Term for SelfContact {
             return 0.0;
         }
         let active = self.active(map, x);
+        let gauss_newton = projection == HessianProjection::GaussNewton;
         assemble_elements::<12, 4, _>(
             map,
             |e, nodes, g, h| {
                 if active[e] {
-                    self.element(nodes, x, g, h)
+                    self.element(nodes, x, gauss_newton, g, h)
                 } else {
                     if let Some(g) = g {
                         g.fill(0.0);
