@@ -1,9 +1,11 @@
 //! Self-contact from the command line: a strip rolled by an end moment past a full turn winds
-//! onto itself with its layers a thickness apart. Every frame is checked by an independent
-//! script (`scripts/contact_check.py`: VTK's readers and a brute-force numpy search over every
-//! pair of faces, none of shellsim's code) for crossing faces and for the smallest distance
-//! between mid-surfaces; the same run without self-contact is the control that the check can
-//! fail; the frames are bitwise identical on 1 and 3 threads.
+//! onto itself with its layers a thickness apart; a stack of sheets sinks into its offset by
+//! the penalty's closed form; a sheet dropped onto another lands without crossing it. Frames
+//! are checked by an independent script (`scripts/contact_check.py`: VTK's readers and a
+//! brute-force numpy search over every pair of faces, none of shellsim's code) for crossing
+//! faces and for the smallest distance between mid-surfaces; the rolled strip without
+//! self-contact is the control that the check can fail, and its frames are bitwise identical
+//! on 1, 2 and 3 threads.
 //!
 //! Needs VTK's Python package: `scripts/test.sh` makes the project's `.venv/` with it and names
 //! its interpreter in `SHELLSIM_PYTHON` (without that variable, `python3` is used).

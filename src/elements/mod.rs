@@ -29,6 +29,23 @@ use crate::mesh::topology::NONE;
 use projection::{project, HessianProjection};
 use rayon::prelude::*;
 
+/// A kernel's answer for an element that contributes nothing here (a fixed vertex, a contact
+/// pair out of reach): its gradient and Hessian buffers, which the element loops reuse from
+/// element to element, set to zero, and energy 0.
+#[inline]
+pub fn no_contribution<const N: usize>(
+    grad: Option<&mut SVec<N>>,
+    hess: Option<&mut SMat<N, N>>,
+) -> Real {
+    if let Some(g) = grad {
+        g.fill(0.0);
+    }
+    if let Some(h) = hess {
+        h.fill(0.0);
+    }
+    0.0
+}
+
 /// The stencil of an element term: every element's DOF nodes in slot order (`NONE` where a slot
 /// is absent), the number of DOFs of each slot, and one point per element that orders elements
 /// into spatially coherent blocks.

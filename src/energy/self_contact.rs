@@ -54,7 +54,7 @@ use super::term::{Reports, StepBound, StepLimit, Term};
 use crate::body::Body;
 use crate::contact::{broad, ccd, distance, penalty};
 use crate::elements::Stencil;
-use crate::elements::{assemble_elements, ElementMap, Want};
+use crate::elements::{assemble_elements, no_contribution, ElementMap, Want};
 use crate::energy::term::ChangingElements;
 use crate::energy::{HessianProjection, Potential};
 use crate::math::{Real, SMat, SVec, Vec3};
@@ -159,51 +159,53 @@ impl SelfContact {
         }
     }
 
-    /// The pairs within `radius` (beyond each pair's offset) at `x`, not excluded: the
-    /// stencil, point–triangle pairs first (module doc for the slot order).
+    /// The nodes of point–triangle pair `(p, f)` in slot order (module doc).
+    #[inline]
+    fn pt_nodes(&self, p: usize, f: usize) -> [usize; 4] {
+        let mut t = self.faces[f];
+        t.sort_unstable();
+        [p, t[2], t[1], t[0]]
+    }
+
+    /// The nodes of edge–edge pair `(a, b)` (edge indices) in slot order.
+    #[inline]
+    fn ee_nodes(&self, a: usize, b: usize) -> [usize; 4] {
+        let (ea, eb) = (self.edges[a], self.edges[b]);
+        [ea[0], ea[1], eb[0], eb[1]]
+    }
+
+    /// The pairs the broad phase finds within `radius` at `x` (over the straight paths to
+    /// `to`, when given), not excluded: their nodes, point–triangle pairs first, each kind
+    /// sorted.
+    fn candidates(&self, x: &[Vec3], to: Option<&[Vec3]>, radius: Real) -> Vec<[usize; 4]> {
+        let pt = broad::point_triangle(x, to, &self.faces, radius);
+        let ee = broad::edge_edge(x, to, &self.edges, radius);
+        let key = |a: u32, b: u32| (a as u64) << 32 | b as u64;
+        pt.par_iter()
+            .filter(|&&(p, f)| self.excluded_pt.binary_search(&key(p, f)).is_err())
+            .map(|&(p, f)| self.pt_nodes(p as usize, f as usize))
+            .chain(
+                ee.par_iter()
+                    .filter(|&&(a, b)| self.excluded_ee.binary_search(&key(a, b)).is_err())
+                    .map(|&(a, b)| self.ee_nodes(a as usize, b as usize)),
+            )
+            .collect()
+    }
+
+    /// The pairs within `beyond` of their offset at `x`, not excluded: the stencil,
+    /// point–triangle pairs first (module doc for the slot order).
     fn pairs(&self, x: &[Vec3], beyond: Real) -> Stencil {
-        let reach = self.xi_max + beyond;
-        let pt = broad::point_triangle(x, None, &self.faces, reach);
-        let ee = broad::edge_edge(x, None, &self.edges, reach);
-        let pt: Vec<[usize; 4]> = pt
-            .par_iter()
-            .filter(|&&(p, f)| {
-                self.excluded_pt
-                    .binary_search(&((p as u64) << 32 | f as u64))
-                    .is_err()
-            })
-            .map(|&(p, f)| {
-                let mut t = self.faces[f as usize];
-                t.sort_unstable();
-                [p as usize, t[2], t[1], t[0]]
-            })
-            .filter(|n| {
-                let d2 = distance::point_triangle(&points(x, n)).d2;
-                d2 < (self.offset(n) + beyond).powi(2)
-            })
-            .collect();
-        let ee: Vec<[usize; 4]> = ee
-            .par_iter()
-            .filter(|&&(a, b)| {
-                self.excluded_ee
-                    .binary_search(&((a as u64) << 32 | b as u64))
-                    .is_err()
-            })
-            .map(|&(a, b)| {
-                let (ea, eb) = (self.edges[a as usize], self.edges[b as usize]);
-                [ea[0], ea[1], eb[0], eb[1]]
-            })
-            .filter(|n| {
-                let d2 = distance::edge_edge(&points(x, n)).d2;
-                d2 < (self.offset(n) + beyond).powi(2)
-            })
+        let near: Vec<[usize; 4]> = self
+            .candidates(x, None, self.xi_max + beyond)
+            .into_par_iter()
+            .filter(|n| self.closest(&points(x, n), n).d2 < (self.offset(n) + beyond).powi(2))
             .collect();
         let mut st = Stencil {
             slot_dofs: vec![3; 4],
-            nodes: Vec::with_capacity(4 * (pt.len() + ee.len())),
-            anchors: Vec::with_capacity(pt.len() + ee.len()),
+            nodes: Vec::with_capacity(4 * near.len()),
+            anchors: Vec::with_capacity(near.len()),
         };
-        for n in pt.iter().chain(&ee) {
+        for n in &near {
             st.nodes.extend_from_slice(n);
             st.anchors.push(points(x, n).iter().sum::<Vec3>() / 4.0);
         }
@@ -286,17 +288,8 @@ impl SelfContact {
         let pt = is_point_triangle(nodes);
         let (reach, weight) = self.law(nodes);
         let cl = self.closest(&y, nodes);
-        let zero = |g: Option<&mut SVec<12>>, h: Option<&mut SMat<12, 12>>| {
-            if let Some(g) = g {
-                g.fill(0.0);
-            }
-            if let Some(h) = h {
-                h.fill(0.0);
-            }
-            0.0
-        };
         if cl.d2 >= reach * reach || cl.d2 <= 0.0 {
-            return zero(grad, hess);
+            return no_contribution(grad, hess);
         }
         let d = cl.d2.sqrt();
         let w = self.stiffness * weight;
@@ -496,32 +489,9 @@ impl StepLimit for SelfContact {
             x
         };
         let to: Vec<Vec3> = (0..x.len()).map(|v| x[v] + dx(v)).collect();
-        let pt = broad::point_triangle(x, Some(&to), &self.faces, self.xi_max);
-        let ee = broad::edge_edge(x, Some(&to), &self.edges, self.xi_max);
-        let others = pt
-            .par_iter()
-            .filter(|&&(p, f)| {
-                self.excluded_pt
-                    .binary_search(&((p as u64) << 32 | f as u64))
-                    .is_err()
-            })
-            .map(|&(p, f)| {
-                let mut t = self.faces[f as usize];
-                t.sort_unstable();
-                [p as usize, t[2], t[1], t[0]]
-            })
-            .chain(
-                ee.par_iter()
-                    .filter(|&&(a, b)| {
-                        self.excluded_ee
-                            .binary_search(&((a as u64) << 32 | b as u64))
-                            .is_err()
-                    })
-                    .map(|&(a, b)| {
-                        let (ea, eb) = (self.edges[a as usize], self.edges[b as usize]);
-                        [ea[0], ea[1], eb[0], eb[1]]
-                    }),
-            )
+        let others = self
+            .candidates(x, Some(&to), self.xi_max)
+            .into_par_iter()
             .map(|n| {
                 let d: [Vec3; 4] = std::array::from_fn(|i| dx(n[i]));
                 let y = points(x, &n);
@@ -598,13 +568,7 @@ impl Term for SelfContact {
                 if active[e] {
                     self.element(nodes, x, gauss_newton, g, h)
                 } else {
-                    if let Some(g) = g {
-                        g.fill(0.0);
-                    }
-                    if let Some(h) = h {
-                        h.fill(0.0);
-                    }
-                    0.0
+                    no_contribution(g, h)
                 }
             },
             pot.node_fixed,
@@ -690,28 +654,23 @@ fn exclude(sc: &mut SelfContact, body: &Body) -> Result<(), MeshError> {
             (d2 < r * r).then_some((a, b, d2.sqrt()))
         })
         .collect();
-    // For each source vertex, the vertices within the graph radius.
-    let near = |from: usize, reach: Real, targets: &[usize]| -> bool {
-        adjacency.within(from, reach, targets)
-    };
+    // Close along the sheet too: a vertex of the other primitive within the graph radius.
     let pt_flags: Vec<bool> = pt
         .par_iter()
-        .map(|&(p, f, _)| near(p as usize, graph, &sc.faces[f as usize]))
+        .map(|&(p, f, _)| adjacency.within(p as usize, graph, &sc.faces[f as usize]))
         .collect();
     let ee_flags: Vec<bool> = ee
         .par_iter()
         .map(|&(a, b, _)| {
             let (ea, eb) = (sc.edges[a as usize], sc.edges[b as usize]);
-            near(ea[0], graph + longest, &eb)
+            adjacency.within(ea[0], graph + longest, &eb)
         })
         .collect();
     for (&(p, f, d), &close) in pt.iter().zip(&pt_flags) {
         if close {
             sc.excluded_pt.push((p as u64) << 32 | f as u64);
         } else {
-            let mut t = sc.faces[f as usize];
-            t.sort_unstable();
-            let n = [p as usize, t[2], t[1], t[0]];
+            let n = sc.pt_nodes(p as usize, f as usize);
             if d < sc.offset(&n) {
                 return Err(body.mesh.invalid(format!(
                     "self_contact: vertex {p} and face {f} are {} apart in the reference \
@@ -727,17 +686,16 @@ fn exclude(sc: &mut SelfContact, body: &Body) -> Result<(), MeshError> {
         if close {
             sc.excluded_ee.push((a as u64) << 32 | b as u64);
         } else {
-            let (ea, eb) = (sc.edges[a as usize], sc.edges[b as usize]);
-            let n = [ea[0], ea[1], eb[0], eb[1]];
+            let n = sc.ee_nodes(a as usize, b as usize);
             if d < sc.offset(&n) {
                 return Err(body.mesh.invalid(format!(
                     "self_contact: edges {}–{} and {}–{} are {} apart in the reference state, \
                      closer than their offset {} though far apart along the sheet: separate \
                      the layers, or set self_contact.offset smaller",
-                    ea[0],
-                    ea[1],
-                    eb[0],
-                    eb[1],
+                    n[0],
+                    n[1],
+                    n[2],
+                    n[3],
                     crate::math::human(d),
                     crate::math::human(sc.offset(&n)),
                 )));

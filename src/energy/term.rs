@@ -18,7 +18,9 @@
 
 use crate::body::Body;
 pub use crate::elements::Stencil;
-use crate::elements::{assemble_elements, assemble_elements_owned, ElementMap, Want};
+use crate::elements::{
+    assemble_elements, assemble_elements_owned, no_contribution, ElementMap, Want,
+};
 use crate::energy::HessianProjection;
 use crate::energy::Potential;
 use crate::math::{Mat3, Real, SMat, SVec, Vec3};
@@ -736,13 +738,7 @@ impl<K: VertexKernel> Term for VertexTerm<K> {
             map,
             |v, _, g, h| {
                 if fixed[v] {
-                    if let Some(g) = g {
-                        g.fill(0.0);
-                    }
-                    if let Some(h) = h {
-                        h.fill(0.0);
-                    }
-                    return 0.0;
+                    return no_contribution(g, h);
                 }
                 let (e, gv, hv) = self.kernel.eval(pot, own, v, &x[v]).unwrap_or((
                     0.0,

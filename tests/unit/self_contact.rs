@@ -1,6 +1,6 @@
-//! Self-contact: the term against finite differences on a strip folded onto itself, its pairs
-//! and exclusions, the step bound that keeps every pair apart, and the closed form of two
-//! sheets pressed together.
+//! Self-contact: the term against finite differences on a strip folded onto itself (the flat
+//! strip has no pairs; the fold gathers point–triangle and edge–edge pairs). The scenes that
+//! run the term end to end are in `tests/self_contact.rs`.
 
 use shellsim::assembly::{Pattern, Want};
 use shellsim::contact::distance;
@@ -101,7 +101,6 @@ fn self_contact_matches_finite_differences_on_a_folded_strip() {
         &mut [],
     );
     assert!(e > 0.0);
-    // Both kinds of pair carry energy: the edge–edge pairs alone, evaluated on their own map.
     super::terms::fd_check(
         &sc,
         &p,
