@@ -47,6 +47,7 @@ pub const UNITS: &[(&str, &str, &str)] = &[
     ("self_contact_pairs", "–", "log.csv"),
     ("self_contact_gap", "–", "log.csv"),
     ("self_contact_force", "N", "log.csv"),
+    ("self_contact_friction", "N", "log.csv"),
     ("gas_pressure", "Pa", "log.csv"),
     ("gas_volume", "m³", "log.csv"),
     ("skin_volume_ratio", "–", "log.csv"),

@@ -299,3 +299,126 @@ fn a_dropped_sheet_lands_on_another_without_crossing_it() {
     let dmin = c["min_distance"].as_f64().unwrap();
     assert!(dmin >= 0.1 * h && dmin < h, "{dmin}");
 }
+
+/// A 5 cm square (h = 1 mm, E = 1 MPa, ρ = 1000 kg/m³) resting on a held 15 cm one, gravity
+/// tilted by θ = 30° from their normal (an incline), friction between the sheets μ, dynamic
+/// mode. With μ = 0.3 < tan θ the top sheet slides at `a = g (sin θ − μ cos θ)`: its mean
+/// velocity down the slope is `a t` (implicit Euler is exact under a constant force), counting
+/// the momentum of its first settling onto the penalty, `v_x + μ v_z` (as on the plane
+/// obstacle), asserted to 1e-3 (measured 8e-6), and its pairs' friction forces sum to μ times
+/// the weight's normal part (1e-3; measured 1.4e-5). With μ = 0.8 > tan θ it sticks: the
+/// smoothed friction balances the slope where `f₁ = 2r − r² = tan θ / μ`, so the sheet creeps
+/// at exactly `r ε_v`, `r = 1 − √(1 − tan θ/μ)` (ε_v = 1e-5 m/s, the default slip speed;
+/// measured to 5e-4, asserted to 1e-3).
+#[test]
+fn a_sheet_on_an_inclined_sheet_slides_or_sticks_by_coulomb() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let h = 1e-3;
+    use shellsim::mesh::generate::{rectangle, Spacing};
+    let mut mesh = shellsim::mesh::Mesh::default();
+    for (x0, side, z, seed) in [(0.0, 0.15, 0.0, 3), (0.01, 0.05, 1.0005 * h, 4)] {
+        let m = rectangle(
+            x0,
+            0.05 - side / 2.0,
+            side,
+            side,
+            0.01,
+            Spacing {
+                jitter: 0.2,
+                seed,
+                ..Default::default()
+            },
+        );
+        let base = mesh.positions.len();
+        mesh.positions.extend(
+            m.positions
+                .iter()
+                .map(|p| shellsim::math::Vec3::new(p.x, p.y, z)),
+        );
+        mesh.faces.extend(
+            m.faces
+                .iter()
+                .map(|f| [f[0] + base, f[1] + base, f[2] + base]),
+        );
+    }
+    let nv = mesh.positions.len();
+    let top: Vec<usize> = (0..nv).filter(|&v| mesh.positions[v].z > 0.5 * h).collect();
+    shellsim::mesh::io::write_mesh(
+        &dir.join("incline.vtk"),
+        &mesh,
+        shellsim::mesh::io::Format::Vtk,
+        "incline",
+    )
+    .unwrap();
+    let (g, theta) = (9.81_f64, 30_f64.to_radians());
+    for mu in [0.3, 0.8] {
+        let tag = format!("mu{}", (mu * 10.0) as i32);
+        std::fs::write(
+            dir.join(format!("{tag}.toml")),
+            format!(
+                "[material]\nyoung = 1e6\nthickness = {h}\ndensity = 1000\n\
+                 [solver]\nmode = \"dynamic\"\nsymmetry_breaking = 0\n\
+                 [time]\nend = 0.2\ndt = 1e-3\ndt_max = 0.01\noutput_interval = 0.05\n\
+                 [loads]\ngravity = [{}, 0, {}]\n\
+                 [constraints]\nfix_boxes = [{{ min = [-1, -1, -1e-4], max = [1, 1, 1e-4] }}]\n\
+                 [self_contact]\nenabled = true\nfriction = {mu}\n",
+                g * theta.sin(),
+                -g * theta.cos()
+            ),
+        )
+        .unwrap();
+        shellsim(
+            &[&format!("{tag}.toml"), "incline.vtk", "--out", &tag, "-q"],
+            dir,
+        );
+        let s: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.join(&tag).join("summary.json")).unwrap(),
+        )
+        .unwrap();
+        let frame = dir.join(&tag).join(s["final_frame"].as_str().unwrap());
+        let m = shellsim::mesh::io::read_mesh(&frame).unwrap();
+        let mean = |name: &str| {
+            let f = &m.vertex_fields[name];
+            let mut out = [0.0; 3];
+            for &v in &top {
+                for (k, o) in out.iter_mut().enumerate() {
+                    *o += f.get(v)[k] / top.len() as f64;
+                }
+            }
+            out
+        };
+        let (v, u) = (mean("velocity"), mean("displacement"));
+        let row = log_rows(&dir.join(&tag)).pop().unwrap();
+        let t = row["time"];
+        let a = g * (theta.sin() - mu * theta.cos());
+        let weight_n = 1000.0 * h * 0.05 * 0.05 * g * theta.cos();
+        println!(
+            "μ = {mu}: t {t} s, velocity {v:?} m/s, displacement {u:?} m, a t = {}; \
+             friction {} N, μ N = {}",
+            a * t,
+            row["self_contact_friction"],
+            mu * weight_n
+        );
+        assert!((t - 0.2).abs() < 1e-9, "{tag}: t = {t}");
+        assert!(v[1].abs() < 1e-3 * (a * t).abs().max(1e-5), "{tag}: {v:?}");
+        if mu < theta.tan() {
+            let slide = v[0] + mu * v[2];
+            assert!(
+                (slide / (a * t) - 1.0).abs() < 1e-3,
+                "{tag}: {v:?} vs {}",
+                a * t
+            );
+            let f = row["self_contact_friction"];
+            assert!(
+                (f / (mu * weight_n) - 1.0).abs() < 1e-3,
+                "{tag}: friction {f} vs {}",
+                mu * weight_n
+            );
+        } else {
+            let creep = (1.0 - (1.0 - theta.tan() / mu).sqrt()) * 1e-5;
+            assert!((v[0] / creep - 1.0).abs() < 1e-3, "{tag}: {v:?} vs {creep}");
+            assert!(u[0].abs() <= 1e-5 * t, "{tag}: {u:?}");
+        }
+    }
+}

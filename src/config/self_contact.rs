@@ -32,6 +32,9 @@ pub struct SelfContact {
     /// The smallest distance two mid-surfaces may come to, as a fraction of their offset
     /// (default `0.1`): no step takes a pair closer.
     pub min_separation: Real,
+    /// Coulomb coefficient μ between the sheets' surfaces, ≥ 0 (default 0: frictionless).
+    /// Dynamic mode; the slip speed of its smoothing is `contact.slip_speed`.
+    pub friction: Real,
 }
 
 impl Default for SelfContact {
@@ -44,6 +47,7 @@ impl Default for SelfContact {
             exclusion: AutoOr::Auto(Auto::Auto),
             halo: AutoOr::Auto(Auto::Auto),
             min_separation: 0.1,
+            friction: 0.0,
         }
     }
 }
@@ -76,6 +80,7 @@ impl SelfContact {
                 ck.pos(key, x)?;
             }
         }
+        ck.nonneg("self_contact.friction", self.friction)?;
         let s = self.min_separation;
         if !(s > 0.0 && s <= 0.9) {
             return ck.inv(
@@ -119,6 +124,16 @@ mod tests {
             bad.validate(Mode::Static).unwrap_err().key,
             "self_contact.halo"
         );
+        for mu in [-0.1, Real::NAN, Real::INFINITY] {
+            let bad = SelfContact {
+                friction: mu,
+                ..on.clone()
+            };
+            assert_eq!(
+                bad.validate(Mode::Dynamic).unwrap_err().key,
+                "self_contact.friction"
+            );
+        }
         for s in [0.0, 0.95, Real::NAN] {
             let bad = SelfContact {
                 min_separation: s,

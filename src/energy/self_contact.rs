@@ -28,6 +28,24 @@
 //! ([`crate::contact::distance::mollifier`]): on a flat contact they are idle and the pressure
 //! is the vertex law's alone.
 //!
+//! **Friction** (`friction` μ > 0, dynamic mode): the ground's lagged, smoothed Coulomb
+//! dissipation ([`crate::contact::friction_potential`]) on each pair's relative slip. A pair
+//! that presses at the friction lag's iterate `x̃` ([`crate::energy::potential::Friction`])
+//! has there its normal force `λ = m k w ψ′`, its closest points' coefficients `c` (the
+//! distance vector is `r = Σᵢ cᵢ yᵢ`, point minus closest point; `c = (1, −β₂, −β₁, −β₀)` for a
+//! point and a triangle's barycentric `β`, `(1 − s, s, −(1 − t), −t)` for two edges) and
+//! its normal `n = r/‖r‖`. Over the step from `x⁰` the pair slips by
+//! `u = (I − n nᵀ) Σᵢ cᵢ (xᵢ − x⁰ᵢ)`, the motion of the point relative to the surface it
+//! touches, and dissipates
+//!
+//! `D = μ λ f₀(‖u‖)`,
+//!
+//! exactly Coulomb's force μλ against the slip once it exceeds `ε = ε_v Δt` (`contact.slip_speed`
+//! ε_v), a stiff sticking spring below. Its gradient on vertex `i` is `cᵢ ∇_u D` and its Hessian
+//! block `(i, j)` is `cᵢ cⱼ ∇²_u D` (positive semi-definite). The integrator re-solves a step
+//! until the normal forces agree with the lag ([`crate::integrate`]). Static solves are
+//! frictionless.
+//!
 //! **The guarantee.** No step takes a pair closer than `s ξ` (`min_separation` s, default 0.1):
 //! every Newton step is bounded by additive CCD over the pairs ([`crate::contact::ccd`]) and
 //! every trial state is checked before the line search accepts it. The pairs are gathered into
@@ -50,9 +68,9 @@
 //! points' coordinates, point–triangle `(p, t₂, t₁, t₀)` with `t₀ < t₁ < t₂`, edge–edge
 //! `(a, b, c, d)` with `a < b`, `c < d` (the order of the last two slots tells the kinds apart).
 
-use super::term::{Reports, StepBound, StepLimit, Term};
+use super::term::{LaggedNormals, Reports, StepBound, StepLimit, Term};
 use crate::body::Body;
-use crate::contact::{broad, ccd, distance, penalty};
+use crate::contact::{broad, ccd, distance, friction_potential, penalty};
 use crate::elements::Stencil;
 use crate::elements::{assemble_elements, no_contribution, ElementMap, Want};
 use crate::energy::term::ChangingElements;
@@ -89,6 +107,8 @@ pub struct SelfContact {
     pub exclusion: Real,
     /// The smallest distance as a fraction of the offset.
     pub min_separation: Real,
+    /// Coulomb coefficient μ between sheets (0: frictionless, and always in statics).
+    pub friction: Real,
     /// Excluded point–triangle pairs `p << 32 | f`, sorted.
     excluded_pt: Vec<u64>,
     /// Excluded edge–edge pairs `a << 32 | b` (edge indices, `a < b`), sorted.
@@ -106,6 +126,17 @@ fn is_point_triangle(nodes: &[usize]) -> bool {
 #[inline]
 fn points(x: &[Vec3], nodes: &[usize]) -> [Vec3; 4] {
     std::array::from_fn(|i| x[nodes[i]])
+}
+
+/// A pair's friction over a step, lagged (module doc).
+#[derive(Clone, Copy)]
+struct Slip {
+    /// `μ λ` (N).
+    bound: Real,
+    /// The closest points' coefficients.
+    c: [Real; 4],
+    /// The unit normal from the surface to the point.
+    normal: Vec3,
 }
 
 impl SelfContact {
@@ -224,11 +255,10 @@ impl SelfContact {
         n
     }
 
-    /// Per element of `map`, whether it carries energy at `x`: every edge–edge pair, and of
+    /// Per pair of `nodes` (four per pair), whether it carries energy at `x`: every edge–edge pair, and of
     /// each vertex's point–triangle pairs the nearest on each side (module doc; ties go to the
     /// first in element order).
-    fn active(&self, map: &ElementMap, x: &[Vec3]) -> Vec<bool> {
-        let nodes = &map.nodes;
+    fn active(&self, nodes: &[usize], x: &[Vec3]) -> Vec<bool> {
         let ne = nodes.len() / 4;
         let normals = self.vertex_normals(x);
         let measured: Vec<Option<(usize, bool, Real)>> = (0..ne)
@@ -339,11 +369,10 @@ impl SelfContact {
 }
 
 impl SelfContact {
-    /// The normal force `λ = m k w ψ′` (N) of every pair of `map` that carries energy at
-    /// `x`, with its closest points' coefficients (module doc).
-    fn forces(&self, map: &ElementMap, x: &[Vec3]) -> Vec<(usize, Real, [Real; 4])> {
-        let nodes = &map.nodes;
-        let active = self.active(map, x);
+    /// The normal force `λ = m k w ψ′` (N) of every pair of `nodes` (four per pair) that
+    /// carries energy at `x`, with its closest points' coefficients (module doc).
+    fn forces(&self, nodes: &[usize], x: &[Vec3]) -> Vec<(usize, Real, [Real; 4])> {
+        let active = self.active(nodes, x);
         (0..nodes.len() / 4)
             .into_par_iter()
             .filter(|&e| active[e])
@@ -367,6 +396,143 @@ impl SelfContact {
             .collect()
     }
 
+    /// Per pair of `nodes`, its friction at the lag's iterate `x_lag` (module doc): the bound
+    /// `μ λ` (N), the closest points' coefficients and the unit normal, for the pairs that press
+    /// there; `None` for the others.
+    fn lagged_friction(&self, nodes: &[usize], x_lag: &[Vec3]) -> Vec<Option<Slip>> {
+        let mut out = vec![None; nodes.len() / 4];
+        for (e, lambda, c) in self.forces(nodes, x_lag) {
+            let y = points(x_lag, &nodes[4 * e..4 * e + 4]);
+            let r: Vec3 = (0..4).map(|i| y[i] * c[i]).sum();
+            let norm = r.norm();
+            if norm > 0.0 && lambda > 0.0 {
+                out[e] = Some(Slip {
+                    bound: self.friction * lambda,
+                    c,
+                    normal: r / norm,
+                });
+            }
+        }
+        out
+    }
+
+    /// The friction of one pair at `x` over the step from `x_prev` with slip smoothing `eps`
+    /// (module doc): its dissipation, added to `grad` and `hess` (DOF order of the pair).
+    fn slip(
+        s: &Slip,
+        nodes: &[usize],
+        x: &[Vec3],
+        x_prev: &[Vec3],
+        eps: Real,
+        grad: Option<&mut SVec<12>>,
+        hess: Option<&mut SMat<12, 12>>,
+    ) -> Real {
+        let moved: Vec3 = (0..4)
+            .map(|i| (x[nodes[i]] - x_prev[nodes[i]]) * s.c[i])
+            .sum();
+        let (e, g, h) = friction_potential(s.bound, &s.normal, &moved, eps);
+        if let Some(grad) = grad {
+            for i in 0..4 {
+                for a in 0..3 {
+                    grad[3 * i + a] += s.c[i] * g[a];
+                }
+            }
+        }
+        if let Some(hess) = hess {
+            for i in 0..4 {
+                for j in 0..4 {
+                    let cc = s.c[i] * s.c[j];
+                    for a in 0..3 {
+                        for b in 0..3 {
+                            hess[(3 * i + a, 3 * j + b)] += cc * h[a][b];
+                        }
+                    }
+                }
+            }
+        }
+        e
+    }
+
+    /// The normal force on each vertex (N) from the pairs that press at `x`, each pair's
+    /// force shared by its closest points' coefficients.
+    fn vertex_forces(&self, x: &[Vec3]) -> Vec<Real> {
+        let st = self.pairs(x, 0.0);
+        let mut f = vec![0.0; x.len()];
+        for (e, lambda, c) in self.forces(&st.nodes, x) {
+            for (k, ci) in c.iter().enumerate() {
+                f[st.nodes[4 * e + k]] += lambda * ci.abs();
+            }
+        }
+        f
+    }
+
+    /// Energy of the term at `x` (with its gradient and Hessian as `want` asks), with the
+    /// friction when `with_friction` and the potential carries a step's.
+    #[allow(clippy::too_many_arguments)]
+    fn assemble(
+        &self,
+        pot: &Potential,
+        map: &ElementMap,
+        x: &[Vec3],
+        want: Want,
+        projection: HessianProjection,
+        grad: &mut [Real],
+        values: &mut [Real],
+        with_friction: bool,
+    ) -> Real {
+        if map.nodes.is_empty() {
+            return 0.0;
+        }
+        let active = self.active(&map.nodes, x);
+        let gauss_newton = projection == HessianProjection::GaussNewton;
+        let friction = pot
+            .friction
+            .filter(|_| with_friction && self.friction > 0.0)
+            .map(|fr| (fr, self.lagged_friction(&map.nodes, fr.x_lag)));
+        assemble_elements::<12, 4, _>(
+            map,
+            |e, nodes, mut g, mut h| {
+                let mut energy = if active[e] {
+                    self.element(nodes, x, gauss_newton, g.as_deref_mut(), h.as_deref_mut())
+                } else {
+                    no_contribution(g.as_deref_mut(), h.as_deref_mut())
+                };
+                if let Some((fr, Some(s))) = friction.as_ref().map(|(fr, l)| (fr, &l[e])) {
+                    energy += Self::slip(s, nodes, x, fr.x_prev, fr.eps, g, h);
+                }
+                energy
+            },
+            pot.node_fixed,
+            projection,
+            want,
+            grad,
+            values,
+            &pot.pattern.col_ptr,
+        )
+    }
+
+    /// The sum over the pairs of the magnitudes of their friction forces at `x` over the
+    /// potential's step (N; 0 without one).
+    fn friction_force(&self, pot: &Potential, map: &ElementMap, x: &[Vec3]) -> Real {
+        let Some(fr) = pot.friction.as_ref() else {
+            return 0.0;
+        };
+        let lagged = self.lagged_friction(&map.nodes, fr.x_lag);
+        (0..lagged.len())
+            .into_par_iter()
+            .filter_map(|e| {
+                let s = lagged[e].as_ref()?;
+                let n = &map.nodes[4 * e..4 * e + 4];
+                let moved: Vec3 = (0..4).map(|i| (x[n[i]] - fr.x_prev[n[i]]) * s.c[i]).sum();
+                Some(
+                    friction_potential(s.bound, &s.normal, &moved, fr.eps)
+                        .1
+                        .norm(),
+                )
+            })
+            .sum()
+    }
+
     /// This term's element map in `pot`'s pattern.
     fn map<'p>(&self, pot: &Potential<'p>) -> Option<&'p ElementMap> {
         let i = pot.terms.iter().position(|t| t.name() == self.name())?;
@@ -375,14 +541,36 @@ impl SelfContact {
 }
 
 impl Reports for SelfContact {
-    /// `self_contact_pairs`: the pairs that press; `self_contact_gap`: the smallest distance
+    /// The normal law's energy alone (the friction is dissipated, not stored).
+    fn energies(
+        &self,
+        pot: &Potential,
+        map: &ElementMap,
+        x: &[Vec3],
+        _phi: &[Real],
+    ) -> Option<Vec<(&'static str, Real)>> {
+        let e = self.assemble(
+            pot,
+            map,
+            x,
+            Want::Energy,
+            HessianProjection::None,
+            &mut [],
+            &mut [],
+            false,
+        );
+        Some(vec![("self_contact", e)])
+    }
+
+    /// `self_contact_pairs`: the pairs that press; `self_contact_friction` (with friction):
+    /// the sum of the magnitudes of their friction forces (N); `self_contact_gap`: the smallest distance
     /// of a gathered pair over its offset (the gathering's reach over the offset when none
     /// was gathered); `self_contact_force`: the sum of the pairs' normal forces (N).
     fn observables(&self, pot: &Potential, x: &[Vec3], _phi: &[Real]) -> Vec<(String, Real)> {
         let Some(map) = self.map(pot) else {
             return Vec::new();
         };
-        let forces = self.forces(map, x);
+        let forces = self.forces(&map.nodes, x);
         let gap = map
             .nodes
             .par_chunks(4)
@@ -391,14 +579,21 @@ impl Reports for SelfContact {
                 || 1.0 + self.halo / self.xi_max.max(Real::MIN_POSITIVE),
                 Real::min,
             );
-        vec![
+        let mut out = vec![
             ("self_contact_pairs".into(), forces.len() as Real),
             ("self_contact_gap".into(), gap),
             (
                 "self_contact_force".into(),
                 forces.iter().map(|f| f.1).sum(),
             ),
-        ]
+        ];
+        if self.friction > 0.0 {
+            out.push((
+                "self_contact_friction".into(),
+                self.friction_force(pot, map, x),
+            ));
+        }
+        out
     }
 
     /// `contact_pressure` (Pa): per face, the mean over its vertices of the normal force the
@@ -411,7 +606,7 @@ impl Reports for SelfContact {
         };
         let nv = x.len();
         let mut force = vec![0.0; nv];
-        for (e, lambda, c) in self.forces(map, x) {
+        for (e, lambda, c) in self.forces(&map.nodes, x) {
             for (k, ci) in c.iter().enumerate() {
                 force[map.nodes[4 * e + k]] += lambda * ci.abs();
             }
@@ -453,6 +648,17 @@ impl Reports for SelfContact {
 impl ChangingElements for SelfContact {
     fn stencil_at(&self, _: &Body, x: &[Vec3], _: &[Real]) -> Stencil {
         self.pairs(x, self.halo)
+    }
+}
+
+impl LaggedNormals for SelfContact {
+    /// Over the vertices, the largest normal force the pairs put on one at `trial`, and the
+    /// largest change of one from the lagged iterate (the pairs that press at each).
+    fn lag_change(&self, trial: &[Vec3], _: Real, lag: &[Vec3], _: Real) -> (Real, Real) {
+        let (new, old) = rayon::join(|| self.vertex_forces(trial), || self.vertex_forces(lag));
+        new.iter().zip(&old).fold((0.0, 0.0), |(s, d), (a, b)| {
+            (Real::max(s, *a), Real::max(d, (a - b).abs()))
+        })
     }
 }
 
@@ -543,6 +749,9 @@ impl Term for SelfContact {
     fn step_limit(&self) -> Option<&dyn StepLimit> {
         Some(self)
     }
+    fn lagged(&self) -> Option<&dyn LaggedNormals> {
+        (self.friction > 0.0).then_some(self as &dyn LaggedNormals)
+    }
     fn reports(&self) -> Option<&dyn Reports> {
         Some(self)
     }
@@ -557,34 +766,16 @@ impl Term for SelfContact {
         grad: &mut [Real],
         values: &mut [Real],
     ) -> Real {
-        if map.nodes.is_empty() {
-            return 0.0;
-        }
-        let active = self.active(map, x);
-        let gauss_newton = projection == HessianProjection::GaussNewton;
-        assemble_elements::<12, 4, _>(
-            map,
-            |e, nodes, g, h| {
-                if active[e] {
-                    self.element(nodes, x, gauss_newton, g, h)
-                } else {
-                    no_contribution(g, h)
-                }
-            },
-            pot.node_fixed,
-            projection,
-            want,
-            grad,
-            values,
-            &pot.pattern.col_ptr,
-        )
+        self.assemble(pot, map, x, want, projection, grad, values, true)
     }
 }
 
-/// The term of `[self_contact]` on `body`, or `None` when disabled.
+/// The term of `[self_contact]` on `body`, or `None` when disabled; friction only when
+/// `dynamic`.
 pub fn term(
     body: &Body,
     c: &crate::config::self_contact::SelfContact,
+    dynamic: bool,
 ) -> Result<Option<Box<dyn Term>>, MeshError> {
     if !c.enabled {
         return Ok(None);
@@ -616,6 +807,7 @@ pub fn term(
         halo: c.halo.or(xi_max),
         exclusion: c.exclusion.or(2.0 * (xi_max + smoothing)),
         min_separation: c.min_separation,
+        friction: if dynamic { c.friction } else { 0.0 },
         excluded_pt: Vec::new(),
         excluded_ee: Vec::new(),
     };

@@ -148,3 +148,92 @@ fn kinds_hold(x: &[Vec3], nodes: &[usize], eps: Real) -> bool {
     }
     true
 }
+
+/// The term with friction (dynamic mode, μ = 0.4) against central differences on the folded
+/// strip: the friction's normal forces, normals and closest points are lagged at a nearby
+/// iterate, and the step started with the folded half moved against the other by `slide`
+/// (plus a noise of a tenth of ε per vertex). The smoothed friction's third derivative jumps
+/// where a pair's slip crosses the smoothing ε, so each check keeps every slip to one side:
+/// a slide of 0.3 ε sticks every pair, one of 3 ε slides them all.
+#[test]
+fn self_contact_friction_matches_finite_differences() {
+    let sc = strip(
+        0.05,
+        "stiffness = 1e7\nsmoothing = 0.004\nfriction = 0.4\n[solver]\nmode = \"dynamic\"\n",
+    );
+    let phi = vec![0.0; sc.num_scalar_dofs()];
+    let p0 = Pattern::for_scene(&sc);
+    let i = term_index(&sc);
+    let (x, p) = (11..60)
+        .map(|seed| {
+            let x = folded(&sc, 0.02, 0.002, seed);
+            let p = p0.refreshed(&sc, &x, &phi).expect("the fold brings pairs");
+            (x, p)
+        })
+        .find(|(x, p)| kinds_hold(x, &p.maps[i].nodes, 1e-6))
+        .expect("a noise with no pair on a change of closest features");
+    let eps = 1e-3;
+    let mut rng = Rng::new(3);
+    let lag: Vec<Vec3> = x
+        .iter()
+        .map(|p| p + Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * 1e-4)
+        .collect();
+    let term = &sc.terms[i];
+    let map = &p.maps[i];
+    assert!(term.lagged().is_some(), "friction lags its normal forces");
+    for slide in [0.3, 3.0] {
+        let prev: Vec<Vec3> = x
+            .iter()
+            .zip(&sc.body.mesh.positions)
+            .map(|(p, r)| {
+                let moved = if r.x > 0.5 {
+                    Vec3::new(0.8, 0.6, 0.0) * slide * eps
+                } else {
+                    Vec3::zeros()
+                };
+                p - moved - Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * 0.1 * eps
+            })
+            .collect();
+        let pot = Potential {
+            friction: Some(shellsim::energy::potential::Friction {
+                x_prev: &prev,
+                dial_prev: 0.0,
+                normal_force: &[],
+                x_lag: &lag,
+                dial_lag: 0.0,
+                eps,
+            }),
+            ..Potential::new(&sc, &p)
+        };
+        // The friction alone: the whole term less the normal law (its reported energy).
+        let whole = term.eval(
+            &pot,
+            map,
+            &x,
+            &phi,
+            Want::Energy,
+            HessianProjection::None,
+            &mut [],
+            &mut [],
+        );
+        let normal = shellsim::energy::term::energies(term.as_ref(), &pot, map, &x, &phi)[0].1;
+        assert!(
+            whole - normal > 1e-3 * normal,
+            "friction dissipates: {whole} vs {normal}"
+        );
+        super::terms::fd_check(
+            &sc,
+            &p,
+            &x,
+            &phi,
+            &format!("self_contact friction, slide {slide} ε"),
+            1,
+            |g, h| g.max(h),
+            |x, phi, want, g, h| {
+                g.iter_mut().for_each(|v| *v = 0.0);
+                h.iter_mut().for_each(|v| *v = 0.0);
+                term.eval(&pot, map, x, phi, want, HessianProjection::None, g, h)
+            },
+        );
+    }
+}
