@@ -422,3 +422,94 @@ fn a_sheet_on_an_inclined_sheet_slides_or_sticks_by_coulomb() {
         }
     }
 }
+
+/// Bad self-contact input is exit 2 with a message naming what is wrong, and nothing written:
+/// two sheets that pass through each other (naming the two faces), two sheets closer than
+/// their offset (naming the vertex and the face), an exclusion radius too small for a mesh
+/// finer than its thickness (naming the radius that would do), a negative friction and
+/// explicit mode (naming the key).
+#[test]
+fn bad_self_contact_input_is_named_and_writes_nothing() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let h = 1e-3;
+    // A square, and a second one standing up through its middle.
+    use shellsim::math::Vec3;
+    use shellsim::mesh::generate::{rectangle, Spacing};
+    let flat = rectangle(0.0, 0.0, 0.02, 0.02, 0.005, Spacing::default());
+    let mut mesh = flat.clone();
+    let base = mesh.positions.len();
+    mesh.positions.extend(
+        flat.positions
+            .iter()
+            .map(|p| Vec3::new(p.x + 0.001, 0.0101, p.y - 0.0097)),
+    );
+    mesh.faces.extend(
+        flat.faces
+            .iter()
+            .map(|f| [f[0] + base, f[1] + base, f[2] + base]),
+    );
+    let write = |name: &str, m: &shellsim::mesh::Mesh| {
+        shellsim::mesh::io::write_mesh(&dir.join(name), m, shellsim::mesh::io::Format::Vtk, name)
+            .unwrap()
+    };
+    write("crossed.vtk", &mesh);
+    sheets_mesh(
+        dir,
+        "close.vtk",
+        0.02,
+        0.005,
+        &[(0.0, 0.0, 0.0), (0.0, 0.0, 0.5 * h)],
+    );
+    sheets_mesh(dir, "fine.vtk", 0.01, 0.5 * h, &[(0.0, 0.0, 0.0)]);
+    let base = format!("[material]\nyoung = 1e6\nthickness = {h}\n");
+    let cases: [(&str, &str, &str, &[&str]); 5] = [
+        (
+            "crossed.vtk",
+            "",
+            "",
+            &["faces", "intersect", "passes through face"],
+        ),
+        (
+            "close.vtk",
+            "",
+            "",
+            &["vertex", "face", "closer than their offset"],
+        ),
+        (
+            "fine.vtk",
+            "exclusion = 2e-4\n",
+            "",
+            &["raise self_contact.exclusion to at least"],
+        ),
+        (
+            "close.vtk",
+            "friction = -0.1\n",
+            "",
+            &["self_contact.friction"],
+        ),
+        (
+            "close.vtk",
+            "",
+            "bending = \"patch_fit\"\n[solver]\nmode = \"explicit\"\n",
+            &["self_contact.enabled", "explicit"],
+        ),
+    ];
+    for (k, (mesh, extra, solver, words)) in cases.iter().enumerate() {
+        let toml = format!("bad{k}.toml");
+        std::fs::write(
+            dir.join(&toml),
+            format!("{base}{solver}[self_contact]\nenabled = true\n{extra}"),
+        )
+        .unwrap();
+        let out = format!("out{k}");
+        let (code, _, err) = common::run_status(&[&toml, mesh, "--out", &out, "-q"], dir);
+        println!("{mesh} {extra}{solver}: {err}");
+        assert_eq!(code, 2, "{mesh}: {err}");
+        for w in *words {
+            assert!(err.contains(w), "{mesh}: no {w:?} in {err}");
+        }
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(!dir.join(&out).exists(), "{mesh}: {out} was written");
+    }
+}

@@ -163,6 +163,37 @@ pub fn point_triangle(
     per.into_iter().flatten().collect()
 }
 
+/// Edge `e` and face `f` sharing no vertex whose boxes at `x` overlap: the candidates for an
+/// edge crossing a face. Sorted by edge, then face.
+pub fn edge_triangle(x: &[Vec3], edges: &[[usize; 2]], faces: &[[usize; 3]]) -> Vec<(u32, u32)> {
+    if faces.is_empty() || edges.is_empty() {
+        return Vec::new();
+    }
+    let boxes: Vec<Aabb> = faces.par_iter().map(|f| span(f, x, None, 0.0)).collect();
+    let grid = Grid::new(&boxes);
+    let per: Vec<Vec<(u32, u32)>> = (0..edges.len())
+        .into_par_iter()
+        .map(|e| {
+            let own = span(&edges[e], x, None, 0.0);
+            let mut out = Vec::new();
+            grid.cells(&own, |k| {
+                for &(_, f) in grid.at(k) {
+                    let face = &faces[f as usize];
+                    if !edges[e].iter().any(|v| face.contains(v))
+                        && boxes[f as usize].overlaps(&own)
+                    {
+                        out.push((e as u32, f));
+                    }
+                }
+            });
+            out.sort_unstable();
+            out.dedup();
+            out
+        })
+        .collect();
+    per.into_iter().flatten().collect()
+}
+
 /// Edge pairs `(a, b)`, `a < b`, sharing no vertex, whose boxes (one inflated by `radius`)
 /// overlap, the boxes holding `x` and, when given, `to` as in [`point_triangle`]: sorted.
 pub fn edge_edge(
@@ -265,6 +296,17 @@ mod tests {
             }
         }
         assert_eq!(edge_edge(&x, None, &edges, r), brute);
+        let mut brute = Vec::new();
+        for (e, ed) in edges.iter().enumerate() {
+            let own = Aabb::of(ed.iter().map(|&v| x[v]), 0.0);
+            for (f, t) in faces.iter().enumerate() {
+                let fb = Aabb::of(t.iter().map(|&v| x[v]), 0.0);
+                if !ed.iter().any(|v| t.contains(v)) && fb.overlaps(&own) {
+                    brute.push((e as u32, f as u32));
+                }
+            }
+        }
+        assert_eq!(edge_triangle(&x, &edges, &faces), brute);
         // Swept: the boxes hold both ends of a random motion.
         let to: Vec<Vec3> = x
             .iter()

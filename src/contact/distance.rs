@@ -300,9 +300,45 @@ pub fn mollifier(c: Real, eps: Real) -> (Real, Real, Real) {
     }
 }
 
+/// Whether the segment `s = (x[0], x[1])` crosses the triangle `(x[2], x[3], x[4])`: its ends
+/// strictly on opposite sides of the triangle's plane and the line through it strictly inside
+/// the triangle, by the signs of orientation determinants (a segment touching the triangle's
+/// boundary, or coplanar with it, does not cross).
+pub fn segment_crosses_triangle(x: &[Vec3; 5]) -> bool {
+    let orient = |a: &Vec3, b: &Vec3, c: &Vec3, d: &Vec3| (b - a).cross(&(c - a)).dot(&(d - a));
+    let (p, q) = (&x[0], &x[1]);
+    let (a, b, c) = (&x[2], &x[3], &x[4]);
+    let (sp, sq) = (orient(a, b, c, p), orient(a, b, c, q));
+    if !(sp > 0.0 && sq < 0.0 || sp < 0.0 && sq > 0.0) {
+        return false;
+    }
+    let s = [orient(p, q, a, b), orient(p, q, b, c), orient(p, q, c, a)];
+    s.iter().all(|&v| v > 0.0) || s.iter().all(|&v| v < 0.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A segment through a triangle's interior crosses it; one beside it, one ending on its
+    /// plane, one in its plane and one parallel above it do not.
+    #[test]
+    fn segments_cross_triangles_only_through_their_interior() {
+        let t = [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ];
+        let with = |p: [Real; 3], q: [Real; 3]| {
+            segment_crosses_triangle(&[Vec3::from(p), Vec3::from(q), t[0], t[1], t[2]])
+        };
+        assert!(with([0.2, 0.2, -1.0], [0.3, 0.1, 1.0]));
+        assert!(with([0.3, 0.1, 1.0], [0.2, 0.2, -1.0]));
+        assert!(!with([0.8, 0.8, -1.0], [0.8, 0.8, 1.0]));
+        assert!(!with([0.2, 0.2, 0.0], [0.2, 0.2, 1.0]));
+        assert!(!with([-0.5, 0.2, 0.0], [1.0, 0.2, 0.0]));
+        assert!(!with([0.1, 0.1, 0.5], [0.5, 0.1, 0.5]));
+    }
 
     fn pts(v: [[Real; 3]; 4]) -> [Vec3; 4] {
         v.map(Vec3::from)

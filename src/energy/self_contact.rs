@@ -62,7 +62,8 @@
 //! offset of its own start only when bent to a radius below about `0.53 (ξ + δ)`: folds
 //! tighter than about half the thickness cannot self-contact, and Kirchhoff–Love shells cannot
 //! represent them anyway. Reference pairs that are close in space but far along the sheet are
-//! separate layers: closer than their offset, they are an error naming the faces.
+//! separate layers: closer than their offset, they are an error naming the faces. A reference
+//! surface with an edge through a face (not sharing a vertex) is an error naming the two faces.
 //!
 //! Units: positions m, k Pa/m, δ, ξ, R m, A m², energies J. DOF order per pair: the four
 //! points' coordinates, point–triangle `(p, t₂, t₁, t₀)` with `t₀ < t₁ < t₂`, edge–edge
@@ -826,6 +827,17 @@ fn exclude(sc: &mut SelfContact, body: &Body) -> Result<(), MeshError> {
         .map(|e| (x[e[1]] - x[e[0]]).norm())
         .fold(0.0, Real::max);
     let graph = 2.0 * r + 2.0 * longest;
+    if let Some((e, f)) = crossing(x, &sc.edges, &sc.faces) {
+        let [a, b] = sc.edges[e];
+        let g = (0..sc.faces.len())
+            .find(|&g| sc.faces[g].contains(&a) && sc.faces[g].contains(&b))
+            .unwrap_or(0);
+        return Err(body.mesh.invalid(format!(
+            "self_contact: faces {g} and {f} intersect in the reference state (the edge \
+             {a}–{b} of face {g} passes through face {f}): the sheet must start free of \
+             crossings"
+        )));
+    }
     let adjacency = Adjacency::new(x.len(), &sc.edges, x);
     // Point–triangle pairs within r in space, grouped by vertex.
     let pt = broad::point_triangle(x, None, &sc.faces, r);
@@ -912,6 +924,19 @@ fn exclude(sc: &mut SelfContact, body: &Body) -> Result<(), MeshError> {
         )));
     }
     Ok(())
+}
+
+/// The first edge (in edge order) that passes through a face at `x`, with that face (the
+/// face first in order); `None` when the surface has no crossing. Edges and faces that share a
+/// vertex are not tested.
+fn crossing(x: &[Vec3], edges: &[[usize; 2]], faces: &[[usize; 3]]) -> Option<(usize, usize)> {
+    broad::edge_triangle(x, edges, faces)
+        .into_par_iter()
+        .find_first(|&(e, f)| {
+            let (ed, t) = (edges[e as usize], faces[f as usize]);
+            distance::segment_crosses_triangle(&[x[ed[0]], x[ed[1]], x[t[0]], x[t[1]], x[t[2]]])
+        })
+        .map(|(e, f)| (e as usize, f as usize))
 }
 
 /// The mesh's edge graph with reference edge lengths, for bounded Dijkstra searches.
