@@ -389,7 +389,15 @@ fn a_sheet_on_an_inclined_sheet_slides_or_sticks_by_coulomb() {
             out
         };
         let (v, u) = (mean("velocity"), mean("displacement"));
-        let row = log_rows(&dir.join(&tag)).pop().unwrap();
+        let rows = log_rows(&dir.join(&tag));
+        // The contact's timings: present, and growing over the run.
+        for part in ["broad", "ccd", "assembly"] {
+            let col = format!("self_contact_{part}_seconds");
+            let first = rows[0][&col];
+            let last = rows.last().unwrap()[&col];
+            assert!(first >= 0.0 && last > first, "{col}: {first} → {last}");
+        }
+        let row = rows.last().unwrap().clone();
         let t = row["time"];
         let a = g * (theta.sin() - mu * theta.cos());
         let weight_n = 1000.0 * h * 0.05 * 0.05 * g * theta.cos();

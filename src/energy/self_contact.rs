@@ -79,6 +79,7 @@ use crate::energy::{HessianProjection, Potential};
 use crate::math::{Real, SMat, SVec, Vec3};
 use crate::mesh::MeshError;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The mollifier's threshold as a fraction of the product of the squared rest lengths
 /// (Li et al. 2020, §4.3).
@@ -110,6 +111,9 @@ pub struct SelfContact {
     pub min_separation: Real,
     /// Coulomb coefficient μ between sheets (0: frictionless, and always in statics).
     pub friction: Real,
+    /// Wall time spent so far (ns) in the broad phase and gathering, in CCD and the
+    /// separation checks, and in the term's assembly ([`Clock`]).
+    clock: [AtomicU64; 3],
     /// Excluded point–triangle pairs `p << 32 | f`, sorted.
     excluded_pt: Vec<u64>,
     /// Excluded edge–edge pairs `a << 32 | b` (edge indices, `a < b`), sorted.
@@ -129,6 +133,14 @@ fn points(x: &[Vec3], nodes: &[usize]) -> [Vec3; 4] {
     std::array::from_fn(|i| x[nodes[i]])
 }
 
+/// The parts of [`SelfContact::clock`].
+#[derive(Clone, Copy)]
+enum Clock {
+    Broad = 0,
+    Ccd = 1,
+    Assembly = 2,
+}
+
 /// A pair's friction over a step, lagged (module doc).
 #[derive(Clone, Copy)]
 struct Slip {
@@ -141,6 +153,16 @@ struct Slip {
 }
 
 impl SelfContact {
+    /// Runs `f`, adding its wall time to the clock of `part`.
+    #[inline]
+    fn timed<T>(&self, part: Clock, f: impl FnOnce() -> T) -> T {
+        let start = std::time::Instant::now();
+        let out = f();
+        let ns = u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        self.clock[part as usize].fetch_add(ns, Ordering::Relaxed);
+        out
+    }
+
     /// The offset of the pair with these nodes (m).
     #[inline]
     fn offset(&self, nodes: &[usize]) -> Real {
@@ -210,6 +232,11 @@ impl SelfContact {
     /// `to`, when given), not excluded: their nodes, point–triangle pairs first, each kind
     /// sorted.
     fn candidates(&self, x: &[Vec3], to: Option<&[Vec3]>, radius: Real) -> Vec<[usize; 4]> {
+        self.timed(Clock::Broad, || self.candidates_untimed(x, to, radius))
+    }
+
+    /// [`SelfContact::candidates`], untimed.
+    fn candidates_untimed(&self, x: &[Vec3], to: Option<&[Vec3]>, radius: Real) -> Vec<[usize; 4]> {
         let pt = broad::point_triangle(x, to, &self.faces, radius);
         let ee = broad::edge_edge(x, to, &self.edges, radius);
         let key = |a: u32, b: u32| (a as u64) << 32 | b as u64;
@@ -227,11 +254,12 @@ impl SelfContact {
     /// The pairs within `beyond` of their offset at `x`, not excluded: the stencil,
     /// point–triangle pairs first (module doc for the slot order).
     fn pairs(&self, x: &[Vec3], beyond: Real) -> Stencil {
-        let near: Vec<[usize; 4]> = self
-            .candidates(x, None, self.xi_max + beyond)
-            .into_par_iter()
-            .filter(|n| self.closest(&points(x, n), n).d2 < (self.offset(n) + beyond).powi(2))
-            .collect();
+        let near: Vec<[usize; 4]> = self.timed(Clock::Broad, || {
+            self.candidates_untimed(x, None, self.xi_max + beyond)
+                .into_par_iter()
+                .filter(|n| self.closest(&points(x, n), n).d2 < (self.offset(n) + beyond).powi(2))
+                .collect()
+        });
         let mut st = Stencil {
             slot_dofs: vec![3; 4],
             nodes: Vec::with_capacity(4 * near.len()),
@@ -484,6 +512,24 @@ impl SelfContact {
         if map.nodes.is_empty() {
             return 0.0;
         }
+        self.timed(Clock::Assembly, || {
+            self.assemble_untimed(pot, map, x, want, projection, grad, values, with_friction)
+        })
+    }
+
+    /// [`SelfContact::assemble`], untimed.
+    #[allow(clippy::too_many_arguments)]
+    fn assemble_untimed(
+        &self,
+        pot: &Potential,
+        map: &ElementMap,
+        x: &[Vec3],
+        want: Want,
+        projection: HessianProjection,
+        grad: &mut [Real],
+        values: &mut [Real],
+        with_friction: bool,
+    ) -> Real {
         let active = self.active(&map.nodes, x);
         let gauss_newton = projection == HessianProjection::GaussNewton;
         let friction = pot
@@ -564,7 +610,10 @@ impl Reports for SelfContact {
     }
 
     /// `self_contact_pairs`: the pairs that press; `self_contact_friction` (with friction):
-    /// the sum of the magnitudes of their friction forces (N); `self_contact_gap`: the smallest distance
+    /// the sum of the magnitudes of their friction forces (N); `self_contact_broad_seconds`,
+    /// `self_contact_ccd_seconds`, `self_contact_assembly_seconds`: the wall time spent so far
+    /// in the broad phase and gathering, in CCD and the separation checks, and in the term's
+    /// assembly (s); `self_contact_gap`: the smallest distance
     /// of a gathered pair over its offset (the gathering's reach over the offset when none
     /// was gathered); `self_contact_force`: the sum of the pairs' normal forces (N).
     fn observables(&self, pot: &Potential, x: &[Vec3], _phi: &[Real]) -> Vec<(String, Real)> {
@@ -593,6 +642,14 @@ impl Reports for SelfContact {
                 "self_contact_friction".into(),
                 self.friction_force(pot, map, x),
             ));
+        }
+        for (name, part) in [
+            ("self_contact_broad_seconds", Clock::Broad),
+            ("self_contact_ccd_seconds", Clock::Ccd),
+            ("self_contact_assembly_seconds", Clock::Assembly),
+        ] {
+            let ns = self.clock[part as usize].load(Ordering::Relaxed);
+            out.push((name.into(), ns as Real * 1e-9));
         }
         out
     }
@@ -679,15 +736,17 @@ impl StepLimit for SelfContact {
     ) -> StepBound {
         let dx = |v: usize| Vec3::new(step[3 * v], step[3 * v + 1], step[3 * v + 2]);
         let nodes = &map.nodes;
-        let gathered = (0..nodes.len() / 4)
-            .into_par_iter()
-            .map(|e| {
-                let n = &nodes[4 * e..4 * e + 4];
-                let d: [Vec3; 4] = std::array::from_fn(|i| dx(n[i]));
-                let d_min = self.min_separation * self.offset(n);
-                ccd::safe_fraction(&points(x, n), &d, is_point_triangle(n), d_min, 1.0)
-            })
-            .reduce(|| 1.0, Real::min);
+        let gathered = self.timed(Clock::Ccd, || {
+            (0..nodes.len() / 4)
+                .into_par_iter()
+                .map(|e| {
+                    let n = &nodes[4 * e..4 * e + 4];
+                    let d: [Vec3; 4] = std::array::from_fn(|i| dx(n[i]));
+                    let d_min = self.min_separation * self.offset(n);
+                    ccd::safe_fraction(&points(x, n), &d, is_point_triangle(n), d_min, 1.0)
+                })
+                .reduce(|| 1.0, Real::min)
+        });
         // The pairs not gathered: where the pairs were gathered (the solver's positions, or `x`
         // outside a solve), they were farther apart than their offset and the halo.
         let taken = if pot.taken_at.len() == x.len() {
@@ -696,23 +755,27 @@ impl StepLimit for SelfContact {
             x
         };
         let to: Vec<Vec3> = (0..x.len()).map(|v| x[v] + dx(v)).collect();
-        let others = self
-            .candidates(x, Some(&to), self.xi_max)
-            .into_par_iter()
-            .map(|n| {
-                let d: [Vec3; 4] = std::array::from_fn(|i| dx(n[i]));
-                let y = points(x, &n);
-                let xi = self.offset(&n);
-                let t = ccd::safe_fraction(&y, &d, is_point_triangle(&n), xi, 1.0);
-                // The gathering's own test (`pairs`): those within reach were gathered, and
-                // answer to the bound above.
-                if t >= 1.0 || self.closest(&points(taken, &n), &n).d2 < (xi + self.halo).powi(2) {
-                    return (1.0, false);
-                }
-                // Within reach now: gathering again would add it.
-                (t, self.closest(&y, &n).d2 < (xi + self.halo).powi(2))
-            })
-            .reduce(|| (1.0, false), |a, b| (a.0.min(b.0), a.1 || b.1));
+        let candidates = self.candidates(x, Some(&to), self.xi_max);
+        let others = self.timed(Clock::Ccd, || {
+            candidates
+                .into_par_iter()
+                .map(|n| {
+                    let d: [Vec3; 4] = std::array::from_fn(|i| dx(n[i]));
+                    let y = points(x, &n);
+                    let xi = self.offset(&n);
+                    let t = ccd::safe_fraction(&y, &d, is_point_triangle(&n), xi, 1.0);
+                    // The gathering's own test (`pairs`): those within reach were gathered, and
+                    // answer to the bound above.
+                    if t >= 1.0
+                        || self.closest(&points(taken, &n), &n).d2 < (xi + self.halo).powi(2)
+                    {
+                        return (1.0, false);
+                    }
+                    // Within reach now: gathering again would add it.
+                    (t, self.closest(&y, &n).d2 < (xi + self.halo).powi(2))
+                })
+                .reduce(|| (1.0, false), |a, b| (a.0.min(b.0), a.1 || b.1))
+        });
         let moved = !std::ptr::eq(taken, x) && taken != x;
         if others.0 < gathered && others.1 && moved {
             return StepBound {
@@ -729,10 +792,12 @@ impl StepLimit for SelfContact {
     /// Every pair at least `s ξ` apart.
     fn admits(&self, _: &Potential, map: &ElementMap, x: &[Vec3]) -> bool {
         let nodes = &map.nodes;
-        (0..nodes.len() / 4).into_par_iter().all(|e| {
-            let n = &nodes[4 * e..4 * e + 4];
-            let d_min = self.min_separation * self.offset(n);
-            self.closest(&points(x, n), n).d2 >= d_min * d_min
+        self.timed(Clock::Ccd, || {
+            (0..nodes.len() / 4).into_par_iter().all(|e| {
+                let n = &nodes[4 * e..4 * e + 4];
+                let d_min = self.min_separation * self.offset(n);
+                self.closest(&points(x, n), n).d2 >= d_min * d_min
+            })
         })
     }
 }
@@ -809,6 +874,7 @@ pub fn term(
         exclusion: c.exclusion.or(2.0 * (xi_max + smoothing)),
         min_separation: c.min_separation,
         friction: if dynamic { c.friction } else { 0.0 },
+        clock: Default::default(),
         excluded_pt: Vec::new(),
         excluded_ee: Vec::new(),
     };
