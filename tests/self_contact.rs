@@ -1,6 +1,8 @@
 //! Self-contact from the command line: a strip rolled by an end moment past a full turn winds
 //! onto itself with its layers a thickness apart; a stack of sheets sinks into its offset by
-//! the penalty's closed form; a sheet dropped onto another lands without crossing it. Frames
+//! the penalty's closed form; a sheet dropped onto another lands without crossing it; a sheet
+//! on an inclined sheet slides or sticks by Coulomb's law; random thrusts on a folded sheet
+//! never carry one layer through the other; bad input is named. Frames
 //! are checked by an independent script (`scripts/contact_check.py`: VTK's readers and a
 //! brute-force numpy search over every pair of faces, none of shellsim's code) for crossing
 //! faces and for the smallest distance between mid-surfaces; the rolled strip without
@@ -519,5 +521,114 @@ fn bad_self_contact_input_is_named_and_writes_nothing() {
         }
         assert!(!err.contains("panicked"), "{err}");
         assert!(!dir.join(&out).exists(), "{mesh}: {out} was written");
+    }
+}
+
+/// Random thrusts on a folded sheet: a 10 × 2 cm strip (h = 1 mm, E = 1 MPa) folded at rest
+/// over a half circle of radius 1.5 h, its layers 3 h apart, is started from its rest shape
+/// with random velocities: each layer driven toward the other at 1.5–3 m/s, with random
+/// in-plane and normal components of up to 1 m/s per vertex, three seeds, in dynamic mode
+/// for 10 ms with a frame every 0.2 ms (the layers meet within 0.5 ms, crumple and bounce).
+/// In no frame does a face cross another or two mid-surfaces come closer than the minimum
+/// separation (a tenth of the offset), checked by the independent script over every pair of
+/// faces. Measured: the closest approach 0.67–0.81 h; without self-contact the first seed's
+/// layers cross at 794 face pairs.
+#[test]
+fn random_thrusts_on_a_folded_sheet_never_cross_it() {
+    use shellsim::math::Vec3;
+    use shellsim::mesh::generate::{rectangle, Rng, Spacing};
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let h = 1e-3;
+    let flat = rectangle(
+        0.0,
+        0.0,
+        0.1,
+        0.02,
+        0.004,
+        Spacing {
+            jitter: 0.2,
+            seed: 11,
+            ..Default::default()
+        },
+    );
+    let r = 1.5 * h;
+    let arc = std::f64::consts::PI * r;
+    let mut folded = flat.clone();
+    let mut layer = Vec::new();
+    for p in folded.positions.iter_mut() {
+        let s = p.x - 0.05;
+        let (q, side) = if s <= 0.0 {
+            (Vec3::new(p.x, p.y, 0.0), 1.0)
+        } else if s < arc {
+            let t = s / r;
+            (Vec3::new(0.05 + r * t.sin(), p.y, r * (1.0 - t.cos())), 0.0)
+        } else {
+            (Vec3::new(0.05 - (s - arc), p.y, 2.0 * r), -1.0)
+        };
+        *p = q;
+        layer.push(side);
+    }
+    shellsim::mesh::io::write_mesh(
+        &dir.join("fold.vtk"),
+        &folded,
+        shellsim::mesh::io::Format::Vtk,
+        "fold",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("thrust.toml"),
+        format!(
+            "[material]\nyoung = 1e6\nthickness = {h}\ndensity = 1000\n\
+             [solver]\nmode = \"dynamic\"\nsymmetry_breaking = 0\n\
+             [time]\nend = 0.01\ndt = 1e-4\ndt_max = 1e-4\noutput_interval = 2e-4\n\
+             [self_contact]\nenabled = true\n"
+        ),
+    )
+    .unwrap();
+    for seed in 1..=3u64 {
+        let mut rng = Rng::new(seed);
+        let mut start = folded.clone();
+        let v: Vec<f64> = layer
+            .iter()
+            .flat_map(|&side| {
+                let toward = side * (1.5 + 1.5 * rng.uniform());
+                [rng.symmetric(), rng.symmetric(), toward + rng.symmetric()]
+            })
+            .collect();
+        start.vertex_fields.insert(
+            "velocity".into(),
+            shellsim::mesh::Field {
+                components: 3,
+                data: v,
+            },
+        );
+        let frame = format!("start{seed}.vtk");
+        shellsim::mesh::io::write_mesh(
+            &dir.join(&frame),
+            &start,
+            shellsim::mesh::io::Format::Vtk,
+            "start",
+        )
+        .unwrap();
+        let out = format!("seed{seed}");
+        shellsim(
+            &[
+                "thrust.toml",
+                "fold.vtk",
+                "--out",
+                &out,
+                "-q",
+                "--restart",
+                &frame,
+            ],
+            dir,
+        );
+        let c = check(dir, "fold.vtk", &out, 2.0 * (h + h / 100.0));
+        println!("seed {seed}: {c}");
+        assert_eq!(c["crossing_pairs"], 0, "seed {seed}: {c}");
+        assert_eq!(c["frames"], 51, "seed {seed}");
+        let dmin = c["min_distance"].as_f64().unwrap();
+        assert!(dmin >= 0.1 * h && dmin < h, "seed {seed}: {dmin}");
     }
 }
