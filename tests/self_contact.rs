@@ -300,6 +300,24 @@ fn a_dropped_sheet_lands_on_another_without_crossing_it() {
     assert_eq!(c["frames"], 31);
     let dmin = c["min_distance"].as_f64().unwrap();
     assert!(dmin >= 0.1 * h && dmin < h, "{dmin}");
+    // Every face within reach pressing (pairs = "all"): the same guarantee.
+    shellsim(
+        &[
+            "drop.toml",
+            "drop.vtk",
+            "--out",
+            "all",
+            "-q",
+            "--set",
+            "self_contact.pairs=\"all\"",
+        ],
+        dir,
+    );
+    let c = check(dir, "drop.vtk", "all", 2.0 * (h + h / 100.0));
+    println!("dropped sheet, all pairs: {c}");
+    assert_eq!(c["crossing_pairs"], 0, "{c}");
+    let dmin = c["min_distance"].as_f64().unwrap();
+    assert!(dmin >= 0.1 * h && dmin < h, "{dmin}");
 }
 
 /// A 5 cm square (h = 1 mm, E = 1 MPa, ρ = 1000 kg/m³) resting on a held 15 cm one, gravity

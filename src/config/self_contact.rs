@@ -35,6 +35,23 @@ pub struct SelfContact {
     /// Coulomb coefficient μ between the sheets' surfaces, ≥ 0 (default 0: frictionless).
     /// Dynamic mode; the slip speed of its smoothing is `contact.slip_speed`.
     pub friction: Real,
+    /// Which point–triangle pairs of a vertex press (default `"nearest"`): see
+    /// [`Pairs`].
+    pub pairs: Pairs,
+}
+
+/// Which point–triangle pairs of a vertex press.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Pairs {
+    /// The nearest face on either side of the vertex: exact on flat contacts (the closed-form
+    /// penetration on any mesh), but the faces that count change abruptly where a fold turns
+    /// the other surface edge-on to the vertex.
+    Nearest,
+    /// Every face within reach (IPC's pairs): the energy is C¹ everywhere, and a vertex over
+    /// an edge or a vertex of the other surface presses on each face there (stiffer contact
+    /// where meshes align).
+    All,
 }
 
 impl Default for SelfContact {
@@ -48,6 +65,7 @@ impl Default for SelfContact {
             halo: AutoOr::Auto(Auto::Auto),
             min_separation: 0.1,
             friction: 0.0,
+            pairs: Pairs::Nearest,
         }
     }
 }
@@ -134,6 +152,10 @@ mod tests {
                 "self_contact.friction"
             );
         }
+        let all: SelfContact =
+            toml::from_str("enabled = true\npairs = \"all\"").expect("pairs = all parses");
+        assert_eq!(all.pairs, Pairs::All);
+        assert!(toml::from_str::<SelfContact>("pairs = \"some\"").is_err());
         for s in [0.0, 0.95, Real::NAN] {
             let bad = SelfContact {
                 min_separation: s,

@@ -721,12 +721,17 @@ pub fn newton(
         rep.timing.line_search += clock.elapsed().as_secs_f64();
         if VERBOSE.load(std::sync::atomic::Ordering::Relaxed) {
             eprintln!(
-                "newton {:>3}: energy {:+.9e} J  residual {}  shift {}  step {:.4}{}{}",
+                "newton {:>3}: energy {:+.9e} J  residual {}  shift {}  step {:.4}{}{}{}",
                 rep.iterations,
                 e,
                 crate::math::human(rep.residual),
                 crate::math::human(tau),
                 alpha,
+                if bound.fraction < 1.0 {
+                    format!("  (bounded to {:.4})", bound.fraction)
+                } else {
+                    String::new()
+                },
                 if projected { "  gauss-newton" } else { "" },
                 if accepted {
                     ""
