@@ -3,8 +3,8 @@
 //! Cholesky + solve) on ~5k and ~20k-face meshes for every bending model, with the assembly and
 //! the factorisation also timed apart; the moisture step; and a balloon frame at the size of
 //! seed 002's Table 1 (`balloon`); self-contact between two sheets pressed together
-//! (`self_contact`: the term's Hessian per pressing pair, the CCD step bound, and one Newton
-//! iteration of the same scene).
+//! (`self_contact`, at about 5k, 20k and 80k faces: the term's Hessian per pressing pair, the
+//! gathering of the pairs, the CCD step bound, and one Newton iteration of the same scene).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use shellsim::assembly::{Pattern, Want};
@@ -733,14 +733,16 @@ fn two_sheets(edge: f64, gap: f64) -> (Scene, Pattern, Vec<Vec3>) {
     (sc, p, x)
 }
 
-/// Self-contact of two sheets pressed into their offset (every vertex of both presses): the
-/// term's energy, gradient and Hessian (throughput: pressing pairs), the CCD step bound of a
+/// Self-contact of two sheets pressed into their offset (every vertex of both presses), at
+/// about 5k, 20k and 80k faces: the term's energy, gradient and Hessian (throughput: pressing
+/// pairs), the gathering of the pairs (broad phase and distance filter), the CCD step bound of a
 /// random step of a tenth of the offset, and one Newton iteration (assembly of every term with
 /// the Gauss–Newton projection, numeric Cholesky, solve) of the same scene.
 fn self_contact(c: &mut Criterion) {
     let mut g = c.benchmark_group("self_contact");
     g.sample_size(10);
-    for edge in [1.0 / 50.0, 1.0 / 100.0] {
+    // About 5k, 20k and 80k faces: the scaling of the broad phase, CCD and assembly.
+    for edge in [1.0 / 35.0, 1.0 / 71.0, 1.0 / 141.0] {
         let (sc, p, x) = two_sheets(edge, 0.0018);
         let i = (0..sc.terms.len())
             .find(|&i| sc.terms[i].name() == "self_contact")
@@ -763,6 +765,17 @@ fn self_contact(c: &mut Criterion) {
                     shellsim::energy::HessianProjection::None,
                     &mut gr,
                     &mut h,
+                )
+            })
+        });
+        g.bench_function(BenchmarkId::new("gather_per_pair", nf), |b| {
+            b.iter(|| {
+                black_box(
+                    term.changing()
+                        .unwrap()
+                        .stencil_at(&sc.body, &x, &phi)
+                        .nodes
+                        .len(),
                 )
             })
         });
