@@ -171,4 +171,30 @@ impl Topology {
     pub fn num_edges(&self) -> usize {
         self.edges.len()
     }
+
+    /// The connected piece of each face (faces sharing an edge are connected; the pieces
+    /// numbered in the order of their first face), and the number of pieces.
+    pub fn face_pieces(&self) -> (Vec<usize>, usize) {
+        let nf = self.face_neighbors.len();
+        let mut piece = vec![usize::MAX; nf];
+        let mut count = 0;
+        let mut stack = Vec::new();
+        for start in 0..nf {
+            if piece[start] != usize::MAX {
+                continue;
+            }
+            piece[start] = count;
+            stack.push(start);
+            while let Some(f) = stack.pop() {
+                for &g in &self.face_neighbors[f] {
+                    if g != NONE && piece[g] == usize::MAX {
+                        piece[g] = count;
+                        stack.push(g);
+                    }
+                }
+            }
+            count += 1;
+        }
+        (piece, count)
+    }
 }
