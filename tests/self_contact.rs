@@ -170,6 +170,50 @@ fn sheets_mesh(dir: &Path, name: &str, side: f64, edge: f64, corners: &[(f64, f6
     .unwrap();
 }
 
+/// The force (N, along z) that the self-contact carries through each interface of a stack of
+/// `sheets` sheets of equal vertex counts, numbered from the bottom, at the positions of
+/// `frame`: the contact forces `−∇E` summed over the vertices of the sheets above interface
+/// `k` (between sheets `k − 1` and `k`), for `k = 1 … sheets − 1`. The scene is built from the
+/// run's settings and reference mesh with the library, and its contact term evaluated alone.
+fn interface_forces(
+    dir: &Path,
+    settings: &str,
+    mesh: &str,
+    frame: &Path,
+    sheets: usize,
+) -> Vec<f64> {
+    use shellsim::assembly::{Pattern, Want};
+    use shellsim::energy::{HessianProjection, Potential};
+    let text = std::fs::read_to_string(dir.join(settings)).unwrap();
+    let m = shellsim::mesh::io::read_mesh(&dir.join(mesh)).unwrap();
+    let sc = shellsim::model::Scene::build(
+        m,
+        shellsim::settings::Settings::from_str_with(&text, settings, &[]).unwrap(),
+    )
+    .unwrap();
+    let x = shellsim::mesh::io::read_mesh(frame).unwrap().positions;
+    let phi = vec![0.0; sc.num_scalar_dofs()];
+    let p = Pattern::for_scene(&sc).refreshed(&sc, &x, &phi).unwrap();
+    let i = (0..sc.terms.len())
+        .find(|&i| sc.terms[i].name() == "self_contact")
+        .unwrap();
+    let pot = Potential::new(&sc, &p);
+    let mut g = vec![0.0; p.n];
+    sc.terms[i].eval(
+        &pot,
+        &p.maps[i],
+        &x,
+        &phi,
+        Want::Gradient,
+        HessianProjection::None,
+        &mut g,
+        &mut [],
+    );
+    let n = x.len() / sheets;
+    let up = |k: usize| -> f64 { (k * n..(k + 1) * n).map(|v| -g[3 * v + 2]).sum() };
+    (1..sheets).map(|k| (k..sheets).map(up).sum()).collect()
+}
+
 /// Three 5 cm squares (h = 1 mm, E = 1 MPa, ρ = 1000 kg/m³) stacked a thickness apart under a
 /// gravity of 1000 m/s²: the bottom one held, the others free to move up and down. Each
 /// interface carries the weight above it, σ = ρ h g per sheet (1 and 2 kPa), below the
@@ -177,6 +221,8 @@ fn sheets_mesh(dir: &Path, name: &str, side: f64, edge: f64, corners: &[(f64, f6
 /// √(2δσ/k), 4.47 µm and 6.32 µm. Measured as the offset less the mean distance between the
 /// sheets: 0.42% and 0.46% below (the pressure varies a little over the jittered meshes, and
 /// the mean of the square root is below the square root of the mean); asserted within 1%. The
+/// contact forces through the two interfaces (`−∇E` of the contact term, summed over the
+/// sheets above each) are the weights above them, the
 /// pairs' normal forces sum to the weights above the two interfaces (measured to 1.6e-9), the
 /// frames' mean contact pressure on each sheet is the weight pressure on its sides (to 3e-9),
 /// and the held sheet's support carries all three sheets, all asserted to 1e-6.
@@ -211,6 +257,18 @@ fn a_stack_of_sheets_sinks_into_its_offset_by_the_closed_form() {
         3.0 * w1
     );
     assert!((carried - 3.0 * w1).abs() < 1e-6 * 3.0 * w1, "{carried}");
+    let through = interface_forces(
+        dir,
+        "stack.toml",
+        "stack.vtk",
+        &dir.join("out").join(s["final_frame"].as_str().unwrap()),
+        3,
+    );
+    println!("forces through the interfaces {through:?} N");
+    for (k, f) in through.iter().enumerate() {
+        let w = (2 - k) as f64 * w1;
+        assert!((f - w).abs() < 1e-6 * w, "interface {}: {f} vs {w}", k + 1);
+    }
     let held = s["reactions"]
         .as_array()
         .unwrap()
@@ -654,7 +712,9 @@ fn random_thrusts_on_a_folded_sheet_never_cross_it() {
 /// A stack of eight 5 cm squares (h = 1 mm, E = 1 MPa) a thickness apart, pressed between two
 /// glass slides: plane obstacles, the lower fixed, the upper pushed down by F = 5 N (force
 /// control, its height a global DOF of the static solve); the sheets held only in their plane.
-/// Each of the seven interfaces carries the load: the pairs' normal forces sum to 7F and the
+/// Each of the seven interfaces carries the load: the contact forces through each (`−∇E` of the
+/// contact term, summed over the sheets above it) equal F to 1e-6, the pairs' normal forces
+/// sum to 7F and the
 /// frames' mean contact pressure on each sheet is σ = F/A on the two outer sheets (pressed on
 /// one side by another sheet) and 2σ on the six inner ones, all to 1e-6 (measured 3.8e-9 and
 /// 1.1e-8); each interface sinks into its offset by the closed form √(2δσ/k) = 6.32 µm
@@ -698,6 +758,17 @@ fn a_stack_of_eight_sheets_pressed_between_slides_carries_the_load_through_each(
         (carried - 7.0 * force).abs() < 1e-6 * 7.0 * force,
         "{carried}"
     );
+    let through = interface_forces(
+        dir,
+        "stack8.toml",
+        "stack8.vtk",
+        &dir.join("out").join(s["final_frame"].as_str().unwrap()),
+        8,
+    );
+    println!("forces through the interfaces {through:?} N");
+    for (k, f) in through.iter().enumerate() {
+        assert!((f - force).abs() < 1e-6 * force, "interface {}: {f}", k + 1);
+    }
     for k in ["obstacle0_force_z", "obstacle1_force_z"] {
         assert!(
             (last[k].abs() - force).abs() < 1e-6 * force,
