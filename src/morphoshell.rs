@@ -24,7 +24,8 @@
 //! * its equilibrium thresholds (kept in `[explicit]`; the test used stays shellsim's, which
 //!   cannot fire early; `explicit.equilibrium = "morphoshell"` reproduces MorphoShell's stop);
 //! * bend stiffening γ, gravity (gravity layout), the glass slides (`slide_speed_prefactor` × L / T_bend, with L
-//!   the reference perimeter and T_bend the bending long time, needs the mesh: given, the speed
+//!   the largest sheet's reference perimeter (MorphoShell's adds up every sheet's boundary; the
+//!   same for one sheet) and T_bend the bending long time, needs the mesh: given, the speed
 //!   is computed; without it, a nonzero prefactor is an error that says so);
 //! * `dialling_from_ansatz_rather_than_ref_state`: `dial.from = "start"`, with the ansatz given
 //!   as `--restart` (MorphoShell's ansatz files are read as they are:

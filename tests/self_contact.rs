@@ -386,8 +386,9 @@ fn a_dropped_sheet_lands_on_another_without_crossing_it() {
 /// obstacle), asserted to 1e-3 (measured 8e-6), and its pairs' friction forces sum to μ times
 /// the weight's normal part (1e-3; measured 1.4e-5). With μ = 0.8 > tan θ it sticks: the
 /// smoothed friction balances the slope where `f₁ = 2r − r² = tan θ / μ`, so the sheet creeps
-/// at exactly `r ε_v`, `r = 1 − √(1 − tan θ/μ)` (ε_v = 1e-5 m/s, the default slip speed;
-/// measured to 5e-4, asserted to 1e-3).
+/// at exactly `r ε_v`, `r = 1 − √(1 − tan θ/μ)` (ε_v = 1e-5 m/s, `contact.slip_speed` set in the test;
+/// measured to 5e-4, asserted to 1e-3). The sliding run's last frame and friction column are
+/// the same bits on 1 thread as on 2.
 #[test]
 fn a_sheet_on_an_inclined_sheet_slides_or_sticks_by_coulomb() {
     let d = tempfile::tempdir().unwrap();
@@ -440,6 +441,7 @@ fn a_sheet_on_an_inclined_sheet_slides_or_sticks_by_coulomb() {
                  [time]\nend = 0.2\ndt = 1e-3\ndt_max = 0.01\noutput_interval = 0.05\n\
                  [loads]\ngravity = [{}, 0, {}]\n\
                  [constraints]\nfix_boxes = [{{ min = [-1, -1, -1e-4], max = [1, 1, 1e-4] }}]\n\
+                 [contact]\nslip_speed = 1e-5\n\
                  [self_contact]\nenabled = true\nfriction = {mu}\n",
                 g * theta.sin(),
                 -g * theta.cos()
@@ -489,6 +491,29 @@ fn a_sheet_on_an_inclined_sheet_slides_or_sticks_by_coulomb() {
         assert!((t - 0.2).abs() < 1e-9, "{tag}: t = {t}");
         assert!(v[1].abs() < 1e-3 * (a * t).abs().max(1e-5), "{tag}: {v:?}");
         if mu < theta.tan() {
+            // The same bits on one thread: frames and the friction column.
+            shellsim(
+                &[
+                    &format!("{tag}.toml"),
+                    "incline.vtk",
+                    "--out",
+                    "t1",
+                    "-q",
+                    "--threads",
+                    "1",
+                ],
+                dir,
+            );
+            let one = dir.join("t1").join(s["final_frame"].as_str().unwrap());
+            assert!(
+                std::fs::read(&frame).unwrap() == std::fs::read(&one).unwrap(),
+                "the final frame differs on 1 thread"
+            );
+            let row1 = log_rows(&dir.join("t1")).pop().unwrap();
+            assert_eq!(
+                row1["self_contact_friction"].to_bits(),
+                row["self_contact_friction"].to_bits()
+            );
             let slide = v[0] + mu * v[2];
             assert!(
                 (slide / (a * t) - 1.0).abs() < 1e-3,

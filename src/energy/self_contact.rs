@@ -162,6 +162,17 @@ struct Slip {
     normal: Vec3,
 }
 
+impl Slip {
+    /// The relative motion `Σ cᵢ (xᵢ − x⁰ᵢ)` of the pair with these nodes over the step from
+    /// `x_prev` to `x` (m; module doc).
+    #[inline]
+    fn moved(&self, nodes: &[usize], x: &[Vec3], x_prev: &[Vec3]) -> Vec3 {
+        (0..4)
+            .map(|i| (x[nodes[i]] - x_prev[nodes[i]]) * self.c[i])
+            .sum()
+    }
+}
+
 impl SelfContact {
     /// Runs `f`, adding its wall time to the clock of `part`.
     #[inline]
@@ -264,12 +275,16 @@ impl SelfContact {
     /// The pairs within `beyond` of their offset at `x`, not excluded: the stencil,
     /// point–triangle pairs first (module doc for the slot order).
     fn pairs(&self, x: &[Vec3], beyond: Real) -> Stencil {
-        let near: Vec<[usize; 4]> = self.timed(Clock::Broad, || {
-            self.candidates_untimed(x, None, self.xi_max + beyond)
-                .into_par_iter()
-                .filter(|n| self.closest(&points(x, n), n).d2 < (self.offset(n) + beyond).powi(2))
-                .collect()
-        });
+        self.timed(Clock::Broad, || self.pairs_untimed(x, beyond))
+    }
+
+    /// [`SelfContact::pairs`], untimed (the checks at build).
+    fn pairs_untimed(&self, x: &[Vec3], beyond: Real) -> Stencil {
+        let near: Vec<[usize; 4]> = self
+            .candidates_untimed(x, None, self.xi_max + beyond)
+            .into_par_iter()
+            .filter(|n| self.closest(&points(x, n), n).d2 < (self.offset(n) + beyond).powi(2))
+            .collect();
         let mut st = Stencil {
             slot_dofs: vec![3; 4],
             nodes: Vec::with_capacity(4 * near.len()),
@@ -469,10 +484,7 @@ impl SelfContact {
         grad: Option<&mut SVec<12>>,
         hess: Option<&mut SMat<12, 12>>,
     ) -> Real {
-        let moved: Vec3 = (0..4)
-            .map(|i| (x[nodes[i]] - x_prev[nodes[i]]) * s.c[i])
-            .sum();
-        let (e, g, h) = friction_potential(s.bound, &s.normal, &moved, eps);
+        let (e, g, h) = friction_potential(s.bound, &s.normal, &s.moved(nodes, x, x_prev), eps);
         if let Some(grad) = grad {
             for i in 0..4 {
                 for a in 0..3 {
@@ -578,19 +590,19 @@ impl SelfContact {
             return 0.0;
         };
         let lagged = self.lagged_friction(&map.nodes, fr.x_lag);
-        (0..lagged.len())
+        let per_pair: Vec<Real> = (0..lagged.len())
             .into_par_iter()
-            .filter_map(|e| {
-                let s = lagged[e].as_ref()?;
-                let n = &map.nodes[4 * e..4 * e + 4];
-                let moved: Vec3 = (0..4).map(|i| (x[n[i]] - fr.x_prev[n[i]]) * s.c[i]).sum();
-                Some(
+            .map(|e| {
+                lagged[e].as_ref().map_or(0.0, |s| {
+                    let moved = s.moved(&map.nodes[4 * e..4 * e + 4], x, fr.x_prev);
                     friction_potential(s.bound, &s.normal, &moved, fr.eps)
                         .1
-                        .norm(),
-                )
+                        .norm()
+                })
             })
-            .sum()
+            .collect();
+        // Summed in pair order: the same bits on any thread count.
+        per_pair.iter().sum()
     }
 
     /// This term's element map in `pot`'s pattern.
@@ -609,16 +621,20 @@ impl Reports for SelfContact {
         x: &[Vec3],
         _phi: &[Real],
     ) -> Option<Vec<(&'static str, Real)>> {
-        let e = self.assemble(
-            pot,
-            map,
-            x,
-            Want::Energy,
-            HessianProjection::None,
-            &mut [],
-            &mut [],
-            false,
-        );
+        let e = if map.nodes.is_empty() {
+            0.0
+        } else {
+            self.assemble_untimed(
+                pot,
+                map,
+                x,
+                Want::Energy,
+                HessianProjection::None,
+                &mut [],
+                &mut [],
+                false,
+            )
+        };
         Some(vec![("self_contact", e)])
     }
 
@@ -726,7 +742,8 @@ impl LaggedNormals for SelfContact {
     /// Over the vertices, the largest normal force the pairs put on one at `trial`, and the
     /// largest change of one from the lagged iterate (the pairs that press at each).
     fn lag_change(&self, trial: &[Vec3], _: Real, lag: &[Vec3], _: Real) -> (Real, Real) {
-        let (new, old) = rayon::join(|| self.vertex_forces(trial), || self.vertex_forces(lag));
+        // One after the other: each gathering is timed on the broad phase's clock.
+        let (new, old) = (self.vertex_forces(trial), self.vertex_forces(lag));
         new.iter().zip(&old).fold((0.0, 0.0), |(s, d), (a, b)| {
             (Real::max(s, *a), Real::max(d, (a - b).abs()))
         })
@@ -990,7 +1007,7 @@ fn exclude(sc: &mut SelfContact, body: &Body) -> Result<(), MeshError> {
     sc.excluded_ee.sort_unstable();
     // Pairs not excluded that are within the offset at rest: the exclusion radius is too small
     // for this mesh and offset.
-    let reach = sc.pairs(x, 0.0);
+    let reach = sc.pairs_untimed(x, 0.0);
     if let Some(n) = reach.nodes.chunks(4).next() {
         let d = sc.closest(&points(x, n), n).d2.sqrt();
         return Err(body.mesh.invalid(format!(

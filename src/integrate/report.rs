@@ -380,7 +380,7 @@ pub struct ExplicitReport {
     pub damping_rate_dial: Real,
     /// The drag rate c while waiting (1/s).
     pub damping_rate_wait: Real,
-    /// The sample length L (reference perimeter, m).
+    /// The sample length L (the largest sheet's reference perimeter, m).
     pub sample_length: Real,
     /// The smallest reference altitude a_min (m).
     pub min_altitude: Real,

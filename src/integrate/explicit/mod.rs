@@ -30,8 +30,9 @@
 //! `summary.json` (`explicit.stable_prefactor`) and warned about when p exceeds it.
 //!
 //! ## Damping and time scales
-//! The longest bending mode has `k = 2π / L`, with L the reference perimeter (MorphoShell's
-//! sample length; for a closed surface, π × the bounding-box diagonal): `ω_L = √(D/(ρt)) k²`.
+//! The longest bending mode has `k = 2π / L`, with L the reference perimeter of the largest
+//! sheet (MorphoShell's sample length, which adds up every sheet's boundary; for a closed
+//! surface, π × its bounding-box diagonal; `src/scales.rs`): `ω_L = √(D/(ρt)) k²`.
 //! Critical damping of that mode is `c = 2 ω_L`; the drag rate is `c = p_d · 2 ω_L` with the
 //! prefactor `p_d` of the phase (`damping_prefactor_dial` while the forms are dialled,
 //! `damping_prefactor_wait` while waiting for equilibrium). The long time is the period of the
