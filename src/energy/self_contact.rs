@@ -253,11 +253,6 @@ impl SelfContact {
     /// `to`, when given), not excluded: their nodes, point–triangle pairs first, each kind
     /// sorted.
     fn candidates(&self, x: &[Vec3], to: Option<&[Vec3]>, radius: Real) -> Vec<[usize; 4]> {
-        self.timed(Clock::Broad, || self.candidates_untimed(x, to, radius))
-    }
-
-    /// [`SelfContact::candidates`], untimed.
-    fn candidates_untimed(&self, x: &[Vec3], to: Option<&[Vec3]>, radius: Real) -> Vec<[usize; 4]> {
         let pt = broad::point_triangle(x, to, &self.faces, radius);
         let ee = broad::edge_edge(x, to, &self.edges, radius);
         let key = |a: u32, b: u32| (a as u64) << 32 | b as u64;
@@ -281,7 +276,7 @@ impl SelfContact {
     /// [`SelfContact::pairs`], untimed (the checks at build).
     fn pairs_untimed(&self, x: &[Vec3], beyond: Real) -> Stencil {
         let near: Vec<[usize; 4]> = self
-            .candidates_untimed(x, None, self.xi_max + beyond)
+            .candidates(x, None, self.xi_max + beyond)
             .into_par_iter()
             .filter(|n| self.closest(&points(x, n), n).d2 < (self.offset(n) + beyond).powi(2))
             .collect();
@@ -507,14 +502,13 @@ impl SelfContact {
         e
     }
 
-    /// The normal force on each vertex (N) from the pairs that press at `x`, each pair's
-    /// force shared by its closest points' coefficients.
-    fn vertex_forces(&self, x: &[Vec3]) -> Vec<Real> {
-        let st = self.pairs(x, 0.0);
+    /// The normal force on each vertex (N) from the pairs of `nodes` that press at `x`, each
+    /// pair's force shared by its closest points' coefficients.
+    fn vertex_forces(&self, nodes: &[usize], x: &[Vec3]) -> Vec<Real> {
         let mut f = vec![0.0; x.len()];
-        for (e, lambda, c) in self.forces(&st.nodes, x) {
+        for (e, lambda, c) in self.forces(nodes, x) {
             for (k, ci) in c.iter().enumerate() {
-                f[st.nodes[4 * e + k]] += lambda * ci.abs();
+                f[nodes[4 * e + k]] += lambda * ci.abs();
             }
         }
         f
@@ -537,24 +531,6 @@ impl SelfContact {
         if map.nodes.is_empty() {
             return 0.0;
         }
-        self.timed(Clock::Assembly, || {
-            self.assemble_untimed(pot, map, x, want, projection, grad, values, with_friction)
-        })
-    }
-
-    /// [`SelfContact::assemble`], untimed.
-    #[allow(clippy::too_many_arguments)]
-    fn assemble_untimed(
-        &self,
-        pot: &Potential,
-        map: &ElementMap,
-        x: &[Vec3],
-        want: Want,
-        projection: HessianProjection,
-        grad: &mut [Real],
-        values: &mut [Real],
-        with_friction: bool,
-    ) -> Real {
         let active = self.active(&map.nodes, x);
         let gauss_newton = projection == HessianProjection::GaussNewton;
         let friction = pot
@@ -621,20 +597,16 @@ impl Reports for SelfContact {
         x: &[Vec3],
         _phi: &[Real],
     ) -> Option<Vec<(&'static str, Real)>> {
-        let e = if map.nodes.is_empty() {
-            0.0
-        } else {
-            self.assemble_untimed(
-                pot,
-                map,
-                x,
-                Want::Energy,
-                HessianProjection::None,
-                &mut [],
-                &mut [],
-                false,
-            )
-        };
+        let e = self.assemble(
+            pot,
+            map,
+            x,
+            Want::Energy,
+            HessianProjection::None,
+            &mut [],
+            &mut [],
+            false,
+        );
         Some(vec![("self_contact", e)])
     }
 
@@ -692,12 +664,7 @@ impl Reports for SelfContact {
             return Vec::new();
         };
         let nv = x.len();
-        let mut force = vec![0.0; nv];
-        for (e, lambda, c) in self.forces(&map.nodes, x) {
-            for (k, ci) in c.iter().enumerate() {
-                force[map.nodes[4 * e + k]] += lambda * ci.abs();
-            }
-        }
+        let force = self.vertex_forces(&map.nodes, x);
         let mut gap = vec![self.halo; nv];
         for n in map.nodes.chunks(4) {
             let g = self.closest(&points(x, n), n).d2.sqrt() - self.offset(n);
@@ -743,7 +710,8 @@ impl LaggedNormals for SelfContact {
     /// largest change of one from the lagged iterate (the pairs that press at each).
     fn lag_change(&self, trial: &[Vec3], _: Real, lag: &[Vec3], _: Real) -> (Real, Real) {
         // One after the other: each gathering is timed on the broad phase's clock.
-        let (new, old) = (self.vertex_forces(trial), self.vertex_forces(lag));
+        let at = |x: &[Vec3]| self.vertex_forces(&self.pairs(x, 0.0).nodes, x);
+        let (new, old) = (at(trial), at(lag));
         new.iter().zip(&old).fold((0.0, 0.0), |(s, d), (a, b)| {
             (Real::max(s, *a), Real::max(d, (a - b).abs()))
         })
@@ -785,7 +753,7 @@ impl StepLimit for SelfContact {
             x
         };
         let to: Vec<Vec3> = (0..x.len()).map(|v| x[v] + dx(v)).collect();
-        let candidates = self.candidates(x, Some(&to), self.xi_max);
+        let candidates = self.timed(Clock::Broad, || self.candidates(x, Some(&to), self.xi_max));
         let others = self.timed(Clock::Ccd, || {
             candidates
                 .into_par_iter()
@@ -862,7 +830,9 @@ impl Term for SelfContact {
         grad: &mut [Real],
         values: &mut [Real],
     ) -> Real {
-        self.assemble(pot, map, x, want, projection, grad, values, true)
+        self.timed(Clock::Assembly, || {
+            self.assemble(pot, map, x, want, projection, grad, values, true)
+        })
     }
 }
 

@@ -56,6 +56,26 @@ fn folded(sc: &Scene, gap: Real, noise: Real, seed: u64) -> Vec<Vec3> {
         .collect()
 }
 
+/// The strip folded with the layers 0.02 apart, and its pattern with the pairs gathered
+/// there, for the first noise whose pairs (of term `i`) keep their closest features under
+/// every perturbation of the finite-difference check: the distance's Hessian jumps where they
+/// change, and differences across such a place would not measure it.
+fn folded_without_feature_changes(
+    sc: &Scene,
+    p0: &Pattern,
+    phi: &[Real],
+    i: usize,
+) -> (Vec<Vec3>, Pattern) {
+    (11..60)
+        .map(|seed| {
+            let x = folded(sc, 0.02, 0.002, seed);
+            let p = p0.refreshed(sc, &x, phi).expect("the fold brings pairs");
+            (x, p)
+        })
+        .find(|(x, p)| kinds_hold(x, &p.maps[i].nodes, 1e-6))
+        .expect("a noise with no pair on a change of closest features")
+}
+
 fn term_index(sc: &Scene) -> usize {
     (0..sc.terms.len())
         .find(|&i| sc.terms[i].name() == "self_contact")
@@ -72,17 +92,7 @@ fn self_contact_matches_finite_differences_on_a_folded_strip() {
     let p0 = Pattern::for_scene(&sc);
     let i = term_index(&sc);
     assert!(p0.maps[i].nodes.is_empty(), "the flat strip has no pairs");
-    // The distance's Hessian jumps where a pair's closest features change: differences
-    // across such a place would not measure it. The first noise whose pairs keep their
-    // features under every perturbation of the check.
-    let (x, p) = (11..60)
-        .map(|seed| {
-            let x = folded(&sc, 0.02, 0.002, seed);
-            let p = p0.refreshed(&sc, &x, &phi).expect("the fold brings pairs");
-            (x, p)
-        })
-        .find(|(x, p)| kinds_hold(x, &p.maps[i].nodes, 1e-6))
-        .expect("a noise with no pair on a change of closest features");
+    let (x, p) = folded_without_feature_changes(&sc, &p0, &phi, i);
     let n = p.maps[i].nodes.len() / 4;
     let ee = p.maps[i].nodes.chunks(4).filter(|c| c[2] < c[3]).count();
     assert!(n > 50 && ee > 10, "{n} pairs, {ee} edge–edge");
@@ -164,14 +174,7 @@ fn self_contact_friction_matches_finite_differences() {
     let phi = vec![0.0; sc.num_scalar_dofs()];
     let p0 = Pattern::for_scene(&sc);
     let i = term_index(&sc);
-    let (x, p) = (11..60)
-        .map(|seed| {
-            let x = folded(&sc, 0.02, 0.002, seed);
-            let p = p0.refreshed(&sc, &x, &phi).expect("the fold brings pairs");
-            (x, p)
-        })
-        .find(|(x, p)| kinds_hold(x, &p.maps[i].nodes, 1e-6))
-        .expect("a noise with no pair on a change of closest features");
+    let (x, p) = folded_without_feature_changes(&sc, &p0, &phi, i);
     let eps = 1e-3;
     let mut rng = Rng::new(3);
     let lag: Vec<Vec3> = x
