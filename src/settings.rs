@@ -168,7 +168,19 @@ impl Settings {
             path: name.clone(),
             reason: e.to_string(),
         })?;
-        Self::from_str_with(&text, &name, overrides)
+        let mut settings = Self::from_str_with(&text, &name, overrides)?;
+        // A mesh obstacle's file is relative to the settings file's folder.
+        let folder = path.parent().unwrap_or(Path::new(""));
+        for o in &mut settings.obstacles {
+            if let Some(f) = o
+                .file
+                .as_mut()
+                .filter(|f| Path::new(f.as_str()).is_relative())
+            {
+                *f = folder.join(f.as_str()).display().to_string();
+            }
+        }
+        Ok(settings)
     }
 
     /// Parses settings from text (`name` is used in messages).

@@ -940,10 +940,17 @@ fn check_posed(mesh: &Mesh, settings: &Settings, free: bool) -> Result<(), MeshE
              constraints.fix_boxes) or use solver.mode = \"dynamic\"",
         ));
     }
-    let on_plane = settings
-        .obstacles
-        .iter()
-        .any(|o| o.shape == Some(crate::config::obstacle::ShapeKind::Plane));
+    // A mesh obstacle bounds every Newton step by continuous collision detection: the sheet
+    // cannot pass through it, even on the unbounded first step of a free sheet.
+    let on_plane = settings.obstacles.iter().any(|o| {
+        matches!(
+            o.shape,
+            Some(
+                crate::config::obstacle::ShapeKind::Plane
+                    | crate::config::obstacle::ShapeKind::Mesh
+            )
+        )
+    });
     let pressed = settings.obstacles.iter().any(|o| o.force.is_some());
     if free
         && obstacles
@@ -953,8 +960,9 @@ fn check_posed(mesh: &Mesh, settings: &Settings, free: bool) -> Result<(), MeshE
     {
         return Err(mesh.invalid(
             "obstacles: a free sheet under loads in static mode can rest only on a plane \
-             obstacle: Newton's first step of a free sheet is unbounded and can carry it \
-             through a finite obstacle (a sphere, capsule, cylinder or box). Add a plane, fix \
+             or mesh obstacle: Newton's first step of a free sheet is unbounded and can carry \
+             it through a finite analytic obstacle (a sphere, capsule, cylinder or box). Add a \
+             plane, fix \
              some vertices, or use solver.mode = \"dynamic\"",
         ));
     }

@@ -2,7 +2,7 @@
 //!
 //! ```toml
 //! [[obstacles]]
-//! shape = "sphere"          # "sphere", "capsule", "cylinder", "plane" or "box"
+//! shape = "sphere"          # "sphere", "capsule", "cylinder", "plane", "box" or "mesh"
 //! center = [0, 0, -0.3]     # sphere
 //! radius = 0.25             # sphere, capsule, cylinder (m)
 //! displacement = [0, 0, 0]  # moved linearly with the dial to this offset at dial 1 (m)
@@ -11,7 +11,10 @@
 //! Shapes and their keys: `sphere` (`center`, `radius`); `capsule` (the segment `a`–`b` and
 //! `radius`); `cylinder` (infinite: a `point` on its axis, the `axis` direction, `radius`);
 //! `plane` (a `point` and the `normal` toward the sheet's side); `box` (axis-aligned, `min` and
-//! `max` corners). Common keys: `displacement` (m, default none: the obstacle is fixed),
+//! `max` corners); `mesh` (`file`: any triangle mesh shellsim reads, `.stl`, `.obj`, `.off`,
+//! `.ply`, `.vtk`, `.vtu`, `.vtp`, open or closed, its path relative to the settings file;
+//! `scale`, a factor on its coordinates, default 1, and `translate` (m), applied after it; the
+//! sheet's contact pairs with it, [`crate::energy::self_contact`]). Common keys: `displacement` (m, default none: the obstacle is fixed),
 //! `stiffness` (Pa/m, default: the area-weighted mean E/h of the sheet) and `smoothing` (m,
 //! default: the mean thickness over 100), as the ground's (`[contact]`), and `friction` (the
 //! Coulomb coefficient μ, default 0; the smoothed Coulomb law of the ground in dynamic mode, with
@@ -21,7 +24,10 @@
 //! Force control: `force = [Fx, Fy, Fz]` (N, reached at dial 1, linear in the dial) pushes the
 //! obstacle along its direction instead of moving it by `displacement`; its offset along the
 //! force is a global DOF of the solve, and `mass` (kg) its inertia, required in dynamic mode.
-//! Static and dynamic modes; frictionless.
+//! Static and dynamic modes; frictionless; analytic shapes only.
+//!
+//! A `mesh` obstacle is fixed, in static or dynamic mode (its steps are bounded by continuous
+//! collision detection, which the explicit driver does not run).
 //!
 //! The raw table is flat (every key optional, unknown keys refused); [`ObstacleSettings::shape`]
 //! validates it into a [`Shape`] that carries exactly its variant's parameters.
@@ -34,8 +40,14 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ObstacleSettings {
-    /// `"sphere"`, `"capsule"`, `"cylinder"`, `"plane"` or `"box"` (required).
+    /// `"sphere"`, `"capsule"`, `"cylinder"`, `"plane"`, `"box"` or `"mesh"` (required).
     pub shape: Option<ShapeKind>,
+    /// The triangle mesh file of a `mesh` obstacle (relative to the settings file's folder).
+    pub file: Option<String>,
+    /// A factor on a mesh obstacle's coordinates (default 1: as in the file).
+    pub scale: Option<Real>,
+    /// A translation of a mesh obstacle after `scale` (m; default none).
+    pub translate: Option<[Real; 3]>,
     /// Sphere centre (m).
     pub center: Option<[Real; 3]>,
     /// Radius of a sphere, capsule or cylinder (m, > 0).
@@ -103,6 +115,8 @@ pub enum ShapeKind {
     Plane,
     /// An axis-aligned box.
     Box,
+    /// A triangle mesh read from a file.
+    Mesh,
 }
 
 /// A validated shape with its parameters (m; directions of unit length).
@@ -147,6 +161,8 @@ pub enum Shape {
         /// Upper corner.
         max: [Real; 3],
     },
+    /// A triangle mesh, the file `file` names (read when the scene is built).
+    Mesh,
 }
 
 /// Largest coordinate or length accepted (m), as for the mesh.
@@ -200,6 +216,30 @@ impl ObstacleSettings {
                     "mass",
                     "is required by a force-controlled obstacle in dynamic mode (kg, its \
                      inertia)",
+                );
+            }
+        }
+        if self.shape == Some(ShapeKind::Mesh) {
+            if let Control::Pressed { .. } = control {
+                return invalid(
+                    "force",
+                    "force control is available on the analytic shapes; move a mesh obstacle \
+                     by `displacement`",
+                );
+            }
+            if self.displacement.iter().any(|&c| c != 0.0) {
+                return invalid(
+                    "displacement",
+                    "a mesh obstacle stays where its file (with scale and translate) puts it; \
+                     move the sheet instead, or press with an analytic shape",
+                );
+            }
+            if mode == Mode::Explicit {
+                return invalid(
+                    "shape",
+                    "a mesh obstacle's contact bounds every Newton step by continuous \
+                     collision detection, which explicit mode does not run: use solver.mode = \
+                     \"static\" or \"dynamic\", or an analytic shape",
                 );
             }
         }
@@ -292,7 +332,8 @@ impl ObstacleSettings {
         let kind = self.shape.ok_or_else(|| {
             Invalid::new(
                 &key("shape"),
-                "is required: \"sphere\", \"capsule\", \"cylinder\", \"plane\" or \"box\"",
+                "is required: \"sphere\", \"capsule\", \"cylinder\", \"plane\", \"box\" or \
+                 \"mesh\"",
             )
         })?;
         let used: &[&str] = match kind {
@@ -301,6 +342,7 @@ impl ObstacleSettings {
             ShapeKind::Cylinder => &["point", "axis", "radius"],
             ShapeKind::Plane => &["point", "normal"],
             ShapeKind::Box => &["min", "max"],
+            ShapeKind::Mesh => &["file", "scale", "translate"],
         };
         let given = [
             ("center", self.center.is_some()),
@@ -312,6 +354,9 @@ impl ObstacleSettings {
             ("normal", self.normal.is_some()),
             ("min", self.min.is_some()),
             ("max", self.max.is_some()),
+            ("file", self.file.is_some()),
+            ("scale", self.scale.is_some()),
+            ("translate", self.translate.is_some()),
         ];
         if let Some((k, _)) = given.iter().find(|(k, g)| *g && !used.contains(k)) {
             return Err(Invalid::new(
@@ -383,6 +428,30 @@ impl ObstacleSettings {
                 }
                 Shape::Box { min, max }
             }
+            ShapeKind::Mesh => match self.file.as_deref() {
+                Some(f) if !f.trim().is_empty() => {
+                    if let Some(t) = self.translate {
+                        finite3(&key("translate"), t)?;
+                    }
+                    if let Some(c) = self.scale {
+                        if !(c.is_finite() && c > 0.0 && c <= MAX_COORD) {
+                            return Err(Invalid::new(
+                                &key("scale"),
+                                format!("must be > 0, got {}", crate::math::human(c)),
+                            ));
+                        }
+                    }
+                    Shape::Mesh
+                }
+                Some(_) => return Err(Invalid::new(&key("file"), "must name a mesh file")),
+                None => {
+                    return Err(Invalid::new(
+                        &key("file"),
+                        "is required by a mesh obstacle (a triangle mesh file: .stl, .obj, \
+                         .off, .ply, .vtk, .vtu or .vtp)",
+                    ))
+                }
+            },
         })
     }
 }

@@ -46,8 +46,19 @@ pub fn no_contribution<const N: usize>(
     0.0
 }
 
-/// The stencil of an element term: every element's DOF nodes in slot order (`NONE` where a slot
-/// is absent), the number of DOFs of each slot, and one point per element that orders elements
+/// Node ids from this one up are absent slots, which receive no entries: [`NONE`], and the
+/// points of an element that are not DOFs of the solve (a rigid obstacle's vertices in a
+/// contact pair), numbered `ABSENT + k` by the term that owns them.
+pub const ABSENT: usize = usize::MAX / 2;
+
+/// Whether node id `u` is an absent slot ([`ABSENT`]).
+#[inline(always)]
+pub fn is_absent(u: usize) -> bool {
+    u >= ABSENT
+}
+
+/// The stencil of an element term: every element's DOF nodes in slot order (absent slots
+/// numbered from [`ABSENT`] up, [`NONE`] where a slot is empty), the number of DOFs of each slot, and one point per element that orders elements
 /// into spatially coherent blocks.
 #[derive(Clone, Debug)]
 pub struct Stencil {
@@ -106,7 +117,7 @@ pub struct ElementMap {
     pub slots: usize,
     /// Local DOF offset of each slot in the element vector.
     pub local: Vec<usize>,
-    /// Node ids, `elements × slots` (`NONE` where absent).
+    /// Node ids, `elements × slots` (from [`ABSENT`] up where absent).
     pub nodes: Vec<usize>,
     /// Number of vertices (nodes below it are vertices with 3 DOFs, above it edges with 1).
     pub(crate) num_vertices: usize,
@@ -250,7 +261,7 @@ impl ElementMap {
     ) {
         for s in 0..S {
             let u = st[s];
-            if u == NONE || fixed[u] {
+            if is_absent(u) || fixed[u] {
                 continue;
             }
             let (d0, k) = node_dofs(self.num_vertices, u);
@@ -280,14 +291,14 @@ impl ElementMap {
         let off = &self.offsets[e * S * S..(e + 1) * S * S];
         for t in 0..S {
             let v = st[t];
-            if v == NONE || fixed[v] {
+            if is_absent(v) || fixed[v] {
                 continue;
             }
             let (dv, kv) = node_dofs(self.num_vertices, v);
             let lt = local[t];
             for s in 0..S {
                 let u = st[s];
-                if u == NONE || fixed[u] || u < v {
+                if is_absent(u) || fixed[u] || u < v {
                     continue;
                 }
                 let ls = local[s];
@@ -374,7 +385,7 @@ pub(crate) fn colour_blocks(
                 stencil.nodes[f * s..(f + 1) * s]
                     .iter()
                     .copied()
-                    .filter(|&v| v != NONE),
+                    .filter(|&v| !is_absent(v)),
             );
         }
         verts.sort_unstable();
@@ -530,7 +541,7 @@ impl Parts {
         let mut owner = vec![u32::MAX; num_nodes];
         for &e in &map.morton {
             for &u in map.element(e as usize) {
-                if u != NONE && owner[u] == u32::MAX {
+                if !is_absent(u) && owner[u] == u32::MAX {
                     owner[u] = home[e as usize];
                 }
             }
@@ -542,7 +553,7 @@ impl Parts {
             let parts = map
                 .element(e)
                 .iter()
-                .filter(|&&u| u != NONE)
+                .filter(|&&u| !is_absent(u))
                 .map(|&u| owner[u] as usize);
             for p in std::iter::once(h).chain(parts) {
                 if last[p] != e as u32 {
@@ -576,7 +587,7 @@ impl Parts {
                 .iter()
                 .flat_map(|&e| map.element(e as usize))
                 .map(|&u| {
-                    if u != NONE && owner[u] as usize == p {
+                    if !is_absent(u) && owner[u] as usize == p {
                         sum_at[u]
                     } else {
                         u32::MAX

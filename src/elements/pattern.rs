@@ -3,9 +3,9 @@
 //! and the colouring of its element blocks). Built from stencils alone, so it sits below the
 //! terms; [`crate::assembly`] builds it for a scene.
 
+use super::is_absent;
 use super::{block_size, colour_blocks, morton_order, node_dofs, ElementMap, Scratch, Stencil};
 use crate::math::{Mat3, Real, Vec3};
-use crate::mesh::topology::NONE;
 
 /// The Hessian's sparsity pattern and, per term, where its elements' entries go.
 #[derive(Clone, Debug)]
@@ -58,7 +58,7 @@ impl Pattern {
             for el in st.nodes.chunks(st.slots().max(1)) {
                 for &u in el {
                     for &v in el {
-                        if u != NONE && v != NONE && u > v {
+                        if !is_absent(u) && !is_absent(v) && u > v {
                             hi[v].push(u);
                         }
                     }
@@ -116,7 +116,7 @@ impl Pattern {
                     for a in 0..s {
                         for b in 0..s {
                             let (u, v) = (el[a], el[b]);
-                            if u != NONE && v != NONE && u > v {
+                            if !is_absent(u) && !is_absent(v) && u > v {
                                 let rank = hi[v].binary_search(&u).unwrap_or(0);
                                 offsets[e * s * s + s * a + b] = prefix[v][rank];
                             }

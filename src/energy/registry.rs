@@ -183,7 +183,12 @@ pub fn terms(body: &Body, s: &Settings) -> Result<Vec<Box<dyn Term>>, MeshError>
     t.extend(super::loads::moment::term(body, &s.loads.moment)?);
     t.extend(super::gas::term(body, &s.gas)?);
     t.extend(super::slides::term(body, &s.slides, &s.explicit)?);
-    t.extend(super::self_contact::term(body, &s.self_contact, dynamic)?);
+    t.extend(super::self_contact::term(
+        body,
+        &s.self_contact,
+        &s.obstacles,
+        dynamic,
+    )?);
     t.extend(super::obstacles::terms(
         body,
         &s.obstacles,

@@ -73,6 +73,20 @@
 //! separate layers: closer than their offset, they are an error naming the faces. A reference
 //! surface with an edge through a face (not sharing a vertex) is an error naming the two faces.
 //!
+//! **Mesh obstacles** (`[[obstacles]]` with `shape = "mesh"`): a rigid triangle mesh, fixed,
+//! is the one-sided case of the same pairs, through the same distances, CCD and checks. Its
+//! vertices are no DOFs (absent slots of the stencil, [`crate::elements::ABSENT`]) and its
+//! thickness is 0, so the offset of a pair with it is half the sheet's thickness: the sheet's
+//! surface rests on the obstacle's. Only the sheet presses: a sheet vertex on an obstacle's face
+//! with its whole area, `E = k A_p ψ(ξ − d)`, the analytic obstacles' law, so that a sheet on a
+//! flat mesh sinks by the same closed form; an obstacle's vertex on a sheet face (a corner the
+//! sheet's vertices do not see) with half the smaller of its own area and the face's vertex
+//! areas, at the offset; an obstacle's edge against a sheet edge inside half the offset, as
+//! between sheet edges. `k`, `δ` and `μ` are the obstacle's (`stiffness`, `smoothing`,
+//! `friction`; defaults as for the sheet's pairs). Without `[self_contact]` the term is
+//! `mesh_obstacles` and gathers no sheet–sheet pairs. At rest no edge of the sheet may pass
+//! through a face of an obstacle or the reverse, and no pair may be within its reach.
+//!
 //! Units: positions m, k Pa/m, δ, ξ, R m, A m², energies J. DOF order per pair: the four
 //! points' coordinates, point–triangle `(p, t₂, t₁, t₀)` with `t₀ < t₁ < t₂`, edge–edge
 //! `(a, b, c, d)` with `a < b`, `c < d` (the order of the last two slots tells the kinds apart).
@@ -81,29 +95,47 @@ use super::term::{LaggedNormals, Reports, StepBound, StepLimit, Term};
 use crate::body::Body;
 use crate::contact::{broad, ccd, distance, friction_potential, penalty};
 use crate::elements::Stencil;
-use crate::elements::{assemble_elements, no_contribution, ElementMap, Want};
+use crate::elements::{assemble_elements, no_contribution, ElementMap, Want, ABSENT};
 use crate::energy::term::ChangingElements;
 use crate::energy::{HessianProjection, Potential};
 use crate::math::{Real, SMat, SVec, Vec3};
 use crate::mesh::MeshError;
 use rayon::prelude::*;
+use std::borrow::Cow;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The mollifier's threshold as a fraction of the product of the squared rest lengths
 /// (Li et al. 2020, §4.3).
 const MOLLIFIER: Real = 1e-3;
 
-/// The contact of a sheet with itself and with other sheets of the mesh.
+/// The contact of a sheet with itself, with other sheets of the mesh, and with rigid mesh
+/// obstacles.
+///
+/// Vertices are numbered as the sheet's, `0..nv`, then the obstacles' (`nv + k`, the term's
+/// internal numbering; `ABSENT + k` in the stencils it hands out, slots that are no DOF of the
+/// solve). Faces and edges are the sheet's, then the obstacles'.
 pub struct SelfContact {
-    /// The mesh's faces.
+    /// The term's name: `self_contact`, or `mesh_obstacles` when it holds no sheet–sheet pairs.
+    name: &'static str,
+    /// The sheet's vertices.
+    nv: usize,
+    /// The sheet's faces: the first of [`SelfContact::faces`].
+    sheet_faces: usize,
+    /// The sheet's edges: the first of [`SelfContact::edges`].
+    sheet_edges: usize,
+    /// Whether the sheet's pairs with itself count (`[self_contact]` enabled).
+    self_pairs: bool,
+    /// The rigid mesh obstacles.
+    rigid: Rigid,
+    /// The faces, the sheet's then the obstacles'.
     faces: Vec<[usize; 3]>,
-    /// The mesh's edges `(a, b)`, `a < b`.
+    /// The edges `(a, b)`, `a < b`, the sheet's then the obstacles'.
     edges: Vec<[usize; 2]>,
     /// Reference positions (the mollifier's rest lengths).
     rest: Vec<Vec3>,
-    /// Thickness per vertex (m), or the fixed offset in every entry.
+    /// Thickness per vertex (m), or the fixed offset in every entry; 0 on the obstacles.
     thickness: Vec<Real>,
-    /// Reference area per vertex (m²).
+    /// Reference area per vertex (m²); 0 on the obstacles.
     area: Vec<Real>,
     /// Penalty stiffness k (Pa/m).
     pub stiffness: Real,
@@ -128,6 +160,35 @@ pub struct SelfContact {
     excluded_pt: Vec<u64>,
     /// Excluded edge–edge pairs `a << 32 | b` (edge indices, `a < b`), sorted.
     excluded_ee: Vec<u64>,
+}
+
+/// The rigid mesh obstacles' vertices and laws (`[[obstacles]]` with `shape = "mesh"`).
+#[derive(Default)]
+struct Rigid {
+    /// Vertex positions at dial 0 (m).
+    rest: Vec<Vec3>,
+    /// Vertex displacements at dial 1 (m).
+    shift: Vec<Vec3>,
+    /// Per vertex, its obstacle (an index into `bodies`).
+    owner: Vec<u32>,
+    /// Per vertex, a third of the area of its faces (m²).
+    area: Vec<Real>,
+    /// The obstacles.
+    bodies: Vec<RigidBody>,
+}
+
+/// One rigid mesh obstacle's contact law.
+struct RigidBody {
+    /// Its index in `[[obstacles]]`.
+    index: usize,
+    /// Its file, for messages.
+    file: String,
+    /// Penalty stiffness k (Pa/m).
+    stiffness: Real,
+    /// Smoothing length δ (m).
+    smoothing: Real,
+    /// Coulomb coefficient μ against the sheet (0 in statics).
+    friction: Real,
 }
 
 /// Whether the element with these four nodes is a point–triangle pair (module doc: the order
@@ -174,6 +235,71 @@ impl Slip {
 }
 
 impl SelfContact {
+    /// The internal number of node `u` of a stencil (struct doc).
+    #[inline]
+    fn at(&self, u: usize) -> usize {
+        if u < ABSENT {
+            u
+        } else {
+            self.nv + (u - ABSENT)
+        }
+    }
+
+    /// The internal numbers of a stencil's nodes.
+    fn internal<'a>(&self, nodes: &'a [usize]) -> Cow<'a, [usize]> {
+        if self.rigid.rest.is_empty() {
+            Cow::Borrowed(nodes)
+        } else {
+            Cow::Owned(nodes.iter().map(|&u| self.at(u)).collect())
+        }
+    }
+
+    /// The sheet's positions `x` followed by the obstacles' at dial `dial` (clamped to
+    /// [0, 1]).
+    fn placed<'a>(&self, x: &'a [Vec3], dial: Real) -> Cow<'a, [Vec3]> {
+        if self.rigid.rest.is_empty() {
+            return Cow::Borrowed(x);
+        }
+        let s = dial.clamp(0.0, 1.0);
+        let mut all = Vec::with_capacity(x.len() + self.rigid.rest.len());
+        all.extend_from_slice(&x[..self.nv]);
+        all.extend(
+            self.rigid
+                .rest
+                .iter()
+                .zip(&self.rigid.shift)
+                .map(|(r, u)| r + u * s),
+        );
+        Cow::Owned(all)
+    }
+
+    /// The obstacle of a pair that involves one (the one its rigid nodes belong to).
+    #[inline]
+    fn body(&self, nodes: &[usize]) -> Option<&RigidBody> {
+        let u = nodes.iter().copied().find(|&u| u >= self.nv)?;
+        Some(&self.rigid.bodies[self.rigid.owner[u - self.nv] as usize])
+    }
+
+    /// The stiffness k (Pa/m) and smoothing δ (m) of a pair: its obstacle's, or the sheet's.
+    #[inline]
+    fn material(&self, nodes: &[usize]) -> (Real, Real) {
+        self.body(nodes)
+            .map_or((self.stiffness, self.smoothing), |b| {
+                (b.stiffness, b.smoothing)
+            })
+    }
+
+    /// The Coulomb coefficient μ of a pair: its obstacle's, or the sheet's.
+    #[inline]
+    fn mu(&self, nodes: &[usize]) -> Real {
+        self.body(nodes).map_or(self.friction, |b| b.friction)
+    }
+
+    /// Whether any pair has friction.
+    fn has_friction(&self) -> bool {
+        self.friction > 0.0 || self.rigid.bodies.iter().any(|b| b.friction > 0.0)
+    }
+
     /// Runs `f`, adding its wall time to the clock of `part`.
     #[inline]
     fn timed<T>(&self, part: Clock, f: impl FnOnce() -> T) -> T {
@@ -195,20 +321,31 @@ impl SelfContact {
         }
     }
 
-    /// The distance below which a pair presses (the offset for a point–triangle pair, half
-    /// of it for an edge–edge pair) and its area weight (m²): half the vertex's area, or a
-    /// quarter of the mean of the four vertex areas (module doc).
+    /// The distance below which a pair presses and its area weight (m², module doc): a sheet
+    /// vertex on a sheet face, the offset and half the vertex's area; on an obstacle's face, the
+    /// offset and the whole area; an obstacle's vertex on a sheet face, the offset and half the
+    /// smaller of the obstacle vertex's area and the mean of the face's vertex areas; two sheet
+    /// edges, half the offset and a quarter of the mean of the four vertex areas; a sheet edge
+    /// and an obstacle's, half the offset and a quarter of the mean of the sheet edge's two (the
+    /// obstacle's entries of `area` are 0).
     #[inline]
     fn law(&self, nodes: &[usize]) -> (Real, Real) {
         let xi = self.offset(nodes);
         let a = &self.area;
+        let rigid = |k: usize| nodes[k] >= self.nv;
         if is_point_triangle(nodes) {
-            (xi, 0.5 * a[nodes[0]])
+            if rigid(0) {
+                let face = (a[nodes[1]] + a[nodes[2]] + a[nodes[3]]) / 3.0;
+                (xi, 0.5 * face.min(self.rigid.area[nodes[0] - self.nv]))
+            } else if rigid(1) {
+                (xi, a[nodes[0]])
+            } else {
+                (xi, 0.5 * a[nodes[0]])
+            }
         } else {
-            (
-                0.5 * xi,
-                0.0625 * (a[nodes[0]] + a[nodes[1]] + a[nodes[2]] + a[nodes[3]]),
-            )
+            let sum = a[nodes[0]] + a[nodes[1]] + a[nodes[2]] + a[nodes[3]];
+            let share = if rigid(0) || rigid(2) { 0.125 } else { 0.0625 };
+            (0.5 * xi, share * sum)
         }
     }
 
@@ -249,9 +386,17 @@ impl SelfContact {
         [ea[0], ea[1], eb[0], eb[1]]
     }
 
-    /// The pairs the broad phase finds within `radius` at `x` (over the straight paths to
-    /// `to`, when given), not excluded: their nodes, point–triangle pairs first, each kind
-    /// sorted.
+    /// Whether the pair with these nodes counts: one node at least on the sheet, and one on
+    /// an obstacle unless the sheet's pairs with itself count.
+    #[inline]
+    fn counts(&self, nodes: &[usize; 4]) -> bool {
+        let sheet = nodes.iter().filter(|&&u| u < self.nv).count();
+        sheet > 0 && (self.self_pairs || sheet < 4)
+    }
+
+    /// The pairs the broad phase finds within `radius` at `x` (the sheet's and the obstacles'
+    /// positions; over the straight paths to `to`, when given), not excluded: their nodes,
+    /// point–triangle pairs first, each kind sorted.
     fn candidates(&self, x: &[Vec3], to: Option<&[Vec3]>, radius: Real) -> Vec<[usize; 4]> {
         let pt = broad::point_triangle(x, to, &self.faces, radius);
         let ee = broad::edge_edge(x, to, &self.edges, radius);
@@ -264,13 +409,23 @@ impl SelfContact {
                     .filter(|&&(a, b)| self.excluded_ee.binary_search(&key(a, b)).is_err())
                     .map(|&(a, b)| self.ee_nodes(a as usize, b as usize)),
             )
+            .filter(|n| self.counts(n))
             .collect()
     }
 
-    /// The pairs within `beyond` of their offset at `x`, not excluded: the stencil,
-    /// point–triangle pairs first (module doc for the slot order).
+    /// The pairs within `beyond` of their offset at `x` (the sheet's and the obstacles'
+    /// positions), not excluded: the stencil in the internal numbering, point–triangle pairs
+    /// first (module doc for the slot order).
     fn pairs(&self, x: &[Vec3], beyond: Real) -> Stencil {
         self.timed(Clock::Broad, || self.pairs_untimed(x, beyond))
+    }
+
+    /// A stencil in the internal numbering as the solve numbers it (struct doc).
+    fn handed_out(&self, mut st: Stencil) -> Stencil {
+        for u in st.nodes.iter_mut().filter(|u| **u >= self.nv) {
+            *u = ABSENT + (*u - self.nv);
+        }
+        st
     }
 
     /// [`SelfContact::pairs`], untimed (the checks at build).
@@ -317,7 +472,8 @@ impl SelfContact {
             .into_par_iter()
             .map(|e| {
                 let n = &nodes[4 * e..4 * e + 4];
-                if !is_point_triangle(n) {
+                if !is_point_triangle(n) || n[0] >= self.nv {
+                    // Edge pairs and an obstacle's vertices always count.
                     return None;
                 }
                 let y = points(x, n);
@@ -374,8 +530,9 @@ impl SelfContact {
             return no_contribution(grad, hess);
         }
         let d = cl.d2.sqrt();
-        let w = self.stiffness * weight;
-        let (psi, dpsi, ddpsi) = penalty(reach - d, self.smoothing);
+        let (k, delta) = self.material(nodes);
+        let w = k * weight;
+        let (psi, dpsi, ddpsi) = penalty(reach - d, delta);
         let mollifier = if pt { None } else { self.mollifier(nodes, &y) };
         let m = mollifier.map_or(1.0, |(m, _, _)| m);
         let energy = m * w * psi;
@@ -442,8 +599,9 @@ impl SelfContact {
                 } else {
                     self.mollifier(n, &y).map_or(1.0, |(m, _, _)| m)
                 };
-                let dpsi = penalty(reach - d, self.smoothing).1;
-                Some((e, m * self.stiffness * weight * dpsi, cl.c))
+                let (k, delta) = self.material(n);
+                let dpsi = penalty(reach - d, delta).1;
+                Some((e, m * k * weight * dpsi, cl.c))
             })
             .collect()
     }
@@ -454,12 +612,14 @@ impl SelfContact {
     fn lagged_friction(&self, nodes: &[usize], x_lag: &[Vec3]) -> Vec<Option<Slip>> {
         let mut out = vec![None; nodes.len() / 4];
         for (e, lambda, c) in self.forces(nodes, x_lag) {
-            let y = points(x_lag, &nodes[4 * e..4 * e + 4]);
+            let n = &nodes[4 * e..4 * e + 4];
+            let mu = self.mu(n);
+            let y = points(x_lag, n);
             let r: Vec3 = (0..4).map(|i| y[i] * c[i]).sum();
             let norm = r.norm();
-            if norm > 0.0 && lambda > 0.0 {
+            if norm > 0.0 && lambda > 0.0 && mu > 0.0 {
                 out[e] = Some(Slip {
-                    bound: self.friction * lambda,
+                    bound: mu * lambda,
                     c,
                     normal: r / norm,
                 });
@@ -531,22 +691,31 @@ impl SelfContact {
         if map.nodes.is_empty() {
             return 0.0;
         }
-        let active = self.active(&map.nodes, x);
+        let all = self.internal(&map.nodes);
+        let x = &*self.placed(x, pot.dial);
+        let active = self.active(&all, x);
         let gauss_newton = projection == HessianProjection::GaussNewton;
         let friction = pot
             .friction
-            .filter(|_| with_friction && self.friction > 0.0)
-            .map(|fr| (fr, self.lagged_friction(&map.nodes, fr.x_lag)));
+            .filter(|_| with_friction && self.has_friction())
+            .map(|fr| {
+                let lag = self.placed(fr.x_lag, fr.dial_lag);
+                let prev = self.placed(fr.x_prev, fr.dial_prev).into_owned();
+                (fr, prev, self.lagged_friction(&all, &lag))
+            });
         assemble_elements::<12, 4, _>(
             map,
-            |e, nodes, mut g, mut h| {
+            |e, _, mut g, mut h| {
+                let nodes = &all[4 * e..4 * e + 4];
                 let mut energy = if active[e] {
                     self.element(nodes, x, gauss_newton, g.as_deref_mut(), h.as_deref_mut())
                 } else {
                     no_contribution(g.as_deref_mut(), h.as_deref_mut())
                 };
-                if let Some((fr, Some(s))) = friction.as_ref().map(|(fr, l)| (fr, &l[e])) {
-                    energy += Self::slip(s, nodes, x, fr.x_prev, fr.eps, g, h);
+                if let Some((fr, prev, Some(s))) =
+                    friction.as_ref().map(|(fr, prev, l)| (fr, prev, &l[e]))
+                {
+                    energy += Self::slip(s, nodes, x, prev, fr.eps, g, h);
                 }
                 energy
             },
@@ -565,12 +734,15 @@ impl SelfContact {
         let Some(fr) = pot.friction.as_ref() else {
             return 0.0;
         };
-        let lagged = self.lagged_friction(&map.nodes, fr.x_lag);
+        let nodes = self.internal(&map.nodes);
+        let x = &*self.placed(x, pot.dial);
+        let prev = self.placed(fr.x_prev, fr.dial_prev);
+        let lagged = self.lagged_friction(&nodes, &self.placed(fr.x_lag, fr.dial_lag));
         let per_pair: Vec<Real> = (0..lagged.len())
             .into_par_iter()
             .map(|e| {
                 lagged[e].as_ref().map_or(0.0, |s| {
-                    let moved = s.moved(&map.nodes[4 * e..4 * e + 4], x, fr.x_prev);
+                    let moved = s.moved(&nodes[4 * e..4 * e + 4], x, &prev);
                     friction_potential(s.bound, &s.normal, &moved, fr.eps)
                         .1
                         .norm()
@@ -607,51 +779,55 @@ impl Reports for SelfContact {
             &mut [],
             false,
         );
-        Some(vec![("self_contact", e)])
+        Some(vec![(self.name, e)])
     }
 
-    /// `self_contact_pairs`: the pairs that press; `self_contact_friction` (with friction):
-    /// the sum of the magnitudes of their friction forces (N); `self_contact_broad_seconds`,
-    /// `self_contact_ccd_seconds`, `self_contact_assembly_seconds`: the wall time spent so far
-    /// in the broad phase and gathering, in CCD and the separation checks, and in the term's
-    /// assembly (s); `self_contact_gap`: the smallest distance
-    /// of a gathered pair over its offset (the gathering's reach over the offset when none
-    /// was gathered); `self_contact_force`: the sum of the pairs' normal forces (N).
+    /// `NAME_pairs` (NAME the term's name, `self_contact` or `mesh_obstacles`): the pairs
+    /// that press; `NAME_friction` (with friction): the sum of the magnitudes of their friction
+    /// forces (N); `NAME_broad_seconds`, `NAME_ccd_seconds`, `NAME_assembly_seconds`: the wall
+    /// time spent so far in the broad phase and gathering, in CCD and the separation checks,
+    /// and in the term's assembly (s); `NAME_gap`: the smallest distance of a gathered pair over
+    /// its offset (the gathering's reach over the offset when none was gathered);
+    /// `NAME_force`: the sum of the pairs' normal forces (N). Per mesh obstacle `i`:
+    /// `obstacle{i}_force_x/y/z`, the force its pairs exert on the sheet (N, the normal law's
+    /// and, with friction, the friction's), and `obstacle{i}_gap`, the smallest `d − ξ` of its
+    /// gathered pairs (m; the halo when none is gathered).
     fn observables(&self, pot: &Potential, x: &[Vec3], _phi: &[Real]) -> Vec<(String, Real)> {
         let Some(map) = self.map(pot) else {
             return Vec::new();
         };
-        let forces = self.forces(&map.nodes, x);
-        let gap = map
-            .nodes
+        let nodes = self.internal(&map.nodes);
+        let xs = x;
+        let x = &*self.placed(x, pot.dial);
+        let forces = self.forces(&nodes, x);
+        let gap = nodes
             .par_chunks(4)
             .map(|n| self.closest(&points(x, n), n).d2.sqrt() / self.offset(n))
             .reduce(
                 || 1.0 + self.halo / self.xi_max.max(Real::MIN_POSITIVE),
                 Real::min,
             );
+        let name = self.name;
         let mut out = vec![
-            ("self_contact_pairs".into(), forces.len() as Real),
-            ("self_contact_gap".into(), gap),
-            (
-                "self_contact_force".into(),
-                forces.iter().map(|f| f.1).sum(),
-            ),
+            (format!("{name}_pairs"), forces.len() as Real),
+            (format!("{name}_gap"), gap),
+            (format!("{name}_force"), forces.iter().map(|f| f.1).sum()),
         ];
-        if self.friction > 0.0 {
+        if self.has_friction() {
             out.push((
-                "self_contact_friction".into(),
-                self.friction_force(pot, map, x),
+                format!("{name}_friction"),
+                self.friction_force(pot, map, xs),
             ));
         }
-        for (name, part) in [
-            ("self_contact_broad_seconds", Clock::Broad),
-            ("self_contact_ccd_seconds", Clock::Ccd),
-            ("self_contact_assembly_seconds", Clock::Assembly),
+        for (part, clock) in [
+            ("broad", Clock::Broad),
+            ("ccd", Clock::Ccd),
+            ("assembly", Clock::Assembly),
         ] {
-            let ns = self.clock[part as usize].load(Ordering::Relaxed);
-            out.push((name.into(), ns as Real * 1e-9));
+            let ns = self.clock[clock as usize].load(Ordering::Relaxed);
+            out.push((format!("{name}_{part}_seconds"), ns as Real * 1e-9));
         }
+        out.extend(self.rigid_observables(pot, &nodes, x));
         out
     }
 
@@ -663,10 +839,11 @@ impl Reports for SelfContact {
         let Some(map) = self.map(pot) else {
             return Vec::new();
         };
-        let nv = x.len();
-        let force = self.vertex_forces(&map.nodes, x);
-        let mut gap = vec![self.halo; nv];
-        for n in map.nodes.chunks(4) {
+        let nodes = self.internal(&map.nodes);
+        let x = &*self.placed(x, pot.dial);
+        let force = self.vertex_forces(&nodes, x);
+        let mut gap = vec![self.halo; x.len()];
+        for n in nodes.chunks(4) {
             let g = self.closest(&points(x, n), n).d2.sqrt() - self.offset(n);
             for &v in n {
                 gap[v] = gap[v].min(g);
@@ -674,8 +851,8 @@ impl Reports for SelfContact {
         }
         let per_face =
             |f: &[usize; 3], per: &dyn Fn(usize) -> Real| (per(f[0]) + per(f[1]) + per(f[2])) / 3.0;
-        let pressure = self
-            .faces
+        let sheet = &self.faces[..self.sheet_faces];
+        let pressure = sheet
             .iter()
             .map(|f| {
                 per_face(f, &|v| {
@@ -687,8 +864,7 @@ impl Reports for SelfContact {
                 })
             })
             .collect();
-        let face_gap = self
-            .faces
+        let face_gap = sheet
             .iter()
             .map(|f| gap[f[0]].min(gap[f[1]]).min(gap[f[2]]))
             .collect();
@@ -699,19 +875,83 @@ impl Reports for SelfContact {
     }
 }
 
+impl SelfContact {
+    /// Per mesh obstacle, its force on the sheet and its smallest gap ([`Self::observables`]).
+    fn rigid_observables(
+        &self,
+        pot: &Potential,
+        nodes: &[usize],
+        x: &[Vec3],
+    ) -> Vec<(String, Real)> {
+        if self.rigid.bodies.is_empty() {
+            return Vec::new();
+        }
+        let active = self.active(nodes, x);
+        let friction = pot.friction.filter(|_| self.has_friction()).map(|fr| {
+            let lag = self.placed(fr.x_lag, fr.dial_lag);
+            let prev = self.placed(fr.x_prev, fr.dial_prev).into_owned();
+            (fr, prev, self.lagged_friction(nodes, &lag))
+        });
+        let nb = self.rigid.bodies.len();
+        // Per pair with an obstacle: the obstacle, −∇E summed over its sheet nodes (the force
+        // on the sheet) and the pair's d − ξ. Summed in pair order below.
+        let per_pair: Vec<Option<(usize, Vec3, Real)>> = (0..nodes.len() / 4)
+            .into_par_iter()
+            .map(|e| {
+                let n = &nodes[4 * e..4 * e + 4];
+                let u = n.iter().copied().find(|&u| u >= self.nv)?;
+                let b = self.rigid.owner[u - self.nv] as usize;
+                let mut g = SVec::<12>::zeros();
+                if active[e] {
+                    self.element(n, x, false, Some(&mut g), None);
+                }
+                if let Some((fr, prev, Some(s))) =
+                    friction.as_ref().map(|(fr, prev, l)| (fr, prev, &l[e]))
+                {
+                    Self::slip(s, n, x, prev, fr.eps, Some(&mut g), None);
+                }
+                let f: Vec3 = (0..4)
+                    .filter(|&i| n[i] < self.nv)
+                    .map(|i| -Vec3::new(g[3 * i], g[3 * i + 1], g[3 * i + 2]))
+                    .sum();
+                let gap = self.closest(&points(x, n), n).d2.sqrt() - self.offset(n);
+                Some((b, f, gap))
+            })
+            .collect();
+        let mut force = vec![Vec3::zeros(); nb];
+        let mut gap = vec![self.halo; nb];
+        for (b, f, g) in per_pair.into_iter().flatten() {
+            force[b] += f;
+            gap[b] = gap[b].min(g);
+        }
+        let mut out = Vec::new();
+        for (k, body) in self.rigid.bodies.iter().enumerate() {
+            let i = body.index;
+            for (c, v) in ["x", "y", "z"].iter().zip(force[k].iter()) {
+                out.push((format!("obstacle{i}_force_{c}"), *v));
+            }
+            out.push((format!("obstacle{i}_gap"), gap[k]));
+        }
+        out
+    }
+}
+
 impl ChangingElements for SelfContact {
     fn stencil_at(&self, _: &Body, x: &[Vec3], _: &[Real]) -> Stencil {
-        self.pairs(x, self.halo)
+        self.handed_out(self.pairs(&self.placed(x, 0.0), self.halo))
     }
 }
 
 impl LaggedNormals for SelfContact {
     /// Over the vertices, the largest normal force the pairs put on one at `trial`, and the
     /// largest change of one from the lagged iterate (the pairs that press at each).
-    fn lag_change(&self, trial: &[Vec3], _: Real, lag: &[Vec3], _: Real) -> (Real, Real) {
+    fn lag_change(&self, trial: &[Vec3], dial: Real, lag: &[Vec3], dial_lag: Real) -> (Real, Real) {
         // One after the other: each gathering is timed on the broad phase's clock.
-        let at = |x: &[Vec3]| self.vertex_forces(&self.pairs(x, 0.0).nodes, x);
-        let (new, old) = (at(trial), at(lag));
+        let at = |x: &[Vec3], dial: Real| {
+            let x = self.placed(x, dial);
+            self.vertex_forces(&self.pairs(&x, 0.0).nodes, &x)
+        };
+        let (new, old) = (at(trial, dial), at(lag, dial_lag));
         new.iter().zip(&old).fold((0.0, 0.0), |(s, d), (a, b)| {
             (Real::max(s, *a), Real::max(d, (a - b).abs()))
         })
@@ -732,8 +972,18 @@ impl StepLimit for SelfContact {
         x: &[Vec3],
         step: &[Real],
     ) -> StepBound {
-        let dx = |v: usize| Vec3::new(step[3 * v], step[3 * v + 1], step[3 * v + 2]);
-        let nodes = &map.nodes;
+        let nv = self.nv;
+        // The obstacles do not move within a solve.
+        let dx = |v: usize| {
+            if v < nv {
+                Vec3::new(step[3 * v], step[3 * v + 1], step[3 * v + 2])
+            } else {
+                Vec3::zeros()
+            }
+        };
+        let nodes = &*self.internal(&map.nodes);
+        let sheet = x;
+        let x = &*self.placed(x, pot.dial);
         let gathered = self.timed(Clock::Ccd, || {
             (0..nodes.len() / 4)
                 .into_par_iter()
@@ -747,11 +997,13 @@ impl StepLimit for SelfContact {
         });
         // The pairs not gathered: where the pairs were gathered (the solver's positions, or `x`
         // outside a solve), they were farther apart than their offset and the halo.
-        let taken = if pot.taken_at.len() == x.len() {
+        let taken = if pot.taken_at.len() == sheet.len() {
             pot.taken_at
         } else {
-            x
+            sheet
         };
+        let moved = !std::ptr::eq(taken, sheet) && taken != sheet;
+        let taken = &*self.placed(taken, pot.dial);
         let to: Vec<Vec3> = (0..x.len()).map(|v| x[v] + dx(v)).collect();
         let candidates = self.timed(Clock::Broad, || self.candidates(x, Some(&to), self.xi_max));
         let others = self.timed(Clock::Ccd, || {
@@ -774,7 +1026,6 @@ impl StepLimit for SelfContact {
                 })
                 .reduce(|| (1.0, false), |a, b| (a.0.min(b.0), a.1 || b.1))
         });
-        let moved = !std::ptr::eq(taken, x) && taken != x;
         if others.0 < gathered && others.1 && moved {
             return StepBound {
                 fraction: others.0,
@@ -788,8 +1039,9 @@ impl StepLimit for SelfContact {
     }
 
     /// Every pair at least `s ξ` apart.
-    fn admits(&self, _: &Potential, map: &ElementMap, x: &[Vec3]) -> bool {
-        let nodes = &map.nodes;
+    fn admits(&self, pot: &Potential, map: &ElementMap, x: &[Vec3]) -> bool {
+        let nodes = &*self.internal(&map.nodes);
+        let x = &*self.placed(x, pot.dial);
         self.timed(Clock::Ccd, || {
             (0..nodes.len() / 4).into_par_iter().all(|e| {
                 let n = &nodes[4 * e..4 * e + 4];
@@ -802,10 +1054,10 @@ impl StepLimit for SelfContact {
 
 impl Term for SelfContact {
     fn name(&self) -> &'static str {
-        "self_contact"
+        self.name
     }
     fn stencil(&self, body: &Body) -> Stencil {
-        self.pairs(&body.mesh.positions, self.halo)
+        self.handed_out(self.pairs(&self.placed(&body.mesh.positions, 0.0), self.halo))
     }
     fn changing(&self) -> Option<&dyn ChangingElements> {
         Some(self)
@@ -814,7 +1066,7 @@ impl Term for SelfContact {
         Some(self)
     }
     fn lagged(&self) -> Option<&dyn LaggedNormals> {
-        (self.friction > 0.0).then_some(self as &dyn LaggedNormals)
+        self.has_friction().then_some(self as &dyn LaggedNormals)
     }
     fn reports(&self) -> Option<&dyn Reports> {
         Some(self)
@@ -836,14 +1088,22 @@ impl Term for SelfContact {
     }
 }
 
-/// The term of `[self_contact]` on `body`, or `None` when disabled; friction only when
-/// `dynamic`.
+/// The term of `[self_contact]` and the mesh obstacles of `[[obstacles]]` on `body`, or
+/// `None` when self-contact is disabled and no obstacle is a mesh; friction only when
+/// `dynamic`. Errors name the obstacle's file and key: a file that is no valid triangle mesh,
+/// an obstacle that crosses the sheet or lies within its offset at rest.
 pub fn term(
     body: &Body,
     c: &crate::config::self_contact::SelfContact,
+    obstacles: &[crate::config::obstacle::ObstacleSettings],
     dynamic: bool,
 ) -> Result<Option<Box<dyn Term>>, MeshError> {
-    if !c.enabled {
+    let meshes: Vec<(usize, &crate::config::obstacle::ObstacleSettings)> = obstacles
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| o.shape == Some(crate::config::obstacle::ShapeKind::Mesh))
+        .collect();
+    if !c.enabled && meshes.is_empty() {
         return Ok(None);
     }
     let mesh = &body.mesh;
@@ -862,11 +1122,21 @@ pub fn term(
         .collect();
     edges.sort_unstable();
     let mut sc = SelfContact {
+        name: if c.enabled {
+            "self_contact"
+        } else {
+            "mesh_obstacles"
+        },
+        nv: mesh.positions.len(),
+        sheet_faces: mesh.faces.len(),
+        sheet_edges: edges.len(),
+        self_pairs: c.enabled,
+        rigid: Rigid::default(),
         faces: mesh.faces.clone(),
         edges,
         rest: mesh.positions.clone(),
         thickness,
-        area: ca.area,
+        area: ca.area.clone(),
         stiffness: c.stiffness.or(ca.e_over_h),
         smoothing,
         xi_max,
@@ -879,8 +1149,162 @@ pub fn term(
         excluded_pt: Vec::new(),
         excluded_ee: Vec::new(),
     };
-    exclude(&mut sc, body)?;
+    if c.enabled {
+        exclude(&mut sc, body)?;
+    }
+    for (i, o) in meshes {
+        add_rigid(&mut sc, i, o, &ca, dynamic)?;
+    }
+    if !sc.rigid.rest.is_empty() {
+        check_rigid(&sc)?;
+    }
     Ok(Some(Box::new(sc)))
+}
+
+/// Reads mesh obstacle `i` (`o`) and appends its vertices, faces and edges to the term's, with
+/// its law: the obstacle's `stiffness` and `smoothing`, by default the sheet's area-weighted
+/// mean E/h and mean thickness over 100, and its `friction` in dynamic mode. Vertices that no
+/// face uses are dropped.
+fn add_rigid(
+    sc: &mut SelfContact,
+    i: usize,
+    o: &crate::config::obstacle::ObstacleSettings,
+    ca: &crate::body::ContactAreas,
+    dynamic: bool,
+) -> Result<(), MeshError> {
+    let file = o.file.clone().unwrap_or_default();
+    let named = |e: MeshError| MeshError::Invalid {
+        path: file.clone(),
+        reason: format!(
+            "obstacles[{i}].file: {}",
+            match e {
+                MeshError::Read { reason, .. }
+                | MeshError::Write { reason, .. }
+                | MeshError::Invalid { reason, .. } => reason,
+            }
+        ),
+    };
+    let m = crate::mesh::io::read_mesh(std::path::Path::new(&file)).map_err(named)?;
+    m.validate().map_err(named)?;
+    let first = sc.rest.len();
+    let (scale, translate) = (
+        o.scale.unwrap_or(1.0),
+        Vec3::from(o.translate.unwrap_or([0.0; 3])),
+    );
+    let mut number = vec![usize::MAX; m.positions.len()];
+    for f in &m.faces {
+        for &v in f {
+            if number[v] == usize::MAX {
+                number[v] = sc.rest.len();
+                sc.rest.push(m.positions[v] * scale + translate);
+            }
+        }
+    }
+    let added = sc.rest.len() - first;
+    let owner = sc.rigid.bodies.len() as u32;
+    let shift = Vec3::from(o.displacement);
+    sc.rigid.rest.extend_from_slice(&sc.rest[first..]);
+    sc.rigid.shift.extend(std::iter::repeat_n(shift, added));
+    sc.rigid.owner.extend(std::iter::repeat_n(owner, added));
+    sc.thickness.extend(std::iter::repeat_n(0.0, added));
+    sc.area.extend(std::iter::repeat_n(0.0, added));
+    let mut area = vec![0.0; added];
+    let mut edges = Vec::with_capacity(3 * m.faces.len());
+    for f in &m.faces {
+        let t = f.map(|v| number[v]);
+        let y = t.map(|v| sc.rest[v]);
+        let third = 0.5 * (y[1] - y[0]).cross(&(y[2] - y[0])).norm() / 3.0;
+        for &v in &t {
+            area[v - first] += third;
+        }
+        sc.faces.push(t);
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            edges.push([a.min(b), a.max(b)]);
+        }
+    }
+    edges.sort_unstable();
+    edges.dedup();
+    sc.edges.extend(edges);
+    sc.rigid.area.extend(area);
+    sc.rigid.bodies.push(RigidBody {
+        index: i,
+        file,
+        stiffness: o.stiffness.unwrap_or(ca.e_over_h),
+        smoothing: o.smoothing.unwrap_or(ca.h_mean / 100.0),
+        friction: if dynamic { o.friction } else { 0.0 },
+    });
+    Ok(())
+}
+
+/// Checks the sheet against the mesh obstacles at rest (dial 0): no edge of one through a
+/// face of the other, and no pair within the distance where it would press (touching, to
+/// 1e-9 of the offset, is allowed). Errors name the obstacle's file and key, its face or
+/// vertex and the sheet's.
+fn check_rigid(sc: &SelfContact) -> Result<(), MeshError> {
+    let x = &*sc.placed(&sc.rest[..sc.nv], 0.0);
+    let (ne, nf) = (sc.sheet_edges, sc.sheet_faces);
+    let body_err = |n: &[usize], reason: String| match sc.body(n) {
+        Some(b) => MeshError::Invalid {
+            path: b.file.clone(),
+            reason: format!("obstacles[{}]: {reason}", b.index),
+        },
+        None => MeshError::Invalid {
+            path: "[[obstacles]]".into(),
+            reason,
+        },
+    };
+    if let Some((e, f)) = crossing(x, &sc.edges, &sc.faces, |e, f| (e < ne) != (f < nf)) {
+        let [a, b] = sc.edges[e];
+        let t = sc.faces[f];
+        let (what, with) = if e < ne {
+            (
+                format!("the sheet's edge {a}–{b}"),
+                format!("the obstacle's face {}", f - nf),
+            )
+        } else {
+            (
+                format!("the obstacle's edge {}–{}", a - sc.nv, b - sc.nv),
+                format!("the sheet's face {f}"),
+            )
+        };
+        return Err(body_err(
+            &[a, b, t[0], t[1]],
+            format!(
+                "{what} passes through {with} in the reference state: the sheet must start \
+                 clear of the obstacle (move it, or let its displacement bring it in)"
+            ),
+        ));
+    }
+    let near = sc.pairs_untimed(x, 0.0);
+    for n in near
+        .nodes
+        .chunks(4)
+        .filter(|n| n.iter().any(|&u| u >= sc.nv))
+    {
+        let (reach, _) = sc.law(n);
+        let d = sc.closest(&points(x, n), n).d2.sqrt();
+        if d < reach - 1e-9 * sc.offset(n) {
+            let which = if is_point_triangle(n) && n[0] < sc.nv {
+                format!("the sheet's vertex {}", n[0])
+            } else if is_point_triangle(n) {
+                format!("the obstacle's vertex {}", n[0] - sc.nv)
+            } else {
+                format!("the sheet's edge {}–{}", n[0], n[1])
+            };
+            return Err(body_err(
+                n,
+                format!(
+                    "{which} is {} from the obstacle's surface at rest, within the {} where \
+                     contact begins (half the sheet's thickness): move the obstacle away, or \
+                     let its displacement bring it in",
+                    crate::math::human(d),
+                    crate::math::human(reach)
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Fills the exclusion lists (module doc) and checks the reference state: a pair close in
@@ -894,7 +1318,7 @@ fn exclude(sc: &mut SelfContact, body: &Body) -> Result<(), MeshError> {
         .map(|e| (x[e[1]] - x[e[0]]).norm())
         .fold(0.0, Real::max);
     let graph = 2.0 * r + 2.0 * longest;
-    if let Some((e, f)) = crossing(x, &sc.edges, &sc.faces) {
+    if let Some((e, f)) = crossing(x, &sc.edges, &sc.faces, |_, _| true) {
         let [a, b] = sc.edges[e];
         let g = (0..sc.faces.len())
             .find(|&g| sc.faces[g].contains(&a) && sc.faces[g].contains(&b))
@@ -996,9 +1420,15 @@ fn exclude(sc: &mut SelfContact, body: &Body) -> Result<(), MeshError> {
 /// The first edge (in edge order) that passes through a face at `x`, with that face (the
 /// face first in order); `None` when the surface has no crossing. Edges and faces that share a
 /// vertex are not tested.
-fn crossing(x: &[Vec3], edges: &[[usize; 2]], faces: &[[usize; 3]]) -> Option<(usize, usize)> {
+fn crossing(
+    x: &[Vec3],
+    edges: &[[usize; 2]],
+    faces: &[[usize; 3]],
+    keep: impl Fn(usize, usize) -> bool + Sync,
+) -> Option<(usize, usize)> {
     broad::edge_triangle(x, edges, faces)
         .into_par_iter()
+        .filter(|&(e, f)| keep(e as usize, f as usize))
         .find_first(|&(e, f)| {
             let (ed, t) = (edges[e as usize], faces[f as usize]);
             distance::segment_crosses_triangle(&[x[ed[0]], x[ed[1]], x[t[0]], x[t[1]], x[t[2]]])

@@ -240,3 +240,124 @@ fn self_contact_friction_matches_finite_differences() {
         );
     }
 }
+
+/// A strip (h = 0.05) held 0.01 above a mesh obstacle, an icosphere of radius 0.15 (162
+/// vertices) under its middle: the mesh obstacles' term against central differences, with
+/// pairs of every kind (strip vertices on the ball's faces, the ball's vertices on the strip's
+/// faces, the strip's edges across the ball's). The obstacle's vertices are no DOFs: their
+/// stencil slots are absent.
+#[test]
+fn a_mesh_obstacle_matches_finite_differences() {
+    use shellsim::elements::ABSENT;
+    let dir = tempfile::tempdir().unwrap();
+    let ball_file = dir.path().join("ball.vtk");
+    let ball = shellsim::mesh::generate::icosphere(0.15, 2);
+    shellsim::mesh::io::write_mesh(&ball_file, &ball, shellsim::mesh::io::Format::Vtk, "ball")
+        .unwrap();
+    let m = rectangle(
+        0.0,
+        0.0,
+        1.0,
+        0.2,
+        0.05,
+        Spacing {
+            jitter: 0.2,
+            seed: 7,
+            ..Default::default()
+        },
+    );
+    let s = format!(
+        "[material]\nthickness = 0.05\nyoung = 1e6\n[[obstacles]]\nshape = \"mesh\"\n\
+         file = \"{}\"\ntranslate = [0.5, 0.1, -0.2]\nstiffness = 1e7\nsmoothing = 0.004\n",
+        ball_file.display()
+    );
+    let sc = Scene::build(m, Settings::from_str_with(&s, "test", &[]).unwrap()).unwrap();
+    let i = (0..sc.terms.len())
+        .find(|&i| sc.terms[i].name() == "mesh_obstacles")
+        .expect("a mesh_obstacles term");
+    let phi = vec![0.0; sc.num_scalar_dofs()];
+    let p0 = Pattern::for_scene(&sc);
+    let nv = sc.body.num_vertices();
+    let ball_at: Vec<Vec3> = ball
+        .positions
+        .iter()
+        .map(|p| p + Vec3::new(0.5, 0.1, -0.2))
+        .collect();
+    // The pairs' closest features at the sheet's `x`, the ball's vertices numbered after it.
+    let hold = |x: &[Vec3], nodes: &[usize]| {
+        let all: Vec<Vec3> = x.iter().chain(&ball_at).copied().collect();
+        let inner: Vec<usize> = nodes
+            .iter()
+            .map(|&u| if u >= ABSENT { nv + (u - ABSENT) } else { u })
+            .collect();
+        let k0 = kinds(&all, &inner);
+        (0..nv).all(|v| {
+            (0..3).all(|c| {
+                [1e-6, -1e-6].iter().all(|s| {
+                    let mut y = all.clone();
+                    y[v][c] += s;
+                    kinds(&y, &inner) == k0
+                })
+            })
+        })
+    };
+    let (x, p) = (1..60)
+        .map(|seed| {
+            let mut rng = Rng::new(seed);
+            let x: Vec<Vec3> = sc
+                .body
+                .mesh
+                .positions
+                .iter()
+                .map(|q| {
+                    q + Vec3::new(0.0, 0.0, -0.04)
+                        + Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * 0.002
+                })
+                .collect();
+            let p = p0.refreshed(&sc, &x, &phi).expect("the ball is near");
+            (x, p)
+        })
+        .find(|(x, p)| hold(x, &p.maps[i].nodes))
+        .expect("a noise with no pair on a change of closest features");
+    let nodes = &p.maps[i].nodes;
+    let sheet_on_ball = nodes
+        .chunks(4)
+        .filter(|n| n[2] > n[3] && n[0] < ABSENT)
+        .count();
+    let ball_on_sheet = nodes
+        .chunks(4)
+        .filter(|n| n[2] > n[3] && n[0] >= ABSENT)
+        .count();
+    let edges = nodes.chunks(4).filter(|n| n[2] < n[3]).count();
+    println!("{sheet_on_ball} strip vertices, {ball_on_sheet} ball vertices, {edges} edge pairs");
+    assert!(sheet_on_ball > 3 && ball_on_sheet > 0 && edges > 3);
+    let pot = Potential::new(&sc, &p);
+    let term = &sc.terms[i];
+    let map = &p.maps[i];
+    let mut g = vec![0.0; p.n];
+    let e = term.eval(
+        &pot,
+        map,
+        &x,
+        &phi,
+        Want::Gradient,
+        HessianProjection::None,
+        &mut g,
+        &mut [],
+    );
+    assert!(e > 0.0, "the pairs press");
+    super::terms::fd_check(
+        &sc,
+        &p,
+        &x,
+        &phi,
+        "mesh_obstacles",
+        1,
+        |g, h| g.max(h),
+        |x, phi, want, g, h| {
+            g.iter_mut().for_each(|v| *v = 0.0);
+            h.iter_mut().for_each(|v| *v = 0.0);
+            term.eval(&pot, map, x, phi, want, HessianProjection::None, g, h)
+        },
+    );
+}

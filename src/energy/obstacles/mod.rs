@@ -100,10 +100,11 @@ pub enum Solid {
 }
 
 impl Solid {
-    /// The body of a validated shape.
-    pub fn of(s: &Shape) -> Solid {
+    /// The body of a validated analytic shape; `None` for a mesh (its contact is the sheet's
+    /// pairs with its triangles, [`crate::energy::self_contact`]).
+    pub fn of(s: &Shape) -> Option<Solid> {
         let v = |a: &[Real; 3]| Vec3::from(*a);
-        match s {
+        Some(match s {
             Shape::Sphere { center, radius } => Solid::Sphere(sphere::Sphere {
                 center: v(center),
                 radius: *radius,
@@ -130,7 +131,8 @@ impl Solid {
                 min: v(min),
                 max: v(max),
             }),
-        }
+            Shape::Mesh => return None,
+        })
     }
 }
 
@@ -150,6 +152,8 @@ impl Distance for Solid {
 /// One obstacle with its contact law.
 #[derive(Clone, Copy, Debug)]
 pub struct Obstacle {
+    /// Its index in `[[obstacles]]` (the `obstacle{i}_…` columns of `log.csv`).
+    pub index: usize,
     /// Coulomb coefficient μ (0: frictionless).
     pub friction: Real,
     /// Force control: the unit direction, the force at dial 1 (N) and the mass (kg, 0 when
@@ -287,7 +291,8 @@ impl VertexKernel for ObstacleFriction {
     /// the first frame), so that the normal and friction forces together balance the loads.
     fn observables(&self, pot: &Potential, x: &[Vec3]) -> Vec<(String, Real)> {
         let mut out = Vec::new();
-        for (i, o) in self.0.list.iter().enumerate() {
+        for o in &self.0.list {
+            let i = o.index;
             if o.friction <= 0.0 {
                 continue;
             }
@@ -369,7 +374,8 @@ impl VertexKernel for Obstacles {
 
     fn observables(&self, pot: &Potential, x: &[Vec3]) -> Vec<(String, Real)> {
         let mut out = Vec::new();
-        for (i, o) in self.list.iter().enumerate() {
+        for o in &self.list {
+            let i = o.index;
             if o.pressed.is_some() {
                 continue;
             }
@@ -402,7 +408,10 @@ pub fn build(
     mode: crate::settings::Mode,
     explicit: &crate::config::explicit::Explicit,
 ) -> Result<Option<Obstacles>, MeshError> {
-    if list.is_empty() {
+    if list
+        .iter()
+        .all(|o| o.shape == Some(crate::config::obstacle::ShapeKind::Mesh))
+    {
         return Ok(None);
     }
     let mesh = &body.mesh;
@@ -420,6 +429,9 @@ pub fn build(
     for (i, o) in list.iter().enumerate() {
         let invalid = |e: crate::config::Invalid| mesh.invalid(format!("{}: {}", e.key, e.reason));
         let shape = o.shape(i).map_err(invalid)?;
+        let Some(body) = Solid::of(&shape) else {
+            continue;
+        };
         let pressed = match o.control(i).map_err(invalid)? {
             Control::Moved(_) => None,
             Control::Pressed {
@@ -429,8 +441,9 @@ pub fn build(
             } => Some((Vec3::from(direction), magnitude, mass.unwrap_or(0.0))),
         };
         obstacles.push(Obstacle {
+            index: i,
             pressed,
-            body: Solid::of(&shape),
+            body,
             displacement: Vec3::from(o.displacement),
             stiffness: o.stiffness.unwrap_or(k_default),
             smoothing: o.smoothing.unwrap_or(c.h_mean / 100.0),
@@ -443,7 +456,8 @@ pub fn build(
         half_thickness: c.half_thickness,
         h_mean: c.h_mean,
     };
-    for (i, o) in term.list.iter().enumerate() {
+    for o in &term.list {
+        let i = o.index;
         for v in (0..nv).filter(|&v| term.area[v] > 0.0) {
             let (p, _, _) = term.contact(o, v, &mesh.positions[v], 0.0);
             // Touching is allowed (up to round-off of the half thickness).
@@ -479,11 +493,10 @@ pub fn terms(
     let pressed: Vec<Box<dyn Term>> = obstacles
         .list
         .iter()
-        .enumerate()
-        .filter_map(|(index, o)| {
+        .filter_map(|o| {
             let (direction, force, mass) = o.pressed?;
             Some(Box::new(pressed::Pressed {
-                index,
+                index: o.index,
                 body: o.body,
                 direction,
                 force,
