@@ -728,7 +728,7 @@ fn two_sheets(edge: f64, gap: f64) -> (Scene, Pattern, Vec<Vec3>) {
     }
     let phi = vec![0.0; sc.num_scalar_dofs()];
     let p = Pattern::for_scene(&sc)
-        .refreshed(&sc, &x, &phi)
+        .refreshed(&sc, &x, &phi, 0.0)
         .expect("the pressed sheets have pairs");
     (sc, p, x)
 }
@@ -773,7 +773,7 @@ fn self_contact(c: &mut Criterion) {
                 black_box(
                     term.changing()
                         .unwrap()
-                        .stencil_at(&sc.body, &x, &phi)
+                        .stencil_at(&sc.body, &x, &phi, 0.0)
                         .nodes
                         .len(),
                 )

@@ -3,6 +3,7 @@
 come closer than a floor, in every frame.
 
     contact_check.py REFERENCE_MESH OUT_DIR --exclusion R [--floor D] [--json FILE]
+    contact_check.py REFERENCE_MESH OUT_DIR --obstacle FILE [--translate X Y Z] [--floor D] ...
 
 Reads the reference mesh and every frame of OUT_DIR with VTK's own readers, and, brute force
 over every pair of faces that share no vertex (numpy, none of shellsim's code):
@@ -16,6 +17,10 @@ the same way) are excluded, as shellsim excludes them; faces of separate sheets 
 checked. Prints one line per frame and a JSON summary (the smallest distance over all
 frames and pairs, its frame and faces, and the number of intersecting pairs); exits 1 when a
 pair intersects or comes below --floor.
+
+With --obstacle, the pairs are instead every face of the sheet with every face of that rigid
+mesh (moved by --translate), which stands still: the distance is then from the sheet's
+mid-surface to the obstacle's surface. --last checks the last frame only.
 """
 
 import argparse
@@ -111,17 +116,21 @@ def segment_crosses(p, q, a, b, c):
     return ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= 0) & (t <= 1)
 
 
-def pair_distances(x, faces, i, j):
-    fi, fj = faces[i], faces[j]
+def pair_distances(x, faces, i, j, y=None, other=None):
+    """Distances between faces i of (x, faces) and faces j of (y, other), by default the same
+    mesh."""
+    y = x if y is None else y
+    other = faces if other is None else other
+    fi, fj = faces[i], other[j]
     d = np.full(len(i), np.inf)
     for k in range(3):
-        d = np.minimum(d, point_triangle(x[fi[:, k]], x[fj[:, 0]], x[fj[:, 1]], x[fj[:, 2]]))
-        d = np.minimum(d, point_triangle(x[fj[:, k]], x[fi[:, 0]], x[fi[:, 1]], x[fi[:, 2]]))
+        d = np.minimum(d, point_triangle(x[fi[:, k]], y[fj[:, 0]], y[fj[:, 1]], y[fj[:, 2]]))
+        d = np.minimum(d, point_triangle(y[fj[:, k]], x[fi[:, 0]], x[fi[:, 1]], x[fi[:, 2]]))
         for m in range(3):
             d = np.minimum(
                 d,
                 segment_segment(
-                    x[fi[:, k]], x[fi[:, (k + 1) % 3]], x[fj[:, m]], x[fj[:, (m + 1) % 3]]
+                    x[fi[:, k]], x[fi[:, (k + 1) % 3]], y[fj[:, m]], y[fj[:, (m + 1) % 3]]
                 ),
             )
     return d
@@ -145,13 +154,15 @@ def components(faces, nv):
     return np.array([root(f[0]) for f in faces])
 
 
-def crossings(x, faces, i, j):
-    fi, fj = faces[i], faces[j]
+def crossings(x, faces, i, j, y=None, other=None):
+    y = x if y is None else y
+    other = faces if other is None else other
+    fi, fj = faces[i], other[j]
     hit = np.zeros(len(i), dtype=bool)
     for k in range(3):
         a, b = (k, (k + 1) % 3)
-        hit |= segment_crosses(x[fi[:, a]], x[fi[:, b]], x[fj[:, 0]], x[fj[:, 1]], x[fj[:, 2]])
-        hit |= segment_crosses(x[fj[:, a]], x[fj[:, b]], x[fi[:, 0]], x[fi[:, 1]], x[fi[:, 2]])
+        hit |= segment_crosses(x[fi[:, a]], x[fi[:, b]], y[fj[:, 0]], y[fj[:, 1]], y[fj[:, 2]])
+        hit |= segment_crosses(y[fj[:, a]], y[fj[:, b]], x[fi[:, 0]], x[fi[:, 1]], x[fi[:, 2]])
     return hit
 
 
@@ -159,12 +170,23 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("reference")
     ap.add_argument("out")
-    ap.add_argument("--exclusion", type=float, required=True)
+    ap.add_argument("--exclusion", type=float)
+    ap.add_argument("--obstacle")
+    ap.add_argument("--translate", type=float, nargs=3, default=[0.0, 0.0, 0.0])
     ap.add_argument("--floor", type=float, default=0.0)
     ap.add_argument("--json")
+    ap.add_argument("--last", action="store_true", help="check the last frame only")
     a = ap.parse_args()
+    if (a.exclusion is None) == (a.obstacle is None):
+        ap.error("give --exclusion (self-contact) or --obstacle (a rigid mesh)")
     x0, faces = read(a.reference)
     n = len(faces)
+    y, other = None, None
+    if a.obstacle:
+        y, other = read(a.obstacle)
+        y = y + np.array(a.translate)
+        i, j = (g.ravel() for g in np.meshgrid(np.arange(n), np.arange(len(other)), indexing="ij"))
+        return report(a, faces, i, j, y, other)
     i, j = np.triu_indices(n, 1)
     shared = np.zeros(len(i), dtype=bool)
     for k in range(3):
@@ -174,7 +196,14 @@ def main():
     piece = components(faces, len(x0))
     keep = (piece[i] != piece[j]) | (pair_distances(x0, faces, i, j) >= a.exclusion)
     i, j = i[keep], j[keep]
+    return report(a, faces, i, j, None, None)
+
+
+def report(a, faces, i, j, y, other):
+    """Checks the face pairs (i, j) in every frame of a.out (module doc)."""
     frames = sorted(glob.glob(os.path.join(a.out, "frame_*.vtu")))
+    if a.last:
+        frames = frames[-1:]
     if not frames:
         print(f"{a.out}: no frames", file=sys.stderr)
         return 2
@@ -185,9 +214,9 @@ def main():
         if not np.array_equal(fs, faces):
             print(f"{fr}: the faces differ from the reference mesh's", file=sys.stderr)
             return 2
-        d = pair_distances(x, faces, i, j)
+        d = pair_distances(x, faces, i, j, y, other)
         k = int(np.argmin(d)) if len(d) else None
-        c = int(crossings(x, faces, i, j).sum()) if len(i) else 0
+        c = int(crossings(x, faces, i, j, y, other).sum()) if len(i) else 0
         crossing += c
         if k is not None and d[k] < best[0]:
             best = (float(d[k]), os.path.basename(fr), (int(i[k]), int(j[k])))

@@ -47,6 +47,7 @@ impl Pattern {
         scene: &crate::model::Scene,
         x: &[Vec3],
         phi: &[Real],
+        dial: Real,
     ) -> Option<Pattern> {
         let mut changed = false;
         let fresh: Vec<Option<Stencil>> = scene
@@ -54,7 +55,7 @@ impl Pattern {
             .iter()
             .zip(&self.maps)
             .map(|(t, map)| {
-                let st = t.changing()?.stencil_at(&scene.body, x, phi);
+                let st = t.changing()?.stencil_at(&scene.body, x, phi, dial);
                 changed |= st.nodes != map.nodes || st.slot_dofs.len() != map.slots;
                 Some(st)
             })

@@ -193,7 +193,9 @@ fn interface_forces(
     .unwrap();
     let x = shellsim::mesh::io::read_mesh(frame).unwrap().positions;
     let phi = vec![0.0; sc.num_scalar_dofs()];
-    let p = Pattern::for_scene(&sc).refreshed(&sc, &x, &phi).unwrap();
+    let p = Pattern::for_scene(&sc)
+        .refreshed(&sc, &x, &phi, 0.0)
+        .unwrap();
     let i = (0..sc.terms.len())
         .find(|&i| sc.terms[i].name() == "self_contact")
         .unwrap();

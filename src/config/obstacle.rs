@@ -26,8 +26,10 @@
 //! force is a global DOF of the solve, and `mass` (kg) its inertia, required in dynamic mode.
 //! Static and dynamic modes; frictionless; analytic shapes only.
 //!
-//! A `mesh` obstacle is fixed, in static or dynamic mode (its steps are bounded by continuous
-//! collision detection, which the explicit driver does not run).
+//! A `mesh` obstacle is fixed or moved by `displacement`, in static (load-controlled) or dynamic
+//! mode: its steps are bounded by continuous collision detection, which the explicit driver
+//! does not run, and its motion within a step is checked the same way, which arc-length
+//! continuation (the dial an unknown of the solve) cannot do.
 //!
 //! The raw table is flat (every key optional, unknown keys refused); [`ObstacleSettings::shape`]
 //! validates it into a [`Shape`] that carries exactly its variant's parameters.
@@ -225,13 +227,6 @@ impl ObstacleSettings {
                     "force",
                     "force control is available on the analytic shapes; move a mesh obstacle \
                      by `displacement`",
-                );
-            }
-            if self.displacement.iter().any(|&c| c != 0.0) {
-                return invalid(
-                    "displacement",
-                    "a mesh obstacle stays where its file (with scale and translate) puts it; \
-                     move the sheet instead, or press with an analytic shape",
                 );
             }
             if mode == Mode::Explicit {

@@ -235,6 +235,16 @@ impl<'a> Potential<'a> {
             )
     }
 
+    /// The largest fraction of the jump from `from` at dial `from_dial` to `to` at this
+    /// potential's dial that every term that bounds the steps allows
+    /// ([`crate::energy::term::StepLimit::jump_fraction`]).
+    pub fn jump_fraction(&self, from: &[Vec3], to: &[Vec3], from_dial: Real) -> Real {
+        self.terms
+            .iter()
+            .filter_map(|t| Some(t.step_limit()?.jump_fraction(self, from, to, from_dial)))
+            .fold(1.0, Real::min)
+    }
+
     /// Whether every term that bounds the steps admits the positions `x`
     /// ([`crate::energy::term::StepLimit::admits`]).
     pub fn admits(&self, x: &[Vec3]) -> bool {

@@ -73,8 +73,11 @@
 //! separate layers: closer than their offset, they are an error naming the faces. A reference
 //! surface with an edge through a face (not sharing a vertex) is an error naming the two faces.
 //!
-//! **Mesh obstacles** (`[[obstacles]]` with `shape = "mesh"`): a rigid triangle mesh, fixed,
-//! is the one-sided case of the same pairs, through the same distances, CCD and checks. Its
+//! **Mesh obstacles** (`[[obstacles]]` with `shape = "mesh"`): a rigid triangle mesh, fixed or
+//! moved by its `displacement` × the dial, is the one-sided case of the same pairs, through the
+//! same distances, CCD and checks; within a solve it stands still, and its move to a new
+//! step's dial is checked by CCD over the jump before the step is solved (with the jump of the
+//! vertices on prescribed paths), a refused jump cutting the step. Its
 //! vertices are no DOFs (absent slots of the stencil, [`crate::elements::ABSENT`]) and its
 //! thickness is 0, so the offset of a pair with it is half the sheet's thickness: the sheet's
 //! surface rests on the obstacle's. Only the sheet presses: a sheet vertex on an obstacle's face
@@ -937,8 +940,8 @@ impl SelfContact {
 }
 
 impl ChangingElements for SelfContact {
-    fn stencil_at(&self, _: &Body, x: &[Vec3], _: &[Real]) -> Stencil {
-        self.handed_out(self.pairs(&self.placed(x, 0.0), self.halo))
+    fn stencil_at(&self, _: &Body, x: &[Vec3], _: &[Real], dial: Real) -> Stencil {
+        self.handed_out(self.pairs(&self.placed(x, dial), self.halo))
     }
 }
 
@@ -1036,6 +1039,30 @@ impl StepLimit for SelfContact {
             fraction: gathered.min(others.0),
             regather: false,
         }
+    }
+
+    /// The smallest additive CCD fraction to `s ξ` of the pairs the broad phase finds over the
+    /// boxes of the jump's straight paths (the sheet from `from` to `to`, the mesh obstacles
+    /// from their place at `from_dial` to theirs at `pot.dial`), inflated by the largest
+    /// offset.
+    fn jump_fraction(&self, pot: &Potential, from: &[Vec3], to: &[Vec3], from_dial: Real) -> Real {
+        let (x0, x1) = (self.placed(from, from_dial), self.placed(to, pot.dial));
+        if x0 == x1 {
+            return 1.0;
+        }
+        let candidates = self.timed(Clock::Broad, || {
+            self.candidates(&x0, Some(&x1), self.xi_max)
+        });
+        self.timed(Clock::Ccd, || {
+            candidates
+                .into_par_iter()
+                .map(|n| {
+                    let d: [Vec3; 4] = std::array::from_fn(|i| x1[n[i]] - x0[n[i]]);
+                    let d_min = self.min_separation * self.offset(&n);
+                    ccd::safe_fraction(&points(&x0, &n), &d, is_point_triangle(&n), d_min, 1.0)
+                })
+                .reduce(|| 1.0, Real::min)
+        })
     }
 
     /// Every pair at least `s ξ` apart.

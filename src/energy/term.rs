@@ -194,6 +194,21 @@ pub trait StepLimit {
 
     /// Whether the term admits the positions `x` (the static check of a trial state).
     fn admits(&self, pot: &Potential, map: &ElementMap, x: &[Vec3]) -> bool;
+
+    /// The largest fraction in `[0, 1]` of the jump from the positions `from` at dial
+    /// `from_dial` to `to` at `pot.dial` (a new step's start: vertices on prescribed paths and
+    /// the term's own rigid parts moved with the dial, the other vertices where the solve
+    /// starts) that the term allows, every state on the straight paths admissible. 1 by
+    /// default (nothing of the term moves with the dial).
+    fn jump_fraction(
+        &self,
+        _pot: &Potential,
+        _from: &[Vec3],
+        _to: &[Vec3],
+        _from_dial: Real,
+    ) -> Real {
+        1.0
+    }
 }
 
 /// The capability of a term that reports more than its energy under its name.
@@ -470,8 +485,9 @@ pub trait ChangingElements {
     /// pattern is rebuilt when some term's elements changed, and the symbolic factorisation
     /// only when the union of the stencils changed
     /// ([`crate::assembly::Pattern::refreshed`]). The explicit driver does not follow changing
-    /// elements: such a scene is refused there.
-    fn stencil_at(&self, body: &Body, x: &[Vec3], phi: &[Real]) -> Stencil;
+    /// elements: such a scene is refused there. `dial` places what moves with it (a mesh
+    /// obstacle).
+    fn stencil_at(&self, body: &Body, x: &[Vec3], phi: &[Real], dial: Real) -> Stencil;
 }
 
 /// The capability of a term that owns global DOFs (a force-controlled obstacle's offset).

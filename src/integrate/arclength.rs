@@ -272,7 +272,7 @@ fn correct(
         *lambda += dl;
         s.scene.body.prescribe(&mut trial.x, *lambda);
         rep.iterations += 1;
-        s.refresh(trial)?;
+        s.refresh(trial, *lambda)?;
     };
     s.record(&rep);
     Ok(match result {
@@ -337,6 +337,20 @@ pub fn check(scene: &Scene, settings_name: &str) -> Result<(), crate::settings::
              limit points. Use gas.control = \"pressure\" or \"amount\" with arc length, or \
              load control with the volume",
         ));
+    }
+    if let Some(i) = scene.settings.obstacles.iter().position(|o| {
+        o.shape == Some(crate::config::obstacle::ShapeKind::Mesh)
+            && o.displacement.iter().any(|&c| c != 0.0)
+    }) {
+        return Err(crate::settings::SettingsError::Invalid {
+            path: settings_name.to_string(),
+            key: format!("obstacles[{i}].displacement"),
+            reason: "a moving mesh obstacle's motion over each step is checked by continuous \
+                     collision detection before the step is solved; \"arc_length\" solves for \
+                     the dial itself. Use solver.continuation = \"load\", or move an analytic \
+                     shape"
+                .into(),
+        });
     }
     // ∂g/∂λ at the reference state, at mid-dial: zero when nothing follows the dial.
     let pattern = crate::assembly::Pattern::for_scene(scene);
@@ -518,7 +532,7 @@ pub(super) fn run_arc_length(
         add(&mut trial, dir, alpha);
         let mut lt = lambda + dl;
         s.scene.body.prescribe(&mut trial.x, lt);
-        s.refresh(&trial)?;
+        s.refresh(&trial, lt)?;
         let (rep, got) = correct(
             s,
             &w,
@@ -554,7 +568,7 @@ pub(super) fn run_arc_length(
                 add(&mut trial, &inc, frac);
                 let mut lh = h;
                 s.scene.body.prescribe(&mut trial.x, lh);
-                s.refresh(&trial)?;
+                s.refresh(&trial, lh)?;
                 let (rep, landed) =
                     correct(s, &w, &state, lambda, &mut trial, &mut lh, Constraint::Dial)?;
                 iterations += rep.iterations;

@@ -165,8 +165,6 @@ pub(super) fn run_dynamic(
             failure = Some(f);
             break;
         }
-        // Terms whose elements change (contact pairs) follow the state at the step's start.
-        s.refresh(&state)?;
         let h = clock.step_from(t, steps.step).min(tm.end - t);
         let (dial, reaches_hold) = if holding {
             (dial_now, false)
@@ -181,6 +179,9 @@ pub(super) fn run_dynamic(
                 _ => (d, false),
             }
         };
+        // Terms whose elements change (contact pairs) follow the state at the step's start,
+        // with what moves with the dial (a mesh obstacle) where the step takes it.
+        s.refresh(&state, dial)?;
         for i in 0..n {
             xhat[i] = state.x[i] + v[i] * h;
         }
@@ -287,30 +288,43 @@ pub(super) fn run_dynamic(
             l.start_step();
         }
         let pat = s.pattern();
-        let rep = loop {
-            let pot = Potential {
-                dial,
-                inertia: Some(Inertia {
-                    inv_dt2: 1.0 / (h * h),
-                    xhat: &xhat,
-                    dofs_hat: &dofs_hat,
-                }),
-                damping: damping.then_some(Damping {
-                    eta_over_dt: tm.damping / h,
-                    a_prev: &a_prev,
-                    b_prev: &b_prev,
-                }),
-                gravity: s.config.gravity,
-                rest_override: moisture.as_ref().map(|_| &trial_targets[..]),
-                mass: trial_mass,
-                friction: lag.as_ref().map(|l| l.friction(&state.x, dial_now, h)),
-                ..Potential::new(sc, &pat)
-            };
-            let rep = s.solve(&pot, &mut trial, opts);
-            let again =
-                rep.converged && lag.as_mut().is_some_and(|l| l.resolve(sc, &trial.x, dial));
-            if !again {
-                break rep;
+        // The jump to the step's dial (prescribed paths, mesh obstacles) may not carry anything
+        // through the sheet: a step whose jump contact refuses is cut like a failed solve.
+        let refused = (dial != dial_now)
+            .then(|| s.jump_refused(&s.potential(&pat, dial), &state.x, &trial.x, dial_now))
+            .flatten();
+        let rep = if let Some(f) = refused {
+            crate::solve::NewtonReport {
+                converged: false,
+                failure: Some(f),
+                ..Default::default()
+            }
+        } else {
+            loop {
+                let pot = Potential {
+                    dial,
+                    inertia: Some(Inertia {
+                        inv_dt2: 1.0 / (h * h),
+                        xhat: &xhat,
+                        dofs_hat: &dofs_hat,
+                    }),
+                    damping: damping.then_some(Damping {
+                        eta_over_dt: tm.damping / h,
+                        a_prev: &a_prev,
+                        b_prev: &b_prev,
+                    }),
+                    gravity: s.config.gravity,
+                    rest_override: moisture.as_ref().map(|_| &trial_targets[..]),
+                    mass: trial_mass,
+                    friction: lag.as_ref().map(|l| l.friction(&state.x, dial_now, h)),
+                    ..Potential::new(sc, &pat)
+                };
+                let rep = s.solve(&pot, &mut trial, opts);
+                let again =
+                    rep.converged && lag.as_mut().is_some_and(|l| l.resolve(sc, &trial.x, dial));
+                if !again {
+                    break rep;
+                }
             }
         };
         if !rep.converged {

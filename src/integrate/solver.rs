@@ -199,16 +199,20 @@ impl<'a> Solver<'a> {
         self.pattern.clone()
     }
 
-    /// Follows the terms whose elements change to the state `state`: a new pattern when their
-    /// elements there differ, a new symbolic factorisation only when the union of the stencils
-    /// changed. Returns whether the pattern was replaced (take a new [`Solver::pattern`]).
-    pub(super) fn refresh(&mut self, state: &State) -> Result<bool, RunError> {
+    /// Follows the terms whose elements change to the state `state` at dial `dial`: a new
+    /// pattern when their elements there differ, a new symbolic factorisation only when the
+    /// union of the stencils changed. Returns whether the pattern was replaced (take a new
+    /// [`Solver::pattern`]).
+    pub(super) fn refresh(&mut self, state: &State, dial: Real) -> Result<bool, RunError> {
         if !self.changing {
             return Ok(false);
         }
         // The elements are taken at this state: the motion bound starts here.
         self.taken_at.clone_from(&state.x);
-        let Some(p) = self.pattern.refreshed(self.scene, &state.x, &state.dofs) else {
+        let Some(p) = self
+            .pattern
+            .refreshed(self.scene, &state.x, &state.dofs, dial)
+        else {
             return Ok(false);
         };
         self.summary.element_changes += 1;
@@ -319,7 +323,7 @@ impl<'a> Solver<'a> {
                 // iterate and go on from it.
                 regathers += 1;
                 total.failure = None;
-                if self.refresh(state).is_err() {
+                if self.refresh(state, pot.dial).is_err() {
                     total.failure = Some(SolveError::Factor);
                     return total;
                 }
@@ -470,6 +474,27 @@ impl<'a> Solver<'a> {
         if self.allows(pot, state, &predicted.x, &predicted.dofs) {
             state.copy_from(&predicted);
         }
+    }
+
+    /// Whether the terms that bound the steps ([`crate::energy::term::StepLimit`], contact)
+    /// allow the whole jump from the positions `from` at dial `from_dial` to `to` at
+    /// `pot.dial`, a new step's start (prescribed paths and mesh obstacles moved with the dial):
+    /// `None` when they do, else a reason for the step's failure.
+    pub(super) fn jump_refused(
+        &self,
+        pot: &Potential,
+        from: &[Vec3],
+        to: &[Vec3],
+        from_dial: Real,
+    ) -> Option<crate::solve::SolveError> {
+        if !self.scene.terms.iter().any(|t| t.step_limit().is_some()) {
+            return None;
+        }
+        (pot.jump_fraction(from, to, from_dial) < 1.0).then_some(crate::solve::SolveError::Refused(
+            "the step would carry a mesh obstacle or a prescribed vertex within the \
+                 minimum separation of the sheet (checked by continuous collision detection \
+                 over the jump)",
+        ))
     }
 
     /// Whether the terms that bound the steps ([`crate::energy::term::StepLimit`], contact)

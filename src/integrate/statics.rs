@@ -83,13 +83,27 @@ pub(super) fn run_static(
         };
         trial.copy_from(&state);
         s.scene.body.prescribe(&mut trial.x, target);
-        s.refresh(&trial)?;
+        s.refresh(&trial, target)?;
         let pat = s.pattern();
         let pot = s.potential_scaled(&pat, target, target_scale);
-        if target != dial {
+        // The jump to the new dial (prescribed paths, mesh obstacles) may not carry anything
+        // through the sheet: a step whose jump contact refuses is cut like a failed solve.
+        let refused = if target != dial {
+            s.jump_refused(&pot, &state.x, &trial.x, dial)
+        } else {
+            None
+        };
+        if target != dial && refused.is_none() {
             s.predict(&pot, dial, &mut trial);
         }
-        let rep = s.solve(&pot, &mut trial, NewtonOptions { tol: t, ..opts });
+        let rep = match refused {
+            Some(f) => NewtonReport {
+                converged: false,
+                failure: Some(f),
+                ..Default::default()
+            },
+            None => s.solve(&pot, &mut trial, NewtonOptions { tol: t, ..opts }),
+        };
         // A term tracking a state across steps (a moment's angle) may refuse a step too large
         // for it; the step is then cut like a failed solve.
         let admissible = rep.converged && super::hooks::admissible(s.scene, &trial);
@@ -204,7 +218,7 @@ pub(super) fn run_static(
                 amp,
                 seed.wrapping_add(escapes as u64),
             );
-            s.refresh(&state)?;
+            s.refresh(&state, 1.0)?;
             let pat = s.pattern();
             let pot = s.potential(&pat, 1.0);
             let rep = s.solve(

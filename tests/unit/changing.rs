@@ -80,7 +80,7 @@ impl Repulsion {
 }
 
 impl ChangingElements for Repulsion {
-    fn stencil_at(&self, _: &Body, x: &[Vec3], _: &[Real]) -> Stencil {
+    fn stencil_at(&self, _: &Body, x: &[Vec3], _: &[Real], _: Real) -> Stencil {
         self.pairs(x)
     }
 }
@@ -199,11 +199,11 @@ fn the_pattern_follows_changing_elements() {
         })
         .collect();
     let phi = vec![0.0; sc.num_scalar_dofs()];
-    let q = p.refreshed(&sc, &x, &phi).expect("the pairs changed");
+    let q = p.refreshed(&sc, &x, &phi, 0.0).expect("the pairs changed");
     assert!(q.maps[i].len() >= 9, "{} pairs", q.maps[i].len());
     assert!(!q.same_union(&p));
     assert!(
-        q.refreshed(&sc, &x, &phi).is_none(),
+        q.refreshed(&sc, &x, &phi, 0.0).is_none(),
         "same state, same pairs"
     );
     let pot = Potential::new(&sc, &q);

@@ -69,7 +69,9 @@ fn folded_without_feature_changes(
     (11..60)
         .map(|seed| {
             let x = folded(sc, 0.02, 0.002, seed);
-            let p = p0.refreshed(sc, &x, phi).expect("the fold brings pairs");
+            let p = p0
+                .refreshed(sc, &x, phi, 0.0)
+                .expect("the fold brings pairs");
             (x, p)
         })
         .find(|(x, p)| kinds_hold(x, &p.maps[i].nodes, 1e-6))
@@ -314,7 +316,7 @@ fn a_mesh_obstacle_matches_finite_differences() {
                         + Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * 0.002
                 })
                 .collect();
-            let p = p0.refreshed(&sc, &x, &phi).expect("the ball is near");
+            let p = p0.refreshed(&sc, &x, &phi, 0.0).expect("the ball is near");
             (x, p)
         })
         .find(|(x, p)| hold(x, &p.maps[i].nodes))
