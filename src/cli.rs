@@ -655,6 +655,7 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
     crate::output::check_fields(&scene, &settings_path.display().to_string())?;
     crate::integrate::check_continuation(&scene, &settings_path.display().to_string())?;
     crate::integrate::check_supports(&scene, &settings_path.display().to_string())?;
+    crate::integrate::check_start(&scene, &settings_path.display().to_string())?;
     crate::solve::newton::VERBOSE.store(cli.verbose, std::sync::atomic::Ordering::Relaxed);
     let restart = if cli.continue_series {
         Some(continue_from(&cli.out, cli.restart.as_ref())?)
@@ -718,6 +719,13 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
         vertices: scene.body.num_vertices(),
         faces: scene.body.num_faces(),
         restart: restart.as_deref().map(file).transpose()?,
+        obstacle_meshes: scene
+            .settings
+            .obstacles
+            .iter()
+            .filter_map(|o| o.file.as_deref())
+            .map(|f| file(std::path::Path::new(f)))
+            .collect::<Result<_>>()?,
         threads,
         host: crate::provenance::host(),
         started,

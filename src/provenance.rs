@@ -74,6 +74,9 @@ pub struct RunRecord {
     /// The frame the run started from (`--restart`, `--continue`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub restart: Option<FileRecord>,
+    /// The mesh obstacles' files (`[[obstacles]]` with `shape = "mesh"`), in their order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacle_meshes: Vec<FileRecord>,
     /// Worker threads.
     pub threads: usize,
     /// The machine's host name.

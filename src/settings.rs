@@ -169,7 +169,8 @@ impl Settings {
             reason: e.to_string(),
         })?;
         let mut settings = Self::from_str_with(&text, &name, overrides)?;
-        // A mesh obstacle's file is relative to the settings file's folder.
+        // A mesh obstacle's file is relative to the settings file's folder; it is kept absolute,
+        // so that the resolved settings written with a run name it from anywhere.
         let folder = path.parent().unwrap_or(Path::new(""));
         for o in &mut settings.obstacles {
             if let Some(f) = o
@@ -177,7 +178,11 @@ impl Settings {
                 .as_mut()
                 .filter(|f| Path::new(f.as_str()).is_relative())
             {
-                *f = folder.join(f.as_str()).display().to_string();
+                let joined = folder.join(f.as_str());
+                *f = std::path::absolute(&joined)
+                    .unwrap_or(joined)
+                    .display()
+                    .to_string();
             }
         }
         Ok(settings)
@@ -246,7 +251,12 @@ impl Settings {
         self.loads.validate()?;
         self.gas.validate()?;
         self.contact.validate()?;
-        self.self_contact.validate(mode)?;
+        self.self_contact.validate(
+            mode,
+            self.obstacles
+                .iter()
+                .any(|o| o.shape == Some(crate::config::obstacle::ShapeKind::Mesh)),
+        )?;
         for (i, o) in self.obstacles.iter().enumerate() {
             o.validate(i, mode)?;
         }

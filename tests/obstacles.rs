@@ -731,6 +731,13 @@ fn bad_mesh_obstacles_are_refused() {
             &["obstacles[0].radius", "not a key"][..],
         ),
         (
+            format!(
+                "{}\ndisplacement = [0, 0, 0.02]\n[solver]\nmode = \"dynamic\"",
+                mesh("low.obj")
+            ),
+            &["rest.dial_time", "dial 1", "mesh obstacle"][..],
+        ),
+        (
             format!("{}\nscale = 0", mesh("low.obj")),
             &["obstacles[0].scale", "> 0"][..],
         ),
@@ -739,7 +746,7 @@ fn bad_mesh_obstacles_are_refused() {
                 "{}\ndisplacement = [0, 0, 0.1]\n[solver]\ncontinuation = \"arc_length\"",
                 mesh("low.obj")
             ),
-            &["obstacles[0].displacement", "arc_length"][..],
+            &["obstacles[0].shape", "arc_length"][..],
         ),
         (
             format!("{}\nforce = [0, 0, 1]", mesh("low.obj")),

@@ -71,14 +71,15 @@ impl Default for SelfContact {
 }
 
 impl SelfContact {
-    /// Validates `[self_contact]` when enabled: positive lengths and stiffness, a minimum
-    /// separation in (0, 0.9], and a mode that bounds its steps (not explicit).
-    pub fn validate(&self, mode: Mode) -> Result<(), Invalid> {
+    /// Validates `[self_contact]` when enabled, or when the scene has mesh obstacles
+    /// (`meshes`, whose pairs use its keys): positive lengths and stiffness, a minimum
+    /// separation in (0, 0.9], and, when enabled, a mode that bounds its steps (not explicit).
+    pub fn validate(&self, mode: Mode, meshes: bool) -> Result<(), Invalid> {
         let ck = Check;
-        if !self.enabled {
+        if !self.enabled && !meshes {
             return Ok(());
         }
-        if mode == Mode::Explicit {
+        if self.enabled && mode == Mode::Explicit {
             return ck.inv(
                 "self_contact.enabled",
                 "self-contact bounds every Newton step by continuous collision detection; \
@@ -125,21 +126,26 @@ mod tests {
             offset: AutoOr::Value(-1.0),
             ..Default::default()
         };
-        assert!(off.validate(Mode::Explicit).is_ok());
+        assert!(off.validate(Mode::Explicit, false).is_ok());
+        // Mesh obstacles' pairs use its keys: they are checked without `enabled` then.
+        assert_eq!(
+            off.validate(Mode::Static, true).unwrap_err().key,
+            "self_contact.offset"
+        );
         let on = SelfContact {
             enabled: true,
             ..Default::default()
         };
-        assert!(on.validate(Mode::Static).is_ok());
-        assert!(on.validate(Mode::Dynamic).is_ok());
-        let e = on.validate(Mode::Explicit).unwrap_err();
+        assert!(on.validate(Mode::Static, false).is_ok());
+        assert!(on.validate(Mode::Dynamic, false).is_ok());
+        let e = on.validate(Mode::Explicit, false).unwrap_err();
         assert_eq!(e.key, "self_contact.enabled");
         let bad = SelfContact {
             halo: AutoOr::Value(0.0),
             ..on.clone()
         };
         assert_eq!(
-            bad.validate(Mode::Static).unwrap_err().key,
+            bad.validate(Mode::Static, false).unwrap_err().key,
             "self_contact.halo"
         );
         for mu in [-0.1, Real::NAN, Real::INFINITY] {
@@ -148,7 +154,7 @@ mod tests {
                 ..on.clone()
             };
             assert_eq!(
-                bad.validate(Mode::Dynamic).unwrap_err().key,
+                bad.validate(Mode::Dynamic, false).unwrap_err().key,
                 "self_contact.friction"
             );
         }
@@ -162,7 +168,7 @@ mod tests {
                 ..on.clone()
             };
             assert_eq!(
-                bad.validate(Mode::Static).unwrap_err().key,
+                bad.validate(Mode::Static, false).unwrap_err().key,
                 "self_contact.min_separation"
             );
         }

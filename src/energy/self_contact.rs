@@ -476,7 +476,8 @@ impl SelfContact {
             .map(|e| {
                 let n = &nodes[4 * e..4 * e + 4];
                 if !is_point_triangle(n) || n[0] >= self.nv {
-                    // Edge pairs and an obstacle's vertices always count.
+                    // Edge pairs and an obstacle's vertices always count (the nearest face on
+                    // each side of an obstacle's vertex stalled a mesh pressing a sheet).
                     return None;
                 }
                 let y = points(x, n);

@@ -338,17 +338,23 @@ pub fn check(scene: &Scene, settings_name: &str) -> Result<(), crate::settings::
              load control with the volume",
         ));
     }
-    if let Some(i) = scene.settings.obstacles.iter().position(|o| {
-        o.shape == Some(crate::config::obstacle::ShapeKind::Mesh)
-            && o.displacement.iter().any(|&c| c != 0.0)
-    }) {
+    if scene.terms.iter().any(|t| t.step_limit().is_some()) {
+        let key = match scene
+            .settings
+            .obstacles
+            .iter()
+            .position(|o| o.shape == Some(crate::config::obstacle::ShapeKind::Mesh))
+        {
+            Some(i) if !scene.settings.self_contact.enabled => format!("obstacles[{i}].shape"),
+            _ => "self_contact.enabled".into(),
+        };
         return Err(crate::settings::SettingsError::Invalid {
             path: settings_name.to_string(),
-            key: format!("obstacles[{i}].displacement"),
-            reason: "a moving mesh obstacle's motion over each step is checked by continuous \
-                     collision detection before the step is solved; \"arc_length\" solves for \
-                     the dial itself. Use solver.continuation = \"load\", or move an analytic \
-                     shape"
+            key,
+            reason: "self-contact and mesh obstacles bound every Newton step by continuous \
+                     collision detection; \"arc_length\" corrects along the path with steps \
+                     that are not bounded, and the dial is an unknown of its solve. Use \
+                     solver.continuation = \"load\" or an analytic shape"
                 .into(),
         });
     }

@@ -141,6 +141,8 @@ pub(super) fn run_dynamic(
         };
     }
     {
+        // The first frame's contact pairs, where it is.
+        s.refresh(&state, dial_now)?;
         let pat = s.pattern();
         let pot = accepted(s.potential(&pat, dial_now), moisture.as_ref(), &targets);
         s.driver = record!(t0);

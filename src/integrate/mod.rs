@@ -39,7 +39,7 @@ mod symmetry;
 pub use arclength::check as check_continuation;
 pub use failure::{catch_signals, interrupted, RunError, RunFailure};
 pub use resume::{DriverState, InitialState};
-pub use statics::check_supports;
+pub use statics::{check_start, check_supports};
 pub use symmetry::{is_planar, perturb, vertex_normals};
 
 use failure::interruption;

@@ -28,6 +28,8 @@ pub(super) fn run_static(
     let zeros = vec![Vec3::zeros(); state.x.len()];
     let dial_start = restart.unwrap_or(0.0).clamp(0.0, 1.0);
     {
+        // The first frame's contact pairs, where it is.
+        s.refresh(&state, dial_start)?;
         let pat = s.pattern();
         let pot = s.potential(&pat, dial_start);
         s.driver = super::DriverState {
@@ -267,6 +269,41 @@ pub(super) fn reference_potential<'p>(
         ..crate::energy::Potential::new(scene, pattern)
     };
     (x, pot)
+}
+
+/// Rejects a dynamic scene whose dial starts above 0 (`rest.dial_time = 0`: at 1, or at the
+/// first hold) when the jump there from the reference (mesh obstacles moved by their
+/// displacement, vertices on prescribed paths) would carry something within the contact's
+/// minimum separation of the sheet: the run would start from a state the contact never checked.
+pub fn check_start(
+    scene: &crate::model::Scene,
+    settings_name: &str,
+) -> Result<(), crate::settings::SettingsError> {
+    let settings = &scene.settings;
+    if settings.solver.mode != crate::settings::Mode::Dynamic
+        || settings.rest.dial_time > 0.0
+        || !scene.terms.iter().any(|t| t.step_limit().is_some())
+    {
+        return Ok(());
+    }
+    let dial = settings.dial.holds.first().copied().unwrap_or(1.0);
+    let pattern = crate::assembly::Pattern::for_scene(scene);
+    let state = State::reference(scene);
+    let (x, pot) = reference_potential(scene, &pattern, &state, dial);
+    if pot.jump_fraction(&state.x, &x, 0.0) < 1.0 {
+        return Err(crate::settings::SettingsError::Invalid {
+            path: settings_name.to_string(),
+            key: "rest.dial_time".into(),
+            reason: format!(
+                "is 0, so the run starts at dial {}, where a mesh obstacle moved by its \
+                 displacement (or a vertex on a prescribed path) is within the contact's \
+                 minimum separation of the sheet or through it: set rest.dial_time > 0 to \
+                 move it in over time",
+                crate::math::human(dial)
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// How close a continuation step's end may come to dial 1 or a hold and be taken as it.
