@@ -5,10 +5,13 @@
 //! A uniform grid: each face's (each edge's) box, inflated by the radius, is listed under every
 //! cell it overlaps, in a table sorted by cell (and primitive, so the table is the same on any
 //! thread count); each vertex looks up the one cell it lies in, each edge the cells its own box
-//! overlaps. The cell is the largest inflated box's longest side (so a box spans at most two
-//! cells per axis), unless the grid would then be finer than 2²⁰ cells per axis. Build and
-//! queries are linear in the number of primitives for meshes of even size; the queries run in
-//! parallel, one result list per primitive, concatenated in primitive order.
+//! overlaps. The cell is twice the median inflated box's longest side, at most the largest's
+//! (so a box of a mesh of even size spans at most two or three cells per axis), doubled while
+//! the boxes would be listed under more than 16 cells each on average, and never finer than
+//! 2²⁰ cells per axis: a few large boxes (a coarse obstacle's triangles beside a fine sheet) do
+//! not put every small one into one cell. Build and queries are linear in the number of
+//! primitives for meshes of even size; the queries run in parallel, one result list per
+//! primitive, concatenated in primitive order. The candidates do not depend on the cell.
 //!
 //! Units: positions and radius m.
 
@@ -65,14 +68,26 @@ impl Grid {
     /// The grid over `boxes`, each listed under every cell it overlaps.
     fn new(boxes: &[Aabb]) -> Grid {
         let (mut lo, mut hi) = (Vec3::repeat(Real::INFINITY), Vec3::repeat(-Real::INFINITY));
-        let mut side: Real = 0.0;
+        let mut sides: Vec<Real> = Vec::with_capacity(boxes.len());
         for b in boxes {
             lo = lo.inf(&b.min);
             hi = hi.sup(&b.max);
-            side = side.max((b.max - b.min).max());
+            sides.push((b.max - b.min).max());
         }
         let extent = (hi - lo).max();
-        let cell = side.max(extent / MAX_CELLS).max(Real::MIN_POSITIVE);
+        let largest = sides.iter().copied().fold(0.0, Real::max);
+        let mid = sides.len() / 2;
+        let median = *sides.select_nth_unstable_by(mid, Real::total_cmp).1;
+        let floor = (extent / MAX_CELLS).max(Real::MIN_POSITIVE);
+        // Twice the median box, so that a few large boxes (a coarse obstacle's triangles
+        // beside a fine sheet) do not put every small one in the same cell; doubled while the
+        // boxes would be listed in more than 16 cells each on average.
+        let mut cell = largest.min(2.0 * median).max(floor);
+        let budget = 16 * boxes.len() + (1 << 20);
+        while cell < largest && Self::entries(boxes, lo, cell) > budget {
+            cell *= 2.0;
+        }
+        let cell = cell.min(largest).max(floor);
         let mut g = Grid {
             origin: lo,
             cell,
@@ -96,6 +111,21 @@ impl Grid {
         }
         g
     }
+    /// How many (cell, box) entries a grid of cell size `cell` from `origin` lists.
+    fn entries(boxes: &[Aabb], origin: Vec3, cell: Real) -> usize {
+        let span =
+            |a: Real, b: Real, o: Real| ((b - o) / cell).floor() - ((a - o) / cell).floor() + 1.0;
+        boxes
+            .iter()
+            .map(|b| {
+                (0..3)
+                    .map(|k| span(b.min[k], b.max[k], origin[k]))
+                    .product::<Real>()
+            })
+            .sum::<Real>()
+            .min(usize::MAX as Real) as usize
+    }
+
     /// Calls `f` with the key of every cell `b` overlaps.
     fn cells(&self, b: &Aabb, mut f: impl FnMut(u64)) {
         let (a, z) = (self.coord(&b.min), self.coord(&b.max));
@@ -235,6 +265,62 @@ pub fn edge_edge(
 mod tests {
     use super::*;
     use crate::contact::distance;
+
+    /// A fine sheet of small triangles under two triangles a hundred times larger (a coarse
+    /// obstacle): the cell follows the small ones, and the grid finds exactly what brute force
+    /// finds.
+    #[test]
+    fn a_few_large_boxes_keep_the_cell_small_and_the_pairs_exact() {
+        let n = 40;
+        let mut x: Vec<Vec3> = (0..n * n)
+            .map(|k| Vec3::new((k % n) as Real * 0.01, (k / n) as Real * 0.01, 0.0))
+            .collect();
+        let mut faces: Vec<[usize; 3]> = Vec::new();
+        for i in 0..n - 1 {
+            for j in 0..n - 1 {
+                let a = j * n + i;
+                faces.push([a, a + 1, a + n + 1]);
+                faces.push([a, a + n + 1, a + n]);
+            }
+        }
+        let base = x.len();
+        for p in [[-1.0, -1.0], [2.0, -1.0], [2.0, 2.0], [-1.0, 2.0]] {
+            x.push(Vec3::new(p[0], p[1], -0.003));
+        }
+        faces.push([base, base + 1, base + 2]);
+        faces.push([base, base + 2, base + 3]);
+        let r = 0.005;
+        let boxes: Vec<Aabb> = faces
+            .iter()
+            .map(|f| Aabb::of(f.iter().map(|&v| x[v]), r))
+            .collect();
+        let grid = Grid::new(&boxes);
+        assert!(grid.cell < 0.05, "cell {}", grid.cell);
+        let mut brute = Vec::new();
+        for (p, xp) in x.iter().enumerate() {
+            for (f, b) in boxes.iter().enumerate() {
+                if !faces[f].contains(&p) && b.contains(xp) {
+                    brute.push((p as u32, f as u32));
+                }
+            }
+        }
+        assert_eq!(point_triangle(&x, None, &faces, r), brute);
+        let edges: Vec<[usize; 2]> = faces
+            .iter()
+            .flat_map(|f| [[f[0], f[1]], [f[1], f[2]], [f[0], f[2]]])
+            .collect();
+        let mut brute = Vec::new();
+        for a in 0..edges.len() {
+            let own = Aabb::of(edges[a].iter().map(|&v| x[v]), 0.0);
+            for b in a + 1..edges.len() {
+                let ib = Aabb::of(edges[b].iter().map(|&v| x[v]), r);
+                if !edges[b].iter().any(|v| edges[a].contains(v)) && ib.overlaps(&own) {
+                    brute.push((a as u32, b as u32));
+                }
+            }
+        }
+        assert_eq!(edge_edge(&x, None, &edges, r), brute);
+    }
 
     /// Two random triangle soups: the grid finds exactly the pairs a brute-force loop over all
     /// pairs finds with the same box test (so every pair within the radius is among them).
