@@ -168,6 +168,19 @@ pub fn point_triangle(
     faces: &[[usize; 3]],
     radius: Real,
 ) -> Vec<(u32, u32)> {
+    point_triangle_where(x, to, faces, radius, |_, _| true)
+}
+
+/// [`point_triangle`], keeping only the pairs `(p, f)` for which `keep` holds (tested before
+/// they are stored: a scene that wants only the pairs between two parts never holds the
+/// others).
+pub fn point_triangle_where(
+    x: &[Vec3],
+    to: Option<&[Vec3]>,
+    faces: &[[usize; 3]],
+    radius: Real,
+    keep: impl Fn(u32, u32) -> bool + Sync,
+) -> Vec<(u32, u32)> {
     if faces.is_empty() {
         return Vec::new();
     }
@@ -180,7 +193,10 @@ pub fn point_triangle(
             let mut out = Vec::new();
             grid.cells(&own, |k| {
                 for &(_, f) in grid.at(k) {
-                    if !faces[f as usize].contains(&p) && boxes[f as usize].overlaps(&own) {
+                    if !faces[f as usize].contains(&p)
+                        && boxes[f as usize].overlaps(&own)
+                        && keep(p as u32, f)
+                    {
                         out.push((p as u32, f));
                     }
                 }
@@ -232,6 +248,18 @@ pub fn edge_edge(
     edges: &[[usize; 2]],
     radius: Real,
 ) -> Vec<(u32, u32)> {
+    edge_edge_where(x, to, edges, radius, |_, _| true)
+}
+
+/// [`edge_edge`], keeping only the pairs `(a, b)` for which `keep` holds (tested before they
+/// are stored).
+pub fn edge_edge_where(
+    x: &[Vec3],
+    to: Option<&[Vec3]>,
+    edges: &[[usize; 2]],
+    radius: Real,
+    keep: impl Fn(u32, u32) -> bool + Sync,
+) -> Vec<(u32, u32)> {
     if edges.is_empty() {
         return Vec::new();
     }
@@ -248,6 +276,7 @@ pub fn edge_edge(
                     if bu > a
                         && !edges[bu].iter().any(|v| edges[a].contains(v))
                         && inflated[bu].overlaps(&own)
+                        && keep(a as u32, b)
                     {
                         out.push((a as u32, b));
                     }

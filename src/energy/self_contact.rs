@@ -401,8 +401,17 @@ impl SelfContact {
     /// positions; over the straight paths to `to`, when given), not excluded: their nodes,
     /// point–triangle pairs first, each kind sorted.
     fn candidates(&self, x: &[Vec3], to: Option<&[Vec3]>, radius: Real) -> Vec<[usize; 4]> {
-        let pt = broad::point_triangle(x, to, &self.faces, radius);
-        let ee = broad::edge_edge(x, to, &self.edges, radius);
+        // Pairs that do not count are never stored: the sheet's with itself when only mesh
+        // obstacles are on (a free sheet's first step sweeps boxes over the whole sheet).
+        let (nv, nf, ne) = (
+            self.nv as u32,
+            self.sheet_faces as u32,
+            self.sheet_edges as u32,
+        );
+        let both = |a: bool, b: bool| if a && b { self.self_pairs } else { a || b };
+        let pt =
+            broad::point_triangle_where(x, to, &self.faces, radius, |p, f| both(p < nv, f < nf));
+        let ee = broad::edge_edge_where(x, to, &self.edges, radius, |a, b| both(a < ne, b < ne));
         let key = |a: u32, b: u32| (a as u64) << 32 | b as u64;
         pt.par_iter()
             .filter(|&&(p, f)| self.excluded_pt.binary_search(&key(p, f)).is_err())
