@@ -10,7 +10,7 @@
 
 mod common;
 
-use common::{run_status, shellsim};
+use common::{log_rows, run_status, shellsim};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -486,6 +486,19 @@ fn a_sheet_draped_over_a_sphere_rests_on_its_contact_force() {
     assert!(f > 1e-2 * weight, "no friction acts: {friction:?}");
 }
 
+/// The smallest value of the gap column `column` (m) over the frames of the run `out`,
+/// asserting that no frame has a pair closer than a tenth of its offset h/2 (gap ≥ −0.9 h/2).
+fn smallest_gap(out: &Path, column: &str, h: f64) -> f64 {
+    log_rows(out).iter().fold(f64::INFINITY, |smallest, row| {
+        let gap = row[column];
+        assert!(
+            gap >= -0.9 * h / 2.0,
+            "a pair within a tenth of its offset: {gap}"
+        );
+        smallest.min(gap)
+    })
+}
+
 /// A plane of two triangles as an OBJ file, `z` its height (m), spanning ±1 m.
 fn plane_obj(d: &Path, file: &str, z: f64) {
     std::fs::write(
@@ -608,18 +621,7 @@ fn a_sheet_draped_over_a_sphere_mesh_rests_on_its_contact_force() {
     assert_carries(&f, weight, "drape on a mesh");
     assert!(row["mesh_obstacles_friction"] > 1e-2 * weight, "{row:?}");
     let out = d.join("drape");
-    let text = std::fs::read_to_string(out.join("log.csv")).unwrap();
-    let head: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let col = head.iter().position(|h| *h == "obstacle0_gap").unwrap();
-    let mut smallest = f64::INFINITY;
-    for line in text.lines().skip(1) {
-        let gap: f64 = line.split(',').nth(col).unwrap().parse().unwrap();
-        assert!(
-            gap >= -0.9 * h / 2.0,
-            "a pair within a tenth of its offset: {gap}"
-        );
-        smallest = smallest.min(gap);
-    }
+    let smallest = smallest_gap(&out, "obstacle0_gap", h);
     // The independent check (VTK's readers, brute force over every pair of a sheet face and a
     // ball face): no crossing, and the smallest distance the log reports; the last frame
     // against the ball moved 5 mm up crosses it (the control: the check can fail).
@@ -810,14 +812,5 @@ fn a_mesh_moving_with_the_dial_presses_a_disk_onto_a_plane() {
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     println!("steps {} rejected {}", sum["steps"], sum["rejected_steps"]);
     assert!(sum["rejected_steps"].as_u64().unwrap() > 0, "{sum}");
-    let text = std::fs::read_to_string(out.join("log.csv")).unwrap();
-    let head: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let col = head.iter().position(|h| *h == "obstacle1_gap").unwrap();
-    for line in text.lines().skip(1) {
-        let gap: f64 = line.split(',').nth(col).unwrap().parse().unwrap();
-        assert!(
-            gap >= -0.9 * h / 2.0,
-            "a pair within a tenth of its offset: {gap}"
-        );
-    }
+    smallest_gap(&out, "obstacle1_gap", h);
 }

@@ -641,6 +641,23 @@ impl SelfContact {
         out
     }
 
+    /// The friction step of the pairs `nodes` (internal numbering): the potential's friction,
+    /// the step's start placed at its dial (the obstacles where they were), and each pair's
+    /// friction lagged at the lag's iterate and dial.
+    fn step_friction<'f>(
+        &self,
+        fr: crate::energy::potential::Friction<'f>,
+        nodes: &[usize],
+    ) -> (
+        crate::energy::potential::Friction<'f>,
+        Vec<Vec3>,
+        Vec<Option<Slip>>,
+    ) {
+        let lag = self.placed(fr.x_lag, fr.dial_lag);
+        let prev = self.placed(fr.x_prev, fr.dial_prev).into_owned();
+        (fr, prev, self.lagged_friction(nodes, &lag))
+    }
+
     /// The friction of one pair at `x` over the step from `x_prev` with slip smoothing `eps`
     /// (module doc): its dissipation, added to `grad` and `hess` (DOF order of the pair).
     fn slip(
@@ -711,11 +728,7 @@ impl SelfContact {
         let friction = pot
             .friction
             .filter(|_| with_friction && self.has_friction())
-            .map(|fr| {
-                let lag = self.placed(fr.x_lag, fr.dial_lag);
-                let prev = self.placed(fr.x_prev, fr.dial_prev).into_owned();
-                (fr, prev, self.lagged_friction(&all, &lag))
-            });
+            .map(|fr| self.step_friction(fr, &all));
         assemble_elements::<12, 4, _>(
             map,
             |e, _, mut g, mut h| {
@@ -749,8 +762,7 @@ impl SelfContact {
         };
         let nodes = self.internal(&map.nodes);
         let x = &*self.placed(x, pot.dial);
-        let prev = self.placed(fr.x_prev, fr.dial_prev);
-        let lagged = self.lagged_friction(&nodes, &self.placed(fr.x_lag, fr.dial_lag));
+        let (_, prev, lagged) = self.step_friction(*fr, &nodes);
         let per_pair: Vec<Real> = (0..lagged.len())
             .into_par_iter()
             .map(|e| {
@@ -900,11 +912,10 @@ impl SelfContact {
             return Vec::new();
         }
         let active = self.active(nodes, x);
-        let friction = pot.friction.filter(|_| self.has_friction()).map(|fr| {
-            let lag = self.placed(fr.x_lag, fr.dial_lag);
-            let prev = self.placed(fr.x_prev, fr.dial_prev).into_owned();
-            (fr, prev, self.lagged_friction(nodes, &lag))
-        });
+        let friction = pot
+            .friction
+            .filter(|_| self.has_friction())
+            .map(|fr| self.step_friction(fr, nodes));
         let nb = self.rigid.bodies.len();
         // Per pair with an obstacle: the obstacle, −∇E summed over its sheet nodes (the force
         // on the sheet) and the pair's d − ξ. Summed in pair order below.

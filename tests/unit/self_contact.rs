@@ -84,6 +84,46 @@ fn term_index(sc: &Scene) -> usize {
         .expect("a self_contact term")
 }
 
+/// Term `i` of `sc` at `(x, phi)` with pattern `p`: its pairs press (energy > 0), and its
+/// energy, gradient and Hessian match central differences.
+fn pressing_term_matches_finite_differences(
+    sc: &Scene,
+    p: &Pattern,
+    i: usize,
+    x: &[Vec3],
+    phi: &[Real],
+) {
+    let pot = Potential::new(sc, p);
+    let term = &sc.terms[i];
+    let map = &p.maps[i];
+    let mut g = vec![0.0; p.n];
+    let e = term.eval(
+        &pot,
+        map,
+        x,
+        phi,
+        Want::Gradient,
+        HessianProjection::None,
+        &mut g,
+        &mut [],
+    );
+    assert!(e > 0.0, "{}: the pairs press", term.name());
+    super::terms::fd_check(
+        sc,
+        p,
+        x,
+        phi,
+        term.name(),
+        1,
+        |g, h| g.max(h),
+        |x, phi, want, g, h| {
+            g.iter_mut().for_each(|v| *v = 0.0);
+            h.iter_mut().for_each(|v| *v = 0.0);
+            term.eval(&pot, map, x, phi, want, HessianProjection::None, g, h)
+        },
+    );
+}
+
 /// The term alone against central differences on the folded strip, the layers 0.02 apart
 /// (offset 0.05): every vertex of the folded part presses on a face below it, and the
 /// edge–edge pairs, active inside half the offset, press too.
@@ -98,35 +138,7 @@ fn self_contact_matches_finite_differences_on_a_folded_strip() {
     let n = p.maps[i].nodes.len() / 4;
     let ee = p.maps[i].nodes.chunks(4).filter(|c| c[2] < c[3]).count();
     assert!(n > 50 && ee > 10, "{n} pairs, {ee} edge–edge");
-    let pot = Potential::new(&sc, &p);
-    let term = &sc.terms[i];
-    let map = &p.maps[i];
-    let mut g = vec![0.0; p.n];
-    let e = term.eval(
-        &pot,
-        map,
-        &x,
-        &phi,
-        Want::Gradient,
-        HessianProjection::None,
-        &mut g,
-        &mut [],
-    );
-    assert!(e > 0.0);
-    super::terms::fd_check(
-        &sc,
-        &p,
-        &x,
-        &phi,
-        "self_contact",
-        1,
-        |g, h| g.max(h),
-        |x, phi, want, g, h| {
-            g.iter_mut().for_each(|v| *v = 0.0);
-            h.iter_mut().for_each(|v| *v = 0.0);
-            term.eval(&pot, map, x, phi, want, HessianProjection::None, g, h)
-        },
-    );
+    pressing_term_matches_finite_differences(&sc, &p, i, &x, &phi);
 }
 
 /// The closest features of each pair of `nodes` at `x`.
@@ -333,33 +345,5 @@ fn a_mesh_obstacle_matches_finite_differences() {
     let edges = nodes.chunks(4).filter(|n| n[2] < n[3]).count();
     println!("{sheet_on_ball} strip vertices, {ball_on_sheet} ball vertices, {edges} edge pairs");
     assert!(sheet_on_ball > 3 && ball_on_sheet > 0 && edges > 3);
-    let pot = Potential::new(&sc, &p);
-    let term = &sc.terms[i];
-    let map = &p.maps[i];
-    let mut g = vec![0.0; p.n];
-    let e = term.eval(
-        &pot,
-        map,
-        &x,
-        &phi,
-        Want::Gradient,
-        HessianProjection::None,
-        &mut g,
-        &mut [],
-    );
-    assert!(e > 0.0, "the pairs press");
-    super::terms::fd_check(
-        &sc,
-        &p,
-        &x,
-        &phi,
-        "mesh_obstacles",
-        1,
-        |g, h| g.max(h),
-        |x, phi, want, g, h| {
-            g.iter_mut().for_each(|v| *v = 0.0);
-            h.iter_mut().for_each(|v| *v = 0.0);
-            term.eval(&pot, map, x, phi, want, HessianProjection::None, g, h)
-        },
-    );
+    pressing_term_matches_finite_differences(&sc, &p, i, &x, &phi);
 }
