@@ -18,10 +18,14 @@ pub struct SelfContact {
     /// thicknesses, `(h_a + h_b)/2` (default); a number: that offset for every pair (a contact
     /// thickness apart from the material's).
     pub offset: AutoOr,
-    /// Penalty stiffness k: contact pressure per unit penetration into the offset (Pa/m).
-    /// `"auto"`: the area-weighted mean of E/h (default), as for the ground.
+    /// The normal law (default `"penalty"`): see [`Law`].
+    pub law: Law,
+    /// Stiffness k of the normal law (Pa/m): the penalty's contact pressure per unit
+    /// penetration into the offset, or the barrier's scale. `"auto"`: the area-weighted mean
+    /// of E/h (default), as for the ground.
     pub stiffness: AutoOr,
-    /// Smoothing length δ of the penalty (m). `"auto"`: h/100 (default).
+    /// The normal law's length (m): the penalty's smoothing δ, or the barrier's activation
+    /// distance ĝ beyond the offset. `"auto"`: h/100 (default).
     pub smoothing: AutoOr,
     /// Pairs closer than this along the reference surface never touch (m). `"auto"`:
     /// `2 (ξ + δ)` with the largest offset (default).
@@ -38,6 +42,21 @@ pub struct SelfContact {
     /// Which point–triangle pairs of a vertex press (default `"nearest"`): see
     /// [`Pairs`].
     pub pairs: Pairs,
+}
+
+/// The normal law of a pair at distance `d` whose law acts at `r` (the offset ξ for a point
+/// and a face, ξ/2 for two edges).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Law {
+    /// The ground's C² penalty on the penetration `r − d`: a physical stiffness (the
+    /// penetration under a pressure has a closed form that holds on any mesh); pairs may sink
+    /// into the offset, down to the minimum separation.
+    Penalty,
+    /// IPC's log barrier on the gap `d − r`, active below the activation distance: infinite
+    /// at `r`, so the offset itself is never entered; its stiffness is a scale, not a
+    /// material's.
+    Barrier,
 }
 
 /// Which point–triangle pairs of a vertex press.
@@ -59,6 +78,7 @@ impl Default for SelfContact {
         SelfContact {
             enabled: false,
             offset: AutoOr::Auto(Auto::Auto),
+            law: Law::Penalty,
             stiffness: AutoOr::Auto(Auto::Auto),
             smoothing: AutoOr::Auto(Auto::Auto),
             exclusion: AutoOr::Auto(Auto::Auto),

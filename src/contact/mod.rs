@@ -77,6 +77,31 @@ pub fn penalty(p: Real, delta: Real) -> (Real, Real, Real) {
     }
 }
 
+/// `(b, b′, b″)` of IPC's log barrier at gap `g` with activation distance `ĝ` (Li et al. 2020,
+/// "Incremental Potential Contact", eq. 6, here on the distance rather than its square):
+///
+/// `b(g) = −(g − ĝ)² ln(g/ĝ)` for `0 < g < ĝ`, 0 beyond, `+∞` at `g ≤ 0`,
+///
+/// `b′ = −2(g − ĝ) ln(g/ĝ) − (g − ĝ)²/g` (≤ 0), `b″ = −2 ln(g/ĝ) − 4(g − ĝ)/g + (g − ĝ)²/g²`
+/// (> 0). `b` and `b′` vanish at `ĝ` and `b″` is continuous there only up to its value `0`
+/// from the left (C² in the energy: `b″(ĝ⁻) = 0`). Units: `g`, `ĝ` m, `b` m², `b′` m, `b″`
+/// dimensionless; multiplied by a stiffness (Pa/m) and an area (m²) it is an energy (J).
+#[inline]
+pub fn barrier(g: Real, g_hat: Real) -> (Real, Real, Real) {
+    if g >= g_hat {
+        (0.0, 0.0, 0.0)
+    } else if g <= 0.0 {
+        (Real::INFINITY, -Real::INFINITY, Real::INFINITY)
+    } else {
+        let (u, l) = (g - g_hat, (g / g_hat).ln());
+        (
+            -u * u * l,
+            -2.0 * u * l - u * u / g,
+            -2.0 * l - 4.0 * u / g + u * u / (g * g),
+        )
+    }
+}
+
 /// `(f₀, f₁ = f₀′, f₁′)` of the smoothed friction at slip `s ≥ 0` over the step (module doc).
 #[inline]
 pub fn friction_profile(s: Real, eps: Real) -> (Real, Real, Real) {

@@ -225,8 +225,25 @@ pub fn run(
         // The first frame shows the reference state; the drivers start from the perturbed one.
         s.reference = Some(state.clone());
         let amplitude = sb * scene.body.mean_edge;
-        perturb(scene, &mut state.x, amplitude, s.config.seed);
-        s.summary.symmetry_breaking = Some(amplitude);
+        let mut moved = state.x.clone();
+        perturb(scene, &mut moved, amplitude, s.config.seed);
+        // Contact bounds the perturbation like any step: sheets stacked closer than the
+        // amplitude (or a barrier's activation distance) keep their order and separation.
+        let fraction = if scene.terms.iter().any(|t| t.step_limit().is_some()) {
+            let at = dial.or(start).unwrap_or(0.0).clamp(0.0, 1.0);
+            let pat = s.pattern();
+            s.potential(&pat, at).jump_fraction(&state.x, &moved, at)
+        } else {
+            1.0
+        };
+        if fraction >= 1.0 {
+            state.x = moved;
+        } else {
+            for (x, m) in state.x.iter_mut().zip(&moved) {
+                *x += (m - *x) * fraction;
+            }
+        }
+        s.summary.symmetry_breaking = Some(amplitude * fraction.min(1.0));
     }
     let ran = match s.config.mode {
         Mode::Static if scene.settings.solver.continuation == Continuation::ArcLength => {

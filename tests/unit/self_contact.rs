@@ -56,8 +56,8 @@ fn folded(sc: &Scene, gap: Real, noise: Real, seed: u64) -> Vec<Vec3> {
         .collect()
 }
 
-/// The strip folded with the layers 0.02 apart, and its pattern with the pairs gathered
-/// there, for the first noise whose pairs (of term `i`) keep their closest features under
+/// The strip folded with the layers `gap` apart (a noise of `noise`), and its pattern with the
+/// pairs gathered there, for the first noise whose pairs (of term `i`) keep their closest features under
 /// every perturbation of the finite-difference check: the distance's Hessian jumps where they
 /// change, and differences across such a place would not measure it.
 fn folded_without_feature_changes(
@@ -65,10 +65,11 @@ fn folded_without_feature_changes(
     p0: &Pattern,
     phi: &[Real],
     i: usize,
+    (gap, noise): (Real, Real),
 ) -> (Vec<Vec3>, Pattern) {
     (11..60)
         .map(|seed| {
-            let x = folded(sc, 0.02, 0.002, seed);
+            let x = folded(sc, gap, noise, seed);
             let p = p0
                 .refreshed(sc, &x, phi, 0.0)
                 .expect("the fold brings pairs");
@@ -134,11 +135,61 @@ fn self_contact_matches_finite_differences_on_a_folded_strip() {
     let p0 = Pattern::for_scene(&sc);
     let i = term_index(&sc);
     assert!(p0.maps[i].nodes.is_empty(), "the flat strip has no pairs");
-    let (x, p) = folded_without_feature_changes(&sc, &p0, &phi, i);
+    let (x, p) = folded_without_feature_changes(&sc, &p0, &phi, i, (0.02, 0.002));
     let n = p.maps[i].nodes.len() / 4;
     let ee = p.maps[i].nodes.chunks(4).filter(|c| c[2] < c[3]).count();
     assert!(n > 50 && ee > 10, "{n} pairs, {ee} edge–edge");
     pressing_term_matches_finite_differences(&sc, &p, i, &x, &phi);
+}
+
+/// The term with IPC's log barrier (`law = "barrier"`, activation ĝ = 0.01) against central
+/// differences on the strip folded with its layers 0.055 apart (offset 0.05, noise 0.001):
+/// every pair of a vertex with the face below it is in the barrier's range (0.05, 0.06).
+#[test]
+fn the_barrier_matches_finite_differences_on_a_folded_strip() {
+    let sc = strip(
+        0.05,
+        "law = \"barrier\"\nstiffness = 1e7\nsmoothing = 0.01\n",
+    );
+    let phi = vec![0.0; sc.num_scalar_dofs()];
+    let p0 = Pattern::for_scene(&sc);
+    let i = term_index(&sc);
+    let (x, p) = folded_without_feature_changes(&sc, &p0, &phi, i, (0.055, 0.001));
+    let n = p.maps[i].nodes.len() / 4;
+    assert!(n > 50, "{n} pairs");
+    pressing_term_matches_finite_differences(&sc, &p, i, &x, &phi);
+}
+
+/// IPC's log barrier against central differences of itself: `b′` and `b″` across its range,
+/// and `b`, `b′`, `b″` vanishing at the activation distance, infinite at 0.
+#[test]
+fn the_log_barrier_matches_its_derivatives() {
+    use shellsim::contact::barrier;
+    let g_hat = 1e-3;
+    for k in 1..100 {
+        let g = g_hat * k as Real / 100.0;
+        let h = 1e-6 * g;
+        let (b, db, ddb) = barrier(g, g_hat);
+        let fd1 = (barrier(g + h, g_hat).0 - barrier(g - h, g_hat).0) / (2.0 * h);
+        let fd2 = (barrier(g + h, g_hat).1 - barrier(g - h, g_hat).1) / (2.0 * h);
+        assert!(b > 0.0 && db < 0.0 && ddb > 0.0, "g = {g}: {b} {db} {ddb}");
+        assert!(
+            (fd1 - db).abs() <= 1e-7 * db.abs(),
+            "b′ at {g}: {fd1} vs {db}"
+        );
+        assert!(
+            (fd2 - ddb).abs() <= 1e-7 * ddb.abs(),
+            "b″ at {g}: {fd2} vs {ddb}"
+        );
+    }
+    assert_eq!(barrier(g_hat, g_hat), (0.0, 0.0, 0.0));
+    assert_eq!(barrier(2.0 * g_hat, g_hat), (0.0, 0.0, 0.0));
+    let (b, db, _) = barrier(g_hat * (1.0 - 1e-9), g_hat);
+    assert!(
+        b.abs() < 1e-20 && db.abs() < 1e-15,
+        "continuous at ĝ: {b} {db}"
+    );
+    assert!(barrier(0.0, g_hat).0.is_infinite());
 }
 
 /// The closest features of each pair of `nodes` at `x`.
@@ -188,7 +239,7 @@ fn self_contact_friction_matches_finite_differences() {
     let phi = vec![0.0; sc.num_scalar_dofs()];
     let p0 = Pattern::for_scene(&sc);
     let i = term_index(&sc);
-    let (x, p) = folded_without_feature_changes(&sc, &p0, &phi, i);
+    let (x, p) = folded_without_feature_changes(&sc, &p0, &phi, i, (0.02, 0.002));
     let eps = 1e-3;
     let mut rng = Rng::new(3);
     let lag: Vec<Vec3> = x
