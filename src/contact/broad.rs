@@ -23,7 +23,7 @@ const MAX_CELLS: Real = (1u64 << 20) as Real;
 
 /// An axis-aligned box.
 #[derive(Clone, Copy, Debug)]
-struct Aabb {
+pub struct Aabb {
     min: Vec3,
     max: Vec3,
 }
@@ -40,7 +40,9 @@ impl Aabb {
             max: max.add_scalar(inflate),
         }
     }
-    fn overlaps(&self, o: &Aabb) -> bool {
+    /// Whether the two boxes overlap (touching counts).
+    #[inline]
+    pub fn overlaps(&self, o: &Aabb) -> bool {
         (0..3).all(|k| self.min[k] <= o.max[k] && o.min[k] <= self.max[k])
     }
     #[cfg(test)]
@@ -156,6 +158,19 @@ fn span(v: &[usize], x: &[Vec3], to: Option<&[Vec3]>, inflate: Real) -> Aabb {
             inflate,
         ),
     }
+}
+
+/// The boxes of the primitives `prims` (vertex lists) at `x` and, when given, `to`, inflated
+/// by `radius`, as the queries below compute them: a pair is kept when the box of its face
+/// (of its higher-numbered edge), inflated by the query's radius, overlaps that of its vertex
+/// (of its lower-numbered edge), not inflated.
+pub fn boxes<const N: usize>(
+    prims: &[[usize; N]],
+    x: &[Vec3],
+    to: Option<&[Vec3]>,
+    radius: Real,
+) -> Vec<Aabb> {
+    prims.par_iter().map(|p| span(p, x, to, radius)).collect()
 }
 
 /// Vertex `p` and face `f`, `p` not a vertex of `f`, whose boxes overlap, the face's inflated

@@ -78,7 +78,12 @@
 //! all those within `ξ + halo`. Every Newton step also runs the broad phase over the boxes of
 //! the straight paths: a pair that was not gathered may not come within its offset, where its
 //! law would begin (CCD to `ξ`). When such a pair limits the step and is within reach, the pairs
-//! are gathered again at the current iterate (a new pattern), and Newton goes on.
+//! are gathered again at the current iterate (a new pattern), and Newton goes on. The broad
+//! phase's pairs are kept over a wider radius (a few times the last paths' length, at most two
+//! mean edges): a later query whose positions stay within the margin is answered from them by
+//! the broad phase's own box test, the same pairs in the same order, without a new grid; and
+//! while no vertex has moved half the halo from where the pairs were gathered, no pair that was
+//! not gathered can press, and the paths are not searched at all.
 //!
 //! **Exclusion.** Pairs within the exclusion radius `R` of each other on the reference sheet,
 //! measured both in space and along its edges (the graph distance, at most `2R` plus two edge
@@ -185,6 +190,91 @@ pub struct SelfContact {
     excluded_pt: Vec<u64>,
     /// Excluded edge–edge pairs `a << 32 | b` (edge indices, `a < b`), sorted.
     excluded_ee: Vec<u64>,
+    /// The broad phase's pairs over a wider radius, reused while they cover a query.
+    cache: std::sync::Mutex<Option<Cache>>,
+    /// The widest margin a cache may have beyond a query's radius (m): twice the mean edge of
+    /// the sheet, so that it holds a bounded number of pairs per primitive.
+    cache_cap: Real,
+}
+
+/// The pairs the broad phase found at the positions `at` within `reach`: a superset of what
+/// it finds at any positions `x` (over the straight paths to `to`) within a radius `r`, as
+/// long as no vertex is farther than `U` from `at` there, with `r + 2U ≤ reach` (the boxes
+/// grow by at most `U` each). Such a query is served by the broad phase's own box test on the
+/// cached pairs, in their order: the same pairs, in the same order, as the broad phase would
+/// give, so the cache changes no result. It spares a Newton iteration's step bound the broad
+/// phase over its paths.
+struct Cache {
+    /// The positions where the pairs were found (the sheet's and the obstacles').
+    at: Vec<Vec3>,
+    /// The broad phase's radius there (m).
+    reach: Real,
+    /// 1e-12 of the largest coordinate magnitude there (m), against rounding.
+    slack: Real,
+    /// The longest displacement of a query's positions from `at` so far (m): the next cache's
+    /// width.
+    moved: Real,
+    /// Point–triangle pairs `(p, f)`, sorted, not excluded.
+    pt: Vec<(u32, u32)>,
+    /// Edge pairs `(a, b)`, `a < b`, sorted, not excluded.
+    ee: Vec<(u32, u32)>,
+}
+
+impl Cache {
+    /// The largest distance of a point of the query from `at` when the cache covers the
+    /// query (struct doc), `None` when it does not.
+    fn covers(&self, x: &[Vec3], to: Option<&[Vec3]>, r: Real) -> Option<Real> {
+        if self.at.len() != x.len() {
+            return None;
+        }
+        let away = |y: &[Vec3]| {
+            y.par_iter()
+                .zip(&self.at)
+                .map(|(a, b)| (a - b).norm_squared())
+                .reduce(|| 0.0, Real::max)
+        };
+        let u = away(x).max(to.map_or(0.0, away)).sqrt();
+        // The boxes' bounds round at the coordinates' last bits: a margin of 1e-12 of the
+        // largest keeps the superset exact.
+        (r + 2.0 * u + self.slack <= self.reach).then_some(u)
+    }
+
+    /// The cached pairs whose boxes at `x` (with `to`) overlap as the broad phase tests them
+    /// with radius `r`, when the cache covers the query; `None` when it does not.
+    #[allow(clippy::type_complexity)]
+    fn serve(
+        &mut self,
+        faces: &[[usize; 3]],
+        edges: &[[usize; 2]],
+        x: &[Vec3],
+        to: Option<&[Vec3]>,
+        r: Real,
+    ) -> Option<(Vec<(u32, u32)>, Vec<(u32, u32)>)> {
+        let u = self.covers(x, to, r)?;
+        self.moved = self.moved.max(u);
+        let vertices: Vec<[usize; 1]> = (0..x.len()).map(|v| [v]).collect();
+        let (fb, vb) = (
+            broad::boxes(faces, x, to, r),
+            broad::boxes(&vertices, x, to, 0.0),
+        );
+        let pt = self
+            .pt
+            .par_iter()
+            .copied()
+            .filter(|&(p, f)| fb[f as usize].overlaps(&vb[p as usize]))
+            .collect();
+        let (inflated, own) = (
+            broad::boxes(edges, x, to, r),
+            broad::boxes(edges, x, to, 0.0),
+        );
+        let ee = self
+            .ee
+            .par_iter()
+            .copied()
+            .filter(|&(a, b)| inflated[b as usize].overlaps(&own[a as usize]))
+            .collect();
+        Some((pt, ee))
+    }
 }
 
 /// The rigid mesh obstacles' vertices and laws (`[[obstacles]]` with `shape = "mesh"`).
@@ -483,8 +573,75 @@ impl SelfContact {
     /// positions; over the straight paths to `to`, when given), not excluded: their nodes,
     /// point–triangle pairs first, each kind sorted.
     fn candidates(&self, x: &[Vec3], to: Option<&[Vec3]>, radius: Real) -> Vec<[usize; 4]> {
-        // Pairs that do not count are never stored: the sheet's with itself when only mesh
-        // obstacles are on (a free sheet's first step sweeps boxes over the whole sheet).
+        let (pt, ee) = self.candidate_pairs(x, to, radius);
+        pt.par_iter()
+            .map(|&(p, f)| self.pt_nodes(p as usize, f as usize))
+            .chain(
+                ee.par_iter()
+                    .map(|&(a, b)| self.ee_nodes(a as usize, b as usize)),
+            )
+            .filter(|n| self.counts(n))
+            .collect()
+    }
+
+    /// The point–triangle pairs `(p, f)` and edge pairs `(a, b)` of [`Self::candidates`], each
+    /// sorted: from the cache of pairs when it covers the query ([`Cache`]), else from the
+    /// broad phase, caching a wider one first when the query is a step's paths.
+    #[allow(clippy::type_complexity)]
+    fn candidate_pairs(
+        &self,
+        x: &[Vec3],
+        to: Option<&[Vec3]>,
+        radius: Real,
+    ) -> (Vec<(u32, u32)>, Vec<(u32, u32)>) {
+        let mut cache = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(c) = cache.as_mut() {
+            if let Some(hit) = c.serve(&self.faces, &self.edges, x, to, radius) {
+                return hit;
+            }
+        }
+        // The paths' longest displacement: a cache as wide as a few of them serves the
+        // step's next Newton iterations (and, often, the next step's).
+        let moved = to.map_or(0.0, |t| {
+            x.par_iter()
+                .zip(t)
+                .map(|(a, b)| (b - a).norm_squared())
+                .reduce(|| 0.0, Real::max)
+                .sqrt()
+        });
+        let seen = cache.as_ref().map_or(0.0, |c| c.moved);
+        let margin = (3.0 * moved.max(seen)).clamp(self.halo, self.cache_cap);
+        if 2.0 * moved > margin {
+            // Too far for a cache of bounded width: the broad phase over the paths.
+            return self.broad_pairs(x, to, radius);
+        }
+        let (pt, ee) = self.broad_pairs(x, None, radius + margin);
+        let largest = x.par_iter().map(|p| p.amax()).reduce(|| 0.0, Real::max);
+        let mut c = Cache {
+            at: x.to_vec(),
+            reach: radius + margin,
+            slack: 1e-12 * (1.0 + largest),
+            moved,
+            pt,
+            ee,
+        };
+        let hit = c.serve(&self.faces, &self.edges, x, to, radius);
+        *cache = Some(c);
+        // Covered but for the rounding margin at the edge of the width: the broad phase.
+        hit.unwrap_or_else(|| self.broad_pairs(x, to, radius))
+    }
+
+    /// The pairs of [`Self::candidate_pairs`] from the broad phase: those that count and are
+    /// not excluded. Pairs that do not count are never stored: the sheet's with itself when
+    /// only mesh obstacles are on (a free sheet's first step sweeps boxes over the whole
+    /// sheet).
+    #[allow(clippy::type_complexity)]
+    fn broad_pairs(
+        &self,
+        x: &[Vec3],
+        to: Option<&[Vec3]>,
+        radius: Real,
+    ) -> (Vec<(u32, u32)>, Vec<(u32, u32)>) {
         let (nv, nf, ne) = (
             self.nv as u32,
             self.sheet_faces as u32,
@@ -495,16 +652,14 @@ impl SelfContact {
             broad::point_triangle_where(x, to, &self.faces, radius, |p, f| both(p < nv, f < nf));
         let ee = broad::edge_edge_where(x, to, &self.edges, radius, |a, b| both(a < ne, b < ne));
         let key = |a: u32, b: u32| (a as u64) << 32 | b as u64;
-        pt.par_iter()
-            .filter(|&&(p, f)| self.excluded_pt.binary_search(&key(p, f)).is_err())
-            .map(|&(p, f)| self.pt_nodes(p as usize, f as usize))
-            .chain(
-                ee.par_iter()
-                    .filter(|&&(a, b)| self.excluded_ee.binary_search(&key(a, b)).is_err())
-                    .map(|&(a, b)| self.ee_nodes(a as usize, b as usize)),
-            )
-            .filter(|n| self.counts(n))
-            .collect()
+        (
+            pt.into_par_iter()
+                .filter(|&(p, f)| self.excluded_pt.binary_search(&key(p, f)).is_err())
+                .collect(),
+            ee.into_par_iter()
+                .filter(|&(a, b)| self.excluded_ee.binary_search(&key(a, b)).is_err())
+                .collect(),
+        )
     }
 
     /// The pairs within `beyond` of their offset at `x` (the sheet's and the obstacles'
@@ -1259,6 +1414,16 @@ pub fn term(
     obstacles: &[crate::config::obstacle::ObstacleSettings],
     dynamic: bool,
 ) -> Result<Option<Box<dyn Term>>, MeshError> {
+    Ok(build(body, c, obstacles, dynamic)?.map(|sc| Box::new(sc) as Box<dyn Term>))
+}
+
+/// [`term`], unboxed.
+fn build(
+    body: &Body,
+    c: &crate::config::self_contact::SelfContact,
+    obstacles: &[crate::config::obstacle::ObstacleSettings],
+    dynamic: bool,
+) -> Result<Option<SelfContact>, MeshError> {
     let meshes: Vec<(usize, &crate::config::obstacle::ObstacleSettings)> = obstacles
         .iter()
         .enumerate()
@@ -1309,6 +1474,8 @@ pub fn term(
         friction: if dynamic { c.friction } else { 0.0 },
         all_pairs: c.pairs == crate::config::self_contact::Pairs::All,
         clock: Default::default(),
+        cache: Default::default(),
+        cache_cap: 2.0 * body.mean_edge,
         excluded_pt: Vec::new(),
         excluded_ee: Vec::new(),
     };
@@ -1347,7 +1514,7 @@ pub fn term(
     if !sc.rigid.rest.is_empty() {
         check_rigid(&sc)?;
     }
-    Ok(Some(Box::new(sc)))
+    Ok(Some(sc))
 }
 
 /// Reads mesh obstacle `i` (`o`) and appends its vertices, faces and edges to the term's, with
@@ -1699,5 +1866,87 @@ impl PartialOrd for Ordered {
 impl Ord for Ordered {
     fn cmp(&self, o: &Self) -> std::cmp::Ordering {
         self.0.total_cmp(&o.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generate::{rectangle, Rng, Spacing};
+
+    /// The cache of broad-phase pairs ([`Cache`]) serves exactly what the broad phase finds:
+    /// a 1 × 0.2 strip (h = 0.05) folded flat onto itself 0.06 apart, queried over random
+    /// paths whose lengths grow by 1.3× from 1e-4 to 0.2 (each over the gathering's static
+    /// boxes too): every answer equals the broad phase's, pair for pair and in order, while
+    /// some queries are served by a cache built for an earlier one and others are not.
+    #[test]
+    fn cached_candidates_equal_the_broad_phase() {
+        let mesh = rectangle(
+            0.0,
+            0.0,
+            1.0,
+            0.2,
+            0.05,
+            Spacing {
+                jitter: 0.2,
+                seed: 7,
+                ..Default::default()
+            },
+        );
+        let settings = crate::settings::Settings::from_str_with(
+            "[material]\nthickness = 0.05\nyoung = 1e6\n[self_contact]\nenabled = true\n",
+            "test",
+            &[],
+        )
+        .unwrap();
+        let body = Body::build(mesh, &settings).unwrap();
+        let sc = build(&body, &settings.self_contact, &[], false)
+            .unwrap()
+            .unwrap();
+        let folded: Vec<Vec3> = body
+            .mesh
+            .positions
+            .iter()
+            .map(|p| {
+                if p.x > 0.5 {
+                    Vec3::new(1.0 - p.x, p.y, 0.06)
+                } else {
+                    *p
+                }
+            })
+            .collect();
+        let mut rng = Rng::new(3);
+        let mut noise =
+            |scale: Real| Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * scale;
+        // Queries the cache covered, queries it did not (a new cache or the broad phase).
+        let (mut served, mut built, mut pairs) = (0, 0, 0);
+        let mut length = 1e-4;
+        while length < 0.2 {
+            let x: Vec<Vec3> = folded.iter().map(|p| p + noise(0.3 * length)).collect();
+            let to: Vec<Vec3> = x.iter().map(|p| p + noise(length)).collect();
+            for (to, r) in [(Some(&to[..]), sc.xi_max), (None, sc.xi_max + sc.halo)] {
+                let covered = sc
+                    .cache
+                    .lock()
+                    .unwrap()
+                    .as_ref()
+                    .is_some_and(|c| c.covers(&x, to, r).is_some());
+                let got = sc.candidate_pairs(&x, to, r);
+                if covered {
+                    served += 1;
+                } else {
+                    built += 1;
+                }
+                let fresh = sc.broad_pairs(&x, to, r);
+                assert_eq!(got, fresh, "paths of {length} m, radius {r}");
+                pairs += fresh.0.len() + fresh.1.len();
+            }
+            length *= 1.3;
+        }
+        println!("{served} served, {built} built, {pairs} pairs");
+        assert!(
+            served > 10 && built > 2 && pairs > 1000,
+            "{served} {built} {pairs}"
+        );
     }
 }
