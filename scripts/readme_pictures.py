@@ -32,6 +32,7 @@ SCENES = {
     "cloth_drape_baraff_witkin": ("final", "max_stretch", "-70,10", "1,1.25"),
     "cloth_drape_koiter": ("final", "max_stretch", "-70,10", "1,1.25"),
     "cloth_over_sphere_and_box": ("final", "mean_curvature", "-60,30", None),
+    "cloth_folds_on_sphere": ("final", "mean_curvature", "-60,30", None),
     "balloon_sphere": ("final", "max_stretch", "iso", None),
     "balloon_teddy": ("final", "max_stretch", "front", None),
     "balloon_thickness": ("final", "max_stretch", "front", None),

@@ -917,3 +917,67 @@ fn a_stack_of_eight_sheets_pressed_between_slides_carries_the_load_through_each(
     let dmin = c["min_distance"].as_f64().unwrap();
     assert!(dmin >= 0.1 * h && dmin < h, "{c}");
 }
+
+/// The gallery's cloth folding over a sphere (`settings/cloth_folds_on_sphere.toml`, every
+/// face within reach pressing, friction 0.3 between its layers) at a quarter of its size: a
+/// 200-face square (edges 0.1 m), 2 s of dynamics. Its skirt folds onto itself: pairs press
+/// from 0.3 s on (measured 2–9), no two faces ever cross, and no two mid-surfaces come closer
+/// than the minimum separation (measured 0.249 mm of the 0.5 mm offset, an edge pair inside
+/// half the offset), checked over every frame by the independent script. The control without
+/// self-contact passes through itself (measured 574 crossing face pairs).
+#[test]
+fn a_cloth_dropped_on_a_sphere_folds_onto_itself_without_crossing() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::fs::copy(
+        root.join("settings/cloth_folds_on_sphere.toml"),
+        dir.join("fold.toml"),
+    )
+    .unwrap();
+    shellsim(
+        &[
+            "mesh",
+            "square",
+            "--size",
+            "1",
+            "--edge",
+            "0.1",
+            "-o",
+            "cloth.vtk",
+        ],
+        dir,
+    );
+    shellsim(&["fold.toml", "cloth.vtk", "--out", "on", "-q"], dir);
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("on/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(s["converged"], true, "{s}");
+    let pressing = log_rows(&dir.join("on"))
+        .iter()
+        .map(|r| r["self_contact_pairs"])
+        .fold(0.0, f64::max);
+    assert!(pressing > 0.0, "the cloth touches itself");
+    let h = 5e-4;
+    let r = 2.0 * (h + h / 100.0);
+    let c = check(dir, "cloth.vtk", "on", r);
+    println!("cloth folding on a sphere, {pressing} pairs at most: {c}");
+    assert_eq!(c["crossing_pairs"], 0, "{c}");
+    let dmin = c["min_distance"].as_f64().unwrap();
+    assert!(dmin >= 0.1 * h && dmin < h, "{dmin}");
+    shellsim(
+        &[
+            "fold.toml",
+            "cloth.vtk",
+            "--out",
+            "off",
+            "-q",
+            "--set",
+            "self_contact.enabled=false",
+        ],
+        dir,
+    );
+    let c = check(dir, "cloth.vtk", "off", r);
+    println!("without self-contact: {c}");
+    assert!(c["crossing_pairs"].as_u64().unwrap() > 0, "{c}");
+}
