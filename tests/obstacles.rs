@@ -513,7 +513,8 @@ fn plane_obj(d: &Path, file: &str, z: f64) {
 /// settings file) reaches the same equilibrium as on the analytic plane, whose law is the
 /// same `k A_v ψ(h/2 − d)` on every vertex: contact energy, force and smallest gap agree to
 /// 1e-9 (measured: 2e-16 on the energy), the force carries the weight ρ h A g to 1e-6, and
-/// the frames of 1 and 2 threads are identical to the bit.
+/// the frames of 1 and 2 threads are identical to the bit. With the barrier law the disk stops
+/// outside its offset at the barrier's closed-form gap.
 #[test]
 fn a_mesh_plane_holds_a_sheet_as_the_analytic_plane_does() {
     let dir = tempfile::tempdir().unwrap();
@@ -582,6 +583,34 @@ fn a_mesh_plane_holds_a_sheet_as_the_analytic_plane_does() {
         let b = std::fs::read(d.join("mesh1").join(f)).unwrap();
         assert!(a == b, "{f} differs between 1 and 2 threads");
     }
+    // IPC's log barrier (`self_contact.law`, which the mesh's pairs follow): every vertex
+    // stops at the gap g outside the offset where −k b′(g) = σ = ρ h g (ĝ = h/100; bisection),
+    // 48.0 µm; measured equal to 1e-12 (a flat, uniform contact), asserted to 1e-6.
+    let barrier = run(
+        d,
+        &format!(
+            "{}[self_contact]\nlaw = \"barrier\"\n",
+            mesh_settings.replace("../shapes", "shapes")
+        ),
+        "disk.vtk",
+        "barrier",
+        "2",
+    );
+    let (k, g_hat, sigma) = (1e6 / h, h / 100.0, rho * h * g);
+    let (mut lo, mut hi) = (0.0, g_hat);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if -k * shellsim::contact::barrier(mid, g_hat).1 > sigma {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let exact = 0.5 * (lo + hi);
+    let gap = barrier["obstacle0_gap"];
+    println!("barrier: gap {gap:e} m, closed form {exact:e} m");
+    assert!((gap - exact).abs() < 1e-6 * exact, "{gap} vs {exact}");
+    assert_carries(&force(&barrier, 0), weight, "mesh plane, barrier");
 }
 
 /// A disk (radius 0.5 m, h = 5 mm) dropped with friction μ = 0.5 onto a geodesic sphere mesh

@@ -610,7 +610,9 @@ impl SelfContact {
                 .sqrt()
         });
         let seen = cache.as_ref().map_or(0.0, |c| c.moved);
-        let margin = (3.0 * moved.max(seen)).clamp(self.halo, self.cache_cap);
+        // At least the halo, at most the cap (which wins when the halo is wider: a sheet
+        // thicker than its edges).
+        let margin = (3.0 * moved.max(seen)).max(self.halo).min(self.cache_cap);
         if 2.0 * moved > margin {
             // Too far for a cache of bounded width: the broad phase over the paths.
             return self.broad_pairs(x, to, radius);
@@ -1879,8 +1881,8 @@ mod tests {
     /// paths whose lengths grow by 1.3× from 1e-4 to 0.2 (each over the gathering's static
     /// boxes too): every answer equals the broad phase's, pair for pair and in order, while
     /// some queries are served by a cache built for an earlier one and others are not.
-    #[test]
-    fn cached_candidates_equal_the_broad_phase() {
+    /// A 1 × 0.2 strip of thickness `h` with self-contact (edges about 0.05), built.
+    fn strip(h: Real) -> (Body, SelfContact) {
         let mesh = rectangle(
             0.0,
             0.0,
@@ -1894,7 +1896,7 @@ mod tests {
             },
         );
         let settings = crate::settings::Settings::from_str_with(
-            "[material]\nthickness = 0.05\nyoung = 1e6\n[self_contact]\nenabled = true\n",
+            &format!("[material]\nthickness = {h}\nyoung = 1e6\n[self_contact]\nenabled = true\n"),
             "test",
             &[],
         )
@@ -1903,6 +1905,12 @@ mod tests {
         let sc = build(&body, &settings.self_contact, &[], false)
             .unwrap()
             .unwrap();
+        (body, sc)
+    }
+
+    #[test]
+    fn cached_candidates_equal_the_broad_phase() {
+        let (body, sc) = strip(0.05);
         let folded: Vec<Vec3> = body
             .mesh
             .positions
@@ -1948,5 +1956,20 @@ mod tests {
             served > 10 && built > 2 && pairs > 1000,
             "{served} {built} {pairs}"
         );
+    }
+
+    /// A sheet thicker than its edges (h = 0.5 on edges of 0.05): the halo (the offset, 0.5)
+    /// is wider than the cache may be (two mean edges); the cap wins, and the answer is the
+    /// broad phase's (this query once panicked, the bounds crossed).
+    #[test]
+    fn a_sheet_thicker_than_its_edges_caps_its_cache() {
+        let (body, sc) = strip(0.5);
+        assert!(sc.halo > sc.cache_cap, "{} {}", sc.halo, sc.cache_cap);
+        let x = &body.mesh.positions;
+        let to: Vec<Vec3> = x.iter().map(|p| p + Vec3::new(0.0, 0.0, 0.01)).collect();
+        let got = sc.candidate_pairs(x, Some(&to), sc.xi_max);
+        assert_eq!(got, sc.broad_pairs(x, Some(&to), sc.xi_max));
+        let reach = sc.cache.lock().unwrap().as_ref().map(|c| c.reach);
+        assert_eq!(reach, Some(sc.xi_max + sc.cache_cap));
     }
 }
