@@ -211,8 +211,8 @@ struct Cache {
     reach: Real,
     /// 1e-12 of the largest coordinate magnitude there (m), against rounding.
     slack: Real,
-    /// The longest displacement of a query's positions from `at` so far (m): the next cache's
-    /// width.
+    /// The longest path of a query it served or was built for (m): the next cache's width is
+    /// a few of them.
     moved: Real,
     /// Point–triangle pairs `(p, f)`, sorted, not excluded.
     pt: Vec<(u32, u32)>,
@@ -243,15 +243,14 @@ impl Cache {
     /// with radius `r`, when the cache covers the query; `None` when it does not.
     #[allow(clippy::type_complexity)]
     fn serve(
-        &mut self,
+        &self,
         faces: &[[usize; 3]],
         edges: &[[usize; 2]],
         x: &[Vec3],
         to: Option<&[Vec3]>,
         r: Real,
     ) -> Option<(Vec<(u32, u32)>, Vec<(u32, u32)>)> {
-        let u = self.covers(x, to, r)?;
-        self.moved = self.moved.max(u);
+        self.covers(x, to, r)?;
         let vertices: Vec<[usize; 1]> = (0..x.len()).map(|v| [v]).collect();
         let (fb, vb) = (
             broad::boxes(faces, x, to, r),
@@ -594,12 +593,6 @@ impl SelfContact {
         to: Option<&[Vec3]>,
         radius: Real,
     ) -> (Vec<(u32, u32)>, Vec<(u32, u32)>) {
-        let mut cache = self.cache.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(c) = cache.as_mut() {
-            if let Some(hit) = c.serve(&self.faces, &self.edges, x, to, radius) {
-                return hit;
-            }
-        }
         // The paths' longest displacement: a cache as wide as a few of them serves the
         // step's next Newton iterations (and, often, the next step's).
         let moved = to.map_or(0.0, |t| {
@@ -609,6 +602,13 @@ impl SelfContact {
                 .reduce(|| 0.0, Real::max)
                 .sqrt()
         });
+        let mut cache = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(c) = cache.as_mut() {
+            if let Some(hit) = c.serve(&self.faces, &self.edges, x, to, radius) {
+                c.moved = c.moved.max(moved);
+                return hit;
+            }
+        }
         let seen = cache.as_ref().map_or(0.0, |c| c.moved);
         // At least the halo, at most the cap (which wins when the halo is wider: a sheet
         // thicker than its edges).
@@ -619,7 +619,7 @@ impl SelfContact {
         }
         let (pt, ee) = self.broad_pairs(x, None, radius + margin);
         let largest = x.par_iter().map(|p| p.amax()).reduce(|| 0.0, Real::max);
-        let mut c = Cache {
+        let c = Cache {
             at: x.to_vec(),
             reach: radius + margin,
             slack: 1e-12 * (1.0 + largest),
