@@ -596,17 +596,7 @@ fn a_mesh_plane_holds_a_sheet_as_the_analytic_plane_does() {
         "barrier",
         "2",
     );
-    let (k, g_hat, sigma) = (1e6 / h, h / 100.0, rho * h * g);
-    let (mut lo, mut hi) = (0.0, g_hat);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if -k * shellsim::contact::barrier(mid, g_hat).1 > sigma {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    let exact = 0.5 * (lo + hi);
+    let exact = common::barrier_gap(rho * h * g, 1e6 / h, h / 100.0);
     let gap = barrier["obstacle0_gap"];
     println!("barrier: gap {gap:e} m, closed form {exact:e} m");
     assert!((gap - exact).abs() < 1e-6 * exact, "{gap} vs {exact}");

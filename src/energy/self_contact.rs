@@ -1876,11 +1876,6 @@ mod tests {
     use super::*;
     use crate::mesh::generate::{rectangle, Rng, Spacing};
 
-    /// The cache of broad-phase pairs ([`Cache`]) serves exactly what the broad phase finds:
-    /// a 1 × 0.2 strip (h = 0.05) folded flat onto itself 0.06 apart, queried over random
-    /// paths whose lengths grow by 1.3× from 1e-4 to 0.2 (each over the gathering's static
-    /// boxes too): every answer equals the broad phase's, pair for pair and in order, while
-    /// some queries are served by a cache built for an earlier one and others are not.
     /// A 1 × 0.2 strip of thickness `h` with self-contact (edges about 0.05), built.
     fn strip(h: Real) -> (Body, SelfContact) {
         let mesh = rectangle(
@@ -1908,6 +1903,11 @@ mod tests {
         (body, sc)
     }
 
+    /// The cache of broad-phase pairs ([`Cache`]) serves exactly what the broad phase finds:
+    /// a 1 × 0.2 strip (h = 0.05) folded flat onto itself 0.06 apart, queried over random
+    /// paths whose lengths grow by 1.3× from 1e-4 to 0.2 (each over the gathering's static
+    /// boxes too): every answer equals the broad phase's, pair for pair and in order, while
+    /// some queries are served by a cache built for an earlier one and others are not.
     #[test]
     fn cached_candidates_equal_the_broad_phase() {
         let (body, sc) = strip(0.05);

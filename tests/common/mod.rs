@@ -143,3 +143,21 @@ pub fn log_rows(out: &Path) -> Vec<std::collections::HashMap<String, f64>> {
         })
         .collect()
 }
+
+/// The gap `g ∈ (0, ĝ)` (m) at which IPC's log barrier of stiffness `k` (Pa/m) and activation
+/// distance `g_hat` (m) carries the pressure `sigma` (Pa): `−k b′(g) = σ`, by bisection (`b′`
+/// increases on the interval, [`shellsim::contact::barrier`]); the closed form of a flat
+/// contact under the barrier law.
+#[allow(dead_code)] // only the contact tests use it
+pub fn barrier_gap(sigma: f64, k: f64, g_hat: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0, g_hat);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if -k * shellsim::contact::barrier(mid, g_hat).1 > sigma {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
