@@ -775,10 +775,17 @@ fn bad_mesh_obstacles_are_refused() {
         ),
         (
             format!(
-                "{}\n[solver]\nmode = \"explicit\"\n[material]\nbending = \"patch_fit\"",
+                "{}\ndisplacement = [0, 0, 0.1]\n[solver]\nmode = \"explicit\"\n[material]\nbending = \"patch_fit\"",
                 mesh("low.obj")
             ),
-            &["obstacles[0].shape", "explicit"][..],
+            &["obstacles[0].displacement", "explicit", "fixed"][..],
+        ),
+        (
+            format!(
+                "{}\nfriction = 0.2\n[solver]\nmode = \"explicit\"\n[material]\nbending = \"patch_fit\"",
+                mesh("low.obj")
+            ),
+            &["obstacles[0].friction", "dynamic"][..],
         ),
     ] {
         std::fs::write(d.join("o.toml"), format!("[[obstacles]]\n{text}\n")).unwrap();

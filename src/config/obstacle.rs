@@ -26,10 +26,11 @@
 //! force is a global DOF of the solve, and `mass` (kg) its inertia, required in dynamic mode.
 //! Static and dynamic modes; frictionless; analytic shapes only.
 //!
-//! A `mesh` obstacle is fixed or moved by `displacement`, in static (load-controlled) or dynamic
-//! mode: its steps are bounded by continuous collision detection, which the explicit driver
-//! does not run, and its motion within a step is checked the same way, which arc-length
-//! continuation (the dial an unknown of the solve) cannot do.
+//! A `mesh` obstacle is fixed or moved by `displacement` in static (load-controlled) or dynamic
+//! mode: its steps are bounded by continuous collision detection, and its motion within a step
+//! is checked the same way, which arc-length continuation (the dial an unknown of the solve)
+//! cannot do. In explicit mode it is fixed and frictionless: the explicit driver bounds how far
+//! each of the sheet's vertices moves, not the obstacle's.
 //!
 //! The raw table is flat (every key optional, unknown keys refused); [`ObstacleSettings::shape`]
 //! validates it into a [`Shape`] that carries exactly its variant's parameters.
@@ -229,12 +230,19 @@ impl ObstacleSettings {
                      by `displacement`",
                 );
             }
-            if mode == Mode::Explicit {
+            if mode == Mode::Explicit && self.displacement.iter().any(|&c| c != 0.0) {
                 return invalid(
-                    "shape",
-                    "a mesh obstacle's contact bounds every Newton step by continuous \
-                     collision detection, which explicit mode does not run: use solver.mode = \
-                     \"static\" or \"dynamic\", or an analytic shape",
+                    "displacement",
+                    "a moving mesh obstacle needs solver.mode = \"static\" or \"dynamic\" \
+                     (the explicit driver bounds the sheet's vertices only; a fixed mesh \
+                     obstacle, or an analytic shape, may move there)",
+                );
+            }
+            if mode == Mode::Explicit && self.friction > 0.0 {
+                return invalid(
+                    "friction",
+                    "friction on a mesh obstacle needs solver.mode = \"dynamic\" (the \
+                     explicit driver's contact with meshes is frictionless)",
                 );
             }
         }

@@ -93,18 +93,27 @@ impl Default for SelfContact {
 impl SelfContact {
     /// Validates `[self_contact]` when enabled, or when the scene has mesh obstacles
     /// (`meshes`, whose pairs use its keys): positive lengths and stiffness, a minimum
-    /// separation in (0, 0.9], and, when enabled, a mode that bounds its steps (not explicit).
+    /// separation in (0, 0.9]; in explicit mode the penalty law, and no friction between
+    /// sheets.
     pub fn validate(&self, mode: Mode, meshes: bool) -> Result<(), Invalid> {
         let ck = Check;
         if !self.enabled && !meshes {
             return Ok(());
         }
-        if self.enabled && mode == Mode::Explicit {
+        if mode == Mode::Explicit && self.law == Law::Barrier {
             return ck.inv(
-                "self_contact.enabled",
-                "self-contact bounds every Newton step by continuous collision detection; \
-                 explicit mode has no Newton step to bound. Use solver.mode = \"static\" or \
-                 \"dynamic\""
+                "self_contact.law",
+                "the barrier's stiffness grows without bound at the offset, which no explicit \
+                 step resolves: use law = \"penalty\" in explicit mode, or solver.mode = \
+                 \"static\" or \"dynamic\""
+                    .into(),
+            );
+        }
+        if self.enabled && mode == Mode::Explicit && self.friction > 0.0 {
+            return ck.inv(
+                "self_contact.friction",
+                "friction between sheets needs solver.mode = \"dynamic\" (the explicit \
+                 driver's contact is frictionless)"
                     .into(),
             );
         }
@@ -139,9 +148,9 @@ mod tests {
     use super::*;
 
     /// Disabled checks nothing; enabled needs positive values, a separation fraction in
-    /// (0, 0.9], and an implicit mode.
+    /// (0, 0.9], and in explicit mode the penalty without friction.
     #[test]
-    fn enabled_self_contact_needs_positive_values_and_an_implicit_mode() {
+    fn enabled_self_contact_needs_positive_values_and_an_explicit_law() {
         let off = SelfContact {
             offset: AutoOr::Value(-1.0),
             ..Default::default()
@@ -158,8 +167,28 @@ mod tests {
         };
         assert!(on.validate(Mode::Static, false).is_ok());
         assert!(on.validate(Mode::Dynamic, false).is_ok());
-        let e = on.validate(Mode::Explicit, false).unwrap_err();
-        assert_eq!(e.key, "self_contact.enabled");
+        assert!(on.validate(Mode::Explicit, false).is_ok());
+        // Explicit mode: no barrier (on mesh obstacles' pairs too), no friction between sheets.
+        let barrier = SelfContact {
+            law: Law::Barrier,
+            ..on.clone()
+        };
+        assert!(barrier.validate(Mode::Dynamic, false).is_ok());
+        let e = barrier.validate(Mode::Explicit, false).unwrap_err();
+        assert_eq!(e.key, "self_contact.law");
+        let meshes_only = SelfContact {
+            enabled: false,
+            ..barrier
+        };
+        let e = meshes_only.validate(Mode::Explicit, true).unwrap_err();
+        assert_eq!(e.key, "self_contact.law");
+        let rough = SelfContact {
+            friction: 0.3,
+            ..on.clone()
+        };
+        assert!(rough.validate(Mode::Dynamic, false).is_ok());
+        let e = rough.validate(Mode::Explicit, false).unwrap_err();
+        assert_eq!(e.key, "self_contact.friction");
         let bad = SelfContact {
             halo: AutoOr::Value(0.0),
             ..on.clone()

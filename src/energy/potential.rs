@@ -245,6 +245,17 @@ impl<'a> Potential<'a> {
             .fold(1.0, Real::min)
     }
 
+    /// Lowers `bounds[v]` (m) to how far vertex `v` may move from `x`, where the changing
+    /// terms' elements were gathered, for every term that bounds the steps
+    /// ([`crate::energy::term::StepLimit::displacement_bounds`]).
+    pub fn displacement_bounds(&self, x: &[Vec3], bounds: &mut [Real]) {
+        for (t, map) in self.terms.iter().zip(&self.pattern.maps) {
+            if let Some(l) = t.step_limit() {
+                l.displacement_bounds(self, map, x, bounds);
+            }
+        }
+    }
+
     /// Whether every term that bounds the steps admits the positions `x`
     /// ([`crate::energy::term::StepLimit::admits`]).
     pub fn admits(&self, x: &[Vec3]) -> bool {

@@ -188,6 +188,8 @@ pub fn terms(body: &Body, s: &Settings) -> Result<Vec<Box<dyn Term>>, MeshError>
         &s.self_contact,
         &s.obstacles,
         dynamic,
+        (s.solver.mode == crate::settings::Mode::Explicit)
+            .then(|| s.explicit.time_step_prefactor * crate::scales::Scales::of(body).dt_unit),
     )?);
     t.extend(super::obstacles::terms(
         body,

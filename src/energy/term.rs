@@ -209,6 +209,19 @@ pub trait StepLimit {
     ) -> Real {
         1.0
     }
+
+    /// The explicit driver, which has no Newton step to bound: lowers `bounds[v]` to how far
+    /// (m) vertex `v` may move from `x`, the positions the term's elements were gathered at,
+    /// such that while every vertex stays within its bound every state is admissible and no
+    /// element that was not gathered acts (per-vertex displacement bounds, as in offset
+    /// geometric contact, Chen et al. 2025).
+    fn displacement_bounds(
+        &self,
+        pot: &Potential,
+        map: &ElementMap,
+        x: &[Vec3],
+        bounds: &mut [Real],
+    );
 }
 
 /// The capability of a term that reports more than its energy under its name.

@@ -390,6 +390,13 @@ pub struct ExplicitReport {
     pub microseconds_per_face_step: Real,
     /// Hold points at which equilibrium was reached.
     pub holds_reached: usize,
+    /// With contact: how many times the pairs and the vertices' displacement bounds were
+    /// gathered.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_gathers: Option<usize>,
+    /// With contact: vertex steps pulled back inside their displacement bound.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_clipped: Option<usize>,
 }
 
 /// Energies of a state by term.

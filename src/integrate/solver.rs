@@ -216,7 +216,8 @@ impl<'a> Solver<'a> {
             return Ok(false);
         };
         self.summary.element_changes += 1;
-        if !p.same_union(&self.pattern) {
+        // The explicit driver assembles gradients only: nothing to factorise.
+        if self.config.mode != Mode::Explicit && !p.same_union(&self.pattern) {
             let c = self.lin.counts();
             self.retired.factorisations += c.factorisations;
             self.retired.failed += c.failed;

@@ -68,6 +68,16 @@
 //!
 //! [`ExplicitHooks::explicit_unbalanced`]: crate::energy::term::ExplicitHooks::explicit_unbalanced
 //!
+//! ## Contact
+//! With `[self_contact]` or a mesh obstacle, the contact pairs are gathered at the start, at
+//! every frame and whenever a vertex would soon leave the radius it may move from where they
+//! were gathered; a vertex that leaves it is pulled back (the `contact` module). A term whose elements
+//! change and that bounds no displacement is refused.
+//!
+//! ## Tracked states
+//! Every step is an accepted state: terms that track a state across steps (a boundary
+//! moment's angles, [`crate::energy::term::Tracked`]) move it on after each.
+//!
 //! ## Failure
 //! A state that is not finite, or a kinetic energy above 100 × μ t A (strains of order ten
 //! everywhere), stops the run: `summary.json` gives the reason and the last good frame, and the
@@ -82,6 +92,7 @@ use crate::settings::EquilibriumTest;
 use crate::solve::State;
 
 mod bounds;
+mod contact;
 mod equilibrium;
 mod step;
 
@@ -261,19 +272,30 @@ pub(super) fn run_explicit(
         driver,
     } = from;
     let sc = s.scene;
-    if s.changing {
+    let n = state.x.len();
+    // Contact follows the sheet through per-vertex displacement bounds (`contact`).
+    let mut bounds = contact::Bounds::of(s, n);
+    if s.changing && bounds.is_none() {
         return Err(RunError::Unsupported(
-            "a term's elements change during the run (a term declares ChangingElements), which the explicit \
-             driver does not follow: use solver.mode = \"dynamic\""
+            "a term's elements change during the run (a term declares ChangingElements) \
+             without bounding the vertices' motion, which the explicit driver needs to follow \
+             them: use solver.mode = \"dynamic\""
                 .into(),
         ));
     }
-    // The pattern is fixed: the explicit driver assembles gradients only, on its elements.
-    let pat = s.pattern();
+    let tracking = sc.terms.iter().any(|t| t.tracked().is_some());
+    // The vertices on prescribed paths, which contact cannot pull back.
+    let paths: Vec<usize> = {
+        let mut p: Vec<usize> = sc.body.prescribed.iter().map(|&(v, _, _)| v).collect();
+        p.dedup();
+        p
+    };
+    // The explicit driver assembles gradients only, on the pattern's elements (the contact
+    // pairs' change when they are gathered again).
+    let mut pat = s.pattern();
     let cf = sc.settings.explicit.clone();
     let holds = sc.settings.dial.holds.clone();
     let sca = Scales::of(&sc.body);
-    let n = state.x.len();
     let dt = cf.time_step_prefactor * sca.dt_unit;
     let rate_dial = cf.damping_prefactor_dial * 2.0 * sca.omega_long;
     let rate_wait = cf.damping_prefactor_wait * 2.0 * sca.omega_long;
@@ -326,6 +348,8 @@ pub(super) fn run_explicit(
         .into(),
         microseconds_per_face_step: 0.0,
         holds_reached: 0,
+        contact_gathers: None,
+        contact_clipped: None,
     };
     let test = Test {
         cf: &cf,
@@ -388,6 +412,10 @@ pub(super) fn run_explicit(
     }
     s.summary.holds_reached = k.holds_reached;
     report.holds_reached = k.holds_reached;
+    if let Some(b) = bounds.as_mut() {
+        b.gather(s, &state, k.dial)?;
+        pat = s.pattern();
+    }
     {
         let pot = s.potential_at(&pat, k.dial, &state);
         s.summary.residual = residual_at(&pot, &state.x, &mut scratch);
@@ -407,6 +435,10 @@ pub(super) fn run_explicit(
                 break Stop::Other(f.to_string());
             }
             let dial = k.dial;
+            if let Some(b) = bounds.as_mut().filter(|b| b.stale) {
+                b.gather(s, &state, dial)?;
+                pat = s.pattern();
+            }
             if k.phase == Phase::Wait && frozen.as_ref().is_none_or(|(d, _)| *d != dial) {
                 let pot = s.potential(&pat, dial);
                 frozen = Some((
@@ -414,7 +446,37 @@ pub(super) fn run_explicit(
                     (0..sc.body.num_faces()).map(|f| pot.density(f)).collect(),
                 ));
             }
+            let before: Vec<Vec3> = match &bounds {
+                Some(_) => paths.iter().map(|&v| state.x[v]).collect(),
+                None => Vec::new(),
+            };
             sc.body.prescribe(&mut state.x, dial);
+            if let Some(b) = bounds.as_mut() {
+                if let Some(v) = b.prescribed(&paths, &state.x) {
+                    // A path left its vertex's room: check its move, then gather there.
+                    let mut from = state.x.clone();
+                    for (&u, p) in paths.iter().zip(&before) {
+                        from[u] = *p;
+                    }
+                    let pot = s.potential_at(&pat, dial, &state);
+                    if pot.jump_fraction(&from, &state.x, dial) < 1.0 {
+                        state.x = from;
+                        let p = state.x[v];
+                        break Stop::Other(format!(
+                            "the prescribed path of vertex {v} at ({}, {}, {}) m drives the \
+                             sheet within self_contact.min_separation of itself or an obstacle at \
+                             t = {} s, dial {}",
+                            human(p.x),
+                            human(p.y),
+                            human(p.z),
+                            human(k.t),
+                            human(dial)
+                        ));
+                    }
+                    b.gather(s, &state, dial)?;
+                    pat = s.pattern();
+                }
+            }
             // Terms whose own state follows the sheet (a moving slide) catch up with it first.
             for t in sc.terms.iter() {
                 if let Some(hooks) = t.explicit() {
@@ -501,6 +563,10 @@ pub(super) fn run_explicit(
                     k.next_frame = k.t + frame_interval;
                     s.driver = k.saved();
                     s.frame(writer, &pot, &state, &v, k.t)?;
+                    // A restart from this frame gathers the pairs here: so does the run.
+                    if let Some(b) = bounds.as_mut() {
+                        b.stale = true;
+                    }
                 }
             }
             // The step.
@@ -512,12 +578,25 @@ pub(super) fn run_explicit(
                     v[i] = -f * (inv_m[i] / cg);
                     state.x[i] += v[i] * h;
                 }
+                if let Some(b) = bounds.as_mut() {
+                    b.clip(&mut state.x, None, &inv_m, dt);
+                }
                 k.gd_left -= 1;
                 if k.gd_left == 0 {
                     v.iter_mut().for_each(|v| *v = Vec3::zeros());
                 }
-            } else if !fused {
-                advance(&mut state.x, &mut v, &g, &inv_m, c, dt);
+            } else {
+                if !fused {
+                    advance(&mut state.x, &mut v, &g, &inv_m, c, dt);
+                }
+                if let Some(b) = bounds.as_mut() {
+                    b.clip(&mut state.x, Some(&mut v), &inv_m, dt);
+                }
+            }
+            // Every step is accepted: terms that track a state across steps (a moment's
+            // angles, which follow the boundary through full turns) move it on.
+            if tracking {
+                super::hooks::accept(sc, &mut state);
             }
             k.t += dt;
             k.steps += 1;
@@ -544,6 +623,10 @@ pub(super) fn run_explicit(
                 k.next_frame += frame_interval;
                 s.driver = k.saved();
                 s.frame(writer, &pot, &state, &v, k.t)?;
+                // A restart from this frame gathers the pairs here: so does the run.
+                if let Some(b) = bounds.as_mut() {
+                    b.stale = true;
+                }
                 let dialling = k.phase == Phase::Dial;
                 progress.update(
                     if dialling {
@@ -567,6 +650,10 @@ pub(super) fn run_explicit(
     let wall = clock.elapsed().as_secs_f64();
     report.microseconds_per_face_step =
         1e6 * wall / (k.steps.max(1) as Real * sc.body.num_faces() as Real);
+    if let Some(b) = &bounds {
+        report.contact_gathers = Some(b.gathers);
+        report.contact_clipped = Some(b.clipped);
+    }
     finish(
         s,
         writer,
