@@ -780,13 +780,7 @@ fn bad_mesh_obstacles_are_refused() {
             ),
             &["obstacles[0].displacement", "explicit", "fixed"][..],
         ),
-        (
-            format!(
-                "{}\nfriction = 0.2\n[solver]\nmode = \"explicit\"\n[material]\nbending = \"patch_fit\"",
-                mesh("low.obj")
-            ),
-            &["obstacles[0].friction", "dynamic"][..],
-        ),
+
     ] {
         std::fs::write(d.join("o.toml"), format!("[[obstacles]]\n{text}\n")).unwrap();
         let (code, _, err) = run_status(&["o.toml", "d.vtk", "--out", "o", "-q"], d);

@@ -29,8 +29,8 @@
 //! A `mesh` obstacle is fixed or moved by `displacement` in static (load-controlled) or dynamic
 //! mode: its steps are bounded by continuous collision detection, and its motion within a step
 //! is checked the same way, which arc-length continuation (the dial an unknown of the solve)
-//! cannot do. In explicit mode it is fixed and frictionless: the explicit driver bounds how far
-//! each of the sheet's vertices moves, not the obstacle's.
+//! cannot do. In explicit mode it is fixed (the explicit driver bounds how far each of the
+//! sheet's vertices moves, not the obstacle's), with stick/slip friction.
 //!
 //! The raw table is flat (every key optional, unknown keys refused); [`ObstacleSettings::shape`]
 //! validates it into a [`Shape`] that carries exactly its variant's parameters.
@@ -234,15 +234,8 @@ impl ObstacleSettings {
                 return invalid(
                     "displacement",
                     "a moving mesh obstacle needs solver.mode = \"static\" or \"dynamic\" \
-                     (the explicit driver bounds the sheet's vertices only; a fixed mesh \
-                     obstacle, or an analytic shape, may move there)",
-                );
-            }
-            if mode == Mode::Explicit && self.friction > 0.0 {
-                return invalid(
-                    "friction",
-                    "friction on a mesh obstacle needs solver.mode = \"dynamic\" (the \
-                     explicit driver's contact with meshes is frictionless)",
+                     (the explicit driver bounds the sheet's vertices only: a mesh obstacle \
+                     is fixed there, an analytic shape may move)",
                 );
             }
         }

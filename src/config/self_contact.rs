@@ -37,11 +37,15 @@ pub struct SelfContact {
     /// (default `0.1`): no step takes a pair closer.
     pub min_separation: Real,
     /// Coulomb coefficient μ between the sheets' surfaces, ≥ 0 (default 0: frictionless).
-    /// Dynamic mode; the slip speed of its smoothing is `contact.slip_speed`.
+    /// Dynamic mode (the slip speed of its smoothing is `contact.slip_speed`) and explicit
+    /// mode (stick/slip).
     pub friction: Real,
     /// Which point–triangle pairs of a vertex press (default `"nearest"`): see
     /// [`Pairs`].
     pub pairs: Pairs,
+    /// Explicit mode: a dashpot on each pressing pair's normal approach, as a fraction ζ ≥ 0
+    /// of the pair's critical damping on its penalty spring (default 1; 0: none).
+    pub damping: Real,
 }
 
 /// The normal law of a pair at distance `d` whose law acts at `r` (the offset ξ for a point
@@ -86,6 +90,7 @@ impl Default for SelfContact {
             min_separation: 0.1,
             friction: 0.0,
             pairs: Pairs::Nearest,
+            damping: 1.0,
         }
     }
 }
@@ -93,8 +98,7 @@ impl Default for SelfContact {
 impl SelfContact {
     /// Validates `[self_contact]` when enabled, or when the scene has mesh obstacles
     /// (`meshes`, whose pairs use its keys): positive lengths and stiffness, a minimum
-    /// separation in (0, 0.9]; in explicit mode the penalty law, and no friction between
-    /// sheets.
+    /// separation in (0, 0.9]; in explicit mode the penalty law.
     pub fn validate(&self, mode: Mode, meshes: bool) -> Result<(), Invalid> {
         let ck = Check;
         if !self.enabled && !meshes {
@@ -106,14 +110,6 @@ impl SelfContact {
                 "the barrier's stiffness grows without bound at the offset, which no explicit \
                  step resolves: use law = \"penalty\" in explicit mode, or solver.mode = \
                  \"static\" or \"dynamic\""
-                    .into(),
-            );
-        }
-        if self.enabled && mode == Mode::Explicit && self.friction > 0.0 {
-            return ck.inv(
-                "self_contact.friction",
-                "friction between sheets needs solver.mode = \"dynamic\" (the explicit \
-                 driver's contact is frictionless)"
                     .into(),
             );
         }
@@ -129,6 +125,7 @@ impl SelfContact {
             }
         }
         ck.nonneg("self_contact.friction", self.friction)?;
+        ck.nonneg("self_contact.damping", self.damping)?;
         let s = self.min_separation;
         if !(s > 0.0 && s <= 0.9) {
             return ck.inv(
@@ -148,7 +145,7 @@ mod tests {
     use super::*;
 
     /// Disabled checks nothing; enabled needs positive values, a separation fraction in
-    /// (0, 0.9], and in explicit mode the penalty without friction.
+    /// (0, 0.9], and in explicit mode the penalty.
     #[test]
     fn enabled_self_contact_needs_positive_values_and_an_explicit_law() {
         let off = SelfContact {
@@ -168,7 +165,7 @@ mod tests {
         assert!(on.validate(Mode::Static, false).is_ok());
         assert!(on.validate(Mode::Dynamic, false).is_ok());
         assert!(on.validate(Mode::Explicit, false).is_ok());
-        // Explicit mode: no barrier (on mesh obstacles' pairs too), no friction between sheets.
+        // Explicit mode: no barrier (on mesh obstacles' pairs too); friction is stick/slip there.
         let barrier = SelfContact {
             law: Law::Barrier,
             ..on.clone()
@@ -186,9 +183,17 @@ mod tests {
             friction: 0.3,
             ..on.clone()
         };
-        assert!(rough.validate(Mode::Dynamic, false).is_ok());
-        let e = rough.validate(Mode::Explicit, false).unwrap_err();
-        assert_eq!(e.key, "self_contact.friction");
+        assert!(rough.validate(Mode::Explicit, false).is_ok());
+        for z in [-0.5, Real::NAN] {
+            let bad = SelfContact {
+                damping: z,
+                ..on.clone()
+            };
+            assert_eq!(
+                bad.validate(Mode::Explicit, false).unwrap_err().key,
+                "self_contact.damping"
+            );
+        }
         let bad = SelfContact {
             halo: AutoOr::Value(0.0),
             ..on.clone()

@@ -53,7 +53,7 @@
 //! ([`crate::contact::distance::mollifier`]): on a flat contact they are idle and the pressure
 //! is the vertex law's alone.
 //!
-//! **Friction** (`friction` μ > 0, dynamic mode): the ground's lagged, smoothed Coulomb
+//! **Friction** (`friction` μ > 0; dynamic mode, and stick/slip in explicit mode, below): the ground's lagged, smoothed Coulomb
 //! dissipation ([`crate::contact::friction_potential`]) on each pair's relative slip. A pair
 //! that presses at the friction lag's iterate `x̃` ([`crate::energy::potential::Friction`])
 //! has there its normal force `λ = m k w ψ′`, its closest points' coefficients `c` (the
@@ -90,10 +90,14 @@
 //! ([`StepLimit::displacement_bounds`]: half the halo, and half the room each of its gathered
 //! pairs has to its floor), pulls back a vertex that would leave it, and gathers again before
 //! one would (`crate::integrate::explicit`'s contact). The penalty's default stiffness there is
-//! at most `ρh/(4Δt²)` (`default_stiffness`); the barrier and friction between sheets are
-//! refused. Each evaluation skips the exact distance of a pair whose two sides' bounding boxes
-//! are beyond its reach (`beyond_reach`): most gathered pairs of a sheet in
-//! motion, whose halo is as wide as the offset.
+//! at most `ρh/(4Δt²)` (`default_stiffness`); the barrier is refused. Each pressing pair has a
+//! dashpot on its normal approach (`damping` ζ), and friction there is Coulomb's stick/slip of
+//! the pressing pairs solved together in each step (the term's explicit hook,
+//! [`ExplicitHooks::explicit_step`]), not the lagged potential.
+//!
+//! **Far pairs.** Each evaluation skips the exact distance of a pair whose two sides' bounding
+//! boxes are beyond its reach (`beyond_reach`): most gathered pairs of a sheet in motion,
+//! whose halo is as wide as the offset.
 //!
 //! **Exclusion.** Pairs within the exclusion radius `R` of each other on the reference sheet,
 //! measured both in space and along its edges (the graph distance, at most `2R` plus two edge
@@ -126,7 +130,7 @@
 //! points' coordinates, point–triangle `(p, t₂, t₁, t₀)` with `t₀ < t₁ < t₂`, edge–edge
 //! `(a, b, c, d)` with `a < b`, `c < d` (the order of the last two slots tells the kinds apart).
 
-use super::term::{LaggedNormals, Reports, StepBound, StepLimit, Term};
+use super::term::{ExplicitHooks, LaggedNormals, Reports, StepBound, StepLimit, Term};
 use crate::body::Body;
 use crate::contact::{barrier, broad, ccd, distance, friction_potential, penalty};
 use crate::elements::Stencil;
@@ -197,6 +201,9 @@ pub struct SelfContact {
     pub friction: Real,
     /// Every point–triangle pair within reach presses, not only the nearest on either side.
     pub all_pairs: bool,
+    /// The explicit driver's dashpot on each pressing pair, a fraction ζ of critical damping
+    /// (0 in the implicit modes, whose steps damp the contact themselves).
+    pub damping: Real,
     /// Wall time spent so far (ns) in the broad phase and gathering, in CCD and the
     /// separation checks, and in the term's assembly ([`Clock`]).
     clock: [AtomicU64; 3],
@@ -345,6 +352,21 @@ enum Clock {
 struct Slip {
     /// `μ λ` (N).
     bound: Real,
+    /// The closest points' coefficients.
+    c: [Real; 4],
+    /// The unit normal from the surface to the point.
+    normal: Vec3,
+}
+
+/// A pair that presses ([`SelfContact::presses`]).
+struct Press {
+    /// Its index among the pairs.
+    pair: usize,
+    /// Its normal force λ (N).
+    force: Real,
+    /// Its stiffness along the normal, `m k w ψ″` (N/m; the penalty's, the mollifier's `m`
+    /// held).
+    stiffness: Real,
     /// The closest points' coefficients.
     c: [Real; 4],
     /// The unit normal from the surface to the point.
@@ -916,6 +938,38 @@ impl SelfContact {
             .collect()
     }
 
+    /// The pairs of `nodes` that press at `x` ([`Press`]), in pair order.
+    fn presses(&self, nodes: &[usize], x: &[Vec3]) -> Vec<Press> {
+        let active = self.active(nodes, x);
+        (0..nodes.len() / 4)
+            .into_par_iter()
+            .filter(|&e| active[e])
+            .filter_map(|e| {
+                let n = &nodes[4 * e..4 * e + 4];
+                let y = points(x, n);
+                let cl = self.closest(&y, n);
+                let d = cl.d2.sqrt();
+                if d <= 0.0 {
+                    return None;
+                }
+                let (k, weight, _, f, s) = self.normal(n, d)?;
+                let m = if is_point_triangle(n) {
+                    1.0
+                } else {
+                    self.mollifier(n, &y).map_or(1.0, |(m, _, _)| m)
+                };
+                let r: Vec3 = (0..4).map(|i| y[i] * cl.c[i]).sum();
+                Some(Press {
+                    pair: e,
+                    force: m * k * weight * f,
+                    stiffness: m * k * weight * s,
+                    c: cl.c,
+                    normal: r / d,
+                })
+            })
+            .collect()
+    }
+
     /// Per pair of `nodes`, its friction at the lag's iterate `x_lag` (module doc): the bound
     /// `μ λ` (N), the closest points' coefficients and the unit normal, for the pairs that press
     /// there; `None` for the others.
@@ -1303,6 +1357,142 @@ impl LaggedNormals for SelfContact {
     }
 }
 
+impl ExplicitHooks for SelfContact {
+    /// A dashpot on each pressing pair's normal approach, then Coulomb stick/slip on its
+    /// slip, for the pairs that press at `x` in the step `dt`. With `c` a pair's closest
+    /// points' coefficients, `n` its normal, `λ` its normal force, `K` its normal stiffness
+    /// (`m k w ψ″`) and `v*ᵢ = vᵢ − Δt gᵢ/mᵢ` the velocity each of its sheet vertices would
+    /// reach (obstacle vertices stand still), the pair's relative velocity is `Σ cᵢ vᵢ` and
+    /// `w = Σ cᵢ²/mᵢ` its inverse mass along it.
+    ///
+    /// *Dashpot* (`damping` ζ, a fraction of critical damping of the pair on its penalty
+    /// spring): the normal impulse `−2ζ √(K/w) Δt u_n`, `u_n = n·Σ cᵢ vᵢ`, at most what stops
+    /// the normal approach within the step (`u_n/w`), and no more pull while the pair parts than
+    /// its spring pushes (`λ Δt`), so that contact never sticks. Without it an explicit contact
+    /// rings at its own frequency, undamped by the driver's drag, and a sheet resting on
+    /// another chatters: it loses its grip while its vertices hop, and creeps down a slope
+    /// steeper than friction allows.
+    ///
+    /// *Friction* (μ > 0), solved together by projected Gauss–Seidel on the impulses: each
+    /// pair's slip is the tangential part `u` of `Σ cᵢ vᵢ` with the impulses so far, and its
+    /// impulse `J` is updated to `J − u/w`, projected onto the disc `|J| ≤ μ N`, `N` the pair's
+    /// whole normal impulse (its spring's `λ Δt` and its dashpot's): inside, the pair sticks;
+    /// on the edge it slides with Coulomb's force against its slip. Sweeps in pair
+    /// order until no impulse changes by more than 1e-9 of the largest bound (at most
+    /// [`FRICTION_SWEEPS`]).
+    ///
+    /// The impulses enter as the forces `cᵢ J/Δt` on the vertices.
+    fn explicit_step(&self, pot: &Potential, x: &[Vec3], v: &mut [Vec3], g: &mut [Real], dt: Real) {
+        let Some(map) = self.map(pot) else {
+            return;
+        };
+        let nodes = self.internal(&map.nodes);
+        let y = self.placed(x, pot.dial);
+        let fixed = &pot.body.fixed;
+        let free = |u: usize| u < self.nv && !fixed[u] && pot.mass[u] > 0.0;
+        let pairs: Vec<(&[usize], Press, Real)> = self
+            .presses(&nodes, &y)
+            .into_iter()
+            .filter_map(|p| {
+                let n = &nodes[4 * p.pair..4 * p.pair + 4];
+                let w: Real = (0..4)
+                    .filter(|&i| free(n[i]))
+                    .map(|i| p.c[i] * p.c[i] / pot.mass[n[i]])
+                    .sum();
+                (w > 0.0).then_some((n, p, w))
+            })
+            .collect();
+        if pairs.is_empty() {
+            return;
+        }
+        // The velocities the step would reach, then with the impulses.
+        let mut reach: std::collections::BTreeMap<usize, Vec3> = Default::default();
+        for (n, _, _) in &pairs {
+            for &u in n.iter().filter(|&&u| free(u)) {
+                reach.entry(u).or_insert_with(|| {
+                    let gu = Vec3::new(g[3 * u], g[3 * u + 1], g[3 * u + 2]);
+                    v[u] - gu * (dt / pot.mass[u])
+                });
+            }
+        }
+        let relative =
+            |reach: &std::collections::BTreeMap<usize, Vec3>, n: &[usize], c: &[Real; 4]| {
+                (0..4)
+                    .filter(|&i| free(n[i]))
+                    .map(|i| reach[&n[i]] * c[i])
+                    .sum::<Vec3>()
+            };
+        let apply = |reach: &mut std::collections::BTreeMap<usize, Vec3>,
+                     n: &[usize],
+                     c: &[Real; 4],
+                     j: Vec3| {
+            for i in (0..4).filter(|&i| free(n[i])) {
+                if let Some(r) = reach.get_mut(&n[i]) {
+                    *r += j * (c[i] / pot.mass[n[i]]);
+                }
+            }
+        };
+        let mut impulse = vec![Vec3::zeros(); pairs.len()];
+        if self.damping > 0.0 {
+            for (k, (n, p, w)) in pairs.iter().enumerate() {
+                let un = p.normal.dot(&relative(&reach, n, &p.c));
+                let rate = 2.0 * self.damping * (p.stiffness / w).sqrt() * dt;
+                let jn = (-rate * un).clamp(-p.force * dt, (-un / w).max(0.0));
+                let j = p.normal * jn;
+                apply(&mut reach, n, &p.c, j);
+                impulse[k] = j;
+            }
+        }
+        let rough: Vec<usize> = (0..pairs.len())
+            .filter(|&k| self.mu(pairs[k].0) > 0.0)
+            .collect();
+        let mut friction = vec![Vec3::zeros(); pairs.len()];
+        let largest = rough
+            .iter()
+            .map(|&k| {
+                self.mu(pairs[k].0) * (pairs[k].1.force * dt + pairs[k].1.normal.dot(&impulse[k]))
+            })
+            .fold(0.0, Real::max);
+        for _ in 0..FRICTION_SWEEPS {
+            let mut change: Real = 0.0;
+            for &k in &rough {
+                let (n, p, w) = &pairs[k];
+                let rel = relative(&reach, n, &p.c);
+                let slip = rel - p.normal * p.normal.dot(&rel);
+                // Coulomb's bound on the whole normal impulse, the spring's and the dashpot's.
+                let limit = self.mu(n) * (p.force * dt + p.normal.dot(&impulse[k]));
+                let mut j = friction[k] - slip / *w;
+                let size = j.norm();
+                if size > limit {
+                    j *= limit / size;
+                }
+                let delta = j - friction[k];
+                if delta == Vec3::zeros() {
+                    continue;
+                }
+                apply(&mut reach, n, &p.c, delta);
+                friction[k] = j;
+                change = change.max(delta.norm());
+            }
+            if change <= 1e-9 * largest {
+                break;
+            }
+        }
+        for (((n, p, _), j), f) in pairs.iter().zip(&impulse).zip(&friction) {
+            for i in (0..4).filter(|&i| free(n[i])) {
+                let force = (j + f) * (p.c[i] / dt);
+                let u = n[i];
+                for k in 0..3 {
+                    g[3 * u + k] -= force[k];
+                }
+            }
+        }
+    }
+}
+
+/// The most projected Gauss–Seidel sweeps of the explicit friction between sheets per step.
+const FRICTION_SWEEPS: usize = 100;
+
 impl StepLimit for SelfContact {
     /// The smallest of each gathered pair's additive CCD fraction to its floor (`s ξ`; with
     /// the barrier, at least the law's reach), and of each other pair's fraction to its offset
@@ -1484,6 +1674,9 @@ impl Term for SelfContact {
     fn lagged(&self) -> Option<&dyn LaggedNormals> {
         self.has_friction().then_some(self as &dyn LaggedNormals)
     }
+    fn explicit(&self) -> Option<&dyn ExplicitHooks> {
+        (self.damping > 0.0 || self.has_friction()).then_some(self as &dyn ExplicitHooks)
+    }
     fn reports(&self) -> Option<&dyn Reports> {
         Some(self)
     }
@@ -1600,8 +1793,17 @@ fn build(
         halo: c.halo.or(xi_max),
         exclusion: c.exclusion.or(2.0 * (xi_max + smoothing)),
         min_separation: c.min_separation,
-        friction: if dynamic { c.friction } else { 0.0 },
+        friction: if dynamic || explicit_step.is_some() {
+            c.friction
+        } else {
+            0.0
+        },
         all_pairs: c.pairs == crate::config::self_contact::Pairs::All,
+        damping: if explicit_step.is_some() {
+            c.damping
+        } else {
+            0.0
+        },
         clock: Default::default(),
         cache: Default::default(),
         cache_cap: 2.0 * body.mean_edge,
@@ -1612,7 +1814,14 @@ fn build(
         exclude(&mut sc, body)?;
     }
     for (i, o) in meshes {
-        add_rigid(&mut sc, i, o, &ca, k_rigid, dynamic)?;
+        add_rigid(
+            &mut sc,
+            i,
+            o,
+            &ca,
+            k_rigid,
+            dynamic || explicit_step.is_some(),
+        )?;
     }
     if sc.barrier {
         sc.beyond_max = sc
@@ -1648,8 +1857,9 @@ fn build(
 
 /// Reads mesh obstacle `i` (`o`) and appends its vertices, faces and edges to the term's, with
 /// its law: the obstacle's `stiffness` and `smoothing`, by default `k_default`
-/// ([`default_stiffness`]) and the mean thickness over 100, and its `friction` in dynamic
-/// mode. Vertices that no face uses are dropped.
+/// ([`default_stiffness`]) and the mean thickness over 100, and its `friction` when `dynamic`
+/// (a mode with time to slip over: dynamic or explicit). Vertices that no face uses are
+/// dropped.
 fn add_rigid(
     sc: &mut SelfContact,
     i: usize,
