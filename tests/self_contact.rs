@@ -73,9 +73,7 @@ fn a_strip_rolled_past_a_full_turn_winds_onto_itself_a_thickness_apart() {
     );
     std::fs::write(dir.join("roll.toml"), ROLL).unwrap();
     shellsim(&["roll.toml", "strip.vtk", "--out", "on", "-q"], dir);
-    let s: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("on/summary.json")).unwrap())
-            .unwrap();
+    let s: serde_json::Value = common::summary(&dir.join("on"));
     assert_eq!(s["converged"], true, "{s}");
     assert!(s["energy"]["self_contact"].as_f64().unwrap() > 0.0, "{s}");
     // The tip turned through one and a half turns.
@@ -264,9 +262,7 @@ fn stack_of_three(law: &str) {
     );
     std::fs::write(dir.join("stack.toml"), settings).unwrap();
     shellsim(&["stack.toml", "stack.vtk", "--out", "out", "-q"], dir);
-    let s: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
-            .unwrap();
+    let s: serde_json::Value = common::summary(&dir.join("out"));
     assert_eq!(s["converged"], true, "{s}");
     // The contact carries the weight above each interface: one sheet's and two sheets', and
     // the held sheet's support the weight of all three.
@@ -451,6 +447,47 @@ fn incline_mesh(dir: &Path, h: f64) -> Vec<usize> {
     top
 }
 
+/// The run `out`'s summary, its final frame's path, and over the vertices `top` the mean
+/// velocity (m/s) and displacement (m) there: plain, or weighted by the lumped masses (a third
+/// of each face's reference area, the thickness and density being uniform) with `by_mass`.
+fn final_means(
+    out: &Path,
+    top: &[usize],
+    by_mass: bool,
+) -> (serde_json::Value, std::path::PathBuf, [f64; 3], [f64; 3]) {
+    let s = common::summary(out);
+    let frame = out.join(s["final_frame"].as_str().unwrap());
+    let m = shellsim::mesh::io::read_mesh(&frame).unwrap();
+    let mut weight = vec![1.0; m.positions.len()];
+    if by_mass {
+        let u = &m.vertex_fields["displacement"];
+        let rest = |v: usize| m.positions[v] - shellsim::math::Vec3::from_column_slice(u.get(v));
+        weight.fill(0.0);
+        for f in &m.faces {
+            let a = 0.5
+                * (rest(f[1]) - rest(f[0]))
+                    .cross(&(rest(f[2]) - rest(f[0])))
+                    .norm();
+            for &v in f {
+                weight[v] += a / 3.0;
+            }
+        }
+    }
+    let total: f64 = top.iter().map(|&v| weight[v]).sum();
+    let mean = |name: &str| {
+        let f = &m.vertex_fields[name];
+        let mut out = [0.0; 3];
+        for &v in top {
+            for (k, o) in out.iter_mut().enumerate() {
+                *o += f.get(v)[k] * weight[v] / total;
+            }
+        }
+        out
+    };
+    let (v, u) = (mean("velocity"), mean("displacement"));
+    (s, frame, v, u)
+}
+
 /// A 5 cm square (h = 1 mm, E = 1 MPa, ρ = 1000 kg/m³) resting on a held 15 cm one, gravity
 /// tilted by θ = 30° from their normal (an incline), friction between the sheets μ, dynamic
 /// mode. With μ = 0.3 < tan θ the top sheet slides at `a = g (sin θ − μ cos θ)`: its mean
@@ -490,23 +527,7 @@ fn a_sheet_on_an_inclined_sheet_slides_or_sticks_by_coulomb() {
             &[&format!("{tag}.toml"), "incline.vtk", "--out", &tag, "-q"],
             dir,
         );
-        let s: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string(dir.join(&tag).join("summary.json")).unwrap(),
-        )
-        .unwrap();
-        let frame = dir.join(&tag).join(s["final_frame"].as_str().unwrap());
-        let m = shellsim::mesh::io::read_mesh(&frame).unwrap();
-        let mean = |name: &str| {
-            let f = &m.vertex_fields[name];
-            let mut out = [0.0; 3];
-            for &v in &top {
-                for (k, o) in out.iter_mut().enumerate() {
-                    *o += f.get(v)[k] / top.len() as f64;
-                }
-            }
-            out
-        };
-        let (v, u) = (mean("velocity"), mean("displacement"));
+        let (s, frame, v, u) = final_means(&dir.join(&tag), &top, false);
         let rows = log_rows(&dir.join(&tag));
         // The contact's timings: present, and growing over the run.
         for part in ["broad", "ccd", "assembly"] {
@@ -612,38 +633,9 @@ fn a_sheet_on_an_inclined_sheet_slides_or_sticks_in_explicit_mode() {
             dir,
         );
         assert_eq!(code, 1, "{tag}: {err}");
-        let s: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string(dir.join(&tag).join("summary.json")).unwrap(),
-        )
-        .unwrap();
-        let frame = dir.join(&tag).join(s["final_frame"].as_str().unwrap());
-        let m = shellsim::mesh::io::read_mesh(&frame).unwrap();
-        // Weighted by the lumped masses (a third of each face's reference area), the mean is
-        // the sheet's momentum over its mass: its in-plane vibrations drop out.
-        let u = &m.vertex_fields["displacement"];
-        let rest = |v: usize| m.positions[v] - shellsim::math::Vec3::from_column_slice(u.get(v));
-        let mut area = vec![0.0; m.positions.len()];
-        for f in &m.faces {
-            let a = 0.5
-                * (rest(f[1]) - rest(f[0]))
-                    .cross(&(rest(f[2]) - rest(f[0])))
-                    .norm();
-            for &v in f {
-                area[v] += a / 3.0;
-            }
-        }
-        let total: f64 = top.iter().map(|&v| area[v]).sum();
-        let mean = |name: &str| {
-            let f = &m.vertex_fields[name];
-            let mut out = [0.0; 3];
-            for &v in &top {
-                for (k, o) in out.iter_mut().enumerate() {
-                    *o += f.get(v)[k] * area[v] / total;
-                }
-            }
-            out
-        };
-        let (v, u) = (mean("velocity"), mean("displacement"));
+        // Weighted by the lumped masses, the mean is the sheet's momentum over its mass: its
+        // in-plane vibrations drop out.
+        let (s, _, v, u) = final_means(&dir.join(&tag), &top, true);
         let t = s["time"].as_f64().unwrap();
         let a = g * (theta.sin() - mu * theta.cos());
         println!(
@@ -937,10 +929,6 @@ fn random_thrusts_in_explicit_mode_never_cross_the_sheet() {
         ),
     )
     .unwrap();
-    let summary = |out: &str| -> serde_json::Value {
-        serde_json::from_str(&std::fs::read_to_string(dir.join(out).join("summary.json")).unwrap())
-            .unwrap()
-    };
     let mut clipped = 0;
     for seed in 1..=3u64 {
         let frame = thrust(dir, &folded, &layer, seed, 10.0);
@@ -956,7 +944,7 @@ fn random_thrusts_in_explicit_mode_never_cross_the_sheet() {
         ];
         let (code, _, err) = common::run_status(&args, dir);
         assert_eq!(code, 1, "seed {seed}: the time limit ends the run: {err}");
-        let s = summary(&out);
+        let s = common::summary(&dir.join(&out));
         println!("seed {seed}: {}", s["explicit"]);
         clipped += s["explicit"]["contact_clipped"].as_u64().unwrap();
         let c = check(dir, "fold.vtk", &out, 2.0 * (h + h / 100.0));
@@ -1075,9 +1063,7 @@ fn a_prescribed_path_into_another_sheet_stops_the_explicit_run() {
     let (code, _, err) =
         common::run_status(&["press.toml", "press.vtk", "--out", "out", "-q"], dir);
     assert_eq!(code, 1, "{err}");
-    let s: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
-            .unwrap();
+    let s: serde_json::Value = common::summary(&dir.join("out"));
     let reason = s["reason"].as_str().unwrap();
     println!("{reason}");
     assert!(
@@ -1124,9 +1110,7 @@ fn a_stack_of_eight_sheets_pressed_between_slides_carries_the_load_through_each(
     );
     std::fs::write(dir.join("stack8.toml"), settings).unwrap();
     shellsim(&["stack8.toml", "stack8.vtk", "--out", "out", "-q"], dir);
-    let s: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
-            .unwrap();
+    let s: serde_json::Value = common::summary(&dir.join("out"));
     assert_eq!(s["converged"], true, "{s}");
     let last = log_rows(&dir.join("out")).pop().unwrap();
     let carried = last["self_contact_force"];
@@ -1231,9 +1215,7 @@ fn a_cloth_dropped_on_a_sphere_folds_onto_itself_without_crossing() {
         dir,
     );
     shellsim(&["fold.toml", "cloth.vtk", "--out", "on", "-q"], dir);
-    let s: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("on/summary.json")).unwrap())
-            .unwrap();
+    let s: serde_json::Value = common::summary(&dir.join("on"));
     assert_eq!(s["converged"], true, "{s}");
     let pressing = log_rows(&dir.join("on"))
         .iter()

@@ -915,26 +915,9 @@ impl SelfContact {
     /// The normal force `λ = m k w ψ′` (N) of every pair of `nodes` (four per pair) that
     /// carries energy at `x`, with its closest points' coefficients (module doc).
     fn forces(&self, nodes: &[usize], x: &[Vec3]) -> Vec<(usize, Real, [Real; 4])> {
-        let active = self.active(nodes, x);
-        (0..nodes.len() / 4)
-            .into_par_iter()
-            .filter(|&e| active[e])
-            .filter_map(|e| {
-                let n = &nodes[4 * e..4 * e + 4];
-                let y = points(x, n);
-                let cl = self.closest(&y, n);
-                let d = cl.d2.sqrt();
-                if d <= 0.0 {
-                    return None;
-                }
-                let (k, weight, _, f, _) = self.normal(n, d)?;
-                let m = if is_point_triangle(n) {
-                    1.0
-                } else {
-                    self.mollifier(n, &y).map_or(1.0, |(m, _, _)| m)
-                };
-                Some((e, m * k * weight * f, cl.c))
-            })
+        self.presses(nodes, x)
+            .into_iter()
+            .map(|p| (p.pair, p.force, p.c))
             .collect()
     }
 

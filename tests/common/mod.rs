@@ -128,6 +128,14 @@ pub fn graded_cylinder_patch(
     std::fs::write(dir.join(name), s).unwrap();
 }
 
+/// `out/summary.json`, parsed.
+#[allow(dead_code)] // not every test crate reads summaries
+pub fn summary(out: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(out.join("summary.json"))
+        .unwrap_or_else(|e| panic!("{}: summary.json: {e}", out.display()));
+    serde_json::from_str(&text).unwrap()
+}
+
 /// `out/log.csv` as rows of named columns (a cell that is not a number reads as NaN).
 #[allow(dead_code)] // not every test crate reads logs
 pub fn log_rows(out: &Path) -> Vec<std::collections::HashMap<String, f64>> {
