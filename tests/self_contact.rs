@@ -1,5 +1,6 @@
 //! Self-contact from the command line: a strip rolled by an end moment past a full turn winds
-//! onto itself with its layers a thickness apart; a stack of sheets sinks into its offset by
+//! onto itself with its layers a thickness apart, in the spiral of the planar elastica with
+//! self-contact (`scripts/elastica_roll.py`); a stack of sheets sinks into its offset by
 //! the penalty's closed form; a sheet dropped onto another lands without crossing it; a sheet
 //! on an inclined sheet slides or sticks by Coulomb's law; random thrusts on a folded sheet
 //! never carry one layer through the other; bad input is named. Frames
@@ -52,6 +53,32 @@ fn check(dir: &Path, mesh: &str, out: &str, r: f64) -> serde_json::Value {
     serde_json::from_str(&text).unwrap()
 }
 
+/// Runs `scripts/elastica_roll.py` on the rolled strip's run `out` (the strip of [`ROLL`]);
+/// returns its JSON comparison.
+fn elastica(dir: &Path, out: &str, mesh: &str) -> serde_json::Value {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let python = std::env::var("SHELLSIM_PYTHON").unwrap_or_else(|_| "python3".into());
+    let json = dir.join(format!("{out}.elastica.json"));
+    let res = Command::new(&python)
+        .arg(root.join("scripts/elastica_roll.py"))
+        .arg(dir.join(out))
+        .arg(dir.join(mesh))
+        .args(["--length", "1", "--thickness", "0.01", "--young", "1e7"])
+        .args(["--poisson", "0", "--moment", "7.853981633974483"])
+        .args(["--segments", "150", "--json"])
+        .arg(&json)
+        .output()
+        .unwrap_or_else(|e| panic!("{python}: {e}"));
+    let text = std::fs::read_to_string(&json).unwrap_or_else(|_| {
+        panic!(
+            "elastica_roll.py failed:\n{}{}",
+            String::from_utf8_lossy(&res.stdout),
+            String::from_utf8_lossy(&res.stderr)
+        )
+    });
+    serde_json::from_str(&text).unwrap()
+}
+
 #[test]
 fn a_strip_rolled_past_a_full_turn_winds_onto_itself_a_thickness_apart() {
     let d = tempfile::tempdir().unwrap();
@@ -90,6 +117,26 @@ fn a_strip_rolled_past_a_full_turn_winds_onto_itself_a_thickness_apart() {
     // penetration (about 4e-5 here; the closed form's σ/k + δ/2 at the contact pressure).
     let dmin = c["min_distance"].as_f64().unwrap();
     assert!(dmin > 0.99 * h && dmin < 1.001 * h, "{dmin}");
+    // The spiral against the planar elastica with self-contact, solved independently by
+    // `scripts/elastica_roll.py`. The tip winds inside the first turn: the turns' radii r_0 (the
+    // tip's) and r_1 (the first's) are within 1% of the elastica's (measured −0.6% and −0.4% on
+    // this mesh, −0.25% and −0.2% at edges of h/2), and where the tip's turn lies over the first
+    // the layers are h apart to 1% of the radius: r_1 = r_0 + h at every angle they share
+    // (measured 0.998 h to 1.064 h; the elastica: 0.992 h to 1.063 h).
+    let e = elastica(dir, "on", "strip.vtk");
+    println!("against the elastica: {e}");
+    for k in ["r0", "r1"] {
+        let shell = e["shell"][k].as_f64().unwrap();
+        let reference = e["elastica"][k].as_f64().unwrap();
+        assert!(
+            (shell / reference - 1.0).abs() < 0.01,
+            "{k}: {shell} against {reference}"
+        );
+    }
+    let r0 = e["elastica"]["r0"].as_f64().unwrap();
+    let gap = &e["shell"]["gap"];
+    assert!(gap[0].as_f64().unwrap() > 0.99 * h, "{gap}");
+    assert!(gap[2].as_f64().unwrap() < h + 0.01 * r0, "{gap}");
     // The control: without self-contact the strip passes through itself, and the check sees it.
     shellsim(
         &[
