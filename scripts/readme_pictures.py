@@ -39,6 +39,8 @@ SCENES = {
     "paper_strip_md": (1.3, "mean_curvature", "30,25", None),
     "paper_strip_cd": (1.3, "mean_curvature", "30,25", None),
     "paper_annulus": (0.8, "mean_curvature", "30,45", None),
+    "paper_strip_rolls_onto_itself": (1.3, "mean_curvature", "65,15", None),
+    "paper_annulus_rolls_up": (1.2, "mean_curvature", "30,25", None),
     "gel_disk_hyperbolic": ("final", "gauss_curvature", "30,30", "-2000,0"),
     "conformal_cap": ("final", "mean_curvature", "30,20", None),
     "paper_walker": (0.4, "moisture_bottom", "-60,15", None),
