@@ -853,3 +853,39 @@ fn a_mesh_moving_with_the_dial_presses_a_disk_onto_a_plane() {
     assert!(sum["rejected_steps"].as_u64().unwrap() > 0, "{sum}");
     smallest_gap(&out, "obstacle1_gap", h);
 }
+
+/// Explicit mode: a disk (h = 5 mm) under a fixed plane mesh (two triangles, 1 mm above its top
+/// surface), pushed up into it by an analytic plane that moves 1.5 mm with the dial. At
+/// equilibrium the mesh pushes down with the force the plane pushes up, to 1e-6 of it, and the
+/// two equal penalties (E/h) share the 0.5 mm squeeze, each side sinking 0.25 mm into its offset
+/// to 1e-6 (measured: 19090.806 N on both at edges of 5 cm, 4747.958 N at 10 cm). The contact
+/// dashpot acts on the approach the step would reach by backward Euler: one that stopped that
+/// approach outright held the disk where the mesh first touched it (132 N against the plane's
+/// 39 kN, a false equilibrium).
+#[test]
+fn a_disk_pushed_into_a_mesh_in_explicit_mode_balances_its_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    disk(d, "0.1", "disk.vtk");
+    plane_obj(d, "top.obj", 0.0035);
+    let settings = "[material]\nyoung = 1e6\npoisson = 0.3\nthickness = 0.005\n\
+         bending = \"patch_fit\"\n[solver]\nmode = \"explicit\"\n\
+         [[obstacles]]\nshape = \"plane\"\npoint = [0, 0, -0.0025]\nnormal = [0, 0, 1]\n\
+         displacement = [0, 0, 0.0015]\n\
+         [[obstacles]]\nshape = \"mesh\"\nfile = \"top.obj\"\n";
+    let row = run(d, settings, "disk.vtk", "squeeze", "2");
+    let (plane, mesh) = (force(&row, 0), force(&row, 1));
+    println!(
+        "plane pushes {plane:?} N, the mesh {mesh:?} N; gaps {} and {} m",
+        row["obstacle0_gap"], row["obstacle1_gap"]
+    );
+    assert!(plane[2] > 1000.0, "{plane:?}");
+    assert!(
+        (plane[2] + mesh[2]).abs() < 1e-6 * plane[2],
+        "{plane:?} {mesh:?}"
+    );
+    for k in 0..2 {
+        let gap = row[&format!("obstacle{k}_gap")];
+        assert!((gap + 2.5e-4).abs() < 1e-6 * 2.5e-4, "obstacle {k}: {gap}");
+    }
+}

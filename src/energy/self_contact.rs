@@ -1349,9 +1349,11 @@ impl ExplicitHooks for SelfContact {
     /// `w = Σ cᵢ²/mᵢ` its inverse mass along it.
     ///
     /// *Dashpot* (`damping` ζ, a fraction of critical damping of the pair on its penalty
-    /// spring): the normal impulse `−2ζ √(K/w) Δt u_n`, `u_n = n·Σ cᵢ vᵢ`, at most what stops
-    /// the normal approach within the step (`u_n/w`), and no more pull while the pair parts than
-    /// its spring pushes (`λ Δt`), so that contact never sticks. Without it an explicit contact
+    /// spring, `c = 2ζ √(K/w)`): the backward-Euler normal impulse `J = −c Δt u_n/(1 + c Δt w)`,
+    /// `u_n = n·Σ cᵢ v*ᵢ`, which leaves the pair the approach `u_n − w J` and so never stops
+    /// it outright (a dashpot that did would hold a load at rest that the spring never
+    /// carries), and no more pull while the pair parts than its spring pushes (`λ Δt`), so
+    /// that contact never sticks. Without it an explicit contact
     /// rings at its own frequency, undamped by the driver's drag, and a sheet resting on
     /// another chatters: it loses its grip while its vertices hop, and creeps down a slope
     /// steeper than friction allows.
@@ -1418,9 +1420,13 @@ impl ExplicitHooks for SelfContact {
         let mut impulse = vec![Vec3::zeros(); pairs.len()];
         if self.damping > 0.0 {
             for (k, (n, p, w)) in pairs.iter().enumerate() {
+                // Backward Euler on the dashpot, `J = c Δt u'` with `u' = u − w J` the approach
+                // it leaves: `J = c Δt u/(1 + c Δt w)` from the velocity `u` the step would
+                // reach. It never stops the approach outright (which would hold a load at rest
+                // that the spring never carries), and it is stable at any stiffness.
                 let un = p.normal.dot(&relative(&reach, n, &p.c));
                 let rate = 2.0 * self.damping * (p.stiffness / w).sqrt() * dt;
-                let jn = (-rate * un).clamp(-p.force * dt, (-un / w).max(0.0));
+                let jn = (-rate * un / (1.0 + rate * w)).max(-p.force * dt);
                 let j = p.normal * jn;
                 apply(&mut reach, n, &p.c, j);
                 impulse[k] = j;
