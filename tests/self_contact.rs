@@ -29,23 +29,27 @@ const ROLL: &str = "[material]\nyoung = 1e7\npoisson = 0.0\nthickness = 0.01\n\
     inside = { min = [0.499, -1, -1], max = [1, 1, 1] }\n\
     [self_contact]\nenabled = true\n";
 
-/// Runs `scripts/contact_check.py` on the run `out` (reference mesh `mesh`) with exclusion
-/// radius `r`; returns its JSON summary.
-fn check(dir: &Path, mesh: &str, out: &str, r: f64) -> serde_json::Value {
+/// Runs `scripts/<script>` with `args` and `--json dir/<json>` in the project's Python (the
+/// variable `SHELLSIM_PYTHON`, else `python3`); returns the JSON it wrote.
+fn python_json(
+    dir: &Path,
+    script: &str,
+    args: &[&std::ffi::OsStr],
+    json: &str,
+) -> serde_json::Value {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let python = std::env::var("SHELLSIM_PYTHON").unwrap_or_else(|_| "python3".into());
-    let json = dir.join(format!("{out}.check.json"));
+    let json = dir.join(json);
     let res = Command::new(&python)
-        .arg(root.join("scripts/contact_check.py"))
-        .arg(dir.join(mesh))
-        .arg(dir.join(out))
-        .args(["--exclusion", &r.to_string(), "--json"])
+        .arg(root.join("scripts").join(script))
+        .args(args)
+        .arg("--json")
         .arg(&json)
         .output()
         .unwrap_or_else(|e| panic!("{python}: {e}"));
     let text = std::fs::read_to_string(&json).unwrap_or_else(|_| {
         panic!(
-            "contact_check.py failed (is VTK in {python}? run the tests with scripts/test.sh):\n{}{}",
+            "{script} failed (is VTK in {python}? run the tests with scripts/test.sh):\n{}{}",
             String::from_utf8_lossy(&res.stdout),
             String::from_utf8_lossy(&res.stderr)
         )
@@ -53,30 +57,93 @@ fn check(dir: &Path, mesh: &str, out: &str, r: f64) -> serde_json::Value {
     serde_json::from_str(&text).unwrap()
 }
 
+/// Runs `scripts/contact_check.py` on the run `out` (reference mesh `mesh`) with exclusion
+/// radius `r`; returns its JSON summary.
+fn check(dir: &Path, mesh: &str, out: &str, r: f64) -> serde_json::Value {
+    let (mesh, out, r) = (dir.join(mesh), dir.join(out), r.to_string());
+    let args = [
+        mesh.as_os_str(),
+        out.as_os_str(),
+        "--exclusion".as_ref(),
+        r.as_ref(),
+    ];
+    let name = format!("{}.check.json", out.file_name().unwrap().to_string_lossy());
+    python_json(dir, "contact_check.py", &args, &name)
+}
+
 /// Runs `scripts/elastica_roll.py` on the rolled strip's run `out` (the strip of [`ROLL`]);
 /// returns its JSON comparison.
 fn elastica(dir: &Path, out: &str, mesh: &str) -> serde_json::Value {
+    let (run, mesh) = (dir.join(out), dir.join(mesh));
+    let mut args = vec![run.as_os_str(), mesh.as_os_str()];
+    for a in [
+        "--length",
+        "1",
+        "--thickness",
+        "0.01",
+        "--young",
+        "1e7",
+        "--poisson",
+        "0",
+        "--moment",
+        "7.853981633974483",
+        "--segments",
+        "150",
+    ] {
+        args.push(a.as_ref());
+    }
+    python_json(
+        dir,
+        "elastica_roll.py",
+        &args,
+        &format!("{out}.elastica.json"),
+    )
+}
+
+/// A gallery scene that folds or rolls onto itself, checked at small size: copies
+/// `settings/<scene>.toml` into `dir`, writes `shellsim mesh <mesh>` as `sheet.vtk`, and runs
+/// it with the overrides `sets` into `on`, then without self-contact into `off`. Asserts that
+/// the run with it converges, that its pairs press, that the independent script finds no
+/// crossing face in any frame and no two mid-surfaces closer than the minimum separation (a
+/// tenth of the offset, thickness `h`), and that the control crosses itself. Returns the most
+/// pairs pressing at once.
+fn presses_without_crossing(dir: &Path, scene: &str, mesh: &[&str], sets: &[&str], h: f64) -> f64 {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let python = std::env::var("SHELLSIM_PYTHON").unwrap_or_else(|_| "python3".into());
-    let json = dir.join(format!("{out}.elastica.json"));
-    let res = Command::new(&python)
-        .arg(root.join("scripts/elastica_roll.py"))
-        .arg(dir.join(out))
-        .arg(dir.join(mesh))
-        .args(["--length", "1", "--thickness", "0.01", "--young", "1e7"])
-        .args(["--poisson", "0", "--moment", "7.853981633974483"])
-        .args(["--segments", "150", "--json"])
-        .arg(&json)
-        .output()
-        .unwrap_or_else(|e| panic!("{python}: {e}"));
-    let text = std::fs::read_to_string(&json).unwrap_or_else(|_| {
-        panic!(
-            "elastica_roll.py failed:\n{}{}",
-            String::from_utf8_lossy(&res.stdout),
-            String::from_utf8_lossy(&res.stderr)
-        )
-    });
-    serde_json::from_str(&text).unwrap()
+    std::fs::copy(
+        root.join(format!("settings/{scene}.toml")),
+        dir.join("scene.toml"),
+    )
+    .unwrap();
+    let mut args = vec!["mesh"];
+    args.extend_from_slice(mesh);
+    args.extend_from_slice(&["-o", "sheet.vtk"]);
+    shellsim(&args, dir);
+    let run = |out: &str, extra: &[&str]| {
+        let mut args = vec!["scene.toml", "sheet.vtk", "--out", out, "-q"];
+        for s in sets.iter().chain(extra) {
+            args.extend_from_slice(&["--set", s]);
+        }
+        shellsim(&args, dir);
+    };
+    run("on", &[]);
+    let s: serde_json::Value = common::summary(&dir.join("on"));
+    assert_eq!(s["converged"], true, "{scene}: {s}");
+    let pressing = log_rows(&dir.join("on"))
+        .iter()
+        .map(|r| r["self_contact_pairs"])
+        .fold(0.0, f64::max);
+    let r = 2.0 * (h + h / 100.0);
+    let c = check(dir, "sheet.vtk", "on", r);
+    println!("{scene}: {pressing} pairs at most: {c}");
+    assert!(pressing > 0.0, "{scene}: the sheet presses on itself");
+    assert_eq!(c["crossing_pairs"], 0, "{scene}: {c}");
+    let dmin = c["min_distance"].as_f64().unwrap();
+    assert!(dmin >= 0.1 * h && dmin < h, "{scene}: {dmin}");
+    run("off", &["self_contact.enabled=false"]);
+    let c = check(dir, "sheet.vtk", "off", r);
+    println!("{scene} without self-contact: {c}");
+    assert!(c["crossing_pairs"].as_u64().unwrap() > 0, "{scene}: {c}");
+    pressing
 }
 
 #[test]
@@ -1241,56 +1308,13 @@ fn a_stack_of_eight_sheets_pressed_between_slides_carries_the_load_through_each(
 #[test]
 fn a_cloth_dropped_on_a_sphere_folds_onto_itself_without_crossing() {
     let d = tempfile::tempdir().unwrap();
-    let dir = d.path();
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    std::fs::copy(
-        root.join("settings/cloth_folds_on_sphere.toml"),
-        dir.join("fold.toml"),
-    )
-    .unwrap();
-    shellsim(
-        &[
-            "mesh",
-            "square",
-            "--size",
-            "1",
-            "--edge",
-            "0.1",
-            "-o",
-            "cloth.vtk",
-        ],
-        dir,
+    presses_without_crossing(
+        d.path(),
+        "cloth_folds_on_sphere",
+        &["square", "--size", "1", "--edge", "0.1"],
+        &[],
+        5e-4,
     );
-    shellsim(&["fold.toml", "cloth.vtk", "--out", "on", "-q"], dir);
-    let s: serde_json::Value = common::summary(&dir.join("on"));
-    assert_eq!(s["converged"], true, "{s}");
-    let pressing = log_rows(&dir.join("on"))
-        .iter()
-        .map(|r| r["self_contact_pairs"])
-        .fold(0.0, f64::max);
-    assert!(pressing > 0.0, "the cloth touches itself");
-    let h = 5e-4;
-    let r = 2.0 * (h + h / 100.0);
-    let c = check(dir, "cloth.vtk", "on", r);
-    println!("cloth folding on a sphere, {pressing} pairs at most: {c}");
-    assert_eq!(c["crossing_pairs"], 0, "{c}");
-    let dmin = c["min_distance"].as_f64().unwrap();
-    assert!(dmin >= 0.1 * h && dmin < h, "{dmin}");
-    shellsim(
-        &[
-            "fold.toml",
-            "cloth.vtk",
-            "--out",
-            "off",
-            "-q",
-            "--set",
-            "self_contact.enabled=false",
-        ],
-        dir,
-    );
-    let c = check(dir, "cloth.vtk", "off", r);
-    println!("without self-contact: {c}");
-    assert!(c["crossing_pairs"].as_u64().unwrap() > 0, "{c}");
 }
 
 /// The gallery's wetted paper strip rolling onto itself
@@ -1304,15 +1328,10 @@ fn a_cloth_dropped_on_a_sphere_folds_onto_itself_without_crossing() {
 fn a_wetted_paper_strip_rolls_past_a_full_turn_onto_itself() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    std::fs::copy(
-        root.join("settings/paper_strip_rolls_onto_itself.toml"),
-        dir.join("paper.toml"),
-    )
-    .unwrap();
-    shellsim(
+    presses_without_crossing(
+        dir,
+        "paper_strip_rolls_onto_itself",
         &[
-            "mesh",
             "rectangle",
             "--lx",
             "0.12",
@@ -1320,27 +1339,10 @@ fn a_wetted_paper_strip_rolls_past_a_full_turn_onto_itself() {
             "0.01",
             "--edge",
             "0.004",
-            "-o",
-            "strip.vtk",
         ],
-        dir,
+        &["time.end=1.5"],
+        1e-4,
     );
-    let run = |out: &str, extra: &[&str]| {
-        let mut args = vec![
-            "paper.toml",
-            "strip.vtk",
-            "--out",
-            out,
-            "-q",
-            "--set",
-            "time.end=1.5",
-        ];
-        args.extend_from_slice(extra);
-        shellsim(&args, dir);
-    };
-    run("on", &[]);
-    let s: serde_json::Value = common::summary(&dir.join("on"));
-    assert_eq!(s["converged"], true, "{s}");
     // The turns of the strip's centreline (the mean of each station across the width), from
     // the spread of its tangent's angle in the x–z plane.
     let frames = common::finite_frames(&dir.join("on"), "vtu", "paper strip");
@@ -1363,37 +1365,26 @@ fn a_wetted_paper_strip_rolls_past_a_full_turn_onto_itself() {
                 ]
             })
             .collect();
-        let (mut angle, mut lo, mut hi, mut last) = (0.0_f64, 0.0_f64, 0.0_f64, None::<f64>);
-        for w in centre.windows(2) {
-            let a = (w[1][1] - w[0][1]).atan2(w[1][0] - w[0][0]);
-            if let Some(l) = last {
-                let mut da = a - l;
-                da -= std::f64::consts::TAU * (da / std::f64::consts::TAU).round();
-                angle += da;
-            }
-            last = Some(a);
+        let angles: Vec<f64> = centre
+            .windows(2)
+            .map(|w| (w[1][1] - w[0][1]).atan2(w[1][0] - w[0][0]))
+            .collect();
+        let (mut angle, mut lo, mut hi) = (0.0_f64, 0.0_f64, 0.0_f64);
+        for w in angles.windows(2) {
+            angle += wrapped(w[1] - w[0]);
             lo = lo.min(angle);
             hi = hi.max(angle);
         }
         (hi - lo) / std::f64::consts::TAU
     };
     let most = frames.iter().map(turns).fold(0.0, f64::max);
-    let pressing = log_rows(&dir.join("on"))
-        .iter()
-        .map(|r| r["self_contact_pairs"])
-        .fold(0.0, f64::max);
-    let h = 1e-4;
-    let c = check(dir, "strip.vtk", "on", 2.0 * (h + h / 100.0));
-    println!("wetted paper strip: {most:.2} turns, {pressing} pairs at most: {c}");
+    println!("wetted paper strip: {most:.2} turns");
     assert!(most > 1.5, "{most} turns");
-    assert!(pressing > 0.0, "the strip presses on itself");
-    assert_eq!(c["crossing_pairs"], 0, "{c}");
-    let dmin = c["min_distance"].as_f64().unwrap();
-    assert!(dmin >= 0.1 * h && dmin < h, "{dmin}");
-    run("off", &["--set", "self_contact.enabled=false"]);
-    let c = check(dir, "strip.vtk", "off", 2.0 * (h + h / 100.0));
-    println!("without self-contact: {c}");
-    assert!(c["crossing_pairs"].as_u64().unwrap() > 0, "{c}");
+}
+
+/// An angle change brought into (−π, π].
+fn wrapped(d: f64) -> f64 {
+    d - std::f64::consts::TAU * (d / std::f64::consts::TAU).round()
 }
 
 /// How many turns a ring rolled up about one axis wraps: the axis is the deformed sheet's
@@ -1448,12 +1439,7 @@ fn ring_turns(
             })
             .collect();
         line.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut swept = 0.0;
-        for w in line.windows(2) {
-            let mut d = w[1].1 - w[0].1;
-            d -= std::f64::consts::TAU * (d / std::f64::consts::TAU).round();
-            swept += d;
-        }
+        let swept: f64 = line.windows(2).map(|w| wrapped(w[1].1 - w[0].1)).sum();
         total += swept.abs();
     }
     total / std::f64::consts::TAU
@@ -1469,55 +1455,21 @@ fn ring_turns(
 fn a_wide_paper_ring_soaked_on_top_rolls_up_past_a_full_turn() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    std::fs::copy(
-        root.join("settings/paper_annulus_rolls_up.toml"),
-        dir.join("ring.toml"),
-    )
-    .unwrap();
-    shellsim(
-        &[
-            "mesh", "annulus", "--inner", "0.01", "--radius", "0.04", "--edge", "0.005", "-o",
-            "ring.vtk",
-        ],
+    presses_without_crossing(
         dir,
+        "paper_annulus_rolls_up",
+        &[
+            "annulus", "--inner", "0.01", "--radius", "0.04", "--edge", "0.005",
+        ],
+        &["time.end=1.2"],
+        1e-4,
     );
-    let run = |out: &str, extra: &[&str]| {
-        let mut args = vec![
-            "ring.toml",
-            "ring.vtk",
-            "--out",
-            out,
-            "-q",
-            "--set",
-            "time.end=1.2",
-        ];
-        args.extend_from_slice(extra);
-        shellsim(&args, dir);
-    };
-    run("on", &[]);
-    let s: serde_json::Value = common::summary(&dir.join("on"));
-    assert_eq!(s["converged"], true, "{s}");
     let frames = common::finite_frames(&dir.join("on"), "vtu", "paper ring");
     let turns = ring_turns(
         &frames[0].positions,
         &frames.last().unwrap().positions,
         0.003,
     );
-    let pressing = log_rows(&dir.join("on"))
-        .iter()
-        .map(|r| r["self_contact_pairs"])
-        .fold(0.0, f64::max);
-    let h = 1e-4;
-    let c = check(dir, "ring.vtk", "on", 2.0 * (h + h / 100.0));
-    println!("wide paper ring: {turns:.2} turns, {pressing} pairs at most: {c}");
+    println!("wide paper ring: {turns:.2} turns");
     assert!(turns > 1.2, "{turns} turns");
-    assert!(pressing > 0.0, "the ring presses on itself");
-    assert_eq!(c["crossing_pairs"], 0, "{c}");
-    let dmin = c["min_distance"].as_f64().unwrap();
-    assert!(dmin >= 0.1 * h && dmin < h, "{dmin}");
-    run("off", &["--set", "self_contact.enabled=false"]);
-    let c = check(dir, "ring.vtk", "off", 2.0 * (h + h / 100.0));
-    println!("without self-contact: {c}");
-    assert!(c["crossing_pairs"].as_u64().unwrap() > 0, "{c}");
 }
