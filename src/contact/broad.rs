@@ -4,19 +4,45 @@
 //!
 //! A uniform grid: each face's (each edge's) box, inflated by the radius, is listed under every
 //! cell it overlaps, in a table sorted by cell (and primitive, so the table is the same on any
-//! thread count); each vertex looks up the one cell it lies in, each edge the cells its own box
+//! thread count), with a hash index from each occupied cell to its rows; each vertex looks up the one cell it lies in, each edge the cells its own box
 //! overlaps. The cell is twice the median inflated box's longest side, at most the largest's
 //! (so a box of a mesh of even size spans at most two or three cells per axis), doubled while
 //! the boxes would be listed under more than 16 cells each on average, and never finer than
 //! 2²⁰ cells per axis: a few large boxes (a coarse obstacle's triangles beside a fine sheet) do
 //! not put every small one into one cell. Build and queries are linear in the number of
-//! primitives for meshes of even size; the queries run in parallel, one result list per
-//! primitive, concatenated in primitive order. The candidates do not depend on the cell.
+//! primitives for meshes of even size; the queries run in parallel chunks of primitives, each
+//! primitive's results sorted, concatenated in primitive order. The candidates do not depend on
+//! the cell or the thread count.
 //!
 //! Units: positions and radius m.
 
 use crate::math::{Real, Vec3};
 use rayon::prelude::*;
+
+/// Primitives per parallel task of the grid's build and queries.
+const CHUNK: usize = 256;
+
+/// The results of `query(i, out)` for every primitive `i < n`, each primitive's sorted and
+/// without repeats, concatenated in primitive order (the same on any thread count). The
+/// primitives run in parallel chunks, each filling one list: a list per primitive would cost
+/// an allocation each.
+fn gather(n: usize, query: impl Fn(usize, &mut Vec<(u32, u32)>) + Sync) -> Vec<(u32, u32)> {
+    let per: Vec<Vec<(u32, u32)>> = (0..n.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| {
+            let (mut out, mut one) = (Vec::new(), Vec::new());
+            for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                one.clear();
+                query(i, &mut one);
+                one.sort_unstable();
+                one.dedup();
+                out.extend_from_slice(&one);
+            }
+            out
+        })
+        .collect();
+    per.concat()
+}
 
 /// Cells per axis at most (the key packs three 21-bit coordinates).
 const MAX_CELLS: Real = (1u64 << 20) as Real;
@@ -51,17 +77,25 @@ impl Aabb {
     }
 }
 
-/// The grid: origin, cell size, and the sorted (cell key, primitive) table.
+/// The grid: origin, cell size, the sorted (cell key, primitive) table, and an open-addressing
+/// hash index from each occupied cell's key to its range of the table.
 struct Grid {
     origin: Vec3,
     cell: Real,
     table: Vec<(u64, u32)>,
+    /// `(key, start, end)` per slot, [`EMPTY`] keys for free slots; a power of two long.
+    index: Vec<(u64, u32, u32)>,
 }
+
+/// The key of a free slot of [`Grid::index`] (cell keys have 63 bits).
+const EMPTY: u64 = u64::MAX;
 
 impl Grid {
     fn coord(&self, p: &Vec3) -> [u64; 3] {
         std::array::from_fn(|k| {
-            (((p[k] - self.origin[k]) / self.cell).floor().max(0.0) as u64).min((1 << 21) - 1)
+            // Truncation is the floor of a non-negative number (and `floor` is a library call
+            // on the baseline x86-64 target).
+            (((p[k] - self.origin[k]) / self.cell).max(0.0) as u64).min((1 << 21) - 1)
         })
     }
     fn key(c: [u64; 3]) -> u64 {
@@ -94,29 +128,62 @@ impl Grid {
             origin: lo,
             cell,
             table: Vec::new(),
+            index: Vec::new(),
         };
+        // One list per chunk of boxes (not per box: the allocations cost more than the
+        // listing); the sort below fixes the order.
         let per: Vec<Vec<(u64, u32)>> = boxes
-            .par_iter()
+            .par_chunks(CHUNK)
             .enumerate()
-            .map(|(i, b)| {
-                let mut out = Vec::with_capacity(8);
-                g.cells(b, |k| out.push((k, i as u32)));
+            .map(|(c, chunk)| {
+                let mut out = Vec::with_capacity(4 * chunk.len());
+                for (j, b) in chunk.iter().enumerate() {
+                    g.cells(b, |k| out.push((k, (c * CHUNK + j) as u32)));
+                }
                 out
             })
             .collect();
-        g.table = per.into_iter().flatten().collect();
+        g.table = per.concat();
         // Rayon's sort pays only on large tables.
         if g.table.len() > 1 << 16 {
             g.table.par_sort_unstable();
         } else {
             g.table.sort_unstable();
         }
+        g.index_cells();
         g
+    }
+
+    /// The slot of `key` in the index: its own, or the free one where it would go.
+    #[inline]
+    fn slot(&self, key: u64) -> usize {
+        let mask = self.index.len() - 1;
+        let mut i = (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 32) as usize & mask;
+        while self.index[i].0 != key && self.index[i].0 != EMPTY {
+            i = (i + 1) & mask;
+        }
+        i
+    }
+
+    /// Fills the index from the sorted table.
+    fn index_cells(&mut self) {
+        let cells = 1 + self.table.windows(2).filter(|w| w[0].0 != w[1].0).count();
+        self.index = vec![(EMPTY, 0, 0); (2 * cells).next_power_of_two()];
+        let mut start = 0;
+        while start < self.table.len() {
+            let key = self.table[start].0;
+            let end = start + self.table[start..].partition_point(|e| e.0 == key);
+            let i = self.slot(key);
+            self.index[i] = (key, start as u32, end as u32);
+            start = end;
+        }
     }
     /// How many (cell, box) entries a grid of cell size `cell` from `origin` lists.
     fn entries(boxes: &[Aabb], origin: Vec3, cell: Real) -> usize {
-        let span =
-            |a: Real, b: Real, o: Real| ((b - o) / cell).floor() - ((a - o) / cell).floor() + 1.0;
+        let span = |a: Real, b: Real, o: Real| {
+            let at = |v: Real| ((v - o) / cell).max(0.0) as u64;
+            (at(b) - at(a).min(at(b)) + 1) as Real
+        };
         boxes
             .iter()
             .map(|b| {
@@ -141,9 +208,11 @@ impl Grid {
     }
     /// The primitives listed under cell `key`.
     fn at(&self, key: u64) -> &[(u64, u32)] {
-        let lo = self.table.partition_point(|e| e.0 < key);
-        let hi = self.table.partition_point(|e| e.0 <= key);
-        &self.table[lo..hi]
+        let (k, lo, hi) = self.index[self.slot(key)];
+        if k == EMPTY {
+            return &[];
+        }
+        &self.table[lo as usize..hi as usize]
     }
 }
 
@@ -201,27 +270,19 @@ pub fn point_triangle_where(
     }
     let boxes: Vec<Aabb> = faces.par_iter().map(|f| span(f, x, to, radius)).collect();
     let grid = Grid::new(&boxes);
-    let per: Vec<Vec<(u32, u32)>> = (0..x.len())
-        .into_par_iter()
-        .map(|p| {
-            let own = span(&[p], x, to, 0.0);
-            let mut out = Vec::new();
-            grid.cells(&own, |k| {
-                for &(_, f) in grid.at(k) {
-                    if !faces[f as usize].contains(&p)
-                        && boxes[f as usize].overlaps(&own)
-                        && keep(p as u32, f)
-                    {
-                        out.push((p as u32, f));
-                    }
+    gather(x.len(), |p, out| {
+        let own = span(&[p], x, to, 0.0);
+        grid.cells(&own, |k| {
+            for &(_, f) in grid.at(k) {
+                if !faces[f as usize].contains(&p)
+                    && boxes[f as usize].overlaps(&own)
+                    && keep(p as u32, f)
+                {
+                    out.push((p as u32, f));
                 }
-            });
-            out.sort_unstable();
-            out.dedup();
-            out
-        })
-        .collect();
-    per.into_iter().flatten().collect()
+            }
+        });
+    })
 }
 
 /// Edge `e` and face `f` sharing no vertex whose boxes at `x` overlap: the candidates for an
@@ -232,27 +293,17 @@ pub fn edge_triangle(x: &[Vec3], edges: &[[usize; 2]], faces: &[[usize; 3]]) -> 
     }
     let boxes: Vec<Aabb> = faces.par_iter().map(|f| span(f, x, None, 0.0)).collect();
     let grid = Grid::new(&boxes);
-    let per: Vec<Vec<(u32, u32)>> = (0..edges.len())
-        .into_par_iter()
-        .map(|e| {
-            let own = span(&edges[e], x, None, 0.0);
-            let mut out = Vec::new();
-            grid.cells(&own, |k| {
-                for &(_, f) in grid.at(k) {
-                    let face = &faces[f as usize];
-                    if !edges[e].iter().any(|v| face.contains(v))
-                        && boxes[f as usize].overlaps(&own)
-                    {
-                        out.push((e as u32, f));
-                    }
+    gather(edges.len(), |e, out| {
+        let own = span(&edges[e], x, None, 0.0);
+        grid.cells(&own, |k| {
+            for &(_, f) in grid.at(k) {
+                let face = &faces[f as usize];
+                if !edges[e].iter().any(|v| face.contains(v)) && boxes[f as usize].overlaps(&own) {
+                    out.push((e as u32, f));
                 }
-            });
-            out.sort_unstable();
-            out.dedup();
-            out
-        })
-        .collect();
-    per.into_iter().flatten().collect()
+            }
+        });
+    })
 }
 
 /// Edge pairs `(a, b)`, `a < b`, sharing no vertex, whose boxes (one inflated by `radius`)
@@ -280,29 +331,21 @@ pub fn edge_edge_where(
     }
     let inflated: Vec<Aabb> = edges.par_iter().map(|e| span(e, x, to, radius)).collect();
     let grid = Grid::new(&inflated);
-    let per: Vec<Vec<(u32, u32)>> = (0..edges.len())
-        .into_par_iter()
-        .map(|a| {
-            let own = span(&edges[a], x, to, 0.0);
-            let mut out = Vec::new();
-            grid.cells(&own, |k| {
-                for &(_, b) in grid.at(k) {
-                    let bu = b as usize;
-                    if bu > a
-                        && !edges[bu].iter().any(|v| edges[a].contains(v))
-                        && inflated[bu].overlaps(&own)
-                        && keep(a as u32, b)
-                    {
-                        out.push((a as u32, b));
-                    }
+    gather(edges.len(), |a, out| {
+        let own = span(&edges[a], x, to, 0.0);
+        grid.cells(&own, |k| {
+            for &(_, b) in grid.at(k) {
+                let bu = b as usize;
+                if bu > a
+                    && !edges[bu].iter().any(|v| edges[a].contains(v))
+                    && inflated[bu].overlaps(&own)
+                    && keep(a as u32, b)
+                {
+                    out.push((a as u32, b));
                 }
-            });
-            out.sort_unstable();
-            out.dedup();
-            out
-        })
-        .collect();
-    per.into_iter().flatten().collect()
+            }
+        });
+    })
 }
 
 #[cfg(test)]
