@@ -4,15 +4,15 @@
 //!
 //! A uniform grid: each face's (each edge's) box, inflated by the radius, is listed under every
 //! cell it overlaps, in a table sorted by cell (and primitive, so the table is the same on any
-//! thread count), with a hash index from each occupied cell to its rows; each vertex looks up the one cell it lies in, each edge the cells its own box
-//! overlaps. The cell is twice the median inflated box's longest side, at most the largest's
-//! (so a box of a mesh of even size spans at most two or three cells per axis), doubled while
-//! the boxes would be listed under more than 16 cells each on average, and never finer than
-//! 2²⁰ cells per axis: a few large boxes (a coarse obstacle's triangles beside a fine sheet) do
-//! not put every small one into one cell. Build and queries are linear in the number of
-//! primitives for meshes of even size; the queries run in parallel chunks of primitives, each
-//! primitive's results sorted, concatenated in primitive order. The candidates do not depend on
-//! the cell or the thread count.
+//! thread count), with a hash index from each occupied cell to its rows; each vertex looks up the
+//! one cell it lies in, each edge the cells its own box overlaps. The cell is twice the median
+//! inflated box's longest side, at most the largest's (so a box of a mesh of even size spans at
+//! most two or three cells per axis), doubled while the boxes would be listed under more than 16
+//! cells each on average, and never finer than 2²⁰ cells per axis: a few large boxes (a coarse
+//! obstacle's triangles beside a fine sheet) do not put every small one into one cell. Build and
+//! queries are linear in the number of primitives for meshes of even size; the queries run in
+//! parallel chunks of primitives, each primitive's results sorted, concatenated in primitive order.
+//! The candidates do not depend on the cell or the thread count.
 //!
 //! Units: positions and radius m.
 
@@ -182,7 +182,7 @@ impl Grid {
     fn entries(boxes: &[Aabb], origin: Vec3, cell: Real) -> usize {
         let span = |a: Real, b: Real, o: Real| {
             let at = |v: Real| ((v - o) / cell).max(0.0) as u64;
-            (at(b) - at(a).min(at(b)) + 1) as Real
+            (at(b).saturating_sub(at(a)) + 1) as Real
         };
         boxes
             .iter()

@@ -263,31 +263,22 @@ struct Cached {
 }
 
 impl Cache {
-    /// The largest distance of a point of the query from `at` when the cache covers the
-    /// query (struct doc), `None` when it does not.
-    fn covers(&self, x: &[Vec3], to: Option<&[Vec3]>, r: Real) -> Option<Real> {
+    /// Twice the largest distance of a point of `x` (and of `to`) from `at`, plus the rounding
+    /// slack (m): the most any pair's distance, or its boxes' gap, can have shrunk since the
+    /// pairs were found. `None` for points of another scene (another count).
+    fn spread(&self, x: &[Vec3], to: Option<&[Vec3]>) -> Option<Real> {
         if self.at.len() != x.len() {
             return None;
         }
         let u = farthest(x, &self.at).max(to.map_or(0.0, |t| farthest(t, &self.at)));
         // The boxes' bounds round at the coordinates' last bits: a margin of 1e-12 of the
         // largest keeps the superset exact.
-        (r + 2.0 * u + self.slack <= self.reach).then_some(u)
+        Some(2.0 * u + self.slack)
     }
 
-    /// The cached pairs whose boxes at `x` (with `to`) overlap as the broad phase tests them
-    /// with radius `r`, when the cache covers the query; `None` when it does not.
-    #[allow(clippy::type_complexity)]
-    fn serve(
-        &self,
-        faces: &[[usize; 3]],
-        edges: &[[usize; 2]],
-        x: &[Vec3],
-        to: Option<&[Vec3]>,
-        r: Real,
-    ) -> Option<(Vec<(u32, u32)>, Vec<(u32, u32)>)> {
-        self.covers(x, to, r)?;
-        Some(self.filter(faces, edges, x, to, r))
+    /// Whether the cache covers the query (struct doc).
+    fn covers(&self, x: &[Vec3], to: Option<&[Vec3]>, r: Real) -> bool {
+        self.spread(x, to).is_some_and(|s| r + s <= self.reach)
     }
 
     /// The cached pairs whose boxes at `x` (with `to`) overlap as the broad phase tests them
@@ -728,7 +719,8 @@ impl SelfContact {
         if let Some(hit) = cached
             .pairs
             .as_ref()
-            .and_then(|c| c.serve(&self.faces, &self.edges, x, to, radius))
+            .filter(|c| c.covers(x, to, radius))
+            .map(|c| c.filter(&self.faces, &self.edges, x, to, radius))
         {
             return hit;
         }
@@ -749,7 +741,9 @@ impl SelfContact {
             pt,
             ee,
         };
-        let hit = c.serve(&self.faces, &self.edges, x, to, radius);
+        let hit = c
+            .covers(x, to, radius)
+            .then(|| c.filter(&self.faces, &self.edges, x, to, radius));
         cached.pairs = Some(c);
         // Covered but for the rounding margin at the edge of the width: the broad phase.
         hit.unwrap_or_else(|| self.broad_pairs(x, to, radius))
@@ -816,13 +810,11 @@ impl SelfContact {
     /// where it was built ([`Self::room`]).
     fn clear_of_all(&self, x: &[Vec3], beyond: Real) -> bool {
         let cached = self.cache.lock().unwrap_or_else(|e| e.into_inner());
-        let Some(c) = cached.pairs.as_ref() else {
-            return false;
-        };
-        let Some(room) = c.room.filter(|r| *r > beyond && c.at.len() == x.len()) else {
-            return false;
-        };
-        2.0 * farthest(x, &c.at) + c.slack < room - beyond
+        cached.pairs.as_ref().is_some_and(|c| {
+            c.room
+                .zip(c.spread(x, None))
+                .is_some_and(|(room, s)| s < room - beyond)
+        })
     }
 
     /// Whether no pair can come within its law on the straight paths from `x` to `to` (the
@@ -832,13 +824,12 @@ impl SelfContact {
     /// counts as one over paths for [`Self::candidate_pairs`]'s jumps.
     fn roomy(&self, x: &[Vec3], to: &[Vec3]) -> bool {
         let mut cached = self.cache.lock().unwrap_or_else(|e| e.into_inner());
-        let Some(c) = cached.pairs.as_ref() else {
-            return false;
-        };
-        let Some(room) = c.room.filter(|r| *r > 0.0 && c.at.len() == x.len()) else {
-            return false;
-        };
-        if 2.0 * farthest(x, &c.at).max(farthest(to, &c.at)) + c.slack >= 0.9 * room {
+        let passes = cached.pairs.as_ref().is_some_and(|c| {
+            c.room
+                .zip(c.spread(x, Some(to)))
+                .is_some_and(|(room, s)| s < 0.9 * room)
+        });
+        if !passes {
             return false;
         }
         let moved = farthest(to, x);
@@ -2423,7 +2414,7 @@ mod tests {
                     .unwrap()
                     .pairs
                     .as_ref()
-                    .is_some_and(|c| c.covers(&x, to, r).is_some());
+                    .is_some_and(|c| c.covers(&x, to, r));
                 let got = sc.candidate_pairs(&x, to, r);
                 if covered {
                     served += 1;
