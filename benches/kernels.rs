@@ -782,7 +782,7 @@ fn self_contact(c: &mut Criterion) {
         let mut rng = Rng::new(11);
         let step: Vec<f64> = (0..p.n).map(|_| 2e-4 * rng.symmetric()).collect();
         g.bench_function(BenchmarkId::new("ccd_step_bound_per_pair", nf), |b| {
-            b.iter(|| black_box(pot.step_bound(&x, &step).fraction))
+            b.iter(|| black_box(pot.step_bound(&x, &phi, &step).fraction))
         });
         g.throughput(Throughput::Elements(1));
         let mut lin = LinearSolver::new(&p).unwrap();

@@ -3,7 +3,8 @@
 come closer than a floor, in every frame.
 
     contact_check.py REFERENCE_MESH OUT_DIR --exclusion R [--floor D] [--json FILE]
-    contact_check.py REFERENCE_MESH OUT_DIR --obstacle FILE [--translate X Y Z] [--floor D] ...
+    contact_check.py REFERENCE_MESH OUT_DIR --obstacle FILE [--translate X Y Z]
+                     [--push COLUMN EX EY EZ] [--floor D] ...
 
 Reads the reference mesh and every frame of OUT_DIR with VTK's own readers, and, brute force
 over every pair of faces that share no vertex (numpy, none of shellsim's code):
@@ -20,10 +21,13 @@ pair intersects or comes below --floor.
 
 With --obstacle, the pairs are instead every face of the sheet with every face of that rigid
 mesh (moved by --translate), which stands still: the distance is then from the sheet's
-mid-surface to the obstacle's surface. --last checks the last frame only.
+mid-surface to the obstacle's surface. A force-controlled obstacle moves: with --push, each
+frame's obstacle is moved further by q (EX, EY, EZ), q the frame's value of the column COLUMN
+of OUT_DIR/log.csv (its offset, `obstacle{i}_offset`). --last checks the last frame only.
 """
 
 import argparse
+import csv
 import glob
 import json
 import os
@@ -173,6 +177,7 @@ def main():
     ap.add_argument("--exclusion", type=float)
     ap.add_argument("--obstacle")
     ap.add_argument("--translate", type=float, nargs=3, default=[0.0, 0.0, 0.0])
+    ap.add_argument("--push", nargs=4, metavar=("COLUMN", "EX", "EY", "EZ"))
     ap.add_argument("--floor", type=float, default=0.0)
     ap.add_argument("--json")
     ap.add_argument("--last", action="store_true", help="check the last frame only")
@@ -207,9 +212,19 @@ def report(a, faces, i, j, y, other):
     if not frames:
         print(f"{a.out}: no frames", file=sys.stderr)
         return 2
+    offsets = {}
+    if a.push:
+        with open(os.path.join(a.out, "log.csv")) as f:
+            rows = list(csv.DictReader(f))
+        offsets = {int(r["frame"]): float(r[a.push[0]]) for r in rows}
+        direction = np.array([float(c) for c in a.push[1:]])
     best = (np.inf, None, None)
     crossing = 0
+    y_at = y
     for fr in frames:
+        if a.push:
+            number = int(os.path.basename(fr)[len("frame_") : -len(".vtu")])
+            y = y_at + offsets[number] * direction
         x, fs = read(fr)
         if not np.array_equal(fs, faces):
             print(f"{fr}: the faces differ from the reference mesh's", file=sys.stderr)

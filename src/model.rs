@@ -94,6 +94,7 @@ impl<'a> Potential<'a> {
             owned: None,
             force_scale: scene.body.force_scale,
             taken_at: &[],
+            taken_dofs: &[],
             states: &scene.initial_states,
         }
     }

@@ -505,6 +505,28 @@ fn a_sheet_draped_over_a_sphere_rests_on_its_contact_force() {
     assert!(f > 1e-2 * weight, "no friction acts: {friction:?}");
 }
 
+/// The independent check `scripts/contact_check.py` run in `d` with `args` (VTK's readers,
+/// brute force over every pair of a sheet face and an obstacle face): its JSON summary,
+/// written to `d/json`.
+fn contact_check(d: &Path, json: &str, args: &[&str]) -> serde_json::Value {
+    let python = std::env::var("SHELLSIM_PYTHON").unwrap_or_else(|_| "python3".into());
+    let res = std::process::Command::new(&python)
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/contact_check.py"))
+        .args(args)
+        .arg("--json")
+        .arg(json)
+        .current_dir(d)
+        .output()
+        .unwrap_or_else(|e| panic!("{python}: {e}"));
+    let text = std::fs::read_to_string(d.join(json)).unwrap_or_else(|_| {
+        panic!(
+            "contact_check.py failed (is VTK in {python}? run the tests with scripts/test.sh):\n{}",
+            String::from_utf8_lossy(&res.stderr)
+        )
+    });
+    serde_json::from_str(&text).unwrap()
+}
+
 /// The smallest value of the gap column `column` (m) over the frames of the run `out`,
 /// asserting that no frame has a pair closer than a tenth of its offset h/2 (gap ≥ −0.9 h/2).
 fn smallest_gap(out: &Path, column: &str, h: f64) -> f64 {
@@ -622,6 +644,155 @@ fn a_mesh_plane_holds_a_sheet_as_the_analytic_plane_does() {
     assert_carries(&force(&barrier, 0), weight, "mesh plane, barrier");
 }
 
+/// A disk (radius 0.5 m, h = 5 mm) on a plane, pressed by a plate of two triangles (an OBJ
+/// file, 0.1 mm above it) under a prescribed force of 2000 N, the plate's offset along the
+/// force a global DOF of the solve, against the analytic plane pressed the same way, whose law
+/// on every vertex is the same `k A_v ψ(h/2 − d)`:
+/// * statics (the force dialled in): the plate's push balances the force and the plane carries
+///   it, to 1e-6; the plate's offset agrees with the analytic plane's to 1e-6, and its gap with
+///   the closed form `−√(2δσ/k)` of a uniform squeeze (σ = F/A below kδ/2) to 1e-4; the frames
+///   of 1 and 2 threads are identical to the bit;
+/// * dynamics (20 N, mass 0.5 kg, starting 1 cm above the disk): in free flight the plate's speed is
+///   `F t / M` to round-off, and once it rests on the disk its push balances the force to 1e-4;
+///   no frame has a pair within a tenth of its offset.
+#[test]
+fn a_force_controlled_mesh_presses_as_the_analytic_plane_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    disk(d, "0.05", "disk.vtk");
+    let (h, f, e) = (0.005, 2000.0, 1e6);
+    // The plate faces down: its normal, from the winding, points away from the disk.
+    std::fs::write(
+        d.join("plate.obj"),
+        "v -1 -1 0.0026\nv -1 1 0.0026\nv 1 1 0.0026\nv 1 -1 0.0026\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    let base = format!(
+        "[material]\nyoung = {e}\npoisson = 0.3\nthickness = {h}\n\
+         [[obstacles]]\nshape = \"plane\"\npoint = [0, 0, -0.0025]\nnormal = [0, 0, 1]\n"
+    );
+    let plane = "shape = \"plane\"\npoint = [0, 0, 0.0026]\nnormal = [0, 0, -1]\n";
+    let plate = "shape = \"mesh\"\nfile = \"plate.obj\"\n";
+    let statics = |top: &str| {
+        format!(
+            "{base}[[obstacles]]\n{top}force = [0, 0, -{f}]\n\
+             [output]\ncontinuation_frames = false\n"
+        )
+    };
+    let analytic = run(d, &statics(plane), "disk.vtk", "analytic", "2");
+    let one = run(d, &statics(plate), "disk.vtk", "plate1", "1");
+    let two = run(d, &statics(plate), "disk.vtk", "plate2", "2");
+    for (k, v) in &one {
+        assert!(
+            k.ends_with("_seconds") || two[k].to_bits() == v.to_bits(),
+            "{k} differs between 1 and 2 threads"
+        );
+    }
+    let a = std::fs::read(d.join("plate1/frame_00001.vtu")).unwrap();
+    let b = std::fs::read(d.join("plate2/frame_00001.vtu")).unwrap();
+    assert!(a == b, "frames differ between 1 and 2 threads");
+    let (below, above) = (force(&one, 0), force(&one, 1));
+    let (qa, qm) = (analytic["obstacle1_offset"], one["obstacle1_offset"]);
+    // The squeeze's closed form: every vertex sinks p into both sides, ψ′(p) = σ/k.
+    let area = weight_of(d, "disk.vtk", 1.0, 1.0, 1.0);
+    let (k, delta) = (e / h, h / 100.0);
+    let sigma = f / area;
+    assert!(sigma < k * delta / 2.0);
+    let p = (2.0 * delta * sigma / k).sqrt();
+    println!(
+        "statics: plane {below:?} N, plate {above:?} N, offset {qm} m (analytic plane {qa} m), \
+         gap {} m (closed form {})",
+        one["obstacle1_gap"], -p
+    );
+    assert!((above[2] / -f - 1.0).abs() < 1e-6, "{above:?}");
+    assert!((below[2] / f - 1.0).abs() < 1e-6, "{below:?}");
+    assert!((qm - qa).abs() < 1e-6 * qa.abs(), "{qm} vs {qa}");
+    assert!(
+        (one["obstacle1_gap"] + p).abs() < 1e-4 * p,
+        "{} vs {}",
+        one["obstacle1_gap"],
+        -p
+    );
+
+    let (f, m) = (20.0, 0.5);
+    let dynamics = format!(
+        "{base}[solver]\nmode = \"dynamic\"\n[time]\nend = 0.5\ndt = 1e-3\ndt_max = 0.05\n\
+         output_interval = 0.02\ndamping = 0.1\n[[obstacles]]\n{}force = [0, 0, -{f}]\n\
+         mass = {m}\n",
+        plate.to_string() + "translate = [0, 0, 0.01]\n"
+    );
+    let row = run(d, &dynamics, "disk.vtk", "drop", "2");
+    let (q, w) = frame_globals(&d.join("drop"), 1);
+    println!("free flight at 0.02 s: offset {q:?} m, speed {w:?} m/s");
+    assert!((w[0] / (f / m * 0.02) - 1.0).abs() < 1e-12, "{w:?}");
+    let above = force(&row, 1);
+    println!(
+        "at rest: plate {above:?} N, offset {}, smallest gap {}",
+        row["obstacle1_offset"],
+        smallest_gap(&d.join("drop"), "obstacle1_gap", h)
+    );
+    assert!((above[2] / -f - 1.0).abs() < 1e-4, "{above:?}");
+}
+
+/// A disk (radius 0.5 m, h = 5 mm, held sideways) on a plane, pressed with 200 N by a sphere
+/// mesh (radius 0.3 m, edges about 5 cm) that starts 1 cm above it: in statics the offset
+/// crosses the gap by Newton steps that CCD bounds as the ball's vertices move along the
+/// force, comes to rest where the ball's push balances the force and the plane carries it, to
+/// 1e-6, and no continuation step's frame has a pair within a tenth of its offset.
+#[test]
+fn a_force_controlled_sphere_mesh_comes_down_onto_a_disk() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    disk(d, "0.05", "disk.vtk");
+    shellsim(
+        &[
+            "mesh", "sphere", "--radius", "0.3", "--edge", "0.05", "-o", "ball.vtk",
+        ],
+        d,
+    );
+    let (h, f) = (0.005, 200.0);
+    // Frictionless, a free disk squeezed by a faceted ball slides sideways off its facets.
+    let settings = format!(
+        "[material]\nyoung = 1e6\npoisson = 0.3\nthickness = {h}\n\
+         [[constraints.support]]\ncomponents = [\"x\", \"y\"]\n\
+         inside = {{ min = [-1, -1, -1], max = [1, 1, 1] }}\n\
+         [[obstacles]]\nshape = \"plane\"\npoint = [0, 0, -0.0025]\nnormal = [0, 0, 1]\n\
+         [[obstacles]]\nshape = \"mesh\"\nfile = \"ball.vtk\"\ntranslate = [0, 0, 0.3125]\n\
+         force = [0, 0, -{f}]\n[output]\ncontinuation_frames = true\n"
+    );
+    let row = run(d, &settings, "disk.vtk", "ball", "2");
+    let (plane, ball) = (force(&row, 0), force(&row, 1));
+    let gap = smallest_gap(&d.join("ball"), "obstacle1_gap", h);
+    println!(
+        "plane {plane:?} N, ball {ball:?} N, offset {} m, smallest gap {gap} m",
+        row["obstacle1_offset"]
+    );
+    assert!((ball[2] / -f - 1.0).abs() < 1e-6, "{ball:?}");
+    assert!((plane[2] / f - 1.0).abs() < 1e-6, "{plane:?}");
+    assert!(row["obstacle1_offset"] > 0.01, "{row:?}");
+    // The independent check, the ball moved in each frame by its logged offset along the
+    // force: no crossing, and the smallest distance the log reports; the last frame against
+    // the ball pushed 5 mm further crosses it (the control).
+    let check = |z: &str, last: bool| {
+        let mut args = vec!["disk.vtk", "ball", "--obstacle", "ball.vtk"];
+        args.extend(["--translate", "0", "0", z]);
+        args.extend(["--push", "obstacle1_offset", "0", "0", "-1"]);
+        args.extend(last.then_some("--last"));
+        contact_check(d, &format!("check{z}.json"), &args)
+    };
+    let c = check("0.3125", false);
+    println!("independent check: {c}");
+    assert_eq!(c["crossing_pairs"], 0, "{c}");
+    let dmin = c["min_distance"].as_f64().unwrap();
+    assert!(
+        (dmin - (h / 2.0 + gap)).abs() < 1e-9,
+        "the check's smallest distance {dmin} against the log's {}",
+        h / 2.0 + gap
+    );
+    let control = check("0.3075", true);
+    assert!(control["crossing_pairs"].as_u64().unwrap() > 0, "{control}");
+}
+
 /// A disk (radius 0.5 m, h = 5 mm) dropped with friction μ = 0.5 onto a geodesic sphere mesh
 /// (radius 0.3 m, 980 faces, edges about 5 cm, the disk's own size) placed by `translate`:
 /// it drapes and comes to rest, the mesh's normal and friction forces together carrying the
@@ -664,34 +835,10 @@ fn a_sheet_draped_over_a_sphere_mesh_rests_on_its_contact_force() {
     // ball face): no crossing, and the smallest distance the log reports; the last frame
     // against the ball moved 5 mm up crosses it (the control: the check can fail).
     let check = |z: &str, last: bool| {
-        let json = d.join(format!("check{z}.json"));
-        let python = std::env::var("SHELLSIM_PYTHON").unwrap_or_else(|_| "python3".into());
-        let res = std::process::Command::new(&python)
-            .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/contact_check.py"))
-            .args([
-                "disk.vtk",
-                "drape",
-                "--obstacle",
-                "ball.vtk",
-                "--translate",
-                "0",
-                "0",
-                z,
-            ])
-            .args(last.then_some("--last"))
-            .arg("--json")
-            .arg(&json)
-            .current_dir(d)
-            .output()
-            .unwrap_or_else(|e| panic!("{python}: {e}"));
-        let text = std::fs::read_to_string(&json).unwrap_or_else(|_| {
-            panic!(
-                "contact_check.py failed (is VTK in {python}? run the tests with \
-                 scripts/test.sh):\n{}",
-                String::from_utf8_lossy(&res.stderr)
-            )
-        });
-        serde_json::from_str::<serde_json::Value>(&text).unwrap()
+        let mut args = vec!["disk.vtk", "drape", "--obstacle", "ball.vtk"];
+        args.extend(["--translate", "0", "0", z]);
+        args.extend(last.then_some("--last"));
+        contact_check(d, &format!("check{z}.json"), &args)
     };
     let c = check("-0.3026", false);
     println!("independent check: {c}");
@@ -789,8 +936,22 @@ fn bad_mesh_obstacles_are_refused() {
             &["obstacles[0].shape", "arc_length"][..],
         ),
         (
-            format!("{}\nforce = [0, 0, 1]", mesh("low.obj")),
-            &["obstacles[0].force", "mesh"][..],
+            format!(
+                "{}\nforce = [0, 0, 1]\n[solver]\nmode = \"explicit\"\n[material]\nbending = \"patch_fit\"",
+                mesh("low.obj")
+            ),
+            &["obstacles[0].force", "explicit"][..],
+        ),
+        (
+            format!(
+                "{}\nforce = [0, 0, 1]\nmass = 1\nfriction = 0.3\n[solver]\nmode = \"dynamic\"",
+                mesh("low.obj")
+            ),
+            &["obstacles[0].friction", "force-controlled"][..],
+        ),
+        (
+            format!("{}\nforce = [0, 0, 1]\n[solver]\nmode = \"dynamic\"", mesh("low.obj")),
+            &["obstacles[0].mass", "required"][..],
         ),
         (
             format!(

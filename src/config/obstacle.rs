@@ -24,11 +24,12 @@
 //! Force control: `force = [Fx, Fy, Fz]` (N, reached at dial 1, linear in the dial) pushes the
 //! obstacle along its direction instead of moving it by `displacement`; its offset along the
 //! force is a global DOF of the solve, and `mass` (kg) its inertia, required in dynamic mode.
-//! Static and dynamic modes; frictionless; analytic shapes only.
+//! Static and dynamic modes; frictionless; any shape.
 //!
-//! A `mesh` obstacle is fixed or moved by `displacement` in static (load-controlled) or dynamic
-//! mode: its steps are bounded by continuous collision detection, and its motion within a step
-//! is checked the same way, which arc-length continuation (the dial an unknown of the solve)
+//! A `mesh` obstacle is fixed, moved by `displacement` or pushed by a `force` in static
+//! (load-controlled) or dynamic mode: its steps are bounded by continuous collision detection,
+//! and its motion within a step is checked the same way, which arc-length continuation (the
+//! dial an unknown of the solve)
 //! cannot do. In explicit mode it is fixed (the explicit driver bounds how far each of the
 //! sheet's vertices moves, not the obstacle's), with stick/slip friction.
 //!
@@ -222,22 +223,16 @@ impl ObstacleSettings {
                 );
             }
         }
-        if self.shape == Some(ShapeKind::Mesh) {
-            if let Control::Pressed { .. } = control {
-                return invalid(
-                    "force",
-                    "force control is available on the analytic shapes; move a mesh obstacle \
-                     by `displacement`",
-                );
-            }
-            if mode == Mode::Explicit && self.displacement.iter().any(|&c| c != 0.0) {
-                return invalid(
-                    "displacement",
-                    "a moving mesh obstacle needs solver.mode = \"static\" or \"dynamic\" \
-                     (the explicit driver bounds the sheet's vertices only: a mesh obstacle \
-                     is fixed there, an analytic shape may move)",
-                );
-            }
+        if self.shape == Some(ShapeKind::Mesh)
+            && mode == Mode::Explicit
+            && self.displacement.iter().any(|&c| c != 0.0)
+        {
+            return invalid(
+                "displacement",
+                "a moving mesh obstacle needs solver.mode = \"static\" or \"dynamic\" \
+                 (the explicit driver bounds the sheet's vertices only: a mesh obstacle is \
+                 fixed there, an analytic shape may move)",
+            );
         }
         if self.friction > 0.0 && mode == Mode::Static {
             return invalid(

@@ -110,6 +110,9 @@ pub struct Potential<'a> {
     /// (the driver's solver sets them; empty: the positions evaluated): a contact term tells
     /// there which pairs it gathered.
     pub taken_at: &'a [Vec3],
+    /// The scalar DOFs at the same state as [`Potential::taken_at`] (a force-controlled mesh
+    /// obstacle's offset places its vertices there).
+    pub taken_dofs: &'a [Real],
     /// The stateful terms' states the potential is evaluated with ([`crate::solve::State::terms`]): the
     /// scene's initial states unless a driver sets its own.
     pub states: &'a TermStates,
@@ -207,7 +210,12 @@ impl<'a> Potential<'a> {
     /// moves no global DOF by more than its [`crate::energy::term::GlobalDof::max_step`] and
     /// that every term bounding the steps allows ([`crate::energy::term::StepLimit`]; 1 when
     /// none would bound it), and whether a term asks to gather its elements again first.
-    pub fn step_bound(&self, x: &[Vec3], step: &[Real]) -> crate::energy::term::StepBound {
+    pub fn step_bound(
+        &self,
+        x: &[Vec3],
+        phi: &[Real],
+        step: &[Real],
+    ) -> crate::energy::term::StepBound {
         let ne = 3 * self.pattern.num_vertices + self.body.num_edge_dofs();
         let globals = step[ne..]
             .iter()
@@ -222,7 +230,7 @@ impl<'a> Potential<'a> {
         self.terms
             .iter()
             .zip(&self.pattern.maps)
-            .filter_map(|(t, map)| Some(t.step_limit()?.max_fraction(self, map, x, step)))
+            .filter_map(|(t, map)| Some(t.step_limit()?.max_fraction(self, map, x, phi, step)))
             .fold(
                 crate::energy::term::StepBound {
                     fraction: globals,
@@ -236,12 +244,17 @@ impl<'a> Potential<'a> {
     }
 
     /// The largest fraction of the jump from `from` at dial `from_dial` to `to` at this
-    /// potential's dial that every term that bounds the steps allows
-    /// ([`crate::energy::term::StepLimit::jump_fraction`]).
-    pub fn jump_fraction(&self, from: &[Vec3], to: &[Vec3], from_dial: Real) -> Real {
+    /// potential's dial, the scalar DOFs `phi` held, that every term that bounds the steps
+    /// allows ([`crate::energy::term::StepLimit::jump_fraction`]).
+    pub fn jump_fraction(&self, from: &[Vec3], to: &[Vec3], phi: &[Real], from_dial: Real) -> Real {
         self.terms
             .iter()
-            .filter_map(|t| Some(t.step_limit()?.jump_fraction(self, from, to, from_dial)))
+            .filter_map(|t| {
+                Some(
+                    t.step_limit()?
+                        .jump_fraction(self, from, to, phi, from_dial),
+                )
+            })
             .fold(1.0, Real::min)
     }
 
@@ -256,13 +269,13 @@ impl<'a> Potential<'a> {
         }
     }
 
-    /// Whether every term that bounds the steps admits the positions `x`
+    /// Whether every term that bounds the steps admits the state `(x, phi)`
     /// ([`crate::energy::term::StepLimit::admits`]).
-    pub fn admits(&self, x: &[Vec3]) -> bool {
+    pub fn admits(&self, x: &[Vec3], phi: &[Real]) -> bool {
         self.terms
             .iter()
             .zip(&self.pattern.maps)
-            .all(|(t, map)| t.step_limit().is_none_or(|l| l.admits(self, map, x)))
+            .all(|(t, map)| t.step_limit().is_none_or(|l| l.admits(self, map, x, phi)))
     }
 
     /// As [`Potential::eval`], with the element Hessians projected as `projection` says.

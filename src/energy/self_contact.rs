@@ -117,11 +117,12 @@
 //! separate layers: closer than their offset, they are an error naming the faces. A reference
 //! surface with an edge through a face (not sharing a vertex) is an error naming the two faces.
 //!
-//! **Mesh obstacles** (`[[obstacles]]` with `shape = "mesh"`): a rigid triangle mesh, fixed or
-//! moved by its `displacement` × the dial, is the one-sided case of the same pairs, through the
-//! same distances, CCD and checks; within a solve it stands still, and its move to a new
-//! step's dial is checked by CCD over the jump before the step is solved (with the jump of the
-//! vertices on prescribed paths), a refused jump cutting the step. Its
+//! **Mesh obstacles** (`[[obstacles]]` with `shape = "mesh"`): a rigid triangle mesh, fixed,
+//! moved by its `displacement` × the dial, or pushed by a `force`, is the one-sided case of the
+//! same pairs, through the same distances, CCD and checks; moved with the dial, it stands still
+//! within a solve, and its move to a new step's dial is checked by CCD over the jump before the
+//! step is solved (with the jump of the vertices on prescribed paths), a refused jump cutting
+//! the step. Its
 //! vertices are no DOFs (absent slots of the stencil, [`crate::elements::ABSENT`]) and its
 //! thickness is 0, so the offset of a pair with it is half the sheet's thickness: the sheet's
 //! surface rests on the obstacle's. Only the sheet presses: a sheet vertex on an obstacle's face
@@ -134,11 +135,25 @@
 //! `mesh_obstacles` and gathers no sheet–sheet pairs. At rest no edge of the sheet may pass
 //! through a face of an obstacle or the reverse, and no pair may be within its reach.
 //!
+//! **Force control** (`force` F ê at dial 1, `mass` M): the obstacle's vertices sit at
+//! `y_o = ȳ_o + q ê`, its offset `q` (m) a global DOF of the solve, with the energy of an
+//! analytic force-controlled obstacle's force and inertia, `−s F q + M (q − q̂)²/(2Δt²)`
+//! ([`crate::energy::obstacles::pressed`]). A pair with it depends on `q` through its rigid
+//! slots: with `P` the twelve-vector of `ê` in those slots, `∂E/∂q = Pᵀ∇E`,
+//! `∂²E/∂x∂q = ∇²E P`, `∂²E/∂q² = Pᵀ∇²E P`. The stencil then has a fifth slot of one DOF,
+//! `q`'s node (absent for the pairs without such an obstacle), and ends with one element per
+//! such obstacle for its force. Within a solve its vertices move along each Newton step by
+//! `dq ê`, inside the same CCD, broad phase over the paths and checks as the sheet's. It is
+//! frictionless, and refused in explicit mode.
+//!
 //! Units: positions m, k Pa/m, δ, ξ, R m, A m², energies J. DOF order per pair: the four
 //! points' coordinates, point–triangle `(p, t₂, t₁, t₀)` with `t₀ < t₁ < t₂`, edge–edge
-//! `(a, b, c, d)` with `a < b`, `c < d` (the order of the last two slots tells the kinds apart).
+//! `(a, b, c, d)` with `a < b`, `c < d` (the order of the last two slots tells the kinds apart);
+//! with a force-controlled mesh obstacle, then its offset `q` (m; a 13th DOF, the fifth slot).
 
-use super::term::{ExplicitHooks, LaggedNormals, Reports, StepBound, StepLimit, Term};
+use super::term::{
+    ExplicitHooks, GlobalDof, GlobalDofs, LaggedNormals, Reports, StepBound, StepLimit, Term,
+};
 use crate::body::Body;
 use crate::contact::{barrier, broad, ccd, distance, friction_potential, penalty};
 use crate::elements::Stencil;
@@ -146,6 +161,7 @@ use crate::elements::{assemble_elements, no_contribution, ElementMap, Want, ABSE
 use crate::energy::term::ChangingElements;
 use crate::energy::{HessianProjection, Potential};
 use crate::math::{Real, SMat, SVec, Vec3};
+use crate::mesh::topology::NONE;
 use crate::mesh::MeshError;
 use rayon::prelude::*;
 use std::borrow::Cow;
@@ -225,6 +241,9 @@ pub struct SelfContact {
     /// The widest margin a cache may have beyond a query's radius (m): twice the mean edge of
     /// the sheet, so that it holds a bounded number of pairs per primitive.
     cache_cap: Real,
+    /// The force-controlled mesh obstacles (indices into the rigid bodies), in the order of
+    /// their global DOFs; empty when none is: the stencil then has no fifth slot.
+    pushed: Vec<usize>,
 }
 
 /// The pairs the broad phase found at the positions `at` within `reach`: a superset of what
@@ -344,6 +363,24 @@ struct RigidBody {
     smoothing: Real,
     /// Coulomb coefficient μ against the sheet (0 in statics).
     friction: Real,
+    /// The force that pushes it, when it is force-controlled (`force`).
+    push: Option<Push>,
+}
+
+/// A force-controlled mesh obstacle's push: it moves by `q ê`, `q` a global DOF of the solve
+/// (module doc).
+#[derive(Clone, Copy)]
+struct Push {
+    /// Unit direction ê of the force.
+    direction: Vec3,
+    /// Magnitude of the force at dial 1 (N).
+    force: Real,
+    /// Mass (kg; 0 in statics).
+    mass: Real,
+    /// Largest Newton step of the offset (m).
+    max_step: Real,
+    /// Its global node (set by [`GlobalDofs::bind`]).
+    node: usize,
 }
 
 /// Whether the element with these four nodes is a point–triangle pair (module doc: the order
@@ -443,22 +480,52 @@ impl SelfContact {
         }
     }
 
-    /// The internal numbers of a stencil's nodes.
+    /// The internal numbers of a stencil's pairs, four nodes each: without the fifth slot
+    /// and the force elements a stencil has with force-controlled obstacles
+    /// ([`Self::handed_out`]).
     fn internal<'a>(&self, nodes: &'a [usize]) -> Cow<'a, [usize]> {
         if self.rigid.rest.is_empty() {
             Cow::Borrowed(nodes)
-        } else {
+        } else if self.pushed.is_empty() {
             Cow::Owned(nodes.iter().map(|&u| self.at(u)).collect())
+        } else {
+            let pairs = (nodes.len() / 5).saturating_sub(self.pushed.len());
+            Cow::Owned(
+                nodes[..5 * pairs]
+                    .chunks_exact(5)
+                    .flat_map(|n| n[..4].iter().map(|&u| self.at(u)))
+                    .collect(),
+            )
         }
     }
 
+    /// The offset `q` (m) of rigid body `b` in the scalar DOFs `phi`: 0 unless it is
+    /// force-controlled (and 0 where `phi` does not hold its DOF: the explicit driver's
+    /// positions, which no force-controlled obstacle takes part in).
+    #[inline]
+    fn pushed_by(&self, b: usize, phi: &[Real]) -> Real {
+        self.rigid.bodies[b]
+            .push
+            .map_or(0.0, |p| phi.get(p.node - self.nv).copied().unwrap_or(0.0))
+    }
+
     /// The sheet's positions `x` followed by the obstacles' at dial `dial` (clamped to
-    /// [0, 1]).
-    fn placed<'a>(&self, x: &'a [Vec3], dial: Real) -> Cow<'a, [Vec3]> {
+    /// [0, 1]), a force-controlled one offset along its force by its DOF in `phi`.
+    fn placed<'a>(&self, x: &'a [Vec3], phi: &[Real], dial: Real) -> Cow<'a, [Vec3]> {
         if self.rigid.rest.is_empty() {
             return Cow::Borrowed(x);
         }
         let s = dial.clamp(0.0, 1.0);
+        let offsets: Vec<Vec3> = self
+            .rigid
+            .bodies
+            .iter()
+            .enumerate()
+            .map(|(b, body)| {
+                body.push
+                    .map_or(Vec3::zeros(), |p| p.direction * self.pushed_by(b, phi))
+            })
+            .collect();
         let mut all = Vec::with_capacity(x.len() + self.rigid.rest.len());
         all.extend_from_slice(&x[..self.nv]);
         all.extend(
@@ -466,9 +533,18 @@ impl SelfContact {
                 .rest
                 .iter()
                 .zip(&self.rigid.shift)
-                .map(|(r, u)| r + u * s),
+                .zip(&self.rigid.owner)
+                .map(|((r, u), &b)| r + u * s + offsets[b as usize]),
         );
         Cow::Owned(all)
+    }
+
+    /// The force-controlled obstacle a pair (internal numbering) involves, as its body index.
+    #[inline]
+    fn pusher(&self, nodes: &[usize]) -> Option<usize> {
+        let u = nodes.iter().copied().find(|&u| u >= self.nv)?;
+        let b = self.rigid.owner[u - self.nv] as usize;
+        self.rigid.bodies[b].push.is_some().then_some(b)
     }
 
     /// The obstacle of a pair that involves one (the one its rigid nodes belong to).
@@ -845,12 +921,52 @@ impl SelfContact {
         self.timed(Clock::Broad, || self.pairs_untimed(x, beyond))
     }
 
-    /// A stencil in the internal numbering as the solve numbers it (struct doc).
+    /// A stencil in the internal numbering as the solve numbers it (struct doc). With
+    /// force-controlled obstacles, each pair has a fifth slot, the global node of the
+    /// obstacle it involves (or none), and the stencil ends with one element per such
+    /// obstacle, its force and inertia on its node alone.
     fn handed_out(&self, mut st: Stencil) -> Stencil {
-        for u in st.nodes.iter_mut().filter(|u| **u >= self.nv) {
-            *u = ABSENT + (*u - self.nv);
+        let solve = |u: usize| {
+            if u >= self.nv {
+                ABSENT + (u - self.nv)
+            } else {
+                u
+            }
+        };
+        if self.pushed.is_empty() {
+            for u in st.nodes.iter_mut() {
+                *u = solve(*u);
+            }
+            return st;
         }
+        let pairs = st.nodes.len() / 4;
+        let mut nodes = Vec::with_capacity(5 * (pairs + self.pushed.len()));
+        for n in st.nodes.chunks_exact(4) {
+            nodes.extend(n.iter().map(|&u| solve(u)));
+            nodes.push(self.pusher(n).map_or(NONE, |b| self.push_node(b)));
+        }
+        for &b in &self.pushed {
+            nodes.extend_from_slice(&[NONE, NONE, NONE, NONE, self.push_node(b)]);
+            st.anchors.push(self.rigid.rest[self.first_vertex(b)]);
+        }
+        st.nodes = nodes;
+        st.slot_dofs = vec![3, 3, 3, 3, 1];
         st
+    }
+
+    /// The global node of force-controlled body `b`.
+    #[inline]
+    fn push_node(&self, b: usize) -> usize {
+        self.rigid.bodies[b].push.map_or(NONE, |p| p.node)
+    }
+
+    /// The first vertex of rigid body `b` (an index into the obstacles' vertices).
+    fn first_vertex(&self, b: usize) -> usize {
+        self.rigid
+            .owner
+            .iter()
+            .position(|&o| o as usize == b)
+            .unwrap_or(0)
     }
 
     /// [`SelfContact::pairs`], untimed (the checks at build).
@@ -1122,8 +1238,10 @@ impl SelfContact {
         Vec<Vec3>,
         Vec<Option<Slip>>,
     ) {
-        let lag = self.placed(fr.x_lag, fr.dial_lag);
-        let prev = self.placed(fr.x_prev, fr.dial_prev).into_owned();
+        // A force-controlled obstacle is frictionless: its pairs have no friction to lag, and
+        // its place (offset 0 here) in these positions is never read.
+        let lag = self.placed(fr.x_lag, &[], fr.dial_lag);
+        let prev = self.placed(fr.x_prev, &[], fr.dial_prev).into_owned();
         (fr, prev, self.lagged_friction(nodes, &lag))
     }
 
@@ -1181,6 +1299,7 @@ impl SelfContact {
         pot: &Potential,
         map: &ElementMap,
         x: &[Vec3],
+        phi: &[Real],
         want: Want,
         projection: HessianProjection,
         grad: &mut [Real],
@@ -1191,27 +1310,59 @@ impl SelfContact {
             return 0.0;
         }
         let all = self.internal(&map.nodes);
-        let x = &*self.placed(x, pot.dial);
+        let x = &*self.placed(x, phi, pot.dial);
         let active = self.active(&all, x);
         let gauss_newton = projection == HessianProjection::GaussNewton;
         let friction = pot
             .friction
             .filter(|_| with_friction && self.has_friction())
             .map(|fr| self.step_friction(fr, &all));
-        assemble_elements::<12, 4, _>(
+        let pair = |e: usize, mut g: Option<&mut SVec<12>>, mut h: Option<&mut SMat<12, 12>>| {
+            let nodes = &all[4 * e..4 * e + 4];
+            let mut energy = if active[e] {
+                self.element(nodes, x, gauss_newton, g.as_deref_mut(), h.as_deref_mut())
+            } else {
+                no_contribution(g.as_deref_mut(), h.as_deref_mut())
+            };
+            if let Some((fr, prev, Some(s))) =
+                friction.as_ref().map(|(fr, prev, l)| (fr, prev, &l[e]))
+            {
+                energy += Self::slip(s, nodes, x, prev, fr.eps, g, h);
+            }
+            energy
+        };
+        if self.pushed.is_empty() {
+            return assemble_elements::<12, 4, _>(
+                map,
+                |e, _, g, h| pair(e, g, h),
+                pot.node_fixed,
+                projection,
+                want,
+                grad,
+                values,
+                &pot.pattern.col_ptr,
+            );
+        }
+        let pairs = all.len() / 4;
+        assemble_elements::<13, 5, _>(
             map,
-            |e, _, mut g, mut h| {
-                let nodes = &all[4 * e..4 * e + 4];
-                let mut energy = if active[e] {
-                    self.element(nodes, x, gauss_newton, g.as_deref_mut(), h.as_deref_mut())
-                } else {
-                    no_contribution(g.as_deref_mut(), h.as_deref_mut())
-                };
-                if let Some((fr, prev, Some(s))) =
-                    friction.as_ref().map(|(fr, prev, l)| (fr, prev, &l[e]))
-                {
-                    energy += Self::slip(s, nodes, x, prev, fr.eps, g, h);
+            |e, slots, g, h| {
+                if e >= pairs {
+                    return self.force_element(pot, phi, self.pushed[e - pairs], g, h);
                 }
+                let nodes = &all[4 * e..4 * e + 4];
+                let direction = self
+                    .pusher(nodes)
+                    .and_then(|b| self.rigid.bodies[b].push)
+                    .map(|p| p.direction);
+                debug_assert_eq!(direction.is_some(), slots[4] != NONE);
+                let (mut g12, mut h12) = (SVec::<12>::zeros(), SMat::<12, 12>::zeros());
+                let energy = pair(
+                    e,
+                    g.is_some().then_some(&mut g12),
+                    h.is_some().then_some(&mut h12),
+                );
+                Self::pushed_pair(nodes, self.nv, direction, &g12, &h12, g, h);
                 energy
             },
             pot.node_fixed,
@@ -1223,14 +1374,91 @@ impl SelfContact {
         )
     }
 
+    /// A pair's derivatives in the DOF order of a stencil with force-controlled obstacles:
+    /// its twelve coordinates, then the offset `q` of the obstacle it involves, if it is
+    /// pushed along `direction` ê. Its rigid vertices move with `q` by `ê`, so with `P` the
+    /// twelve-vector of `ê` in their slots (0 in the sheet's), `∂E/∂q = Pᵀg`,
+    /// `∂²E/∂x∂q = H P` and `∂²E/∂q² = PᵀHP`; the rigid slots, no DOFs of the solve, are
+    /// cleared, so that a projected Hessian is the projection of the one over the pair's true
+    /// DOFs.
+    fn pushed_pair(
+        nodes: &[usize],
+        nv: usize,
+        direction: Option<Vec3>,
+        g12: &SVec<12>,
+        h12: &SMat<12, 12>,
+        grad: Option<&mut SVec<13>>,
+        hess: Option<&mut SMat<13, 13>>,
+    ) {
+        let mut p = SVec::<12>::zeros();
+        if let Some(u) = direction {
+            for (i, &n) in nodes.iter().enumerate() {
+                if n >= nv {
+                    p.fixed_rows_mut::<3>(3 * i).copy_from(&u);
+                }
+            }
+        }
+        let rigid = |k: usize| direction.is_some() && nodes[k / 3] >= nv;
+        if let Some(g) = grad {
+            g.fixed_rows_mut::<12>(0).copy_from(g12);
+            g[12] = p.dot(g12);
+            for k in (0..12).filter(|&k| rigid(k)) {
+                g[k] = 0.0;
+            }
+        }
+        if let Some(h) = hess {
+            let hp = h12 * p;
+            h.fixed_view_mut::<12, 12>(0, 0).copy_from(h12);
+            h.fixed_view_mut::<12, 1>(0, 12).copy_from(&hp);
+            h.fixed_view_mut::<1, 12>(12, 0).copy_from(&hp.transpose());
+            h[(12, 12)] = p.dot(&hp);
+            for k in (0..12).filter(|&k| rigid(k)) {
+                h.row_mut(k).fill(0.0);
+                h.column_mut(k).fill(0.0);
+            }
+        }
+    }
+
+    /// The force's element of force-controlled body `b` ([`crate::energy::obstacles::pressed::push`]),
+    /// in the fifth slot's DOF.
+    fn force_element(
+        &self,
+        pot: &Potential,
+        phi: &[Real],
+        b: usize,
+        grad: Option<&mut SVec<13>>,
+        hess: Option<&mut SMat<13, 13>>,
+    ) -> Real {
+        let Some(p) = self.rigid.bodies[b].push else {
+            return no_contribution(grad, hess);
+        };
+        let k = p.node - self.nv;
+        let (e, dq, ddq) = crate::energy::obstacles::pressed::push(
+            pot,
+            k,
+            self.pushed_by(b, phi),
+            p.force,
+            p.mass,
+        );
+        if let Some(g) = grad {
+            g.fill(0.0);
+            g[12] = dq;
+        }
+        if let Some(h) = hess {
+            h.fill(0.0);
+            h[(12, 12)] = ddq;
+        }
+        e
+    }
+
     /// The sum over the pairs of the magnitudes of their friction forces at `x` over the
     /// potential's step (N; 0 without one).
-    fn friction_force(&self, pot: &Potential, map: &ElementMap, x: &[Vec3]) -> Real {
+    fn friction_force(&self, pot: &Potential, map: &ElementMap, x: &[Vec3], phi: &[Real]) -> Real {
         let Some(fr) = pot.friction.as_ref() else {
             return 0.0;
         };
         let nodes = self.internal(&map.nodes);
-        let x = &*self.placed(x, pot.dial);
+        let x = &*self.placed(x, phi, pot.dial);
         let (_, prev, lagged) = self.step_friction(*fr, &nodes);
         let per_pair: Vec<Real> = (0..lagged.len())
             .into_par_iter()
@@ -1261,12 +1489,13 @@ impl Reports for SelfContact {
         pot: &Potential,
         map: &ElementMap,
         x: &[Vec3],
-        _phi: &[Real],
+        phi: &[Real],
     ) -> Option<Vec<(&'static str, Real)>> {
         let e = self.assemble(
             pot,
             map,
             x,
+            phi,
             Want::Energy,
             HessianProjection::None,
             &mut [],
@@ -1286,13 +1515,13 @@ impl Reports for SelfContact {
     /// `obstacle{i}_force_x/y/z`, the force its pairs exert on the sheet (N, the normal law's
     /// and, with friction, the friction's), and `obstacle{i}_gap`, the smallest `d − ξ` of its
     /// gathered pairs (m; the halo when none is gathered).
-    fn observables(&self, pot: &Potential, x: &[Vec3], _phi: &[Real]) -> Vec<(String, Real)> {
+    fn observables(&self, pot: &Potential, x: &[Vec3], phi: &[Real]) -> Vec<(String, Real)> {
         let Some(map) = self.map(pot) else {
             return Vec::new();
         };
         let nodes = self.internal(&map.nodes);
         let xs = x;
-        let x = &*self.placed(x, pot.dial);
+        let x = &*self.placed(x, phi, pot.dial);
         let forces = self.forces(&nodes, x);
         let gap = nodes
             .par_chunks(4)
@@ -1310,7 +1539,7 @@ impl Reports for SelfContact {
         if self.has_friction() {
             out.push((
                 format!("{name}_friction"),
-                self.friction_force(pot, map, xs),
+                self.friction_force(pot, map, xs, phi),
             ));
         }
         for (part, clock) in [
@@ -1321,7 +1550,7 @@ impl Reports for SelfContact {
             let ns = self.clock[clock as usize].load(Ordering::Relaxed);
             out.push((format!("{name}_{part}_seconds"), ns as Real * 1e-9));
         }
-        out.extend(self.rigid_observables(pot, &nodes, x));
+        out.extend(self.rigid_observables(pot, &nodes, x, phi));
         out
     }
 
@@ -1329,12 +1558,12 @@ impl Reports for SelfContact {
     /// pairs put on the vertex (shared by the closest points' coefficients) over its area;
     /// `contact_gap` (m): per face, the smallest `d − ξ` of the gathered pairs that involve one
     /// of its vertices (the halo where none does).
-    fn face_fields(&self, pot: &Potential, x: &[Vec3], _phi: &[Real]) -> Vec<(String, Vec<Real>)> {
+    fn face_fields(&self, pot: &Potential, x: &[Vec3], phi: &[Real]) -> Vec<(String, Vec<Real>)> {
         let Some(map) = self.map(pot) else {
             return Vec::new();
         };
         let nodes = self.internal(&map.nodes);
-        let x = &*self.placed(x, pot.dial);
+        let x = &*self.placed(x, phi, pot.dial);
         let force = self.vertex_forces(&nodes, x);
         let mut gap = vec![self.halo; x.len()];
         for n in nodes.chunks(4) {
@@ -1376,6 +1605,7 @@ impl SelfContact {
         pot: &Potential,
         nodes: &[usize],
         x: &[Vec3],
+        phi: &[Real],
     ) -> Vec<(String, Real)> {
         if self.rigid.bodies.is_empty() {
             return Vec::new();
@@ -1424,6 +1654,9 @@ impl SelfContact {
                 out.push((format!("obstacle{i}_force_{c}"), *v));
             }
             out.push((format!("obstacle{i}_gap"), gap[k]));
+            if body.push.is_some() {
+                out.push((format!("obstacle{i}_offset"), self.pushed_by(k, phi)));
+            }
         }
         out
     }
@@ -1453,9 +1686,36 @@ impl SelfContact {
     }
 }
 
+impl GlobalDofs for SelfContact {
+    /// The offset of each force-controlled mesh obstacle along its force (m), as an analytic
+    /// force-controlled obstacle's ([`crate::energy::obstacles::pressed`]).
+    fn dofs(&self) -> Vec<GlobalDof> {
+        self.pushed
+            .iter()
+            .filter_map(|&b| {
+                let body = &self.rigid.bodies[b];
+                body.push.map(|p| GlobalDof {
+                    name: format!("obstacle{}_offset", body.index),
+                    length: 1.0,
+                    max_step: p.max_step,
+                    mass: p.mass,
+                })
+            })
+            .collect()
+    }
+
+    fn bind(&mut self, first_node: usize) {
+        for (k, &b) in self.pushed.iter().enumerate() {
+            if let Some(p) = self.rigid.bodies[b].push.as_mut() {
+                p.node = first_node + k;
+            }
+        }
+    }
+}
+
 impl ChangingElements for SelfContact {
-    fn stencil_at(&self, _: &Body, x: &[Vec3], _: &[Real], dial: Real) -> Stencil {
-        self.handed_out(self.pairs(&self.placed(x, dial), self.halo))
+    fn stencil_at(&self, _: &Body, x: &[Vec3], phi: &[Real], dial: Real) -> Stencil {
+        self.handed_out(self.pairs(&self.placed(x, phi, dial), self.halo))
     }
 }
 
@@ -1464,9 +1724,19 @@ impl LaggedNormals for SelfContact {
     /// largest change of one from the lagged iterate (the pairs that press at each).
     fn lag_change(&self, trial: &[Vec3], dial: Real, lag: &[Vec3], dial_lag: Real) -> (Real, Real) {
         // One after the other: each gathering is timed on the broad phase's clock.
+        // A force-controlled obstacle is frictionless: its pairs, whose place these positions
+        // do not hold, are left out.
         let at = |x: &[Vec3], dial: Real| {
-            let x = self.placed(x, dial);
-            self.vertex_forces(&self.pairs(&x, 0.0).nodes, &x)
+            let x = self.placed(x, &[], dial);
+            let nodes: Vec<usize> = self
+                .pairs(&x, 0.0)
+                .nodes
+                .chunks_exact(4)
+                .filter(|n| self.pusher(n).is_none())
+                .flatten()
+                .copied()
+                .collect();
+            self.vertex_forces(&nodes, &x)
         };
         let (new, old) = (at(trial, dial), at(lag, dial_lag));
         new.iter().zip(&old).fold((0.0, 0.0), |(s, d), (a, b)| {
@@ -1507,7 +1777,8 @@ impl ExplicitHooks for SelfContact {
             return;
         };
         let nodes = self.internal(&map.nodes);
-        let y = self.placed(x, pot.dial);
+        // No force-controlled obstacle in explicit mode.
+        let y = self.placed(x, &[], pot.dial);
         let fixed = &pot.body.fixed;
         let free = |u: usize| u < self.nv && !fixed[u] && pot.mass[u] > 0.0;
         let pairs: Vec<(&[usize], Press, Real)> = self
@@ -1630,28 +1901,41 @@ impl StepLimit for SelfContact {
     /// broad phase over the boxes of the straight paths, inflated by that distance. When one
     /// of them would begin to press and is within the gathering's reach now, gathering again
     /// at `x` adds it and allows the longer step. The broad phase is skipped while no sheet
-    /// vertex has moved from where the pairs were gathered by more than 0.45 of the halo
-    /// (less the barrier's activation distance) along the step: no pair not gathered can then
-    /// come near its law.
+    /// vertex (nor force-controlled obstacle) has moved from where the pairs were gathered by
+    /// more than 0.45 of the halo (less the barrier's activation distance) along the step: no
+    /// pair not gathered can then come near its law. A force-controlled obstacle's vertices
+    /// move along the step by its offset's step times its direction; the others stand still.
     fn max_fraction(
         &self,
         pot: &Potential,
         map: &ElementMap,
         x: &[Vec3],
+        phi: &[Real],
         step: &[Real],
     ) -> StepBound {
         let nv = self.nv;
-        // The obstacles do not move within a solve.
+        // Each obstacle's move along the step: a force-controlled one's offset step along its
+        // force, the others none.
+        let pushes: Vec<Vec3> = self
+            .rigid
+            .bodies
+            .iter()
+            .map(|b| {
+                b.push.map_or(Vec3::zeros(), |p| {
+                    p.direction * step[crate::elements::node_dofs(nv, p.node).0]
+                })
+            })
+            .collect();
         let dx = |v: usize| {
             if v < nv {
                 Vec3::new(step[3 * v], step[3 * v + 1], step[3 * v + 2])
             } else {
-                Vec3::zeros()
+                pushes[self.rigid.owner[v - nv] as usize]
             }
         };
         let nodes = &*self.internal(&map.nodes);
         let sheet = x;
-        let x = &*self.placed(x, pot.dial);
+        let x = &*self.placed(x, phi, pot.dial);
         let gathered = self.timed(Clock::Ccd, || {
             (0..nodes.len() / 4)
                 .into_par_iter()
@@ -1665,19 +1949,31 @@ impl StepLimit for SelfContact {
         });
         // The pairs not gathered: where the pairs were gathered (the solver's positions, or `x`
         // outside a solve), they were farther apart than their offset and the halo.
-        let taken = if pot.taken_at.len() == sheet.len() {
-            pot.taken_at
+        let (taken, taken_phi) = if pot.taken_at.len() == sheet.len() {
+            (pot.taken_at, pot.taken_dofs)
         } else {
-            sheet
+            (sheet, phi)
         };
-        let moved = !std::ptr::eq(taken, sheet) && taken != sheet;
+        // The force-controlled obstacles' offsets from where the pairs were gathered, now and
+        // at the step's end.
+        let pushed_from: Vec<(Real, Real)> = self
+            .pushed
+            .iter()
+            .map(|&b| {
+                let p = self.rigid.bodies[b].push.map_or(NONE, |p| p.node);
+                let now = self.pushed_by(b, phi) - self.pushed_by(b, taken_phi);
+                (now, now + step[crate::elements::node_dofs(nv, p).0])
+            })
+            .collect();
+        let moved = (!std::ptr::eq(taken, sheet) && taken != sheet)
+            || pushed_from.iter().any(|&(now, _)| now != 0.0);
         // Every pair not gathered was at least the halo beyond where its law begins (its
         // offset, plus the barrier's activation distance) where the pairs were gathered, and
         // along the step its distance has changed by at most twice the largest displacement
-        // of a sheet vertex from there (the obstacles stand still). While that is below 0.9
-        // of the margin, none comes within its law, nor within the tenth of its margin at
-        // which the CCD below would stop: the broad phase over the paths is skipped (a scene
-        // with nothing near contact then pays O(n) per step bound).
+        // of a sheet vertex or an obstacle from there. While that is below 0.9 of the margin,
+        // none comes within its law, nor within the tenth of its margin at which the CCD below
+        // would stop: the broad phase over the paths is skipped (a scene with nothing near
+        // contact then pays O(n) per step bound).
         let far = (0..nv)
             .into_par_iter()
             .map(|v| {
@@ -1685,7 +1981,12 @@ impl StepLimit for SelfContact {
                 a.norm_squared().max(b.norm_squared())
             })
             .reduce(|| 0.0, Real::max)
-            .sqrt();
+            .sqrt()
+            .max(
+                pushed_from
+                    .iter()
+                    .fold(0.0, |m: Real, &(a, b)| m.max(a.abs()).max(b.abs())),
+            );
         if 2.0 * far < 0.9 * (self.halo - self.beyond_max) {
             return StepBound {
                 fraction: gathered,
@@ -1701,7 +2002,7 @@ impl StepLimit for SelfContact {
                 regather: false,
             };
         }
-        let taken = &*self.placed(taken, pot.dial);
+        let taken = &*self.placed(taken, taken_phi, pot.dial);
         let candidates = self.timed(Clock::Broad, || {
             self.candidates(x, Some(&to), self.xi_max + self.beyond_max)
         });
@@ -1743,8 +2044,18 @@ impl StepLimit for SelfContact {
     /// boxes of the jump's straight paths (the sheet from `from` to `to`, the mesh obstacles
     /// from their place at `from_dial` to theirs at `pot.dial`), inflated by the largest
     /// offset.
-    fn jump_fraction(&self, pot: &Potential, from: &[Vec3], to: &[Vec3], from_dial: Real) -> Real {
-        let (x0, x1) = (self.placed(from, from_dial), self.placed(to, pot.dial));
+    fn jump_fraction(
+        &self,
+        pot: &Potential,
+        from: &[Vec3],
+        to: &[Vec3],
+        phi: &[Real],
+        from_dial: Real,
+    ) -> Real {
+        let (x0, x1) = (
+            self.placed(from, phi, from_dial),
+            self.placed(to, phi, pot.dial),
+        );
         if x0 == x1 {
             return 1.0;
         }
@@ -1778,14 +2089,15 @@ impl StepLimit for SelfContact {
         bounds: &mut [Real],
     ) {
         let nodes = &*self.internal(&map.nodes);
-        let y = &*self.placed(x, pot.dial);
+        // No force-controlled obstacle in explicit mode.
+        let y = &*self.placed(x, &[], pot.dial);
         self.timed(Clock::Ccd, || self.bounds_at(nodes, y, bounds));
     }
 
     /// Every pair at least `s ξ` apart, and with the barrier farther than its law's reach.
-    fn admits(&self, pot: &Potential, map: &ElementMap, x: &[Vec3]) -> bool {
+    fn admits(&self, pot: &Potential, map: &ElementMap, x: &[Vec3], phi: &[Real]) -> bool {
         let nodes = &*self.internal(&map.nodes);
-        let x = &*self.placed(x, pot.dial);
+        let x = &*self.placed(x, phi, pot.dial);
         self.timed(Clock::Ccd, || {
             (0..nodes.len() / 4).into_par_iter().all(|e| {
                 let n = &nodes[4 * e..4 * e + 4];
@@ -1800,10 +2112,13 @@ impl Term for SelfContact {
         self.name
     }
     fn stencil(&self, body: &Body) -> Stencil {
-        self.handed_out(self.pairs(&self.placed(&body.mesh.positions, 0.0), self.halo))
+        self.handed_out(self.pairs(&self.placed(&body.mesh.positions, &[], 0.0), self.halo))
     }
     fn changing(&self) -> Option<&dyn ChangingElements> {
         Some(self)
+    }
+    fn global_dofs(&mut self) -> Option<&mut dyn GlobalDofs> {
+        (!self.pushed.is_empty()).then_some(self as &mut dyn GlobalDofs)
     }
     fn step_limit(&self) -> Option<&dyn StepLimit> {
         Some(self)
@@ -1822,14 +2137,14 @@ impl Term for SelfContact {
         pot: &Potential,
         map: &ElementMap,
         x: &[Vec3],
-        _phi: &[Real],
+        phi: &[Real],
         want: Want,
         projection: HessianProjection,
         grad: &mut [Real],
         values: &mut [Real],
     ) -> Real {
         self.timed(Clock::Assembly, || {
-            self.assemble(pot, map, x, want, projection, grad, values, true)
+            self.assemble(pot, map, x, phi, want, projection, grad, values, true)
         })
     }
 }
@@ -1946,6 +2261,7 @@ fn build(
         cache_cap: 2.0 * body.mean_edge,
         excluded_pt: Vec::new(),
         excluded_ee: Vec::new(),
+        pushed: Vec::new(),
     };
     if c.enabled {
         exclude(&mut sc, body)?;
@@ -2060,12 +2376,34 @@ fn add_rigid(
     edges.dedup();
     sc.edges.extend(edges);
     sc.rigid.area.extend(area);
+    let push = match o.control(i).map_err(|e| MeshError::Invalid {
+        path: file.clone(),
+        reason: format!("{}: {}", e.key, e.reason),
+    })? {
+        crate::config::obstacle::Control::Moved(_) => None,
+        crate::config::obstacle::Control::Pressed {
+            direction,
+            magnitude,
+            mass,
+        } => Some(Push {
+            direction: Vec3::from(direction),
+            force: magnitude,
+            mass: mass.unwrap_or(0.0),
+            // As an analytic force-controlled obstacle's.
+            max_step: ca.h_mean / 2.0,
+            node: NONE,
+        }),
+    };
+    if push.is_some() {
+        sc.pushed.push(sc.rigid.bodies.len());
+    }
     sc.rigid.bodies.push(RigidBody {
         index: i,
         file,
         stiffness: o.stiffness.unwrap_or(k_default),
         smoothing: o.smoothing.unwrap_or(ca.h_mean / 100.0),
         friction: if dynamic { o.friction } else { 0.0 },
+        push,
     });
     Ok(())
 }
@@ -2075,7 +2413,7 @@ fn add_rigid(
 /// 1e-9 of the offset, is allowed). Errors name the obstacle's file and key, its face or
 /// vertex and the sheet's.
 fn check_rigid(sc: &SelfContact) -> Result<(), MeshError> {
-    let x = &*sc.placed(&sc.rest[..sc.nv], 0.0);
+    let x = &*sc.placed(&sc.rest[..sc.nv], &[], 0.0);
     let (ne, nf) = (sc.sheet_edges, sc.sheet_faces);
     let body_err = |n: &[usize], reason: String| match sc.body(n) {
         Some(b) => MeshError::Invalid {

@@ -181,30 +181,32 @@ pub struct StepBound {
 /// largest fraction of the step every such term allows, and accepts no trial state a term
 /// does not admit (it halves the step instead).
 pub trait StepLimit {
-    /// The largest fraction in `[0, 1]` of `step` (DOF order) from the positions `x` that the
-    /// term allows (every state on the segment is admissible), and whether gathering its
+    /// The largest fraction in `[0, 1]` of `step` (DOF order) from the state `(x, phi)` that
+    /// the term allows (every state on the segment is admissible), and whether gathering its
     /// elements again at `x` would allow a longer one.
     fn max_fraction(
         &self,
         pot: &Potential,
         map: &ElementMap,
         x: &[Vec3],
+        phi: &[Real],
         step: &[Real],
     ) -> StepBound;
 
-    /// Whether the term admits the positions `x` (the static check of a trial state).
-    fn admits(&self, pot: &Potential, map: &ElementMap, x: &[Vec3]) -> bool;
+    /// Whether the term admits the state `(x, phi)` (the static check of a trial state).
+    fn admits(&self, pot: &Potential, map: &ElementMap, x: &[Vec3], phi: &[Real]) -> bool;
 
     /// The largest fraction in `[0, 1]` of the jump from the positions `from` at dial
     /// `from_dial` to `to` at `pot.dial` (a new step's start: vertices on prescribed paths and
     /// the term's own rigid parts moved with the dial, the other vertices where the solve
-    /// starts) that the term allows, every state on the straight paths admissible. 1 by
-    /// default (nothing of the term moves with the dial).
+    /// starts), the scalar DOFs `phi` held, that the term allows, every state on the straight
+    /// paths admissible. 1 by default (nothing of the term moves with the dial).
     fn jump_fraction(
         &self,
         _pot: &Potential,
         _from: &[Vec3],
         _to: &[Vec3],
+        _phi: &[Real],
         _from_dial: Real,
     ) -> Real {
         1.0

@@ -293,7 +293,15 @@ pub(super) fn run_dynamic(
         // The jump to the step's dial (prescribed paths, mesh obstacles) may not carry anything
         // through the sheet: a step whose jump contact refuses is cut like a failed solve.
         let refused = (dial != dial_now)
-            .then(|| s.jump_refused(&s.potential(&pat, dial), &state.x, &trial.x, dial_now))
+            .then(|| {
+                s.jump_refused(
+                    &s.potential(&pat, dial),
+                    &state.x,
+                    &trial.x,
+                    &state.dofs,
+                    dial_now,
+                )
+            })
             .flatten();
         let rep = if let Some(f) = refused {
             crate::solve::NewtonReport {

@@ -232,7 +232,8 @@ pub fn run(
         let fraction = if scene.terms.iter().any(|t| t.step_limit().is_some()) {
             let at = dial.or(start).unwrap_or(0.0).clamp(0.0, 1.0);
             let pat = s.pattern();
-            s.potential(&pat, at).jump_fraction(&state.x, &moved, at)
+            s.potential(&pat, at)
+                .jump_fraction(&state.x, &moved, &state.dofs, at)
         } else {
             1.0
         };

@@ -50,6 +50,8 @@ pub(super) struct Solver<'a> {
     /// The positions at which the changing terms' elements were last gathered (empty when no
     /// term's elements change): a contact term tells there which pairs it gathered.
     pub(super) taken_at: Vec<Vec3>,
+    /// The scalar DOFs there.
+    pub(super) taken_dofs: Vec<Real>,
     /// The run's controls, from the validated settings.
     pub(super) config: config::RunConfig,
     pub(super) lin: LinearSolver,
@@ -141,6 +143,11 @@ impl<'a> Solver<'a> {
             } else {
                 Vec::new()
             },
+            taken_dofs: if changing {
+                vec![0.0; scene.num_scalar_dofs()]
+            } else {
+                Vec::new()
+            },
             changing,
             config,
             lin,
@@ -209,6 +216,7 @@ impl<'a> Solver<'a> {
         }
         // The elements are taken at this state: the motion bound starts here.
         self.taken_at.clone_from(&state.x);
+        self.taken_dofs.clone_from(&state.dofs);
         let Some(p) = self
             .pattern
             .refreshed(self.scene, &state.x, &state.dofs, dial)
@@ -310,10 +318,12 @@ impl<'a> Solver<'a> {
             let pat = self.pattern();
             let terms = state.terms.clone();
             let taken = self.taken_at.clone();
+            let taken_dofs = self.taken_dofs.clone();
             let pot = &Potential {
                 states: &terms,
                 pattern: &pat,
                 taken_at: &taken,
+                taken_dofs: &taken_dofs,
                 ..*pot
             };
             let rep = newton(pot, &mut self.lin, &mut self.ws, state, opts);
@@ -479,23 +489,26 @@ impl<'a> Solver<'a> {
 
     /// Whether the terms that bound the steps ([`crate::energy::term::StepLimit`], contact)
     /// allow the whole jump from the positions `from` at dial `from_dial` to `to` at
-    /// `pot.dial`, a new step's start (prescribed paths and mesh obstacles moved with the dial):
+    /// `pot.dial`, the scalar DOFs `phi` held, a new step's start (prescribed paths and mesh obstacles moved with the dial):
     /// `None` when they do, else a reason for the step's failure.
     pub(super) fn jump_refused(
         &self,
         pot: &Potential,
         from: &[Vec3],
         to: &[Vec3],
+        phi: &[Real],
         from_dial: Real,
     ) -> Option<crate::solve::SolveError> {
         if !self.scene.terms.iter().any(|t| t.step_limit().is_some()) {
             return None;
         }
-        (pot.jump_fraction(from, to, from_dial) < 1.0).then_some(crate::solve::SolveError::Refused(
-            "the step would carry a mesh obstacle or a prescribed vertex within the \
+        (pot.jump_fraction(from, to, phi, from_dial) < 1.0).then_some(
+            crate::solve::SolveError::Refused(
+                "the step would carry a mesh obstacle or a prescribed vertex within the \
                  minimum separation of the sheet (checked by continuous collision detection \
                  over the jump)",
-        ))
+            ),
+        )
     }
 
     /// Whether the terms that bound the steps ([`crate::energy::term::StepLimit`], contact)
@@ -525,9 +538,10 @@ impl<'a> Solver<'a> {
         let bound = Potential {
             states: &from.terms,
             taken_at: &self.taken_at,
+            taken_dofs: &self.taken_dofs,
             ..*pot
         }
-        .step_bound(&from.x, &step);
+        .step_bound(&from.x, &from.dofs, &step);
         !bound.regather && bound.fraction >= 1.0
     }
 

@@ -91,7 +91,7 @@ pub(super) fn run_static(
         // The jump to the new dial (prescribed paths, mesh obstacles) may not carry anything
         // through the sheet: a step whose jump contact refuses is cut like a failed solve.
         let refused = if target != dial {
-            s.jump_refused(&pot, &state.x, &trial.x, dial)
+            s.jump_refused(&pot, &state.x, &trial.x, &state.dofs, dial)
         } else {
             None
         };
@@ -290,7 +290,7 @@ pub fn check_start(
     let pattern = crate::assembly::Pattern::for_scene(scene);
     let state = State::reference(scene);
     let (x, pot) = reference_potential(scene, &pattern, &state, dial);
-    if pot.jump_fraction(&state.x, &x, 0.0) < 1.0 {
+    if pot.jump_fraction(&state.x, &x, &state.dofs, 0.0) < 1.0 {
         return Err(crate::settings::SettingsError::Invalid {
             path: settings_name.to_string(),
             key: "rest.dial_time".into(),

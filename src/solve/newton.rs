@@ -442,7 +442,9 @@ fn sufficient_decrease(
     let slack = 1e-13 * e.abs().max(Real::MIN_POSITIVE);
     ws.trial.set_step(state, &ws.step, alpha);
     let et = pot.eval(&ws.trial.x, &ws.trial.dofs, Want::Energy, &mut [], &mut []);
-    et.is_finite() && et <= e + 1e-4 * alpha * slope + slack && pot.admits(&ws.trial.x)
+    et.is_finite()
+        && et <= e + 1e-4 * alpha * slope + slack
+        && pot.admits(&ws.trial.x, &ws.trial.dofs)
 }
 
 /// Minimises `pot` from `state` (updated in place).
@@ -554,7 +556,10 @@ pub fn newton(
                 // Only the full step: a chord step that needs a line search is a sign that the
                 // old model no longer fits, and a fresh factorisation is cheaper than the cuts.
                 let clock = Instant::now();
-                let alpha = pot.step_bound(&state.x, &ws.step).fraction.min(1.0);
+                let alpha = pot
+                    .step_bound(&state.x, &state.dofs, &ws.step)
+                    .fraction
+                    .min(1.0);
                 let accepted = alpha == 1.0 && sufficient_decrease(pot, ws, state, e, slope, alpha);
                 rep.timing.line_search += clock.elapsed().as_secs_f64();
                 if VERBOSE.load(std::sync::atomic::Ordering::Relaxed) {
@@ -711,7 +716,7 @@ pub fn newton(
             rep.failure = Some(SolveError::NotDescent);
             return rep;
         }
-        let bound = pot.step_bound(&state.x, &ws.step);
+        let bound = pot.step_bound(&state.x, &state.dofs, &ws.step);
         if bound.regather {
             rep.timing.line_search += clock.elapsed().as_secs_f64();
             rep.failure = Some(SolveError::Regather);

@@ -313,6 +313,32 @@ fn self_contact_friction_matches_finite_differences() {
 /// stencil slots are absent.
 #[test]
 fn a_mesh_obstacle_matches_finite_differences() {
+    mesh_obstacle_against_finite_differences("", None);
+}
+
+/// The same ball force-controlled (`force` along ê = (0.2, −0.1, 1)/‖·‖, mass 0.7 kg, in
+/// dynamics), placed at its offset q = 0.004 along ê, with the inertia of the offset (q̂ =
+/// 0.003, 1/Δt² = 10⁴): every pair with the ball couples its strip vertices to the offset, a
+/// global DOF, through the ball's vertices moving by ê per unit of it, and the force's own
+/// element adds −F q + M (q − q̂)²/(2Δt²); all against central differences in x and q.
+#[test]
+fn a_force_controlled_mesh_obstacle_matches_finite_differences() {
+    let e = Vec3::new(0.2, -0.1, 1.0).normalize();
+    mesh_obstacle_against_finite_differences(
+        &format!(
+            "force = [{}, {}, {}]\nmass = 0.7\n[solver]\nmode = \"dynamic\"\n",
+            3.0 * e.x,
+            3.0 * e.y,
+            3.0 * e.z
+        ),
+        Some((e, 0.004)),
+    );
+}
+
+/// The mesh obstacles' term on the strip over the icosphere against central differences (the
+/// settings `extra` added to the obstacle's table; `push`, the direction and offset of a
+/// force-controlled ball).
+fn mesh_obstacle_against_finite_differences(extra: &str, push: Option<(Vec3, Real)>) {
     use shellsim::elements::ABSENT;
     let dir = tempfile::tempdir().unwrap();
     let ball_file = dir.path().join("ball.vtk");
@@ -333,38 +359,60 @@ fn a_mesh_obstacle_matches_finite_differences() {
     );
     let s = format!(
         "[material]\nthickness = 0.05\nyoung = 1e6\n[[obstacles]]\nshape = \"mesh\"\n\
-         file = \"{}\"\ntranslate = [0.5, 0.1, -0.2]\nstiffness = 1e7\nsmoothing = 0.004\n",
+         file = \"{}\"\ntranslate = [0.5, 0.1, -0.2]\nstiffness = 1e7\nsmoothing = 0.004\n{extra}",
         ball_file.display()
     );
     let sc = Scene::build(m, Settings::from_str_with(&s, "test", &[]).unwrap()).unwrap();
     let i = (0..sc.terms.len())
         .find(|&i| sc.terms[i].name() == "mesh_obstacles")
         .expect("a mesh_obstacles term");
-    let phi = vec![0.0; sc.num_scalar_dofs()];
+    let mut phi = vec![0.0; sc.num_scalar_dofs()];
+    let (direction, q) = push.unwrap_or((Vec3::zeros(), 0.0));
+    if push.is_some() {
+        assert_eq!(sc.globals.len(), 1);
+        assert_eq!(sc.globals[0].name, "obstacle0_offset");
+        *phi.last_mut().unwrap() = q;
+    }
     let p0 = Pattern::for_scene(&sc);
     let nv = sc.body.num_vertices();
-    let ball_at: Vec<Vec3> = ball
-        .positions
-        .iter()
-        .map(|p| p + Vec3::new(0.5, 0.1, -0.2))
-        .collect();
-    // The pairs' closest features at the sheet's `x`, the ball's vertices numbered after it.
+    let ball_at = |q: Real| -> Vec<Vec3> {
+        ball.positions
+            .iter()
+            .map(|p| p + Vec3::new(0.5, 0.1, -0.2) + direction * q)
+            .collect()
+    };
+    // The pairs' four nodes (the stencil's first four slots, without the force's element).
+    let pairs = |nodes: &[usize], slots: usize| -> Vec<usize> {
+        nodes
+            .chunks(slots)
+            .filter(|n| n[0] != usize::MAX)
+            .flat_map(|n| n[..4].iter().copied())
+            .collect()
+    };
+    // The pairs' closest features at the sheet's `x`, the ball's vertices numbered after it,
+    // unchanged by a move of ±1e-6 of any coordinate or of the offset.
     let hold = |x: &[Vec3], nodes: &[usize]| {
-        let all: Vec<Vec3> = x.iter().chain(&ball_at).copied().collect();
+        let at =
+            |x: &[Vec3], q: Real| -> Vec<Vec3> { x.iter().copied().chain(ball_at(q)).collect() };
+        let all = at(x, q);
         let inner: Vec<usize> = nodes
             .iter()
             .map(|&u| if u >= ABSENT { nv + (u - ABSENT) } else { u })
             .collect();
         let k0 = kinds(&all, &inner);
-        (0..nv).all(|v| {
-            (0..3).all(|c| {
-                [1e-6, -1e-6].iter().all(|s| {
-                    let mut y = all.clone();
-                    y[v][c] += s;
-                    kinds(&y, &inner) == k0
+        let offsets = [1e-6, -1e-6]
+            .iter()
+            .all(|s| kinds(&at(x, q + s), &inner) == k0);
+        offsets
+            && (0..nv).all(|v| {
+                (0..3).all(|c| {
+                    [1e-6, -1e-6].iter().all(|s| {
+                        let mut y = all.clone();
+                        y[v][c] += s;
+                        kinds(&y, &inner) == k0
+                    })
                 })
             })
-        })
     };
     let (x, p) = (1..60)
         .map(|seed| {
@@ -374,17 +422,17 @@ fn a_mesh_obstacle_matches_finite_differences() {
                 .mesh
                 .positions
                 .iter()
-                .map(|q| {
-                    q + Vec3::new(0.0, 0.0, -0.04)
+                .map(|v| {
+                    v + Vec3::new(0.0, 0.0, -0.04)
                         + Vec3::new(rng.symmetric(), rng.symmetric(), rng.symmetric()) * 0.002
                 })
                 .collect();
             let p = p0.refreshed(&sc, &x, &phi, 0.0).expect("the ball is near");
             (x, p)
         })
-        .find(|(x, p)| hold(x, &p.maps[i].nodes))
+        .find(|(x, p)| hold(x, &pairs(&p.maps[i].nodes, p.maps[i].slots)))
         .expect("a noise with no pair on a change of closest features");
-    let nodes = &p.maps[i].nodes;
+    let nodes = pairs(&p.maps[i].nodes, p.maps[i].slots);
     let sheet_on_ball = nodes
         .chunks(4)
         .filter(|n| n[2] > n[3] && n[0] < ABSENT)
@@ -396,5 +444,75 @@ fn a_mesh_obstacle_matches_finite_differences() {
     let edges = nodes.chunks(4).filter(|n| n[2] < n[3]).count();
     println!("{sheet_on_ball} strip vertices, {ball_on_sheet} ball vertices, {edges} edge pairs");
     assert!(sheet_on_ball > 3 && ball_on_sheet > 0 && edges > 3);
-    pressing_term_matches_finite_differences(&sc, &p, i, &x, &phi);
+    if push.is_none() {
+        pressing_term_matches_finite_differences(&sc, &p, i, &x, &phi);
+        return;
+    }
+    let mut dofs_hat = phi.clone();
+    *dofs_hat.last_mut().unwrap() = 0.003;
+    let pot = Potential {
+        inertia: Some(shellsim::energy::potential::Inertia {
+            inv_dt2: 1e4,
+            xhat: &x,
+            dofs_hat: &dofs_hat,
+        }),
+        ..Potential::new(&sc, &p)
+    };
+    let mut g = vec![0.0; p.n];
+    sc.terms[i].eval(
+        &pot,
+        &p.maps[i],
+        &x,
+        &phi,
+        Want::Gradient,
+        HessianProjection::None,
+        &mut g,
+        &mut [],
+    );
+    assert!(g[p.n - 1] != 0.0, "the offset has a gradient");
+    super::terms::fd_check(
+        &sc,
+        &p,
+        &x,
+        &phi,
+        "force-controlled mesh obstacle",
+        1,
+        |g, h| g.max(h),
+        |x, phi, want, g, h| {
+            g.iter_mut().for_each(|v| *v = 0.0);
+            h.iter_mut().for_each(|v| *v = 0.0);
+            sc.terms[i].eval(
+                &pot,
+                &p.maps[i],
+                x,
+                phi,
+                want,
+                HessianProjection::None,
+                g,
+                h,
+            )
+        },
+    );
+    // The offset moves every vertex of the ball: a step of the offset alone 0.1 into the strip
+    // (the ball's top is 6 mm into its offset) is cut by CCD short of the minimum separation,
+    // where the state is admitted and past which it is not; the same step away is whole.
+    let limit = sc.terms[i].step_limit().expect("the term bounds the steps");
+    let mut step = vec![0.0; p.n];
+    let along = |dq: Real| {
+        let mut s = phi.clone();
+        *s.last_mut().unwrap() += dq;
+        s
+    };
+    step[p.n - 1] = 0.1;
+    let bound = limit.max_fraction(&pot, &p.maps[i], &x, &phi, &step);
+    println!(
+        "a push of the ball 0.1 into the strip: fraction {}",
+        bound.fraction
+    );
+    assert!(bound.fraction > 0.0 && bound.fraction < 0.1, "{bound:?}");
+    assert!(limit.admits(&pot, &p.maps[i], &x, &along(bound.fraction * 0.1)));
+    assert!(!limit.admits(&pot, &p.maps[i], &x, &along(0.1)));
+    step[p.n - 1] = -0.1;
+    let away = limit.max_fraction(&pot, &p.maps[i], &x, &phi, &step);
+    assert_eq!(away.fraction, 1.0, "{away:?}");
 }

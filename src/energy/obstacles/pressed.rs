@@ -89,17 +89,9 @@ impl Pressed {
         let mut g = SVec::<4>::zeros();
         let mut h = SMat::<4, 4>::zeros();
         let e = if nodes[0] == NONE {
-            let s = pot.dial.clamp(0.0, 1.0);
-            let mut e = -s * self.force * q;
-            g[3] = -s * self.force;
-            if let (Some(inr), true) = (pot.inertia.as_ref(), self.mass > 0.0) {
-                if let Some(&qhat) = inr.dofs_hat.get(k) {
-                    let m = self.mass * inr.inv_dt2;
-                    e += 0.5 * m * (q - qhat) * (q - qhat);
-                    g[3] += m * (q - qhat);
-                    h[(3, 3)] = m;
-                }
-            }
+            let (e, dq, ddq) = push(pot, k, q, self.force, self.mass);
+            g[3] = dq;
+            h[(3, 3)] = ddq;
             e
         } else {
             let v = nodes[0];
@@ -126,6 +118,29 @@ impl Pressed {
         }
         e
     }
+}
+
+/// The force's element of a force-controlled obstacle whose offset `q` (m) is scalar DOF `k`:
+/// `E = −s F q + M/(2Δt²) (q − q̂)²` (module doc; the inertia only in dynamics and with a mass),
+/// with its derivatives `(E, ∂E/∂q, ∂²E/∂q²)` (J, N, N/m).
+pub(crate) fn push(
+    pot: &Potential,
+    k: usize,
+    q: Real,
+    force: Real,
+    mass: Real,
+) -> (Real, Real, Real) {
+    let s = pot.dial.clamp(0.0, 1.0);
+    let (mut e, mut g, mut h) = (-s * force * q, -s * force, 0.0);
+    if let (Some(inr), true) = (pot.inertia.as_ref(), mass > 0.0) {
+        if let Some(&qhat) = inr.dofs_hat.get(k) {
+            let m = mass * inr.inv_dt2;
+            e += 0.5 * m * (q - qhat) * (q - qhat);
+            g += m * (q - qhat);
+            h = m;
+        }
+    }
+    (e, g, h)
 }
 
 impl GlobalDofs for Pressed {

@@ -459,7 +459,7 @@ pub(super) fn run_explicit(
                         from[u] = *p;
                     }
                     let pot = s.potential_at(&pat, dial, &state);
-                    if pot.jump_fraction(&from, &state.x, dial) < 1.0 {
+                    if pot.jump_fraction(&from, &state.x, &state.dofs, dial) < 1.0 {
                         state.x = from;
                         let p = state.x[v];
                         break Stop::Other(format!(
