@@ -39,6 +39,18 @@ from vtk.util.numpy_support import vtk_to_numpy
 
 
 def read(path):
+    if path.endswith(".obj"):
+        # Wavefront OBJ of triangles, read here: `v` and `f` lines (1-based indices, the
+        # `i/t/n` forms allowed), vertices in file order as shellsim numbers them.
+        pts, faces = [], []
+        with open(path) as f:
+            for line in f:
+                w = line.split()
+                if w and w[0] == "v":
+                    pts.append([float(c) for c in w[1:4]])
+                elif w and w[0] == "f":
+                    faces.append([int(c.split("/")[0]) - 1 for c in w[1:4]])
+        return np.array(pts, dtype=float), np.array(faces, dtype=np.int64)
     if path.endswith(".vtu"):
         r = vtk.vtkXMLUnstructuredGridReader()
     else:

@@ -93,6 +93,7 @@ impl<'a> Potential<'a> {
             frozen: None,
             owned: None,
             force_scale: scene.body.force_scale,
+            dial_rate: 0.0,
             taken_at: &[],
             taken_dofs: &[],
             states: &scene.initial_states,

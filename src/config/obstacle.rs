@@ -29,9 +29,9 @@
 //! A `mesh` obstacle is fixed, moved by `displacement` or pushed by a `force` in static
 //! (load-controlled) or dynamic mode: its steps are bounded by continuous collision detection,
 //! and its motion within a step is checked the same way, which arc-length continuation (the
-//! dial an unknown of the solve)
-//! cannot do. In explicit mode it is fixed (the explicit driver bounds how far each of the
-//! sheet's vertices moves, not the obstacle's), with stick/slip friction.
+//! dial an unknown of the solve) cannot do. In explicit mode it is fixed, with stick/slip
+//! friction, or moved by `displacement` (frictionless), the explicit driver bounding its move
+//! with the dial as it bounds the sheet's vertices.
 //!
 //! The raw table is flat (every key optional, unknown keys refused); [`ObstacleSettings::shape`]
 //! validates it into a [`Shape`] that carries exactly its variant's parameters.
@@ -222,17 +222,6 @@ impl ObstacleSettings {
                      inertia)",
                 );
             }
-        }
-        if self.shape == Some(ShapeKind::Mesh)
-            && mode == Mode::Explicit
-            && self.displacement.iter().any(|&c| c != 0.0)
-        {
-            return invalid(
-                "displacement",
-                "a moving mesh obstacle needs solver.mode = \"static\" or \"dynamic\" \
-                 (the explicit driver bounds the sheet's vertices only: a mesh obstacle is \
-                 fixed there, an analytic shape may move)",
-            );
         }
         if self.friction > 0.0 && mode == Mode::Static {
             return invalid(

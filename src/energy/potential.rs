@@ -106,6 +106,9 @@ pub struct Potential<'a> {
     /// The force scale F of the residual (N): the body's, `max(E h) × mean edge`, or in
     /// statics the applied loads' when smaller ([`Potential::load_scale`]).
     pub force_scale: Real,
+    /// How fast the dial moves (1/s): the explicit driver's while it dials, 0 elsewhere (what
+    /// moves with the dial then moves at its displacement × this rate).
+    pub dial_rate: Real,
     /// The positions at which the elements of the terms whose elements change were gathered
     /// (the driver's solver sets them; empty: the positions evaluated): a contact term tells
     /// there which pairs it gathered.
@@ -267,6 +270,18 @@ impl<'a> Potential<'a> {
                 l.displacement_bounds(self, map, x, bounds);
             }
         }
+    }
+
+    /// How far the dial may move from this potential's, the positions held at `x`, where the
+    /// changing terms' elements were gathered, before what moves with it (a mesh obstacle)
+    /// could bring an element below its floor, for every term that bounds the steps
+    /// ([`crate::energy::term::StepLimit::dial_room`]; `+∞` when nothing moves).
+    pub fn dial_room(&self, x: &[Vec3]) -> Real {
+        self.terms
+            .iter()
+            .zip(&self.pattern.maps)
+            .filter_map(|(t, map)| Some(t.step_limit()?.dial_room(self, map, x)))
+            .fold(Real::INFINITY, Real::min)
     }
 
     /// Whether every term that bounds the steps admits the state `(x, phi)`

@@ -97,7 +97,9 @@
 //! at most a radius from where the pairs were gathered
 //! ([`StepLimit::displacement_bounds`]: half the halo, and half the room each of its gathered
 //! pairs has to its floor), pulls back a vertex that would leave it, and gathers again before
-//! one would (`crate::integrate::explicit`'s contact). The penalty's default stiffness there is
+//! one would (`crate::integrate::explicit`'s contact). A mesh obstacle moved with the dial gets
+//! the same radius for its move ([`StepLimit::dial_room`]), and its move past it is checked by
+//! CCD. The penalty's default stiffness there is
 //! at most `ρh/(4Δt²)` (`default_stiffness`); the barrier is refused. Each pressing pair has a
 //! dashpot on its normal approach (`damping` ζ), and friction there is Coulomb's stick/slip of
 //! the pressing pairs solved together in each step (the term's explicit hook,
@@ -1750,7 +1752,7 @@ impl ExplicitHooks for SelfContact {
     /// slip, for the pairs that press at `x` in the step `dt`. With `c` a pair's closest
     /// points' coefficients, `n` its normal, `λ` its normal force, `K` its normal stiffness
     /// (`m k w ψ″`) and `v*ᵢ = vᵢ − Δt gᵢ/mᵢ` the velocity each of its sheet vertices would
-    /// reach (obstacle vertices stand still), the pair's relative velocity is `Σ cᵢ vᵢ` and
+    /// reach (a mesh obstacle's vertices move at its displacement × the dial's rate, `Potential::dial_rate`), the pair's relative velocity is `Σ cᵢ vᵢ` and
     /// `w = Σ cᵢ²/mᵢ` its inverse mass along it.
     ///
     /// *Dashpot* (`damping` ζ, a fraction of critical damping of the pair on its penalty
@@ -1806,11 +1808,24 @@ impl ExplicitHooks for SelfContact {
                 });
             }
         }
+        // A mesh obstacle moved with the dial moves at its displacement × the dial's rate.
+        let carried = |u: usize| {
+            if u >= self.nv && u < y.len() {
+                self.rigid.shift[u - self.nv] * pot.dial_rate
+            } else {
+                Vec3::zeros()
+            }
+        };
         let relative =
             |reach: &std::collections::BTreeMap<usize, Vec3>, n: &[usize], c: &[Real; 4]| {
                 (0..4)
-                    .filter(|&i| free(n[i]))
-                    .map(|i| reach[&n[i]] * c[i])
+                    .map(|i| {
+                        if free(n[i]) {
+                            reach[&n[i]] * c[i]
+                        } else {
+                            carried(n[i]) * c[i]
+                        }
+                    })
                     .sum::<Vec3>()
             };
         let apply = |reach: &mut std::collections::BTreeMap<usize, Vec3>,
@@ -2078,9 +2093,10 @@ impl StepLimit for SelfContact {
     /// `x`, and half its room to the floor in each gathered pair it belongs to,
     /// `(d − max(s ξ, r))/2` at the pair's distance `d` there. A pair's distance shrinks by at
     /// most the largest displacement of its point (or first edge) plus that of its triangle
-    /// (or second edge), every point of which is a convex combination of its vertices; the
-    /// obstacles stand still. So a gathered pair stays at or above its floor, and one that was
-    /// not gathered, at least `ξ + halo` apart at `x`, stays beyond the reach of its law.
+    /// (or second edge), every point of which is a convex combination of its vertices; a mesh
+    /// obstacle that moves with the dial takes the other half ([`StepLimit::dial_room`]). So a
+    /// gathered pair stays at or above its floor, and one that was not gathered, at least
+    /// `ξ + halo` apart at `x`, stays beyond the reach of its law.
     fn displacement_bounds(
         &self,
         pot: &Potential,
@@ -2092,6 +2108,49 @@ impl StepLimit for SelfContact {
         // No force-controlled obstacle in explicit mode.
         let y = &*self.placed(x, &[], pot.dial);
         self.timed(Clock::Ccd, || self.bounds_at(nodes, y, bounds));
+    }
+
+    /// Each mesh obstacle moved with the dial may move half the halo from its place at
+    /// `pot.dial`, and half the room to the floor of each gathered pair it is part of: with
+    /// every sheet vertex within its bound (which leaves each pair's other half to it), a
+    /// gathered pair stays at or above its floor, and one that was not gathered, at least
+    /// `ξ + halo` apart at `x`, beyond the reach of its law. An obstacle moved by `u` at dial 1
+    /// moves by `|u| Δs` over a change `Δs` of the dial (the dial clamped to [0, 1] moves no
+    /// more): the room is the least of those radii over `|u|`.
+    fn dial_room(&self, pot: &Potential, map: &ElementMap, x: &[Vec3]) -> Real {
+        let moving: Vec<Real> = (0..self.rigid.bodies.len())
+            .map(|b| {
+                self.rigid
+                    .owner
+                    .iter()
+                    .position(|&o| o as usize == b)
+                    .map_or(0.0, |v| self.rigid.shift[v].norm())
+            })
+            .collect();
+        if moving.iter().all(|&u| u == 0.0) {
+            return Real::INFINITY;
+        }
+        let nodes = &*self.internal(&map.nodes);
+        let y = &*self.placed(x, &[], pot.dial);
+        let mut room = vec![0.5 * (self.halo - self.beyond_max); moving.len()];
+        let per_pair: Vec<Option<(usize, Real)>> = (0..nodes.len() / 4)
+            .into_par_iter()
+            .map(|e| {
+                let n = &nodes[4 * e..4 * e + 4];
+                let u = n.iter().copied().find(|&u| u >= self.nv)?;
+                let b = self.rigid.owner[u - self.nv] as usize;
+                let d = self.closest(&points(y, n), n).d2.sqrt();
+                Some((b, (0.5 * (d - self.floor(n))).max(0.0)))
+            })
+            .collect();
+        for (b, r) in per_pair.into_iter().flatten() {
+            room[b] = room[b].min(r);
+        }
+        room.iter()
+            .zip(&moving)
+            .filter(|(_, &u)| u > 0.0)
+            .map(|(r, u)| r / u)
+            .fold(Real::INFINITY, Real::min)
     }
 
     /// Every pair at least `s ξ` apart, and with the barrier farther than its law's reach.

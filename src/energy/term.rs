@@ -224,6 +224,15 @@ pub trait StepLimit {
         x: &[Vec3],
         bounds: &mut [Real],
     );
+
+    /// The explicit driver, with [`StepLimit::displacement_bounds`]: how far the dial may
+    /// move from `pot.dial` (either way) with the term's own parts that move with it (a mesh
+    /// obstacle), such that, while every vertex also stays within its bound from `x`, every
+    /// state is admissible and no element that was not gathered acts. `+∞` by default
+    /// (nothing of the term moves with the dial).
+    fn dial_room(&self, _pot: &Potential, _map: &ElementMap, _x: &[Vec3]) -> Real {
+        Real::INFINITY
+    }
 }
 
 /// The capability of a term that reports more than its energy under its name.

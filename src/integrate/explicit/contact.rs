@@ -23,6 +23,14 @@
 //! the pairs are gathered again where the paths took the sheet, and otherwise the run stops,
 //! naming the vertex: its path drives the sheet into itself or an obstacle.
 //!
+//! A mesh obstacle that moves with the dial cannot be pulled back either. Its radius is the
+//! dial's: it may move half the halo, and half the room of each gathered pair it is part of
+//! (the sheet's vertices take the other half), from where the pairs were gathered
+//! ([`crate::energy::term::StepLimit::dial_room`]). The pairs are gathered again before the
+//! dial would use 0.9 of that room within three more steps; when one step's dial moves it
+//! further, its move from the last step's dial is checked by additive CCD, and either the pairs
+//! are gathered again there or the run stops, naming the obstacle.
+//!
 //! A frame's state is always a gathering's: the pairs are gathered again right after each
 //! frame, so that a restart from a frame continues with the same pairs and radii, bit for bit.
 
@@ -37,6 +45,11 @@ pub(super) struct Bounds {
     at: Vec<Vec3>,
     /// How far each vertex may move from there (m; `+∞` where no term bounds it).
     room: Vec<Real>,
+    /// The dial they were gathered at.
+    dial: Real,
+    /// How far the dial may move from there with what moves with it (a mesh obstacle; `+∞`
+    /// when nothing does).
+    dial_room: Real,
     /// Gather again before the next step.
     pub(super) stale: bool,
     /// Gatherings so far.
@@ -55,6 +68,8 @@ impl Bounds {
             .then(|| Bounds {
                 at: vec![Vec3::zeros(); n],
                 room: vec![Real::INFINITY; n],
+                dial: 0.0,
+                dial_room: Real::INFINITY,
                 stale: true,
                 gathers: 0,
                 clipped: 0,
@@ -74,10 +89,60 @@ impl Bounds {
         let pot = s.potential_at(&pat, dial, state);
         self.room.fill(Real::INFINITY);
         pot.displacement_bounds(&state.x, &mut self.room);
+        self.dial_room = pot.dial_room(&state.x);
+        self.dial = dial;
         self.at.copy_from_slice(&state.x);
         self.stale = false;
         self.gathers += 1;
         Ok(())
+    }
+
+    /// Before a step at dial `dial`, the last one's at `last`, with the sheet at `state`: when
+    /// what moves with the dial (a mesh obstacle) has left its room from where the pairs were
+    /// gathered, checks its move from `last` (where it was within its room, and the sheet
+    /// within its radii: an admissible state) to `dial` by additive CCD over every pair the
+    /// broad phase finds along it, and gathers the pairs again at `dial`, or returns why the
+    /// run stops at time `t`: the move would bring a pair below its floor (the run then ends
+    /// at `last`). When it would leave 0.9 of its
+    /// room within [`LOOKAHEAD`] more steps like the last, marks the pairs stale.
+    pub(super) fn dialled(
+        &mut self,
+        s: &mut Solver,
+        state: &State,
+        dial: Real,
+        last: Real,
+        t: Real,
+    ) -> Result<Option<String>, RunError> {
+        let moved = (dial - self.dial).abs();
+        if moved > self.dial_room {
+            let pat = s.pattern();
+            let pot = s.potential_at(&pat, dial, state);
+            if pot.jump_fraction(&state.x, &state.x, &state.dofs, last) < 1.0 {
+                let moving: Vec<String> = s
+                    .scene
+                    .settings
+                    .obstacles
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, o)| {
+                        o.shape == Some(crate::config::obstacle::ShapeKind::Mesh)
+                            && o.displacement.iter().any(|&c| c != 0.0)
+                    })
+                    .map(|(i, _)| format!("obstacles[{i}]"))
+                    .collect();
+                return Ok(Some(format!(
+                    "the mesh obstacle moving with the dial ({}) would drive the sheet within \
+                     self_contact.min_separation of it at t = {} s, as the dial moves from \
+                     {last:.9} to {dial:.9}; the state written is the last one before",
+                    moving.join(", "),
+                    crate::math::human(t),
+                )));
+            }
+            self.gather(s, state, dial)?;
+        } else if moved + LOOKAHEAD * (dial - last).abs() > 0.9 * self.dial_room {
+            self.stale = true;
+        }
+        Ok(None)
     }
 
     /// After the step's paths moved the vertices of `paths` (the prescribed ones) to `x`: the

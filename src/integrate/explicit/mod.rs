@@ -429,12 +429,23 @@ pub(super) fn run_explicit(
     // sleeping workers to be woken twice per step (`crate::team`).
     let team = crate::team::Team::new(rayon::current_num_threads());
     let mut step = Step::new(&s.potential_at(&pat, k.dial, &state), true);
+    // The last step's dial: what moves with it was within its room there.
+    let mut last_dial = k.dial;
     let stop = team.activate(|| -> Result<Stop, RunError> {
         Ok(loop {
             if let Some(f) = super::interruption("t", k.t) {
                 break Stop::Other(f.to_string());
             }
             let dial = k.dial;
+            if let Some(b) = bounds.as_mut() {
+                if let Some(why) = b.dialled(s, &state, dial, last_dial, k.t)? {
+                    // The state written is the last admissible one.
+                    k.dial = last_dial;
+                    break Stop::Other(why);
+                }
+                pat = s.pattern();
+            }
+            last_dial = dial;
             if let Some(b) = bounds.as_mut().filter(|b| b.stale) {
                 b.gather(s, &state, dial)?;
                 pat = s.pattern();
@@ -490,6 +501,11 @@ pub(super) fn run_explicit(
                     .filter(|(d, _)| *d == dial)
                     .map(|(_, v)| &v[..]),
                 states: &state.terms,
+                dial_rate: if k.phase == Phase::Dial && dial < 1.0 && dial_time > 0.0 {
+                    1.0 / dial_time
+                } else {
+                    0.0
+                },
                 ..s.potential(&pat, dial)
             };
             let c = if k.phase == Phase::Dial {
