@@ -527,6 +527,20 @@ fn contact_check(d: &Path, json: &str, args: &[&str]) -> serde_json::Value {
     serde_json::from_str(&text).unwrap()
 }
 
+/// The independent check `c` found no crossing and the smallest distance `logged` (m, the
+/// log's smallest gap plus the offset) to 1e-9, and its `control` (the obstacle moved into the
+/// sheet) found crossings: the check can fail.
+fn agrees_with_the_log(c: &serde_json::Value, logged: f64, control: &serde_json::Value) {
+    println!("independent check: {c}");
+    assert_eq!(c["crossing_pairs"], 0, "{c}");
+    let dmin = c["min_distance"].as_f64().unwrap();
+    assert!(
+        (dmin - logged).abs() < 1e-9,
+        "the check's smallest distance {dmin} against the log's {logged}"
+    );
+    assert!(control["crossing_pairs"].as_u64().unwrap() > 0, "{control}");
+}
+
 /// The smallest value of the gap column `column` (m) over the frames of the run `out`,
 /// asserting that no frame has a pair closer than a tenth of its offset h/2 (gap ≥ −0.9 h/2).
 fn smallest_gap(out: &Path, column: &str, h: f64) -> f64 {
@@ -780,17 +794,11 @@ fn a_force_controlled_sphere_mesh_comes_down_onto_a_disk() {
         args.extend(last.then_some("--last"));
         contact_check(d, &format!("check{z}.json"), &args)
     };
-    let c = check("0.3125", false);
-    println!("independent check: {c}");
-    assert_eq!(c["crossing_pairs"], 0, "{c}");
-    let dmin = c["min_distance"].as_f64().unwrap();
-    assert!(
-        (dmin - (h / 2.0 + gap)).abs() < 1e-9,
-        "the check's smallest distance {dmin} against the log's {}",
-        h / 2.0 + gap
+    agrees_with_the_log(
+        &check("0.3125", false),
+        h / 2.0 + gap,
+        &check("0.3075", true),
     );
-    let control = check("0.3075", true);
-    assert!(control["crossing_pairs"].as_u64().unwrap() > 0, "{control}");
 }
 
 /// A disk (radius 0.5 m, h = 5 mm) dropped with friction μ = 0.5 onto a geodesic sphere mesh
@@ -840,17 +848,11 @@ fn a_sheet_draped_over_a_sphere_mesh_rests_on_its_contact_force() {
         args.extend(last.then_some("--last"));
         contact_check(d, &format!("check{z}.json"), &args)
     };
-    let c = check("-0.3026", false);
-    println!("independent check: {c}");
-    assert_eq!(c["crossing_pairs"], 0, "{c}");
-    let dmin = c["min_distance"].as_f64().unwrap();
-    assert!(
-        (dmin - (h / 2.0 + smallest)).abs() < 1e-9,
-        "the check's smallest distance {dmin} against the log's {}",
-        h / 2.0 + smallest
+    agrees_with_the_log(
+        &check("-0.3026", false),
+        h / 2.0 + smallest,
+        &check("-0.2976", true),
     );
-    let control = check("-0.2976", true);
-    assert!(control["crossing_pairs"].as_u64().unwrap() > 0, "{control}");
 }
 
 /// Bad mesh obstacles: exit 2 naming the key or the obstacle's file and what is wrong, nothing
@@ -1008,41 +1010,6 @@ fn a_mesh_moving_with_the_dial_presses_a_disk_onto_a_plane() {
     smallest_gap(&out, "obstacle1_gap", h);
 }
 
-/// Explicit mode, the other way round: a disk (h = 5 mm, 157 faces) on a fixed analytic plane,
-/// pressed by a plane mesh (two triangles, 1 mm above its top surface) that moves 1.5 mm down
-/// with the dial. The mesh's move is bounded as the sheet's vertices are (its room from where
-/// the pairs were gathered, the pairs gathered again before it is used up), and the contact
-/// dashpot measures the approach against the mesh's own velocity. At equilibrium the plane
-/// pushes up with the force the mesh pushes down, to 1e-6 of it, and the two equal penalties
-/// share the 0.5 mm squeeze, each side sinking 0.25 mm into its offset, to 1e-6.
-#[test]
-fn a_mesh_moving_with_the_dial_in_explicit_mode_balances_its_load() {
-    let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
-    disk(d, "0.1", "disk.vtk");
-    plane_obj(d, "top.obj", 0.0035);
-    let settings = "[material]\nyoung = 1e6\npoisson = 0.3\nthickness = 0.005\n\
-         bending = \"patch_fit\"\n[solver]\nmode = \"explicit\"\n\
-         [[obstacles]]\nshape = \"plane\"\npoint = [0, 0, -0.0025]\nnormal = [0, 0, 1]\n\
-         [[obstacles]]\nshape = \"mesh\"\nfile = \"top.obj\"\ndisplacement = [0, 0, -0.0015]\n";
-    let row = run(d, settings, "disk.vtk", "press", "2");
-    let (plane, mesh) = (force(&row, 0), force(&row, 1));
-    println!(
-        "plane pushes {plane:?} N, the mesh {mesh:?} N; gaps {} and {} m",
-        row["obstacle0_gap"], row["obstacle1_gap"]
-    );
-    assert!(plane[2] > 1000.0, "{plane:?}");
-    assert!(
-        (plane[2] + mesh[2]).abs() < 1e-6 * plane[2],
-        "{plane:?} {mesh:?}"
-    );
-    for k in 0..2 {
-        let gap = row[&format!("obstacle{k}_gap")];
-        assert!((gap + 2.5e-4).abs() < 1e-6 * 2.5e-4, "obstacle {k}: {gap}");
-    }
-    smallest_gap(&d.join("press"), "obstacle1_gap", 0.005);
-}
-
 /// Explicit mode: a plane mesh driven 6.8 mm down toward another 7 mm below it, a 5 mm disk
 /// between them, asks for more than the guarantee allows: the two surfaces would come within
 /// 0.2 mm, where each side keeps a tenth of the sheet's offset (0.25 mm) from its mid-surface.
@@ -1106,38 +1073,51 @@ fn a_mesh_driven_through_a_sheet_in_explicit_mode_stops() {
     }
 }
 
-/// Explicit mode: a disk (h = 5 mm) under a fixed plane mesh (two triangles, 1 mm above its top
-/// surface), pushed up into it by an analytic plane that moves 1.5 mm with the dial. At
-/// equilibrium the mesh pushes down with the force the plane pushes up, to 1e-6 of it, and the
-/// two equal penalties (E/h) share the 0.5 mm squeeze, each side sinking 0.25 mm into its offset
-/// to 1e-6 (measured: 19090.806 N on both at edges of 5 cm, 4747.958 N at 10 cm). The contact
-/// dashpot acts on the approach the step would reach by backward Euler: one that stopped that
-/// approach outright held the disk where the mesh first touched it (132 N against the plane's
-/// 39 kN, a false equilibrium).
+/// Explicit mode: a disk (h = 5 mm, 157 faces) squeezed 0.5 mm between an analytic plane and a
+/// plane mesh (two triangles, 1 mm above its top surface), once with the plane moving 1.5 mm up
+/// with the dial and the mesh fixed, once with the mesh moving 1.5 mm down and the plane fixed.
+/// The moving mesh's move is bounded as the sheet's vertices are (its room from where the pairs
+/// were gathered, the pairs gathered again before it is used up), and the contact dashpot
+/// measures the approach against its own velocity. At equilibrium the mesh and the plane push
+/// with the same force, to 1e-6 of it, and the two equal penalties (E/h) share the squeeze,
+/// each side sinking 0.25 mm into its offset to 1e-6 (measured: 19090.806 N on both at edges of
+/// 5 cm, 4747.958 N at 10 cm, either way). The contact dashpot acts on the approach the step
+/// would reach by backward Euler: one that stopped that approach outright held the disk where
+/// the mesh first touched it (132 N against the plane's 39 kN, a false equilibrium).
 #[test]
-fn a_disk_pushed_into_a_mesh_in_explicit_mode_balances_its_load() {
+fn a_disk_squeezed_between_a_plane_and_a_plane_mesh_in_explicit_mode_balances_its_load() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     disk(d, "0.1", "disk.vtk");
     plane_obj(d, "top.obj", 0.0035);
-    let settings = "[material]\nyoung = 1e6\npoisson = 0.3\nthickness = 0.005\n\
-         bending = \"patch_fit\"\n[solver]\nmode = \"explicit\"\n\
-         [[obstacles]]\nshape = \"plane\"\npoint = [0, 0, -0.0025]\nnormal = [0, 0, 1]\n\
-         displacement = [0, 0, 0.0015]\n\
-         [[obstacles]]\nshape = \"mesh\"\nfile = \"top.obj\"\n";
-    let row = run(d, settings, "disk.vtk", "squeeze", "2");
-    let (plane, mesh) = (force(&row, 0), force(&row, 1));
-    println!(
-        "plane pushes {plane:?} N, the mesh {mesh:?} N; gaps {} and {} m",
-        row["obstacle0_gap"], row["obstacle1_gap"]
-    );
-    assert!(plane[2] > 1000.0, "{plane:?}");
-    assert!(
-        (plane[2] + mesh[2]).abs() < 1e-6 * plane[2],
-        "{plane:?} {mesh:?}"
-    );
-    for k in 0..2 {
-        let gap = row[&format!("obstacle{k}_gap")];
-        assert!((gap + 2.5e-4).abs() < 1e-6 * 2.5e-4, "obstacle {k}: {gap}");
+    for (tag, plane_moves, mesh_moves) in [
+        ("squeeze", "displacement = [0, 0, 0.0015]\n", ""),
+        ("press", "", "displacement = [0, 0, -0.0015]\n"),
+    ] {
+        let settings = format!(
+            "[material]\nyoung = 1e6\npoisson = 0.3\nthickness = 0.005\n\
+             bending = \"patch_fit\"\n[solver]\nmode = \"explicit\"\n\
+             [[obstacles]]\nshape = \"plane\"\npoint = [0, 0, -0.0025]\nnormal = [0, 0, 1]\n\
+             {plane_moves}[[obstacles]]\nshape = \"mesh\"\nfile = \"top.obj\"\n{mesh_moves}"
+        );
+        let row = run(d, &settings, "disk.vtk", tag, "2");
+        let (plane, mesh) = (force(&row, 0), force(&row, 1));
+        println!(
+            "{tag}: plane pushes {plane:?} N, the mesh {mesh:?} N; gaps {} and {} m",
+            row["obstacle0_gap"], row["obstacle1_gap"]
+        );
+        assert!(plane[2] > 1000.0, "{tag}: {plane:?}");
+        assert!(
+            (plane[2] + mesh[2]).abs() < 1e-6 * plane[2],
+            "{tag}: {plane:?} {mesh:?}"
+        );
+        for k in 0..2 {
+            let gap = row[&format!("obstacle{k}_gap")];
+            assert!(
+                (gap + 2.5e-4).abs() < 1e-6 * 2.5e-4,
+                "{tag}: obstacle {k}: {gap}"
+            );
+        }
+        smallest_gap(&d.join(tag), "obstacle1_gap", 0.005);
     }
 }
