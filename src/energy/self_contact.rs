@@ -343,8 +343,6 @@ impl Cache {
 struct Rigid {
     /// Vertex positions at dial 0 (m).
     rest: Vec<Vec3>,
-    /// Vertex displacements at dial 1 (m).
-    shift: Vec<Vec3>,
     /// Per vertex, its obstacle (an index into `bodies`).
     owner: Vec<u32>,
     /// Per vertex, a third of the area of its faces (m²).
@@ -365,6 +363,8 @@ struct RigidBody {
     smoothing: Real,
     /// Coulomb coefficient μ against the sheet (0 in statics).
     friction: Real,
+    /// Its displacement at dial 1 (m; zero when fixed or force-controlled).
+    shift: Vec3,
     /// The force that pushes it, when it is force-controlled (`force`).
     push: Option<Push>,
 }
@@ -534,9 +534,8 @@ impl SelfContact {
             self.rigid
                 .rest
                 .iter()
-                .zip(&self.rigid.shift)
                 .zip(&self.rigid.owner)
-                .map(|((r, u), &b)| r + u * s + offsets[b as usize]),
+                .map(|(r, &b)| r + self.rigid.bodies[b as usize].shift * s + offsets[b as usize]),
         );
         Cow::Owned(all)
     }
@@ -1752,8 +1751,9 @@ impl ExplicitHooks for SelfContact {
     /// slip, for the pairs that press at `x` in the step `dt`. With `c` a pair's closest
     /// points' coefficients, `n` its normal, `λ` its normal force, `K` its normal stiffness
     /// (`m k w ψ″`) and `v*ᵢ = vᵢ − Δt gᵢ/mᵢ` the velocity each of its sheet vertices would
-    /// reach (a mesh obstacle's vertices move at its displacement × the dial's rate, `Potential::dial_rate`), the pair's relative velocity is `Σ cᵢ vᵢ` and
-    /// `w = Σ cᵢ²/mᵢ` its inverse mass along it.
+    /// reach (a mesh obstacle's vertices move at its displacement × the dial's rate,
+    /// `Potential::dial_rate`), the pair's relative velocity is `Σ cᵢ vᵢ` and `w = Σ cᵢ²/mᵢ`
+    /// its inverse mass along it.
     ///
     /// *Dashpot* (`damping` ζ, a fraction of critical damping of the pair on its penalty
     /// spring, `c = 2ζ √(K/w)`): the backward-Euler normal impulse `J = −c Δt u_n/(1 + c Δt w)`,
@@ -1811,7 +1811,7 @@ impl ExplicitHooks for SelfContact {
         // A mesh obstacle moved with the dial moves at its displacement × the dial's rate.
         let carried = |u: usize| {
             if u >= self.nv && u < y.len() {
-                self.rigid.shift[u - self.nv] * pot.dial_rate
+                self.rigid.bodies[self.rigid.owner[u - self.nv] as usize].shift * pot.dial_rate
             } else {
                 Vec3::zeros()
             }
@@ -1929,17 +1929,23 @@ impl StepLimit for SelfContact {
         step: &[Real],
     ) -> StepBound {
         let nv = self.nv;
-        // Each obstacle's move along the step: a force-controlled one's offset step along its
-        // force, the others none.
-        let pushes: Vec<Vec3> = self
+        // Each obstacle's offset step (a force-controlled one's, 0 for the others) and its move
+        // along the step, the offset step along its force.
+        let dq: Vec<Real> = self
             .rigid
             .bodies
             .iter()
             .map(|b| {
-                b.push.map_or(Vec3::zeros(), |p| {
-                    p.direction * step[crate::elements::node_dofs(nv, p.node).0]
-                })
+                b.push
+                    .map_or(0.0, |p| step[crate::elements::node_dofs(nv, p.node).0])
             })
+            .collect();
+        let pushes: Vec<Vec3> = self
+            .rigid
+            .bodies
+            .iter()
+            .zip(&dq)
+            .map(|(b, &d)| b.push.map_or(Vec3::zeros(), |p| p.direction * d))
             .collect();
         let dx = |v: usize| {
             if v < nv {
@@ -1975,9 +1981,8 @@ impl StepLimit for SelfContact {
             .pushed
             .iter()
             .map(|&b| {
-                let p = self.rigid.bodies[b].push.map_or(NONE, |p| p.node);
                 let now = self.pushed_by(b, phi) - self.pushed_by(b, taken_phi);
-                (now, now + step[crate::elements::node_dofs(nv, p).0])
+                (now, now + dq[b])
             })
             .collect();
         let moved = (!std::ptr::eq(taken, sheet) && taken != sheet)
@@ -2118,15 +2123,7 @@ impl StepLimit for SelfContact {
     /// moves by `|u| Δs` over a change `Δs` of the dial (the dial clamped to [0, 1] moves no
     /// more): the room is the least of those radii over `|u|`.
     fn dial_room(&self, pot: &Potential, map: &ElementMap, x: &[Vec3]) -> Real {
-        let moving: Vec<Real> = (0..self.rigid.bodies.len())
-            .map(|b| {
-                self.rigid
-                    .owner
-                    .iter()
-                    .position(|&o| o as usize == b)
-                    .map_or(0.0, |v| self.rigid.shift[v].norm())
-            })
-            .collect();
+        let moving: Vec<Real> = self.rigid.bodies.iter().map(|b| b.shift.norm()).collect();
         if moving.iter().all(|&u| u == 0.0) {
             return Real::INFINITY;
         }
@@ -2410,9 +2407,7 @@ fn add_rigid(
     }
     let added = sc.rest.len() - first;
     let owner = sc.rigid.bodies.len() as u32;
-    let shift = Vec3::from(o.displacement);
     sc.rigid.rest.extend_from_slice(&sc.rest[first..]);
-    sc.rigid.shift.extend(std::iter::repeat_n(shift, added));
     sc.rigid.owner.extend(std::iter::repeat_n(owner, added));
     sc.thickness.extend(std::iter::repeat_n(0.0, added));
     sc.area.extend(std::iter::repeat_n(0.0, added));
@@ -2462,6 +2457,7 @@ fn add_rigid(
         stiffness: o.stiffness.unwrap_or(k_default),
         smoothing: o.smoothing.unwrap_or(ca.h_mean / 100.0),
         friction: if dynamic { o.friction } else { 0.0 },
+        shift: Vec3::from(o.displacement),
         push,
     });
     Ok(())

@@ -470,29 +470,7 @@ fn mesh_obstacle_against_finite_differences(extra: &str, push: Option<(Vec3, Rea
         &mut [],
     );
     assert!(g[p.n - 1] != 0.0, "the offset has a gradient");
-    super::terms::fd_check(
-        &sc,
-        &p,
-        &x,
-        &phi,
-        "force-controlled mesh obstacle",
-        1,
-        |g, h| g.max(h),
-        |x, phi, want, g, h| {
-            g.iter_mut().for_each(|v| *v = 0.0);
-            h.iter_mut().for_each(|v| *v = 0.0);
-            sc.terms[i].eval(
-                &pot,
-                &p.maps[i],
-                x,
-                phi,
-                want,
-                HessianProjection::None,
-                g,
-                h,
-            )
-        },
-    );
+    super::terms::check_term(&sc, &p, &pot, &x, &phi, i);
     // The offset moves every vertex of the ball: a step of the offset alone 0.1 into the strip
     // (the ball's top is 6 mm into its offset) is cut by CCD short of the minimum separation,
     // where the state is admitted and past which it is not; the same step away is whole.

@@ -125,7 +125,7 @@ pub fn fd_check(
 
 /// Term `i` alone through [`fd_check`], every DOF; its Hessian relative to the larger of the
 /// largest gradient and Hessian entries (a dead load has no Hessian at all).
-fn check_term(sc: &Scene, p: &Pattern, pot: &Potential, x: &[Vec3], phi: &[Real], i: usize) {
+pub fn check_term(sc: &Scene, p: &Pattern, pot: &Potential, x: &[Vec3], phi: &[Real], i: usize) {
     let term = &sc.terms[i];
     let map: &ElementMap = &p.maps[i];
     let label = format!("{} ({:?})", term.name(), sc.settings.material.model);

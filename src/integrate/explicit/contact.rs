@@ -103,8 +103,8 @@ impl Bounds {
     /// within its radii: an admissible state) to `dial` by additive CCD over every pair the
     /// broad phase finds along it, and gathers the pairs again at `dial`, or returns why the
     /// run stops at time `t`: the move would bring a pair below its floor (the run then ends
-    /// at `last`). When it would leave 0.9 of its
-    /// room within [`LOOKAHEAD`] more steps like the last, marks the pairs stale.
+    /// at `last`). When it would leave 0.9 of its room within [`LOOKAHEAD`] more steps like
+    /// the last, marks the pairs stale.
     pub(super) fn dialled(
         &mut self,
         s: &mut Solver,
