@@ -44,6 +44,7 @@ SCENES = {
     "gel_disk_hyperbolic": ("final", "gauss_curvature", "30,30", "-2000,0"),
     "conformal_cap": ("final", "mean_curvature", "30,20", None),
     "paper_walker": (0.4, "moisture_bottom", "-60,15", None),
+    "spoon_heated": ("final", "temperature_max_top", "-50,35", None),
 }
 
 

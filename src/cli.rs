@@ -201,6 +201,9 @@ enum Shape {
     Teddy,
     /// Closed: a torus of major radius --radius and tube radius --tube.
     Torus,
+    /// Open: a plastic spoon of total length --size, an elliptical bowl 0.28 × size long and
+    /// 0.044 × size deep and a curved, tapering handle (tri_tags 1 bowl, 2 handle); Delaunay.
+    Spoon,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
@@ -220,7 +223,7 @@ pub(crate) struct MeshArgs {
     /// Target edge length (m).
     #[arg(long)]
     edge: Real,
-    /// Side of a square (m).
+    /// Side of a square, or a spoon's length (m).
     #[arg(long, default_value_t = 1.0)]
     size: Real,
     /// Rectangle length along x (m).
@@ -911,7 +914,7 @@ pub(crate) fn build_mesh(a: &MeshArgs, max_faces: Real) -> Result<crate::mesh::M
         a.shape,
         Shape::Sphere | Shape::Capsule | Shape::Peanut | Shape::Teddy | Shape::Torus
     );
-    if a.delaunay && (closed || matches!(a.shape, Shape::Disk)) {
+    if a.delaunay && (closed || matches!(a.shape, Shape::Disk | Shape::Spoon)) {
         bail!("--delaunay supports square, rectangle and annulus");
     }
     if closed && (a.jitter > 0.0 || a.grading != 1.0 || a.checkerboard || a.program.is_some()) {
@@ -997,6 +1000,20 @@ pub(crate) fn build_mesh(a: &MeshArgs, max_faces: Real) -> Result<crate::mesh::M
             let name = format!("{:?}", a.shape).to_lowercase();
             crate::mesh::surfaces::closed_shape_within(&name, a.radius, a.edge, max_faces)
                 .map_err(|e| anyhow!("cannot mesh the {name}: {e}"))?
+        }
+        Shape::Spoon => {
+            pos("size", a.size)?;
+            let faces = crate::mesh::spoon::planned_faces(a.size, a.edge);
+            check_planned(faces, "faces", "--edge and --size").map_err(|e| anyhow!(e))?;
+            if a.edge > 0.02 * a.size {
+                bail!(
+                    "--edge ({}) must be at most 0.02 × --size ({}) to resolve the spoon's \
+                     handle",
+                    a.edge,
+                    a.size
+                );
+            }
+            crate::mesh::spoon::spoon(a.size, a.edge, sp)
         }
         Shape::Torus => {
             pos("radius", a.radius)?;

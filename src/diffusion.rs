@@ -187,6 +187,10 @@ pub enum DiffusionError {
 /// The diffusion system of one mesh.
 pub struct Diffusion {
     layers: usize,
+    /// Heights of the layer boundaries as fractions of the thickness ([`Layering::fractions`]).
+    heights: Vec<Real>,
+    /// The sources' load per node ([`Diffusion::set_sources`]), added to `rhs`.
+    source: Vec<Real>,
     nv: usize,
     faces: Vec<[usize; 3]>,
     areas: Vec<Real>,
@@ -417,6 +421,8 @@ impl Diffusion {
         };
         Ok(Diffusion {
             layers,
+            heights,
+            source: vec![0.0; nn],
             nv,
             faces: faces.to_vec(),
             areas,
@@ -833,7 +839,10 @@ impl Diffusion {
         for i in 0..n {
             ug[i] = match self.fixed[i] {
                 Some(gi) => gi,
-                None => self.mass[i] * u[i] - c * au[i] + 2.0 * c * self.rhs[i] - c * lift[i],
+                None => {
+                    self.mass[i] * u[i] - c * au[i] + 2.0 * c * (self.rhs[i] + self.source[i])
+                        - c * lift[i]
+                }
             };
         }
         self.solve(h, &mut ug, Some(u), report)?;
@@ -844,7 +853,8 @@ impl Diffusion {
             out[i] = match self.fixed[i] {
                 Some(gi) => gi,
                 None => {
-                    self.mass[i] * (a1 * ug[i] - a0 * u[i]) + c * self.rhs[i] - c * self.lift[i]
+                    self.mass[i] * (a1 * ug[i] - a0 * u[i]) + c * (self.rhs[i] + self.source[i])
+                        - c * self.lift[i]
                 }
             };
         }
@@ -959,6 +969,55 @@ impl Diffusion {
             }
         }
         Ok(report)
+    }
+
+    /// Sets the sources' inward fluxes per face `[top, bottom]` (field × m/s), replacing the
+    /// last ones: a load like [`SurfaceBc::Flux`]'s (lumped, `q A/3` per face vertex) that adds
+    /// to whatever condition the side has, for sources that move or switch from step to step.
+    pub fn set_sources(&mut self, q: &[[Real; 2]]) {
+        self.source.iter_mut().for_each(|s| *s = 0.0);
+        let top = 2 * self.layers;
+        for (f, qf) in q.iter().enumerate().take(self.faces.len()) {
+            for (k, &qs) in [top, 0].iter().zip(qf) {
+                if qs != 0.0 {
+                    for v in self.faces[f] {
+                        let i = v * self.column() + k;
+                        self.source[i] += qs * self.areas[f] / 3.0;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The mean over face `f`'s three vertex columns of the nodal field `u` at heights
+    /// `fractions` of the thickness (0 bottom, 1 top), interpolated by each layer's quadratic
+    /// shape functions.
+    pub fn profile<const N: usize>(
+        &self,
+        u: &[Real],
+        f: usize,
+        fractions: &[Real; N],
+    ) -> [Real; N] {
+        let h = &self.heights;
+        let face = self.faces[f];
+        fractions.map(|z| {
+            let z = z.clamp(0.0, 1.0);
+            let k = (h.partition_point(|&b| b <= z).max(1) - 1).min(self.layers - 1);
+            let zeta = 2.0 * (z - h[k]) / (h[k + 1] - h[k]) - 1.0;
+            let n = [
+                0.5 * zeta * (zeta - 1.0),
+                1.0 - zeta * zeta,
+                0.5 * zeta * (zeta + 1.0),
+            ];
+            face.iter()
+                .map(|&v| {
+                    (0..3)
+                        .map(|j| n[j] * u[self.node(v, 2 * k + j)])
+                        .sum::<Real>()
+                })
+                .sum::<Real>()
+                / 3.0
+        })
     }
 
     /// Mean moisture over face `f`'s top and bottom surfaces `(m⁺, m⁻)`.

@@ -88,6 +88,7 @@ impl<'a> Potential<'a> {
             gravity: Vec3::zeros(),
             stretch_scale: 1.0,
             rest_override: None,
+            thickness_override: None,
             mass: &scene.body.mass,
             friction: None,
             frozen: None,

@@ -172,9 +172,11 @@ pub fn check_fields(
         .chain(w.frame_mesh.vertex_fields.keys())
         .cloned()
         .collect();
-    if scene.settings.moisture.enabled {
-        names.extend(crate::integrate::moisture::FRAME_FIELDS.map(String::from));
-    }
+    names.extend(
+        crate::integrate::transport::frame_fields(&scene.settings)
+            .iter()
+            .map(|f| f.to_string()),
+    );
     names.sort();
     let keys = out
         .fields

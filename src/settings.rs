@@ -81,6 +81,8 @@ pub struct Settings {
     pub growth: Growth,
     /// Moisture diffusion that drives the swelling laws in time (seed 000 §4).
     pub moisture: Moisture,
+    /// Heat conduction that drives the thermal shrink law in time.
+    pub temperature: crate::config::temperature::Temperature,
     /// What is solved: statics or dynamics, and the Newton solver's controls.
     pub solver: Solver,
     /// Time stepping (dynamic mode).
@@ -235,10 +237,13 @@ impl Settings {
         self.growth.validate(self.rest.target)?;
         self.moisture
             .validate(&self.growth, self.contact.enabled, mode)?;
+        self.temperature
+            .validate(&self.growth, self.moisture.enabled, mode)?;
         self.time.validate()?;
         self.explicit.validate()?;
-        self.dial
-            .validate(self.growth.law != GrowthLaw::None || self.moisture.enabled)?;
+        self.dial.validate(
+            self.growth.law != GrowthLaw::None || self.moisture.enabled || self.temperature.enabled,
+        )?;
         if mode == Mode::Explicit && self.material.bending.angle_variant().is_some() {
             return Err(Invalid::new(
                 "material.bending",

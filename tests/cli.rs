@@ -1588,6 +1588,13 @@ fn restart_follows_the_uninterrupted_moisture_run_exactly() {
 }
 
 #[test]
+fn restart_follows_the_uninterrupted_heated_spoon_exactly() {
+    // The conduction's nodal temperatures, the highest each has reached and its sub-step
+    // control are carried over; the run crosses the end of the heat gun's window.
+    restart_is_exact("spoon_heated.toml", "spoon.vtk", &["time.end=50"], 3, "25");
+}
+
+#[test]
 fn restart_follows_the_uninterrupted_balloon_run_exactly() {
     // An enclosed gas with the prism element's tracked thickness, in dynamics.
     restart_is_exact(

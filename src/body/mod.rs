@@ -204,6 +204,9 @@ impl Body {
         if settings.moisture.enabled {
             check_moisture_regions(&mesh, settings)?;
         }
+        if settings.temperature.enabled {
+            check_heat_regions(&mesh, settings)?;
+        }
         let mass = lumped_masses(&mesh, &thickness, m.density);
         // Free: no vertex that carries the sheet is held (unused vertices are held, inertly).
         let free = unused.len() < nv
@@ -1099,6 +1102,53 @@ fn check_moisture_regions(mesh: &Mesh, settings: &Settings) -> Result<(), MeshEr
                 }
             }
             seen.insert((f, b.side), i);
+        }
+    }
+    Ok(())
+}
+
+/// Rejects temperature boundary regions that give one face side two different conditions at
+/// the same time: two permanent ones, two windowed ones whose windows overlap, or a windowed one
+/// over a prescribed temperature (a windowed flux or Robin condition otherwise replaces the
+/// side's permanent one while it is open).
+fn check_heat_regions(mesh: &Mesh, settings: &Settings) -> Result<(), MeshError> {
+    let bs = &settings.temperature.boundary;
+    let faces: Vec<Vec<usize>> = bs
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            select::faces_matching(
+                mesh,
+                &b.tags,
+                b.inside.as_ref(),
+                &format!("temperature.boundary[{i}]"),
+            )
+        })
+        .collect::<Result<_, _>>()?;
+    for (i, a) in bs.iter().enumerate() {
+        for (j, b) in bs.iter().enumerate().skip(i + 1) {
+            let (ua, ub) = (
+                a.until.unwrap_or(Real::INFINITY),
+                b.until.unwrap_or(Real::INFINITY),
+            );
+            let same = (a.kind, a.value, a.h, a.ambient) == (b.kind, b.value, b.h, b.ambient);
+            // A windowed condition replaces a permanent one while it is open, unless that one
+            // is a prescribed temperature.
+            let value = |c: &crate::config::temperature::HeatBoundary| {
+                c.kind == crate::settings::SurfaceKind::Value
+            };
+            let overrides = a.permanent() != b.permanent() && !value(a) && !value(b);
+            if a.side != b.side || same || overrides || ua <= b.from || ub <= a.from {
+                continue;
+            }
+            let set: std::collections::HashSet<usize> = faces[i].iter().copied().collect();
+            if let Some(f) = faces[j].iter().find(|f| set.contains(f)) {
+                return Err(mesh.invalid(format!(
+                    "temperature.boundary[{i}] and temperature.boundary[{j}] both set the {:?} \
+                     surface of face {f} to different conditions at the same time",
+                    b.side
+                )));
+            }
         }
     }
     Ok(())

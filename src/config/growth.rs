@@ -28,11 +28,14 @@ pub enum GrowthLaw {
     Bilayer,
     /// Linear swelling with a machine direction: `mu` along it, `mu_perp` across it.
     MachineDirection,
+    /// Irreversible shrink set by the highest temperature reached, from the table `shrink`,
+    /// along and across the machine direction and through the thickness.
+    ThermalShrink,
 }
 
 impl GrowthLaw {
     /// Every law, `"none"` first (the registry in `rest::laws` has an entry for each other one).
-    pub const ALL: [GrowthLaw; 7] = [
+    pub const ALL: [GrowthLaw; 8] = [
         GrowthLaw::None,
         GrowthLaw::Isotropic,
         GrowthLaw::IsotropicInPlane,
@@ -40,6 +43,7 @@ impl GrowthLaw {
         GrowthLaw::LinearSwelling,
         GrowthLaw::Bilayer,
         GrowthLaw::MachineDirection,
+        GrowthLaw::ThermalShrink,
     ];
 
     /// The law's settings value, as in the settings file.
@@ -52,6 +56,7 @@ impl GrowthLaw {
             GrowthLaw::LinearSwelling => "linear_swelling",
             GrowthLaw::Bilayer => "bilayer",
             GrowthLaw::MachineDirection => "machine_direction",
+            GrowthLaw::ThermalShrink => "thermal_shrink",
         }
     }
 
@@ -61,6 +66,7 @@ impl GrowthLaw {
             GrowthLaw::LinearSwelling => &["mu"],
             GrowthLaw::Bilayer => &["mu_top", "mu_bottom"],
             GrowthLaw::MachineDirection => &["mu", "mu_perp"],
+            GrowthLaw::ThermalShrink => &["shrink"],
             _ => &[],
         }
     }
@@ -69,7 +75,7 @@ impl GrowthLaw {
 /// A growth law with the coefficients it reads: `[growth]` once validated ([`Growth::model`]).
 /// The isotropic laws' factor `s` and the moisture are per-face inputs
 /// ([`crate::rest::laws::GrowthInputs`]), not coefficients.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum GrowthModel {
     /// No growth law.
     None,
@@ -98,11 +104,55 @@ pub enum GrowthModel {
         /// Coefficient across it (per unit moisture).
         mu_perp: Real,
     },
+    /// Irreversible thermal shrink.
+    ThermalShrink {
+        /// Shrink against the highest temperature reached.
+        table: ShrinkTable,
+    },
+}
+
+/// The thermal shrink law's table, validated ([`Growth::validate`]): at each temperature
+/// (K, strictly increasing) the shrink strains along the machine direction, across it and
+/// through the thickness (fractions of the length lost; negative: expansion). Linear between
+/// rows, constant beyond the first and the last.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShrinkTable {
+    /// Temperatures (K).
+    pub temperature: Vec<Real>,
+    /// Shrink along, across and through at each temperature.
+    pub shrink: Vec<[Real; 3]>,
+}
+
+impl ShrinkTable {
+    /// The shrink strains `[along, across, through]` at temperature `t` (K).
+    pub fn at(&self, t: Real) -> [Real; 3] {
+        let ts = &self.temperature;
+        let n = ts.len();
+        if n == 0 {
+            return [0.0; 3];
+        }
+        if t.is_nan() || t <= ts[0] {
+            return self.shrink[0];
+        }
+        if t >= ts[n - 1] {
+            return self.shrink[n - 1];
+        }
+        let k = ts.partition_point(|&x| x <= t);
+        let s = (t - ts[k - 1]) / (ts[k] - ts[k - 1]);
+        let (a, b) = (self.shrink[k - 1], self.shrink[k]);
+        std::array::from_fn(|i| a[i] + s * (b[i] - a[i]))
+    }
+
+    /// Whether the in-plane shrink is the same along and across at every row (no machine
+    /// direction needed).
+    pub fn isotropic_in_plane(&self) -> bool {
+        self.shrink.iter().all(|r| r[0] == r[1])
+    }
 }
 
 impl GrowthModel {
     /// The law's settings value.
-    pub fn law(self) -> GrowthLaw {
+    pub fn law(&self) -> GrowthLaw {
         match self {
             GrowthModel::None => GrowthLaw::None,
             GrowthModel::Isotropic => GrowthLaw::Isotropic,
@@ -111,6 +161,7 @@ impl GrowthModel {
             GrowthModel::LinearSwelling { .. } => GrowthLaw::LinearSwelling,
             GrowthModel::Bilayer { .. } => GrowthLaw::Bilayer,
             GrowthModel::MachineDirection { .. } => GrowthLaw::MachineDirection,
+            GrowthModel::ThermalShrink { .. } => GrowthLaw::ThermalShrink,
         }
     }
 }
@@ -142,6 +193,15 @@ pub struct Growth {
     pub s: Option<Field>,
     /// Uniform machine direction in reference Cartesian coordinates (default `[1, 0, 0]`).
     pub machine_direction: [Real; 3],
+    /// Thermal shrink table (required by `"thermal_shrink"`): rows `[T, along, across]` or
+    /// `[T, along, across, through]`, T in kelvin strictly increasing, the shrink strains
+    /// (fractions) each monotone in T; `through` is 0 with three columns.
+    pub shrink: Option<Vec<Vec<Real>>>,
+    /// Highest temperature reached at the top surface, without `[temperature]` (K, default
+    /// `293.15`); linear through the thickness to `temperature_bottom`.
+    pub temperature_top: Real,
+    /// See `temperature_top` (K, default `293.15`).
+    pub temperature_bottom: Real,
 }
 
 impl Default for Growth {
@@ -156,6 +216,9 @@ impl Default for Growth {
             moisture_bottom: 0.0,
             s: None,
             machine_direction: [1.0, 0.0, 0.0],
+            shrink: None,
+            temperature_top: 293.15,
+            temperature_bottom: 293.15,
         }
     }
 }
@@ -179,7 +242,99 @@ impl Growth {
                 mu: c(self.mu),
                 mu_perp: c(self.mu_perp),
             },
+            GrowthLaw::ThermalShrink => GrowthModel::ThermalShrink {
+                table: self.shrink_table(),
+            },
         }
+    }
+
+    /// `shrink` as a table (empty when not given; validated settings have one).
+    pub fn shrink_table(&self) -> ShrinkTable {
+        let rows = self.shrink.as_deref().unwrap_or(&[]);
+        ShrinkTable {
+            temperature: rows
+                .iter()
+                .map(|r| r.first().copied().unwrap_or(0.0))
+                .collect(),
+            shrink: rows
+                .iter()
+                .map(|r| std::array::from_fn(|i| r.get(i + 1).copied().unwrap_or(0.0)))
+                .collect(),
+        }
+    }
+
+    /// Checks `shrink`: at least two rows of 3 or 4 finite numbers, all of one length,
+    /// temperatures above 0 K strictly increasing, shrink strains in (−1, 1) and each column
+    /// monotone in temperature (the shrink set free by heating never reverses on further
+    /// heating).
+    fn validate_shrink(&self) -> Result<(), Invalid> {
+        let ck = Check;
+        let Some(rows) = &self.shrink else {
+            return Ok(());
+        };
+        if rows.len() < 2 {
+            return ck.inv(
+                "growth.shrink",
+                format!(
+                    "needs at least two rows [T, along, across(, through)], got {}",
+                    rows.len()
+                ),
+            );
+        }
+        let width = rows[0].len();
+        for (i, r) in rows.iter().enumerate() {
+            let key = format!("growth.shrink[{i}]");
+            if !(r.len() == 3 || r.len() == 4) || r.len() != width {
+                return ck.inv(
+                    &key,
+                    format!(
+                        "rows are [T (K), along, across] or [T, along, across, through], all of                          one length; this one has {} numbers, the first {width}",
+                        r.len()
+                    ),
+                );
+            }
+            super::temperature::absolute(&key, r[0])?;
+            if let Some(v) = r[1..].iter().find(|v| !(v.is_finite() && v.abs() < 1.0)) {
+                return ck.inv(
+                    &key,
+                    format!(
+                        "shrink strains are fractions in (−1, 1) (a length cannot vanish), got                          {}",
+                        crate::math::human(*v)
+                    ),
+                );
+            }
+            if i > 0 && r[0] <= rows[i - 1][0] {
+                return ck.inv(
+                    &key,
+                    format!(
+                        "the table is not monotone in temperature: {} K after {} K (temperatures                          must increase strictly)",
+                        crate::math::human(r[0]),
+                        crate::math::human(rows[i - 1][0])
+                    ),
+                );
+            }
+        }
+        let names = ["along", "across", "through"];
+        for c in 1..width {
+            let mut dir = 0.0;
+            for i in 1..rows.len() {
+                let d = rows[i][c] - rows[i - 1][c];
+                if d * dir < 0.0 {
+                    return ck.inv(
+                        &format!("growth.shrink[{i}]"),
+                        format!(
+                            "the {} shrink is not monotone in temperature: it turns at {} K                              (the shrink set free by heating cannot reverse on further heating)",
+                            names[c - 1],
+                            crate::math::human(rows[i - 1][0])
+                        ),
+                    );
+                }
+                if d != 0.0 {
+                    dir = d;
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Validates `[growth]`: finite coefficients, a valid `s`, and no growth law together with `rest.target`.
@@ -224,6 +379,17 @@ impl Growth {
                 );
             }
         }
+        if g.shrink.is_none() && g.law == GrowthLaw::ThermalShrink {
+            return ck.inv(
+                "growth.shrink",
+                "growth.law = \"thermal_shrink\" needs its table shrink = [[T (K), along, \
+                 across], ...]"
+                    .into(),
+            );
+        }
+        g.validate_shrink()?;
+        super::temperature::absolute("growth.temperature_top", g.temperature_top)?;
+        super::temperature::absolute("growth.temperature_bottom", g.temperature_bottom)?;
         match &g.s {
             Some(Field::Value(v)) if !v.is_finite() => {
                 return ck.inv(

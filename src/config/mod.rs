@@ -45,6 +45,7 @@ pub mod self_contact;
 pub mod shell;
 pub mod slides;
 pub mod solver;
+pub mod temperature;
 pub mod time;
 pub mod values;
 pub mod view;

@@ -90,6 +90,9 @@ pub struct Potential<'a> {
     pub stretch_scale: Real,
     /// Per-face rest forms `(ā, b̄)` that replace the dialled ones (moisture-driven growth).
     pub rest_override: Option<&'a [(Sym2, Sym2)]>,
+    /// Per-face rest thickness over the reference thickness that replaces the dialled one
+    /// (a thermal shrink through the thickness).
+    pub thickness_override: Option<&'a [Real]>,
     /// Lumped vertex masses (kg): the scene's, or moisture-dependent ones.
     pub mass: &'a [Real],
     /// Friction against the ground and the obstacles (their normal contact terms are on
@@ -142,6 +145,9 @@ impl<'a> Potential<'a> {
     #[inline(always)]
     pub fn thickness(&self, f: usize) -> Real {
         let sc = self.body;
+        if let Some(t) = self.thickness_override {
+            return sc.thickness[f] * t[f];
+        }
         match sc.grown_thickness.get(f) {
             None => sc.thickness[f],
             Some(&r) => sc.thickness[f] * sc.rest.thickness_ratio(r, self.dial),

@@ -56,8 +56,6 @@ pub struct DynamicConfig {
     pub time: Time,
     /// The dial reaches 1 at this time (s; 0 = at once).
     pub dial_time: Real,
-    /// A step that changes the moisture by more than this anywhere is cut.
-    pub moisture_max_change: Real,
     /// Slip speed of the smoothed Coulomb friction (m/s).
     pub slip_speed: Real,
 }
@@ -112,7 +110,6 @@ impl RunConfig {
             dynamics: DynamicConfig {
                 time: s.time.clone(),
                 dial_time: s.rest.dial_time,
-                moisture_max_change: s.moisture.max_change,
                 slip_speed: s.contact.slip_speed,
             },
         }

@@ -3,13 +3,13 @@
 //! ([`super::friction`]) are their own modules.
 
 use super::friction::FrictionLag;
-use super::moisture::{accepted, Moisture};
+use super::transport::{accepted, Field, Targets, Transport};
 use super::Sink;
 use super::{OutputClock, Progress, RunError, RunFailure, Solver, StepControl};
 use crate::assembly::Want;
 use crate::energy::potential::{Damping, Inertia};
 use crate::energy::Potential;
-use crate::math::{Real, Sym2, Vec3};
+use crate::math::{Real, Vec3};
 use crate::solve::State;
 use std::time::Instant;
 
@@ -105,15 +105,16 @@ pub(super) fn run_dynamic(
     } else {
         (Vec::new(), Vec::new())
     };
-    // Moisture: the diffusion state and the rest forms it sets (None without diffusion).
-    let mut moisture = Moisture::new(sc)?;
-    let mut targets: Vec<(Sym2, Sym2)> = Vec::new();
-    let mut trial_targets: Vec<(Sym2, Sym2)> = Vec::new();
+    // Moisture or temperature: the diffusion state and the rest forms it sets (None without
+    // a coupled field).
+    let mut moisture = Transport::new(sc)?;
+    let mut targets = Targets::default();
+    let mut trial_targets = Targets::default();
     if let (Some(m), Some(d)) = (&mut moisture, &driver) {
         m.resume(sc, d).map_err(RunError::Restart)?;
     }
     if let Some(m) = &moisture {
-        targets = m.targets_of(sc, &m.u)?;
+        targets = m.targets_of(sc, false)?;
         m.publish(writer);
     }
     // Halved on failure, ×1.5 after 3 easy steps (≤ 3 Newton iterations).
@@ -132,7 +133,18 @@ pub(super) fn run_dynamic(
                 holding,
                 next_hold,
                 holds_reached,
-                moisture: moisture.as_ref().map(|m| m.u.clone()),
+                moisture: moisture
+                    .as_ref()
+                    .filter(|m| m.field == Field::Moisture)
+                    .map(|m| m.u.clone()),
+                temperature: moisture
+                    .as_ref()
+                    .filter(|m| m.field == Field::Temperature)
+                    .map(|m| m.u.clone()),
+                temperature_max: moisture
+                    .as_ref()
+                    .filter(|m| m.field == Field::Temperature)
+                    .map(|m| m.peak.clone()),
                 diffusion_substep: moisture.as_ref().map(|m| m.diffusion.next_substep()),
                 global_velocities: w.clone(),
                 acceleration: Some(acc.clone()),
@@ -167,7 +179,11 @@ pub(super) fn run_dynamic(
             failure = Some(f);
             break;
         }
-        let h = clock.step_from(t, steps.step).min(tm.end - t);
+        let mut h = clock.step_from(t, steps.step).min(tm.end - t);
+        // A step ends where a windowed surface condition starts or stops.
+        if let Some(ts) = moisture.as_ref().and_then(|m| m.next_switch(t)) {
+            h = h.min(ts - t);
+        }
         let (dial, reaches_hold) = if holding {
             (dial_now, false)
         } else {
@@ -239,10 +255,14 @@ pub(super) fn run_dynamic(
         }
         if let Some(m) = &mut moisture {
             // Diffuse over the step, then set the rest forms from the new surface moisture.
-            if let Err(e) = m.update_ground(sc, &state.x) {
+            if let Err(e) = m
+                .update_ground(sc, &state.x)
+                .and_then(|_| m.update_windows(t))
+            {
                 failure = Some(RunFailure::MoistureSurface { t, source: e });
                 break;
             }
+            m.update_sources(sc, t, h);
             m.trial.copy_from_slice(&m.u);
             let tol = m.tolerance(sc);
             match m.diffusion.advance(&mut m.trial, h, tol) {
@@ -264,14 +284,15 @@ pub(super) fn run_dynamic(
             m.change = (0..m.u.len())
                 .filter(|&i| !m.diffusion.is_prescribed(i))
                 .fold(0.0, |c: Real, i| c.max((m.trial[i] - m.u[i]).abs()));
-            if m.change > cf.moisture_max_change && h > tm.dt_min {
+            if m.change > m.max_change && h > tm.dt_min {
                 s.summary.moisture_seconds += moisture_clock.elapsed().as_secs_f64();
                 s.summary.rejected_steps += 1;
                 steps.rejected(h);
                 steps.step = steps.step.max(tm.dt_min);
                 continue;
             }
-            match m.targets_of(sc, &m.trial) {
+            m.raise_peak();
+            match m.targets_of(sc, true) {
                 Ok(tt) => trial_targets = tt,
                 Err(e) => {
                     failure = Some(RunFailure::Growth { t, source: e });
@@ -324,7 +345,11 @@ pub(super) fn run_dynamic(
                         b_prev: &b_prev,
                     }),
                     gravity: s.config.gravity,
-                    rest_override: moisture.as_ref().map(|_| &trial_targets[..]),
+                    rest_override: moisture.as_ref().map(|_| &trial_targets.forms[..]),
+                    thickness_override: moisture
+                        .as_ref()
+                        .filter(|_| !trial_targets.thickness.is_empty())
+                        .map(|_| &trial_targets.thickness[..]),
                     mass: trial_mass,
                     friction: lag.as_ref().map(|l| l.friction(&state.x, dial_now, h)),
                     ..Potential::new(sc, &pat)
@@ -387,9 +412,8 @@ pub(super) fn run_dynamic(
         state.copy_from(&trial);
         super::hooks::accept(sc, &mut state);
         if let Some(m) = &mut moisture {
-            m.u.copy_from_slice(&m.trial);
+            m.accept();
             std::mem::swap(&mut targets, &mut trial_targets);
-            std::mem::swap(&mut m.mass, &mut m.trial_mass);
         }
         t += h;
         s.summary.steps += 1;
@@ -404,7 +428,7 @@ pub(super) fn run_dynamic(
         }
         let calm = moisture
             .as_ref()
-            .is_none_or(|m| m.change <= 0.5 * cf.moisture_max_change);
+            .is_none_or(|m| m.change <= 0.5 * m.max_change);
         steps.accepted(rep.iterations, calm);
         progress.update(
             t / tm.end,

@@ -16,14 +16,14 @@ pub enum RunError {
     /// The linear solver could not be set up.
     #[error(transparent)]
     Linear(#[from] LinearError),
-    /// The moisture state made the rest forms invalid.
-    #[error("moisture: {0}")]
+    /// The moisture or temperature state made the rest forms invalid.
+    #[error("rest forms: {0}")]
     Growth(#[from] crate::rest::laws::GrowthError),
-    /// The moisture boundary conditions contradict each other.
-    #[error("moisture: {0}")]
+    /// The moisture or temperature boundary conditions contradict each other.
+    #[error("surface conditions: {0}")]
     Surface(#[from] crate::diffusion::SurfaceError),
-    /// The moisture regions or fields are invalid.
-    #[error("moisture: {0}")]
+    /// The moisture or temperature regions or fields are invalid.
+    #[error("{0}")]
     Regions(#[from] crate::mesh::MeshError),
     /// A restart's driver state does not fit the scene.
     #[error("restart: {0}")]
@@ -156,16 +156,16 @@ pub enum RunFailure {
         /// The dial or time reached.
         at: Real,
     },
-    /// Dynamics: the moisture boundary conditions could not be switched.
-    #[error("moisture at t = {t_h}: {source}", t_h = crate::math::human(*.t))]
+    /// Dynamics: the moisture or temperature boundary conditions could not be switched.
+    #[error("surface conditions at t = {t_h}: {source}", t_h = crate::math::human(*.t))]
     MoistureSurface {
         /// The time reached (s).
         t: Real,
         /// What went wrong.
         source: crate::diffusion::SurfaceError,
     },
-    /// Dynamics: the moisture diffusion solve failed.
-    #[error("moisture diffusion at t = {t_h}: {source}", t_h = crate::math::human(*.t))]
+    /// Dynamics: the moisture or heat diffusion solve failed.
+    #[error("diffusion at t = {t_h}: {source}", t_h = crate::math::human(*.t))]
     Diffusion {
         /// The time reached (s).
         t: Real,

@@ -9,7 +9,7 @@
 //!   saddle is perturbed again (amplitude ×10 each time) and re-solved, so a saddle is never
 //!   reported as an equilibrium;
 //! * `dynamics.rs`: implicit Euler with adaptive time steps, the friction lag (`friction.rs`)
-//!   and the moisture coupling (`moisture.rs`);
+//!   and the coupled moisture or temperature field (`transport.rs`);
 //! * `explicit/`: MorphoShell's damped Newtonian dynamics, gradient only.
 //!
 //! They share the solver state (`solver.rs`: the pattern, the factorisation, Newton's workspace,
@@ -29,12 +29,12 @@ pub mod explicit;
 mod failure;
 pub mod friction;
 pub(crate) mod hooks;
-pub(crate) mod moisture;
 pub mod report;
 mod resume;
 mod solver;
 mod statics;
 mod symmetry;
+pub(crate) mod transport;
 
 pub use arclength::check as check_continuation;
 pub use failure::{catch_signals, interrupted, RunError, RunFailure};

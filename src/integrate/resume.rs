@@ -33,6 +33,10 @@ pub struct DriverState {
     pub moisture: Option<Vec<Real>>,
     /// See `moisture`.
     pub diffusion_substep: Option<Real>,
+    /// Temperature: the conduction's nodal values (K) and the highest each has reached.
+    pub temperature: Option<Vec<Real>>,
+    /// See `temperature`.
+    pub temperature_max: Option<Vec<Real>>,
     /// The stateful terms' states ([`crate::solve::State::terms`]: a gas's pressure
     /// multiplier, a moving slide, a moment's frames, the prism's thickness), by term name.
     pub terms: std::collections::BTreeMap<String, Vec<Real>>,

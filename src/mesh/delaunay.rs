@@ -243,7 +243,7 @@ pub fn delaunay_annulus(r_in: Real, r_out: Real, sweep: Real, edge: Real, sp: Sp
 /// (`0.7 × edge` apart, at least `0.5 × edge` from the boundary) until about
 /// `1.15 area / (√3/2 edge²)` points, then the triangles whose centroid lies outside are dropped
 /// (this carves holes and notches out of the convex hull).
-fn delaunay_domain(
+pub(crate) fn delaunay_domain(
     mut pts: Vec<Vec2>,
     depth: impl Fn(Vec2) -> Real,
     lo: [Real; 2],

@@ -10,6 +10,7 @@ pub mod generate;
 pub mod io;
 mod legacy;
 mod shapes;
+pub mod spoon;
 pub mod surfaces;
 pub mod topology;
 pub mod vtu;

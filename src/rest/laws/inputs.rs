@@ -32,6 +32,9 @@ pub struct GrowthInputs {
     /// Machine direction per face: barycentric coordinates, and the unit 3D vector in the face
     /// plane (for the diffusivity). Empty unless the law or the diffusion needs it.
     pub direction: Vec<([Real; 2], Vec3)>,
+    /// `growth.temperature_top`, `growth.temperature_bottom` (K): the highest temperatures
+    /// reached without `[temperature]`.
+    pub temperature: (Real, Real),
     /// `growth.law`.
     pub which: crate::settings::GrowthLaw,
     /// The growth law with its coefficients (`None`: no growth law).
@@ -60,10 +63,14 @@ impl GrowthInputs {
                 (None, None) => vec![0.0; mesh.faces.len()],
             },
             direction: Vec::new(),
+            temperature: (g.temperature_top, g.temperature_bottom),
             which: g.law,
             law: law.clone(),
         };
-        if law.as_ref().is_some_and(|l| l.needs_direction()) || settings.moisture.enabled {
+        if law.as_ref().is_some_and(|l| l.needs_direction())
+            || settings.moisture.enabled
+            || settings.temperature.enabled
+        {
             let dirs = mesh.face_field("machine_direction", 3)?;
             for f in 0..mesh.faces.len() {
                 let (d, what) = match dirs {

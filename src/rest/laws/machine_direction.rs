@@ -48,18 +48,27 @@ pub fn machine_direction(
     mu_perp: Real,
     d: [Real; 2],
 ) -> (Sym2, Sym2) {
+    let (p, pinv) = direction_frame(a0, d);
+    project_through_thickness(h, |z| {
+        let m = moisture_at(z, h, m_top, m_bottom);
+        let mz = Mat2::new(1.0 + mu * m, 0.0, 0.0, 1.0 + mu_perp * m);
+        pinv.transpose() * mz * p.transpose() * reference_metric(a0, b0, z) * p * mz * pinv
+    })
+}
+
+/// `P = [d d⊥]` and `P⁻¹` for a machine direction `d` (barycentric) and its
+/// `a⁰`-orthogonal complement `d⊥` (the identity when `d` is degenerate).
+pub(crate) fn direction_frame(a0: &Sym2, d: [Real; 2]) -> (Mat2, Mat2) {
     let a = sym_to_mat(a0);
     let dv = crate::math::Vec2::new(d[0], d[1]);
     // d⊥ ⟂ d in the metric a⁰: rotate a⁰d by 90° in the plane.
     let ad = a * dv;
     let dp = crate::math::Vec2::new(-ad.y, ad.x);
     let p = Mat2::new(dv.x, dp.x, dv.y, dp.y);
-    let pinv = p.try_inverse().unwrap_or_else(Mat2::identity);
-    project_through_thickness(h, |z| {
-        let m = moisture_at(z, h, m_top, m_bottom);
-        let mz = Mat2::new(1.0 + mu * m, 0.0, 0.0, 1.0 + mu_perp * m);
-        pinv.transpose() * mz * p.transpose() * reference_metric(a0, b0, z) * p * mz * pinv
-    })
+    match p.try_inverse() {
+        Some(pinv) => (p, pinv),
+        None => (Mat2::identity(), Mat2::identity()),
+    }
 }
 
 impl RestLaw for MachineDirection {

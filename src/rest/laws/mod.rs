@@ -78,6 +78,7 @@ pub mod lce;
 pub mod linear_swelling;
 pub mod machine_direction;
 pub mod mesh_forms;
+pub mod thermal_shrink;
 pub mod uniform_forms;
 
 pub use inputs::GrowthInputs;
@@ -107,6 +108,9 @@ pub struct FaceInput {
     pub s: Real,
     /// The machine direction (barycentric; `[1, 0]` when no law needs it).
     pub direction: [Real; 2],
+    /// The highest temperature reached (K) at the six heights [`sample_heights`] of the
+    /// through-thickness projection, bottom to top (the thermal shrink law's input).
+    pub heat: [Real; 6],
 }
 
 /// What a law gives for one face.
@@ -168,6 +172,7 @@ pub const LAWS: &[LawEntry] = &[
     linear_swelling::ENTRY,
     bilayer::ENTRY,
     machine_direction::ENTRY,
+    thermal_shrink::ENTRY,
 ];
 
 /// The law of `model` with its coefficients (`None` for `"none"`).
@@ -268,7 +273,7 @@ pub fn targets(
                 (growth.moisture_top[f], growth.moisture_bottom[f])
             };
             let reference = (rest.abar0[f], rest.bbar0[f]);
-            let g = growth_face(&growth, f, reference, h, m)
+            let g = growth_face(&growth, f, reference, h, m, None)
                 .map_err(|e| mesh.invalid(e.to_string()))?;
             rest.abar1[f] = g.abar;
             rest.bbar1[f] = g.bbar;
@@ -281,8 +286,10 @@ pub fn targets(
     Ok((growth, grown_thickness))
 }
 
-/// The rest forms and thickness ratio of face `f` under `growth.law`, from its reference forms, thickness and surface moisture
-/// `(m_top, m_bottom)`. Errors name the face: a stretch `1 + μ m ≤ 0`, or an ā that is not
+/// The rest forms and thickness ratio of face `f` under `growth.law`, from its reference forms,
+/// thickness, surface moisture `(m_top, m_bottom)` and the highest temperatures reached at the
+/// heights [`sample_heights`] (K; `None`: `growth.temperature_top` and `temperature_bottom`,
+/// linear between them). Errors name the face: a stretch `1 + μ m ≤ 0`, or an ā that is not
 /// positive definite.
 pub fn growth_face(
     inputs: &GrowthInputs,
@@ -290,7 +297,12 @@ pub fn growth_face(
     reference: (Sym2, Sym2),
     h: Real,
     moisture: (Real, Real),
+    heat: Option<[Real; 6]>,
 ) -> Result<Grown, GrowthError> {
+    let heat = heat.unwrap_or_else(|| {
+        let (top, bottom) = inputs.temperature;
+        sample_heights(1.0).map(|z| 0.5 * (top + bottom) + (top - bottom) * z)
+    });
     let input = FaceInput {
         face: f,
         a0: reference.0,
@@ -300,6 +312,7 @@ pub fn growth_face(
         m_bottom: moisture.1,
         s: inputs.s.get(f).copied().unwrap_or(0.0),
         direction: inputs.direction.get(f).map_or([1.0, 0.0], |d| d.0),
+        heat,
     };
     grow_face(inputs.law.as_deref(), inputs.which, &input)
 }
@@ -377,19 +390,44 @@ const GAUSS3: [(Real, Real); 3] = [
     (0.774_596_669_241_483_4, 5.0 / 9.0),
 ];
 
+/// The six heights `z ∈ (−h/2, h/2)` (m) at which [`project_through_thickness`] samples, bottom
+/// to top: 3-point Gauss–Legendre on each half.
+pub fn sample_heights(h: Real) -> [Real; 6] {
+    std::array::from_fn(|k| {
+        let (c, r) = if k < 3 {
+            (-0.25 * h, 0.25 * h)
+        } else {
+            (0.25 * h, 0.25 * h)
+        };
+        c + r * GAUSS3[k % 3].0
+    })
+}
+
+/// The weights of [`sample_heights`] over the thickness: each height's share of the mean, summing
+/// to 1.
+pub fn sample_weights() -> [Real; 6] {
+    std::array::from_fn(|k| 0.25 * GAUSS3[k % 3].1)
+}
+
 /// Projects a through-thickness metric `g(z)` onto `ā + 2z b̄` (see the module doc). `g` may be
 /// discontinuous at `z = 0`; it is sampled strictly inside each half.
 pub fn project_through_thickness(h: Real, g: impl Fn(Real) -> Mat2) -> (Sym2, Sym2) {
+    project_samples(h, |_, z| g(z))
+}
+
+/// [`project_through_thickness`] with `g(k, z)` told the index `k` of the height
+/// [`sample_heights`]`(h)[k]` it is sampled at.
+pub fn project_samples(h: Real, g: impl Fn(usize, Real) -> Mat2) -> (Sym2, Sym2) {
     let mut mean = Mat2::zeros();
     let mut moment = Mat2::zeros();
-    for (lo, hi) in [(-0.5 * h, 0.0), (0.0, 0.5 * h)] {
-        let (c, r) = (0.5 * (lo + hi), 0.5 * (hi - lo));
-        for (t, w) in GAUSS3 {
-            let z = c + r * t;
-            let gz = g(z);
-            mean += gz * (w * r);
-            moment += gz * (w * r * z);
-        }
+    for (k, (z, w)) in sample_heights(h)
+        .into_iter()
+        .zip(sample_weights())
+        .enumerate()
+    {
+        let gz = g(k, z);
+        mean += gz * (w * h);
+        moment += gz * (w * h * z);
     }
     let abar = mean / h;
     let bbar = moment * (6.0 / (h * h * h));
