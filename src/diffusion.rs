@@ -305,6 +305,20 @@ impl Diffusion {
         diffusivity: Diffusivity,
         layering: Layering,
     ) -> Result<Self, LinearError> {
+        let per_face = vec![diffusivity; faces.len()];
+        Self::with_faces(positions, faces, thickness, directions, &per_face, layering)
+    }
+
+    /// [`Self::new`] with a diffusivity per face (veins that carry water faster, a printed
+    /// layer that blocks it).
+    pub fn with_faces(
+        positions: &[Vec3],
+        faces: &[[usize; 3]],
+        thickness: &[Real],
+        directions: &[Vec3],
+        diffusivity: &[Diffusivity],
+        layering: Layering,
+    ) -> Result<Self, LinearError> {
         let layers = layering.count.max(1);
         let heights = Layering {
             count: layers,
@@ -374,9 +388,10 @@ impl Diffusion {
                 }
             };
             let dp = n.cross(&d);
-            let dm = d * d.transpose() * diffusivity.along
-                + dp * dp.transpose() * diffusivity.across
-                + n * n.transpose() * diffusivity.through;
+            let df = diffusivity[fi];
+            let dm = d * d.transpose() * df.along
+                + dp * dp.transpose() * df.across
+                + n * n.transpose() * df.through;
             for k in 0..layers {
                 let dz = thickness[fi] * (heights[k + 1] - heights[k]);
                 let (me, ke) = prism_matrices(e1, e2, n, dz, &dm);

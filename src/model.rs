@@ -89,6 +89,7 @@ impl<'a> Potential<'a> {
             stretch_scale: 1.0,
             rest_override: None,
             thickness_override: None,
+            modulus_override: None,
             mass: &scene.body.mass,
             friction: None,
             frozen: None,

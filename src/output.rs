@@ -1031,7 +1031,7 @@ fn morphoshell_fields(m: &mut Mesh, pot: &Potential, x: &[Vec3], phi: &[Real], a
     for (f, face) in sc.mesh.faces.iter().enumerate() {
         let (e1, e2) = (x[face[1]] - x[face[0]], x[face[2]] - x[face[0]]);
         let (l, u) = crate::fields::cauchy_principal(&e1, &e2, &a[f], &ga[f]);
-        let mu_t = sc.lame[f].beta * pot.thickness(f);
+        let mu_t = pot.lame(f).beta * pot.thickness(f);
         l1.push(l[0]);
         l2.push(l[1]);
         d1.push(l[0] / mu_t);

@@ -52,31 +52,12 @@ pub fn select_faces(mesh: &Mesh, sel: &Selection, what: &str) -> Result<Vec<usiz
 }
 
 /// The faces whose `tri_tags` value is in `tags` (any, when empty) and whose reference centroid
-/// lies in `inside` (when given); possibly none. Needing `tri_tags` on a mesh without it is an
-/// error naming `what`.
+/// lies in `inside` (when given): [`Mesh::faces_matching`].
 pub fn faces_matching(
     mesh: &Mesh,
     tags: &[i64],
     inside: Option<&crate::settings::FixBox>,
     what: &str,
 ) -> Result<Vec<usize>, MeshError> {
-    let wanted = tags;
-    let tags = if wanted.is_empty() {
-        None
-    } else {
-        Some(mesh.face_field("tri_tags", 1)?.ok_or_else(|| {
-            mesh.invalid(format!(
-                "{what} selects faces by tags, which needs the face field 'tri_tags'"
-            ))
-        })?)
-    };
-    let picked: Vec<usize> = (0..mesh.faces.len())
-        .filter(|&f| tags.is_none_or(|t| wanted.contains(&(t.data[f].round() as i64))))
-        .filter(|&f| {
-            let [p0, p1, p2] = mesh.face_positions(f);
-            let c = (p0 + p1 + p2) / 3.0;
-            inside.is_none_or(|b| (0..3).all(|k| c[k] >= b.min[k] && c[k] <= b.max[k]))
-        })
-        .collect();
-    Ok(picked)
+    mesh.faces_matching(tags, inside.map(|b| (b.min, b.max)), what)
 }

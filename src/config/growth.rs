@@ -111,6 +111,73 @@ pub enum GrowthModel {
     },
 }
 
+/// `[[growth.regions]]`: coefficients on the faces whose `tri_tags` is one of `tags` (any, when
+/// empty) and whose reference centroid lies in `inside` (when given); each given coefficient
+/// replaces the uniform one there (later regions over earlier ones).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GrowthRegion {
+    /// Tags (default: `[]`).
+    pub tags: Vec<i64>,
+    /// Box (m, default: none).
+    pub inside: Option<super::selection::FixBox>,
+    /// See [`Growth::mu`].
+    pub mu: Option<Real>,
+    /// See [`Growth::mu_perp`].
+    pub mu_perp: Option<Real>,
+    /// See [`Growth::mu_top`].
+    pub mu_top: Option<Real>,
+    /// See [`Growth::mu_bottom`].
+    pub mu_bottom: Option<Real>,
+    /// See [`Growth::mu_through`].
+    pub mu_through: Option<Real>,
+}
+
+impl GrowthRegion {
+    /// The coefficients' values as `(key, value)`, the given ones only.
+    pub fn given(&self) -> impl Iterator<Item = (&'static str, Real)> + '_ {
+        [
+            ("mu", self.mu),
+            ("mu_perp", self.mu_perp),
+            ("mu_top", self.mu_top),
+            ("mu_bottom", self.mu_bottom),
+            ("mu_through", self.mu_through),
+        ]
+        .into_iter()
+        .filter_map(|(k, v)| v.map(|v| (k, v)))
+    }
+
+    fn validate(&self, i: usize) -> Result<(), Invalid> {
+        let ck = Check;
+        ck.selection(
+            &format!("growth.regions[{i}]"),
+            &super::selection::Selection {
+                tags: self.tags.clone(),
+                inside: self.inside.clone(),
+            },
+        )?;
+        if self.tags.is_empty() && self.inside.is_none() {
+            return ck.inv(
+                &format!("growth.regions[{i}]"),
+                "needs tags or inside (the uniform coefficients cover every face)".into(),
+            );
+        }
+        for (k, v) in self.given() {
+            if !v.is_finite() || v.abs() > MAX_MOISTURE {
+                return ck.inv(
+                    &format!("growth.regions[{i}].{k}"),
+                    format!(
+                        "must lie in ±{}, got {}",
+                        crate::math::human(MAX_MOISTURE),
+                        crate::math::human(v)
+                    ),
+                );
+            }
+        }
+        Ok(())
+    }
+}
+
 /// The thermal shrink law's table, validated ([`Growth::validate`]): at each temperature
 /// (K, strictly increasing) the shrink strains along the machine direction, across it and
 /// through the thickness (fractions of the length lost; negative: expansion). Linear between
@@ -184,6 +251,13 @@ pub struct Growth {
     pub mu_top: Option<Real>,
     /// Bilayer: coefficient of the bottom layer (required by `"bilayer"`).
     pub mu_bottom: Option<Real>,
+    /// Moisture–thickness coefficient of the moisture laws (per unit moisture, default `0`:
+    /// the thickness is kept): the rest thickness is `h (1 + μ_n (m⁺ + m⁻)/2)`.
+    pub mu_through: Option<Real>,
+    /// Coefficients on regions of faces (veins, a printed layer), over the uniform ones; the
+    /// face fields `growth_mu`, `growth_mu_perp`, `growth_mu_top`, `growth_mu_bottom` and
+    /// `growth_mu_through` take precedence over both.
+    pub regions: Vec<GrowthRegion>,
     /// Uniform moisture at the top surface (dimensionless fraction, default `0`).
     pub moisture_top: Real,
     /// Uniform moisture at the bottom surface (default `0`).
@@ -212,6 +286,8 @@ impl Default for Growth {
             mu_perp: None,
             mu_top: None,
             mu_bottom: None,
+            mu_through: None,
+            regions: Vec::new(),
             moisture_top: 0.0,
             moisture_bottom: 0.0,
             s: None,
@@ -365,6 +441,7 @@ impl Growth {
             ("growth.mu_perp", g.mu_perp.unwrap_or(0.0)),
             ("growth.mu_top", g.mu_top.unwrap_or(0.0)),
             ("growth.mu_bottom", g.mu_bottom.unwrap_or(0.0)),
+            ("growth.mu_through", g.mu_through.unwrap_or(0.0)),
             ("growth.moisture_top", g.moisture_top),
             ("growth.moisture_bottom", g.moisture_bottom),
         ] {
@@ -378,6 +455,9 @@ impl Growth {
                     ),
                 );
             }
+        }
+        for (i, r) in g.regions.iter().enumerate() {
+            r.validate(i)?;
         }
         if g.shrink.is_none() && g.law == GrowthLaw::ThermalShrink {
             return ck.inv(

@@ -46,8 +46,15 @@ pub struct Moisture {
     pub max_change: Real,
     /// Surface conditions by region; faces without one are sealed.
     pub boundary: Vec<MoistureBoundary>,
+    /// Diffusivities on regions of faces (veins that carry water, a printed layer that blocks
+    /// it), over the uniform ones; the face fields `diffusivity_along`, `diffusivity_across` and
+    /// `diffusivity_through` take precedence over both.
+    pub regions: Vec<DiffusionRegion>,
     /// Exchange with a moist ground (`[moisture.ground]`, needs `[contact]`), else none.
     pub ground: Option<GroundMoisture>,
+    /// Softening: rows `[m, factor]`, the moduli of each face times the factor at its mean
+    /// moisture through the thickness (linear between rows, constant beyond; default none).
+    pub softening: Option<Vec<[Real; 2]>>,
 }
 
 /// `[moisture.ground]`: a face side that faces the ground (`[contact]`) and is within
@@ -90,9 +97,71 @@ impl Default for Moisture {
             water_density: 1000.0,
             max_change: 0.02,
             boundary: Vec::new(),
+            regions: Vec::new(),
             ground: None,
+            softening: None,
         }
     }
+}
+
+/// `[[moisture.regions]]` (and, with conductivities, `[[temperature.regions]]`): coefficients of
+/// the faces whose `tri_tags` is one of `tags` (any, when empty) and whose reference centroid
+/// lies in `inside` (when given); each given value replaces the uniform one there (later regions
+/// over earlier ones).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DiffusionRegion {
+    /// Tags (default: `[]`).
+    pub tags: Vec<i64>,
+    /// Box (m, default: none).
+    pub inside: Option<FixBox>,
+    /// Along the machine direction (m²/s).
+    pub diffusivity_along: Option<Real>,
+    /// Across it, in the plane (m²/s).
+    pub diffusivity_across: Option<Real>,
+    /// Through the thickness (m²/s).
+    pub diffusivity_through: Option<Real>,
+}
+
+impl DiffusionRegion {
+    /// The values along, across and through (the given ones).
+    pub fn values(&self) -> [Option<Real>; 3] {
+        [
+            self.diffusivity_along,
+            self.diffusivity_across,
+            self.diffusivity_through,
+        ]
+    }
+}
+
+/// Checks a region of coefficients `values` (named `names`) at `key`: tags or a box, a finite
+/// box, positive finite values.
+pub(crate) fn check_region(
+    key: &str,
+    tags: &[i64],
+    inside: Option<&FixBox>,
+    names: [&str; 3],
+    values: [Option<Real>; 3],
+) -> Result<(), Invalid> {
+    let ck = Check;
+    if tags.is_empty() && inside.is_none() {
+        return ck.inv(
+            key,
+            "needs tags or inside (the uniform values cover every face)".into(),
+        );
+    }
+    if let Some(b) = inside {
+        if b.min.iter().chain(&b.max).any(|v| !v.is_finite()) || (0..3).any(|k| b.min[k] > b.max[k])
+        {
+            return ck.inv(&format!("{key}.inside"), "needs finite min ≤ max".into());
+        }
+    }
+    for (n, v) in names.iter().zip(values) {
+        if let Some(v) = v {
+            ck.pos(&format!("{key}.{n}"), v)?;
+        }
+    }
+    Ok(())
 }
 
 /// One surface condition on a region of faces.
@@ -251,6 +320,22 @@ impl Moisture {
                         g.law
                     ),
                 );
+            }
+            if let Some(rows) = &mo.softening {
+                super::values::check_curve("moisture.softening", rows, "moisture")?;
+            }
+            for (i, r) in mo.regions.iter().enumerate() {
+                check_region(
+                    &format!("moisture.regions[{i}]"),
+                    &r.tags,
+                    r.inside.as_ref(),
+                    [
+                        "diffusivity_along",
+                        "diffusivity_across",
+                        "diffusivity_through",
+                    ],
+                    r.values(),
+                )?;
             }
             for (i, b) in mo.boundary.iter().enumerate() {
                 for v in [b.value, b.k, b.ambient] {

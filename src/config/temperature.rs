@@ -50,6 +50,40 @@ pub struct Temperature {
     pub boundary: Vec<HeatBoundary>,
     /// Moving heat sources (a flame, a laser spot).
     pub source: Vec<HeatSource>,
+    /// Conductivities on regions of faces, over the uniform ones.
+    pub regions: Vec<HeatRegion>,
+    /// Softening E(T): rows `[T (K), factor]`, the moduli of each face times the factor at its
+    /// mean temperature through the thickness (the current one, not the highest; linear between
+    /// rows, constant beyond; default none).
+    pub softening: Option<Vec<[Real; 2]>>,
+}
+
+/// `[[temperature.regions]]`: conductivities (W/(m·K)) of the faces whose `tri_tags` is one of
+/// `tags` (any, when empty) and whose reference centroid lies in `inside` (when given).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct HeatRegion {
+    /// Tags (default: `[]`).
+    pub tags: Vec<i64>,
+    /// Box (m, default: none).
+    pub inside: Option<FixBox>,
+    /// Along the machine direction (W/(m·K)).
+    pub conductivity_along: Option<Real>,
+    /// Across it, in the plane (W/(m·K)).
+    pub conductivity_across: Option<Real>,
+    /// Through the thickness (W/(m·K)).
+    pub conductivity_through: Option<Real>,
+}
+
+impl HeatRegion {
+    /// The values along, across and through (the given ones).
+    pub fn values(&self) -> [Option<Real>; 3] {
+        [
+            self.conductivity_along,
+            self.conductivity_across,
+            self.conductivity_through,
+        ]
+    }
 }
 
 impl Default for Temperature {
@@ -67,6 +101,8 @@ impl Default for Temperature {
             max_change: 5.0,
             boundary: Vec::new(),
             source: Vec::new(),
+            regions: Vec::new(),
+            softening: None,
         }
     }
 }
@@ -242,6 +278,25 @@ impl Temperature {
             );
         }
         absolute("temperature.initial", t.initial)?;
+        if let Some(rows) = &t.softening {
+            super::values::check_curve("temperature.softening", rows, "temperature (K)")?;
+            for (i, r) in rows.iter().enumerate() {
+                absolute(&format!("temperature.softening[{i}]"), r[0])?;
+            }
+        }
+        for (i, r) in t.regions.iter().enumerate() {
+            super::moisture::check_region(
+                &format!("temperature.regions[{i}]"),
+                &r.tags,
+                r.inside.as_ref(),
+                [
+                    "conductivity_along",
+                    "conductivity_across",
+                    "conductivity_through",
+                ],
+                r.values(),
+            )?;
+        }
         for (i, b) in t.boundary.iter().enumerate() {
             let key = |k: &str| format!("temperature.boundary[{i}].{k}");
             if let Some(bx) = &b.inside {
@@ -356,17 +411,6 @@ impl Temperature {
             );
         }
         Ok(())
-    }
-
-    /// The diffusivities `k/(ρ c)` (m²/s) along, across and through, for density `rho`
-    /// (kg/m³).
-    pub fn diffusivities(&self, rho: Real) -> [Real; 3] {
-        let rc = rho * self.specific_heat;
-        [
-            self.conductivity_along / rc,
-            self.conductivity_across / rc,
-            self.conductivity_through / rc,
-        ]
     }
 }
 

@@ -194,3 +194,76 @@ mod tests {
         assert!(e.to_string().contains("a number or \"auto\""), "{e}");
     }
 }
+
+/// A table `y(x)` of rows `[x, y]`, x strictly increasing: linear between rows, constant beyond
+/// the first and the last (a modulus factor against temperature or moisture).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Curve {
+    /// The abscissae, strictly increasing.
+    pub x: Vec<Real>,
+    /// The values.
+    pub y: Vec<Real>,
+}
+
+impl Curve {
+    /// From validated rows (`check_curve`).
+    pub fn from_rows(rows: &[[Real; 2]]) -> Self {
+        Curve {
+            x: rows.iter().map(|r| r[0]).collect(),
+            y: rows.iter().map(|r| r[1]).collect(),
+        }
+    }
+
+    /// `y(x)`.
+    pub fn at(&self, x: Real) -> Real {
+        let n = self.x.len();
+        if n == 0 {
+            return 1.0;
+        }
+        if x.is_nan() || x <= self.x[0] {
+            return self.y[0];
+        }
+        if x >= self.x[n - 1] {
+            return self.y[n - 1];
+        }
+        let k = self.x.partition_point(|&v| v <= x);
+        let s = (x - self.x[k - 1]) / (self.x[k] - self.x[k - 1]);
+        self.y[k - 1] + s * (self.y[k] - self.y[k - 1])
+    }
+}
+
+/// Checks a softening table at `key`: at least one row, finite, the first column strictly
+/// increasing (`what` names it, with its unit), each factor in (0, 1000].
+pub(crate) fn check_curve(key: &str, rows: &[[Real; 2]], what: &str) -> Result<(), super::Invalid> {
+    let ck = super::Check;
+    if rows.is_empty() {
+        return ck.inv(key, format!("needs rows [{what}, factor]"));
+    }
+    for (i, r) in rows.iter().enumerate() {
+        let k = format!("{key}[{i}]");
+        if !r[0].is_finite() {
+            return ck.inv(&k, format!("the {what} must be finite"));
+        }
+        if i > 0 && r[0] <= rows[i - 1][0] {
+            return ck.inv(
+                &k,
+                format!(
+                    "the table is not monotone in its {what}: {} after {} (it must increase \
+                     strictly)",
+                    crate::math::human(r[0]),
+                    crate::math::human(rows[i - 1][0])
+                ),
+            );
+        }
+        if !(r[1].is_finite() && r[1] > 0.0 && r[1] <= 1e3) {
+            return ck.inv(
+                &k,
+                format!(
+                    "the factor on the moduli must lie in (0, 1000], got {}",
+                    crate::math::human(r[1])
+                ),
+            );
+        }
+    }
+    Ok(())
+}

@@ -93,6 +93,9 @@ pub struct Potential<'a> {
     /// Per-face rest thickness over the reference thickness that replaces the dialled one
     /// (a thermal shrink through the thickness).
     pub thickness_override: Option<&'a [Real]>,
+    /// Per-face factor on the elastic moduli (softening with temperature or moisture); `None`
+    /// keeps the body's.
+    pub modulus_override: Option<&'a [Real]>,
     /// Lumped vertex masses (kg): the scene's, or moisture-dependent ones.
     pub mass: &'a [Real],
     /// Friction against the ground and the obstacles (their normal contact terms are on
@@ -154,6 +157,25 @@ impl<'a> Potential<'a> {
         }
     }
 
+    /// The factor on face `f`'s elastic moduli: 1, or the softening's ([`Self::modulus_override`]).
+    #[inline(always)]
+    pub fn modulus(&self, f: usize) -> Real {
+        self.modulus_override.map_or(1.0, |m| m[f])
+    }
+
+    /// Face `f`'s plane-stress Lamé parameters, softened by [`Self::modulus`].
+    #[inline(always)]
+    pub fn lame(&self, f: usize) -> crate::body::Lame2d {
+        let l = self.body.lame[f];
+        match self.modulus_override {
+            None => l,
+            Some(m) => crate::body::Lame2d {
+                alpha: l.alpha * m[f],
+                beta: l.beta * m[f],
+            },
+        }
+    }
+
     /// Koiter elastic (+ damping) density of face `f`.
     #[inline(always)]
     pub fn density(&self, f: usize) -> KoiterDensity {
@@ -167,13 +189,13 @@ impl<'a> Potential<'a> {
         // A pure membrane has no bending energy (b ≡ 0, whatever b̄ the mesh's shape gives).
         let wb = if sc.has_bending { wb } else { 0.0 };
         let mut d = KoiterDensity {
-            c: sv_matrix(&abar, sc.lame[f]),
+            c: sv_matrix(&abar, self.lame(f)),
             stretch: [(ws, abar), (0.0, Sym2::zeros())],
             bend: [(wb, bbar), (0.0, Sym2::zeros())],
             stiffen: crate::energy::stiffening::coefficient(
                 sc.bend_stiffening,
                 0.5 * crate::math::sym_det(&abar).max(0.0).sqrt(),
-                sc.lame[f].beta,
+                self.lame(f).beta,
                 self.thickness(f),
             ),
         };

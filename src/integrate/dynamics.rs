@@ -158,6 +158,7 @@ pub(super) fn run_dynamic(
         let pat = s.pattern();
         let pot = accepted(s.potential(&pat, dial_now), moisture.as_ref(), &targets);
         s.driver = record!(t0);
+        s.path_columns = m_columns(moisture.as_ref(), sc);
         s.frame(writer, &pot, &state, &v, t0)?;
     }
     // Friction: the lagged normal forces, carried from step to step.
@@ -345,14 +346,14 @@ pub(super) fn run_dynamic(
                         b_prev: &b_prev,
                     }),
                     gravity: s.config.gravity,
-                    rest_override: moisture.as_ref().map(|_| &trial_targets.forms[..]),
-                    thickness_override: moisture
-                        .as_ref()
-                        .filter(|_| !trial_targets.thickness.is_empty())
-                        .map(|_| &trial_targets.thickness[..]),
                     mass: trial_mass,
                     friction: lag.as_ref().map(|l| l.friction(&state.x, dial_now, h)),
                     ..Potential::new(sc, &pat)
+                };
+                // The trial's rest forms, thickness and moduli from the coupled field.
+                let pot = match &moisture {
+                    Some(_) => trial_targets.apply(pot),
+                    None => pot,
                 };
                 let rep = s.solve(&pot, &mut trial, opts);
                 let again =
@@ -480,6 +481,7 @@ pub(super) fn run_dynamic(
                 ..accepted(s.potential(&pat, dial), moisture.as_ref(), &targets)
             };
             s.driver = record!(t);
+            s.path_columns = m_columns(moisture.as_ref(), sc);
             s.frame(writer, &pot, &state, &v, t)?;
             clock.passed(t, h, eps_t);
         }
@@ -500,6 +502,16 @@ pub(super) fn run_dynamic(
         return Ok(());
     }
     // Record the state reached when the run stopped early.
+    s.path_columns = m_columns(moisture.as_ref(), sc);
     s.frame(writer, &pot, &state, &v, t)?;
     Ok(())
+}
+
+/// The log's `mass` column (kg) of a run whose absorbed water changes its mass: the sheet's
+/// total mass at the accepted state, dry mass plus water, which falls as a leaf dries.
+fn m_columns(field: Option<&Transport>, sc: &crate::model::Scene) -> Vec<(String, Real)> {
+    match field {
+        Some(m) if m.wet() => vec![("mass".into(), m.mass(&sc.body, false).iter().sum())],
+        _ => Vec::new(),
+    }
 }

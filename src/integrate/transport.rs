@@ -90,6 +90,8 @@ pub(super) struct Transport {
     heat_capacity: Real,
     /// The height fractions of the law's sample heights (bottom 0, top 1).
     samples: [Real; 6],
+    /// The moduli's factor against the field's mean through the thickness (softening).
+    softening: Option<crate::config::values::Curve>,
 }
 
 /// The mean over the triangle `p` of `exp(−|x − c|²/(2σ²))`: the edge-midpoint rule (exact
@@ -124,6 +126,63 @@ fn gaussian_face_mean(p: [Vec3; 3], c: Vec3, sigma: Real) -> Real {
     sum / (n * n) as Real
 }
 
+/// A region of faces with coefficients along, across and through (`None`: not given).
+type Region<'a> = (
+    &'a [i64],
+    Option<&'a crate::settings::FixBox>,
+    [Option<Real>; 3],
+);
+
+/// Per-face coefficients along, across and through: `uniform`, replaced on each region's faces
+/// by the values it gives (`what[i]` names it), then by the face fields `fields` (when given;
+/// checked positive and finite, naming the face).
+fn per_face_diffusivity(
+    sc: &Scene,
+    uniform: [Real; 3],
+    regions: &[Region],
+    what: &str,
+    fields: Option<[&str; 3]>,
+) -> Result<Vec<crate::diffusion::Diffusivity>, RunError> {
+    let mesh = &sc.body.mesh;
+    let mut v = vec![uniform; mesh.faces.len()];
+    for (i, (tags, inside, values)) in regions.iter().enumerate() {
+        let faces = mesh.faces_matching(
+            tags,
+            inside.map(|b| (b.min, b.max)),
+            &format!("{what}[{i}]"),
+        )?;
+        for f in faces {
+            for (k, x) in values.iter().enumerate() {
+                if let Some(x) = x {
+                    v[f][k] = *x;
+                }
+            }
+        }
+    }
+    for (k, name) in fields.into_iter().flatten().enumerate() {
+        if let Some(field) = mesh.face_field(name, 1)? {
+            for (f, &x) in field.data.iter().enumerate() {
+                if !(x.is_finite() && x > 0.0) {
+                    return Err(mesh
+                        .invalid(format!(
+                            "face field '{name}' at face {f} is {x}: a diffusivity must be \
+                             positive and finite"
+                        ))
+                        .into());
+                }
+                v[f][k] = x;
+            }
+        }
+    }
+    Ok(v.into_iter()
+        .map(|[along, across, through]| crate::diffusion::Diffusivity {
+            along,
+            across,
+            through,
+        })
+        .collect())
+}
+
 /// The diffusion's side of a settings side.
 fn side_of(s: crate::settings::SurfaceSide) -> Side {
     match s {
@@ -149,13 +208,13 @@ impl Transport {
     fn empty(
         sc: &Scene,
         field: Field,
-        diffusivity: crate::diffusion::Diffusivity,
+        diffusivity: &[crate::diffusion::Diffusivity],
         layering: crate::diffusion::Layering,
         initial: Real,
         max_change: Real,
     ) -> Result<Self, RunError> {
         let dirs: Vec<Vec3> = sc.body.growth.direction.iter().map(|d| d.1).collect();
-        let diffusion = crate::diffusion::Diffusion::new(
+        let diffusion = crate::diffusion::Diffusion::with_faces(
             &sc.body.mesh.positions,
             &sc.body.mesh.faces,
             &sc.body.thickness,
@@ -192,22 +251,39 @@ impl Transport {
             sources: Vec::new(),
             heat_capacity: 1.0,
             samples,
+            softening: None,
         })
     }
 
     /// The moisture's diffusion, conditions, ground exchange and wet masses.
     fn moisture(sc: &Scene) -> Result<Self, RunError> {
-        use crate::diffusion::{Diffusivity, Layering};
+        use crate::diffusion::Layering;
         use crate::settings::SurfaceKind;
         let mo = &sc.settings.moisture;
+        let regions: Vec<_> = mo
+            .regions
+            .iter()
+            .map(|r| (&r.tags[..], r.inside.as_ref(), r.values()))
+            .collect();
+        let per_face = per_face_diffusivity(
+            sc,
+            [
+                mo.diffusivity_along,
+                mo.diffusivity_across,
+                mo.diffusivity_through,
+            ],
+            &regions,
+            "moisture.regions",
+            Some([
+                "diffusivity_along",
+                "diffusivity_across",
+                "diffusivity_through",
+            ]),
+        )?;
         let mut m = Self::empty(
             sc,
             Field::Moisture,
-            Diffusivity {
-                along: mo.diffusivity_along,
-                across: mo.diffusivity_across,
-                through: mo.diffusivity_through,
-            },
+            &per_face,
             Layering {
                 count: mo.layers,
                 grading: mo.grading,
@@ -247,6 +323,10 @@ impl Transport {
             .as_ref()
             .map(|g| (g.k, g.value, g.distance.or(h_mean)));
         m.water_density = mo.water_density;
+        m.softening = mo
+            .softening
+            .as_deref()
+            .map(crate::config::values::Curve::from_rows);
         m.mass = m.masses_of(&sc.body, &m.u);
         m.trial_mass = m.mass.clone();
         Ok(m)
@@ -256,19 +336,34 @@ impl Transport {
     /// windowed ones kept for [`Self::update_windows`] (checked here: two conditions that
     /// overlap in time on one face side contradict each other unless equal), the sources.
     fn temperature(sc: &Scene) -> Result<Self, RunError> {
-        use crate::diffusion::{Diffusivity, Layering};
+        use crate::diffusion::Layering;
         use crate::settings::SurfaceKind;
         let te = &sc.settings.temperature;
         let rc = sc.settings.material.density * te.specific_heat;
-        let [along, across, through] = te.diffusivities(sc.settings.material.density);
+        let regions: Vec<_> = te
+            .regions
+            .iter()
+            .map(|r| (&r.tags[..], r.inside.as_ref(), r.values()))
+            .collect();
+        let mut per_face = per_face_diffusivity(
+            sc,
+            [
+                te.conductivity_along,
+                te.conductivity_across,
+                te.conductivity_through,
+            ],
+            &regions,
+            "temperature.regions",
+            None,
+        )?;
+        // Conductivities to diffusivities, k/(ρc).
+        for d in &mut per_face {
+            (d.along, d.across, d.through) = (d.along / rc, d.across / rc, d.through / rc);
+        }
         let mut m = Self::empty(
             sc,
             Field::Temperature,
-            Diffusivity {
-                along,
-                across,
-                through,
-            },
+            &per_face,
             Layering {
                 count: te.layers,
                 grading: te.grading,
@@ -316,6 +411,10 @@ impl Transport {
         }
         m.keep_base();
         m.sources = te.source.clone();
+        m.softening = te
+            .softening
+            .as_deref()
+            .map(crate::config::values::Curve::from_rows);
         Ok(m)
     }
 
@@ -561,6 +660,11 @@ impl Transport {
         mass
     }
 
+    /// Whether the masses follow the moisture (`moisture.water_density > 0`).
+    pub(super) fn wet(&self) -> bool {
+        self.field == Field::Moisture && self.water_density > 0.0
+    }
+
     /// The masses at the accepted state (`trial = false`) or the trial one (the scene's without
     /// water density).
     pub(super) fn mass<'s>(&'s self, sc: &'s Body, trial: bool) -> &'s [Real] {
@@ -589,7 +693,18 @@ impl Transport {
         let mut out = Targets {
             forms: Vec::with_capacity(nf),
             thickness: Vec::new(),
+            modulus: Vec::new(),
         };
+        if let Some(curve) = &self.softening {
+            // The face's mean through the thickness of the current field.
+            let w = crate::rest::laws::sample_weights();
+            out.modulus = (0..nf)
+                .map(|f| {
+                    let p = self.diffusion.profile(u, f, &self.samples);
+                    curve.at(p.iter().zip(w).map(|(v, w)| v * w).sum())
+                })
+                .collect();
+        }
         for f in 0..nf {
             let (m, heat) = match self.field {
                 Field::Moisture => {
@@ -662,6 +777,8 @@ impl Transport {
 pub(super) struct Targets {
     pub(super) forms: Vec<(Sym2, Sym2)>,
     pub(super) thickness: Vec<Real>,
+    /// The factor on each face's moduli (softening; empty without it).
+    pub(super) modulus: Vec<Real>,
 }
 
 impl Targets {
@@ -670,6 +787,7 @@ impl Targets {
         Potential {
             rest_override: Some(&self.forms),
             thickness_override: (!self.thickness.is_empty()).then_some(&self.thickness[..]),
+            modulus_override: (!self.modulus.is_empty()).then_some(&self.modulus[..]),
             ..base
         }
     }

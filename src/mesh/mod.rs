@@ -179,7 +179,7 @@ pub struct Mesh {
 pub const MAX_COORDINATE: Real = 1e30;
 
 /// The per-face fields shellsim reads from a mesh (docs/files.md describes each).
-pub const INPUT_FACE_FIELDS: [&str; 10] = [
+pub const INPUT_FACE_FIELDS: [&str; 18] = [
     "abar_info",
     "bbar_info",
     "ref_thicknesses",
@@ -190,6 +190,14 @@ pub const INPUT_FACE_FIELDS: [&str; 10] = [
     "machine_direction",
     "moisture_top",
     "moisture_bottom",
+    "growth_mu",
+    "growth_mu_perp",
+    "growth_mu_top",
+    "growth_mu_bottom",
+    "growth_mu_through",
+    "diffusivity_along",
+    "diffusivity_across",
+    "diffusivity_through",
 ];
 
 /// The per-vertex fields shellsim reads from a mesh.
@@ -264,6 +272,35 @@ pub enum MeshError {
 }
 
 impl Mesh {
+    /// The faces whose `tri_tags` value is in `tags` (any, when empty) and whose centroid lies
+    /// in the box `inside = (min, max)` (when given); possibly none. Needing `tri_tags` on a
+    /// mesh without it is an error naming `what`.
+    pub fn faces_matching(
+        &self,
+        tags: &[i64],
+        inside: Option<([Real; 3], [Real; 3])>,
+        what: &str,
+    ) -> Result<Vec<usize>, MeshError> {
+        let wanted = tags;
+        let tags = if wanted.is_empty() {
+            None
+        } else {
+            Some(self.face_field("tri_tags", 1)?.ok_or_else(|| {
+                self.invalid(format!(
+                    "{what} selects faces by tags, which needs the face field 'tri_tags'"
+                ))
+            })?)
+        };
+        Ok((0..self.faces.len())
+            .filter(|&f| tags.is_none_or(|t| wanted.contains(&(t.data[f].round() as i64))))
+            .filter(|&f| {
+                let [p0, p1, p2] = self.face_positions(f);
+                let c = (p0 + p1 + p2) / 3.0;
+                inside.is_none_or(|(lo, hi)| (0..3).all(|k| c[k] >= lo[k] && c[k] <= hi[k]))
+            })
+            .collect())
+    }
+
     /// Display name of the source, for messages.
     pub fn name(&self) -> String {
         self.source

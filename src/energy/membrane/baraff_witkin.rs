@@ -155,6 +155,7 @@ impl Membrane for BaraffWitkin {
     fn density(&self, pot: &Potential, f: usize) -> Self::Density {
         let (abar, _) = pot.rest_forms(f);
         let (l, m) = self.moduli[f];
+        let (l, m) = (l * pot.modulus(f), m * pot.modulus(f));
         let s = pot.stretch_scale;
         WithKoiterBending {
             law: BaraffWitkinFace::new(

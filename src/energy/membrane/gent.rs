@@ -77,13 +77,12 @@ impl Membrane for Gent {
     #[inline]
     fn density(&self, pot: &Potential, f: usize) -> Self::Density {
         let (abar, _) = pot.rest_forms(f);
-        let sc = pot.body;
         WithKoiterBending {
             law: GentFace {
                 nh: NeoHookeanFace::new(
                     &abar,
                     pot.thickness(f),
-                    sc.lame[f].beta,
+                    pot.lame(f).beta,
                     pot.stretch_scale,
                 ),
                 jm: self.jm,

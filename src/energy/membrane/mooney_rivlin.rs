@@ -73,12 +73,13 @@ impl Membrane for MooneyRivlin {
         let (abar, _) = pot.rest_forms(f);
         let h = pot.thickness(f);
         let s = pot.stretch_scale;
-        let nh = NeoHookeanFace::new(&abar, h, 2.0 * self.c1, s);
+        let soft = pot.modulus(f);
+        let nh = NeoHookeanFace::new(&abar, h, 2.0 * self.c1 * soft, s);
         let vol = h * 0.5 * crate::math::sym_det(&abar).max(0.0).sqrt();
         WithKoiterBending {
             law: MooneyRivlinFace {
                 nh,
-                w2: vol * self.c2 * s,
+                w2: vol * self.c2 * soft * s,
             },
             koiter: bending_wells(pot, f),
         }

@@ -81,9 +81,8 @@ impl Membrane for NeoHookean {
     #[inline]
     fn density(&self, pot: &Potential, f: usize) -> Self::Density {
         let (abar, _) = pot.rest_forms(f);
-        let sc = pot.body;
         WithKoiterBending {
-            law: NeoHookeanFace::new(&abar, pot.thickness(f), sc.lame[f].beta, pot.stretch_scale),
+            law: NeoHookeanFace::new(&abar, pot.thickness(f), pot.lame(f).beta, pot.stretch_scale),
             koiter: bending_wells(pot, f),
         }
     }

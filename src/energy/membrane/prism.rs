@@ -393,7 +393,7 @@ impl Membrane for Prism {
                 self.law,
                 &abar,
                 h0,
-                sc.young[f],
+                sc.young[f] * pot.modulus(f),
                 self.poisson,
                 c,
                 pot.stretch_scale,

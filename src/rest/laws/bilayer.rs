@@ -2,32 +2,27 @@
 //! 2017): the top half has metric `(1 + μ⁺ m⁺)²(a⁰ + 2z b⁰)`, the bottom half
 //! `(1 + μ⁻ m⁻)²(a⁰ + 2z b⁰)`, projected as in [`super`]. For a flat reference,
 //! `ā = (ḡ⁺ + ḡ⁻)/2`, `b̄ = 3(ḡ⁺ − ḡ⁻)/(4h)`: van Rees' equivalence, which with equal layers
-//! reproduces Timoshenko's κ = 3Δε/(2h). The thickness is kept. Coefficients: `growth.mu_top`,
-//! `growth.mu_bottom` (per unit moisture). Units: ā in m², b̄ in m.
+//! reproduces Timoshenko's κ = 3Δε/(2h). The thickness is kept, unless `growth.mu_through`
+//! grows it ([`super::through_thickness`]). Coefficients: `growth.mu_top`, `growth.mu_bottom`
+//! (per unit moisture), per face when regions or face fields give them. Units: ā in m², b̄ in m.
 
 use super::{
-    check_stretch, project_through_thickness, reference_metric, FaceInput, Grown, GrowthError,
-    LawEntry, RestLaw,
+    check_stretch, project_through_thickness, reference_metric, through_thickness, FaceInput,
+    Grown, GrowthError, LawEntry, RestLaw,
 };
 use crate::config::growth::{GrowthLaw, GrowthModel};
 use crate::math::{Real, Sym2};
 
-/// The bilayer law with `growth.mu_top` and `growth.mu_bottom`.
+/// The bilayer law with each face's `mu_top` and `mu_bottom` ([`super::Coefficients`]).
 #[derive(Debug)]
-pub struct Bilayer {
-    /// Coefficient of the top layer (per unit moisture).
-    pub mu_top: Real,
-    /// Coefficient of the bottom layer (per unit moisture).
-    pub mu_bottom: Real,
-}
+pub struct Bilayer;
 
 /// The registry's entry ([`super::LAWS`]).
 pub const ENTRY: LawEntry = LawEntry {
     law: GrowthLaw::Bilayer,
     example: "mu_top = 0.05\nmu_bottom = 0.01\nmoisture_top = 0.4\nmoisture_bottom = 0.3",
-    build: |m| match *m {
-        GrowthModel::Bilayer { mu_top, mu_bottom } => Some(Box::new(Bilayer { mu_top, mu_bottom })),
-        _ => None,
+    build: |m| {
+        matches!(m, GrowthModel::Bilayer { .. }).then(|| Box::new(Bilayer) as Box<dyn RestLaw>)
     },
 };
 
@@ -54,12 +49,10 @@ pub fn bilayer(
 
 impl RestLaw for Bilayer {
     fn grow(&self, i: &FaceInput) -> Result<Grown, GrowthError> {
-        let (mt, mb) = (self.mu_top, self.mu_bottom);
+        let (mt, mb) = (i.coef.mu_top, i.coef.mu_bottom);
         check_stretch(i, mt, true, false)?;
         check_stretch(i, mb, false, true)?;
-        Ok(Grown::at_fixed_thickness(bilayer(
-            &i.a0, &i.b0, i.h, i.m_top, i.m_bottom, mt, mb,
-        )))
+        through_thickness(i, bilayer(&i.a0, &i.b0, i.h, i.m_top, i.m_bottom, mt, mb))
     }
 }
 

@@ -35,6 +35,11 @@ pub struct GrowthInputs {
     /// `growth.temperature_top`, `growth.temperature_bottom` (K): the highest temperatures
     /// reached without `[temperature]`.
     pub temperature: (Real, Real),
+    /// Per face, the swelling coefficients: `uniform`, replaced on `growth.regions` and by the
+    /// face fields `growth_mu`, … (empty when neither is given).
+    pub coef: Vec<super::Coefficients>,
+    /// The uniform coefficients of `[growth]`.
+    pub uniform: super::Coefficients,
     /// `growth.law`.
     pub which: crate::settings::GrowthLaw,
     /// The growth law with its coefficients (`None`: no growth law).
@@ -64,9 +69,18 @@ impl GrowthInputs {
             },
             direction: Vec::new(),
             temperature: (g.temperature_top, g.temperature_bottom),
+            coef: Vec::new(),
+            uniform: super::Coefficients {
+                mu: g.mu.unwrap_or(0.0),
+                mu_perp: g.mu_perp.unwrap_or(0.0),
+                mu_top: g.mu_top.unwrap_or(0.0),
+                mu_bottom: g.mu_bottom.unwrap_or(0.0),
+                mu_through: g.mu_through.unwrap_or(0.0),
+            },
             which: g.law,
             law: law.clone(),
         };
+        out.coef = per_face_coefficients(mesh, settings, out.uniform)?;
         if law.as_ref().is_some_and(|l| l.needs_direction())
             || settings.moisture.enabled
             || settings.temperature.enabled
@@ -94,6 +108,70 @@ impl GrowthInputs {
         }
         Ok(out)
     }
+}
+
+/// Where a coefficient sits in [`super::Coefficients`].
+type Slot = fn(&mut super::Coefficients) -> &mut Real;
+
+/// The face fields of the per-face coefficients, and which coefficient each sets.
+const COEFFICIENT_FIELDS: [(&str, Slot); 5] = [
+    ("growth_mu", |c| &mut c.mu),
+    ("growth_mu_perp", |c| &mut c.mu_perp),
+    ("growth_mu_top", |c| &mut c.mu_top),
+    ("growth_mu_bottom", |c| &mut c.mu_bottom),
+    ("growth_mu_through", |c| &mut c.mu_through),
+];
+
+/// Per-face coefficients: `uniform`, replaced on each `growth.regions` entry's faces by the
+/// coefficients it gives, then by the face fields `growth_mu`, … (checked finite and within
+/// ±`MAX_MOISTURE`, naming the face). Empty when there are neither regions nor fields.
+fn per_face_coefficients(
+    mesh: &Mesh,
+    settings: &Settings,
+    uniform: super::Coefficients,
+) -> Result<Vec<super::Coefficients>, MeshError> {
+    let regions = &settings.growth.regions;
+    let mut fields = Vec::new();
+    for (name, slot) in COEFFICIENT_FIELDS {
+        if let Some(f) = mesh.face_field(name, 1)? {
+            fields.push((name, slot, f.data.clone()));
+        }
+    }
+    if regions.is_empty() && fields.is_empty() {
+        return Ok(Vec::new());
+    }
+    let mut coef = vec![uniform; mesh.faces.len()];
+    for (i, r) in regions.iter().enumerate() {
+        let faces = mesh.faces_matching(
+            &r.tags,
+            r.inside.as_ref().map(|b| (b.min, b.max)),
+            &format!("growth.regions[{i}]"),
+        )?;
+        for f in faces {
+            for (k, v) in r.given() {
+                let slot = COEFFICIENT_FIELDS
+                    .iter()
+                    .find(|(n, _)| n.strip_prefix("growth_") == Some(k))
+                    .map(|(_, s)| *s);
+                if let Some(slot) = slot {
+                    *slot(&mut coef[f]) = v;
+                }
+            }
+        }
+    }
+    let max = crate::config::limits::MAX_MOISTURE;
+    for (name, slot, data) in fields {
+        for (f, &v) in data.iter().enumerate() {
+            if !(v.is_finite() && v.abs() <= max) {
+                return Err(mesh.invalid(format!(
+                    "face field '{name}' at face {f} is {v}: a swelling coefficient must be \
+                     finite and within ±{max}"
+                )));
+            }
+            *slot(&mut coef[f]) = v;
+        }
+    }
+    Ok(coef)
 }
 
 /// A settings field (number or expression of x, y) at every face's reference centroid; a

@@ -8,30 +8,28 @@
 //! Seed 000 prints `ā = (ḡ⁺ + ḡ⁻)/2` (which weights the `z²` term by h²/4 instead of h²/12) and
 //! `b̄ = (ḡ⁻ − ḡ⁺)/(2h)` (the same `s₀s₁` term, opposite sign convention); the projection is the
 //! one consistent with the energy. A wetter top (`m⁺ > m⁻`, μ > 0) gives `b̄ > 0`: the sheet
-//! bulges toward the wet side's normal, i.e. curls away from the water. The thickness is kept.
-//! Coefficient: `growth.mu` (per unit moisture). Units: ā in m², b̄ in m.
+//! bulges toward the wet side's normal, i.e. curls away from the water. The thickness is kept,
+//! unless `growth.mu_through` grows it ([`super::through_thickness`]). Coefficient: `growth.mu`
+//! (per unit moisture), per face when regions or face fields give it. Units: ā in m², b̄ in m.
 
 use super::{
-    check_stretch, moisture_at, project_through_thickness, reference_metric, FaceInput, Grown,
-    GrowthError, LawEntry, RestLaw,
+    check_stretch, moisture_at, project_through_thickness, reference_metric, through_thickness,
+    FaceInput, Grown, GrowthError, LawEntry, RestLaw,
 };
 use crate::config::growth::{GrowthLaw, GrowthModel};
 use crate::math::{Real, Sym2};
 
-/// Linear differential swelling with `growth.mu`.
+/// Linear differential swelling with each face's `mu` ([`super::Coefficients`]).
 #[derive(Debug)]
-pub struct LinearSwelling {
-    /// Moisture–length coefficient (per unit moisture).
-    pub mu: Real,
-}
+pub struct LinearSwelling;
 
 /// The registry's entry ([`super::LAWS`]).
 pub const ENTRY: LawEntry = LawEntry {
     law: GrowthLaw::LinearSwelling,
     example: "mu = 0.05\nmoisture_top = 0.4\nmoisture_bottom = 0.1",
-    build: |m| match *m {
-        GrowthModel::LinearSwelling { mu } => Some(Box::new(LinearSwelling { mu })),
-        _ => None,
+    build: |m| {
+        matches!(m, GrowthModel::LinearSwelling { .. })
+            .then(|| Box::new(LinearSwelling) as Box<dyn RestLaw>)
     },
 };
 
@@ -54,11 +52,12 @@ pub fn linear_swelling(
 
 impl RestLaw for LinearSwelling {
     fn grow(&self, i: &FaceInput) -> Result<Grown, GrowthError> {
-        let mu = self.mu;
+        let mu = i.coef.mu;
         check_stretch(i, mu, true, true)?;
-        Ok(Grown::at_fixed_thickness(linear_swelling(
-            &i.a0, &i.b0, i.h, i.m_top, i.m_bottom, mu,
-        )))
+        through_thickness(
+            i,
+            linear_swelling(&i.a0, &i.b0, i.h, i.m_top, i.m_bottom, mu),
+        )
     }
 }
 

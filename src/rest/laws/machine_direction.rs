@@ -3,35 +3,31 @@
 //! `P = [d d⊥]` and `M(z) = diag(1 + μ m(z), 1 + μ⊥ m(z))` in the `(d, d⊥)` basis,
 //! `ḡ(z) = P⁻ᵀ M(z) Pᵀ (a⁰ + 2z b⁰) P M(z) P⁻¹` (seed 000's `TᵀMT⁻ᵀ(·)T⁻¹MT` with `T = P⁻¹`),
 //! projected as in [`super`]. With `μ⊥ = μ` it is [`super::linear_swelling`]. The thickness is
-//! kept. Coefficients: `growth.mu` along, `growth.mu_perp` across (per unit moisture); the
-//! direction from the face field `machine_direction` or `growth.machine_direction`.
+//! kept, unless `growth.mu_through` grows it ([`super::through_thickness`]). Coefficients:
+//! `growth.mu` along, `growth.mu_perp` across (per unit moisture, per face when regions or face
+//! fields give them); the direction from the face field `machine_direction` or
+//! `growth.machine_direction`.
 //! Units: ā in m², b̄ in m.
 
 use super::{
-    check_stretch, moisture_at, project_through_thickness, reference_metric, FaceInput, Grown,
-    GrowthError, LawEntry, RestLaw,
+    check_stretch, moisture_at, project_through_thickness, reference_metric, through_thickness,
+    FaceInput, Grown, GrowthError, LawEntry, RestLaw,
 };
 use crate::config::growth::{GrowthLaw, GrowthModel};
 use crate::math::{sym_to_mat, Mat2, Real, Sym2};
 
-/// Swelling with a machine direction, `growth.mu` along it and `growth.mu_perp` across.
+/// Swelling with a machine direction, each face's `mu` along it and `mu_perp` across
+/// ([`super::Coefficients`]).
 #[derive(Debug)]
-pub struct MachineDirection {
-    /// Coefficient along the machine direction (per unit moisture).
-    pub mu: Real,
-    /// Coefficient across it (per unit moisture).
-    pub mu_perp: Real,
-}
+pub struct MachineDirection;
 
 /// The registry's entry ([`super::LAWS`]).
 pub const ENTRY: LawEntry = LawEntry {
     law: GrowthLaw::MachineDirection,
     example: "mu = 0.02\nmu_perp = 0.06\nmoisture_top = 0.4\nmoisture_bottom = 0.1\nmachine_direction = [1, 1, 0]",
-    build: |m| match *m {
-        GrowthModel::MachineDirection { mu, mu_perp } => {
-            Some(Box::new(MachineDirection { mu, mu_perp }))
-        }
-        _ => None,
+    build: |m| {
+        matches!(m, GrowthModel::MachineDirection { .. })
+            .then(|| Box::new(MachineDirection) as Box<dyn RestLaw>)
     },
 };
 
@@ -73,19 +69,13 @@ pub(crate) fn direction_frame(a0: &Sym2, d: [Real; 2]) -> (Mat2, Mat2) {
 
 impl RestLaw for MachineDirection {
     fn grow(&self, i: &FaceInput) -> Result<Grown, GrowthError> {
-        let (mu, mp) = (self.mu, self.mu_perp);
+        let (mu, mp) = (i.coef.mu, i.coef.mu_perp);
         check_stretch(i, mu, true, true)?;
         check_stretch(i, mp, true, true)?;
-        Ok(Grown::at_fixed_thickness(machine_direction(
-            &i.a0,
-            &i.b0,
-            i.h,
-            i.m_top,
-            i.m_bottom,
-            mu,
-            mp,
-            i.direction,
-        )))
+        through_thickness(
+            i,
+            machine_direction(&i.a0, &i.b0, i.h, i.m_top, i.m_bottom, mu, mp, i.direction),
+        )
     }
     fn needs_direction(&self) -> bool {
         true

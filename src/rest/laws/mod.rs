@@ -111,6 +111,50 @@ pub struct FaceInput {
     /// The highest temperature reached (K) at the six heights [`sample_heights`] of the
     /// through-thickness projection, bottom to top (the thermal shrink law's input).
     pub heat: [Real; 6],
+    /// The face's swelling coefficients.
+    pub coef: Coefficients,
+}
+
+/// The swelling coefficients of one face (per unit moisture): the uniform `[growth]` ones, or a
+/// region's, or the face fields' ([`GrowthInputs::coef`]). Each law reads those it uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Coefficients {
+    /// μ: in every direction (`linear_swelling`) or along the machine direction.
+    pub mu: Real,
+    /// μ⊥ across the machine direction.
+    pub mu_perp: Real,
+    /// The bilayer's top layer.
+    pub mu_top: Real,
+    /// The bilayer's bottom layer.
+    pub mu_bottom: Real,
+    /// μ_n through the thickness: `h̄ = h (1 + μ_n (m⁺ + m⁻)/2)`.
+    pub mu_through: Real,
+}
+
+/// The forms `(ā, b̄)` of a moisture law at the reference thickness, with the thickness grown
+/// by `1 + μ_n m̄` (m̄ the mean of the surface moistures): heights map `z ↦ λ z`, so `b̄`
+/// divides by λ (as for the thermal shrink; exact for a swelling uniform through the
+/// thickness). Errors when the thickness would vanish.
+pub fn through_thickness(i: &FaceInput, forms: (Sym2, Sym2)) -> Result<Grown, GrowthError> {
+    let mu_n = i.coef.mu_through;
+    if mu_n == 0.0 {
+        return Ok(Grown::at_fixed_thickness(forms));
+    }
+    let lambda = 1.0 + mu_n * 0.5 * (i.m_top + i.m_bottom);
+    if lambda.is_nan() || lambda <= 0.0 {
+        return Err(GrowthError::Stretch {
+            face: i.face,
+            worst: lambda - 1.0,
+            mu: mu_n,
+            top: i.m_top,
+            bottom: i.m_bottom,
+        });
+    }
+    Ok(Grown {
+        abar: forms.0,
+        bbar: forms.1 / lambda,
+        thickness_ratio: lambda,
+    })
 }
 
 /// What a law gives for one face.
@@ -313,6 +357,7 @@ pub fn growth_face(
         s: inputs.s.get(f).copied().unwrap_or(0.0),
         direction: inputs.direction.get(f).map_or([1.0, 0.0], |d| d.0),
         heat,
+        coef: inputs.coef.get(f).copied().unwrap_or(inputs.uniform),
     };
     grow_face(inputs.law.as_deref(), inputs.which, &input)
 }

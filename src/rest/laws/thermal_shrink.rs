@@ -100,6 +100,7 @@ mod tests {
             s: 0.0,
             direction,
             heat,
+            coef: Default::default(),
         }
     }
 
