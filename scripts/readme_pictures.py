@@ -45,6 +45,7 @@ SCENES = {
     "conformal_cap": ("final", "mean_curvature", "30,20", None),
     "paper_walker": (0.4, "moisture_bottom", "-60,15", None),
     "spoon_heated": ("final", "temperature_max_top", "-50,35", None),
+    "leaf_drying": ("final", "mean_curvature", "20,25", "-60,60"),
 }
 
 

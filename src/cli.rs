@@ -201,6 +201,10 @@ enum Shape {
     Teddy,
     /// Closed: a torus of major radius --radius and tube radius --tube.
     Torus,
+    /// Open: a flat ovate leaf of length --size with a midrib and six pairs of secondary veins
+    /// (tri_tags 1 blade, 2 midrib, 3 veins; with --thickness H the veins 2H, the midrib 3H
+    /// thick); Delaunay.
+    Leaf,
     /// Open: a plastic spoon of total length --size, an elliptical bowl 0.28 × size long and
     /// 0.044 × size deep and a curved, tapering handle (tri_tags 1 bowl, 2 handle); Delaunay.
     Spoon,
@@ -223,7 +227,7 @@ pub(crate) struct MeshArgs {
     /// Target edge length (m).
     #[arg(long)]
     edge: Real,
-    /// Side of a square, or a spoon's length (m).
+    /// Side of a square, or a spoon's or leaf's length (m).
     #[arg(long, default_value_t = 1.0)]
     size: Real,
     /// Rectangle length along x (m).
@@ -264,7 +268,8 @@ pub(crate) struct MeshArgs {
     /// hyperboloid, rhombus, cylinder, cone, gcm_cone, bilayer_strip, conformal_cap).
     #[arg(long)]
     program: Option<String>,
-    /// Per-face thickness written as ref_thicknesses (m).
+    /// Per-face thickness written as ref_thicknesses (m); a leaf's secondary veins get 2× and its
+    /// midrib 3× it.
     #[arg(long)]
     thickness: Option<Real>,
     /// File format (default from the extension: .vtu → vtu, .vtk → binary legacy).
@@ -914,7 +919,7 @@ pub(crate) fn build_mesh(a: &MeshArgs, max_faces: Real) -> Result<crate::mesh::M
         a.shape,
         Shape::Sphere | Shape::Capsule | Shape::Peanut | Shape::Teddy | Shape::Torus
     );
-    if a.delaunay && (closed || matches!(a.shape, Shape::Disk | Shape::Spoon)) {
+    if a.delaunay && (closed || matches!(a.shape, Shape::Disk | Shape::Spoon | Shape::Leaf)) {
         bail!("--delaunay supports square, rectangle and annulus");
     }
     if closed && (a.jitter > 0.0 || a.grading != 1.0 || a.checkerboard || a.program.is_some()) {
@@ -922,6 +927,11 @@ pub(crate) fn build_mesh(a: &MeshArgs, max_faces: Real) -> Result<crate::mesh::M
             "--jitter, --grading, --checkerboard and --program apply to flat sheets, not to \
              closed surfaces"
         );
+    }
+    if matches!(a.shape, Shape::Spoon | Shape::Leaf)
+        && (a.jitter > 0.0 || a.grading != 1.0 || a.checkerboard)
+    {
+        bail!("--jitter, --grading and --checkerboard apply to grid meshes; spoons and leaves are Delaunay meshes");
     }
     let mut mesh = match a.shape {
         Shape::Square | Shape::Rectangle => {
@@ -1015,6 +1025,23 @@ pub(crate) fn build_mesh(a: &MeshArgs, max_faces: Real) -> Result<crate::mesh::M
             }
             crate::mesh::spoon::spoon(a.size, a.edge, sp)
         }
+        Shape::Leaf => {
+            pos("size", a.size)?;
+            let faces = crate::mesh::leaf::planned_faces(a.size, a.edge);
+            check_planned(faces, "faces", "--edge and --size").map_err(|e| anyhow!(e))?;
+            if a.edge > 0.03 * a.size {
+                bail!(
+                    "--edge ({}) must be at most 0.03 × --size ({}) to keep the leaf's veins \
+                     connected",
+                    a.edge,
+                    a.size
+                );
+            }
+            if let Some(t) = a.thickness {
+                pos("thickness", t)?;
+            }
+            crate::mesh::leaf::leaf(a.size, a.edge, a.thickness, sp)
+        }
         Shape::Torus => {
             pos("radius", a.radius)?;
             pos("tube", a.tube)?;
@@ -1042,7 +1069,7 @@ pub(crate) fn build_mesh(a: &MeshArgs, max_faces: Real) -> Result<crate::mesh::M
         })?;
         case.program(&mut mesh);
     }
-    if let Some(t) = a.thickness {
+    if let (Some(t), false) = (a.thickness, matches!(a.shape, Shape::Leaf)) {
         pos("thickness", t)?;
         mesh.face_fields.insert(
             "ref_thicknesses".into(),

@@ -1,7 +1,7 @@
 //! A plastic spoon (`shellsim mesh spoon`): an elliptical bowl joined to a tapering handle with a
 //! rounded end, both curved, the proportions of a disposable polypropylene spoon scaled to a
 //! total length `L` (`--size`), meshed by the Delaunay triangulation of points about `edge`
-//! apart ([`super::delaunay`]). Faces carry `tri_tags` 1 (bowl) and 2 (handle).
+//! apart ([`super::planform`]). Faces carry `tri_tags` 1 (bowl) and 2 (handle).
 //!
 //! ## Shape (lengths in units of L; a 160 mm spoon)
 //! * Planform along x ∈ [0, L], symmetric in y, of half-width `w(x) = max(w_bowl, w_handle)`:
@@ -16,10 +16,9 @@
 //! The machine (flow) direction of an injection-moulded spoon runs along the handle, +x: give
 //! `growth.machine_direction = [1, 0, 0]` for an anisotropic shrink.
 
-use super::delaunay::delaunay_domain;
 use super::generate::Spacing;
 use super::{Field, Mesh};
-use crate::math::{Real, Vec2, Vec3};
+use crate::math::{Real, Vec3};
 
 /// Bowl length, width, centre and depth, handle start, widths, end rounding and rise, all over
 /// the total length.
@@ -71,66 +70,18 @@ fn height(x: Real, y: Real) -> Real {
 
 /// The planform's area over L² (for planning the mesh's size).
 pub fn area() -> Real {
-    let n = 4000;
-    (0..n)
-        .map(|i| 2.0 * half_width((i as Real + 0.5) / n as Real) / n as Real)
-        .sum()
+    super::planform::area(half_width)
 }
 
 /// The number of faces a spoon of length `length` with edges `edge` will have, about (for
 /// [`super::generate::check_planned`]).
 pub fn planned_faces(length: Real, edge: Real) -> Real {
-    2.3 * area() * (length / edge).powi(2) / (3f64.sqrt() / 2.0)
+    super::planform::planned_faces(area(), length, edge)
 }
 
 /// A spoon of total length `length` (m) with edges about `edge` (m); see the module doc.
 pub fn spoon(length: Real, edge: Real, sp: Spacing) -> Mesh {
-    let e = edge / length;
-    // The outline traced by arc length: the upper half from tip to tip, then the lower.
-    let fine = ((8.0 / e).ceil() as usize).clamp(200, 2_000_000);
-    let upper: Vec<Vec2> = (0..=fine)
-        .map(|i| {
-            let x = i as Real / fine as Real;
-            Vec2::new(x, half_width(x))
-        })
-        .collect();
-    let mut outline: Vec<Vec2> = upper.clone();
-    outline.extend(
-        upper
-            .iter()
-            .rev()
-            .skip(1)
-            .take(fine - 1)
-            .map(|p| Vec2::new(p.x, -p.y)),
-    );
-    let perimeter: Real = (0..outline.len())
-        .map(|i| (outline[(i + 1) % outline.len()] - outline[i]).norm())
-        .sum();
-    let count = ((perimeter / e).round() as usize).max(8);
-    let step = perimeter / count as Real;
-    let mut boundary = Vec::with_capacity(count);
-    let (mut walked, mut next) = (0.0, 0.0);
-    for i in 0..outline.len() {
-        let (a, b) = (outline[i], outline[(i + 1) % outline.len()]);
-        let l = (b - a).norm();
-        while next < walked + l && boundary.len() < count {
-            let s = (next - walked) / l;
-            boundary.push((a + (b - a) * s) * length);
-            next += step;
-        }
-        walked += l;
-    }
-    let depth = |p: Vec2| half_width(p.x / length) * length - p.y.abs();
-    let half = 0.5 * BOWL_W.max(END) * length;
-    let mut mesh = delaunay_domain(
-        boundary,
-        depth,
-        [0.0, -half],
-        [length, half],
-        area() * length * length,
-        edge,
-        sp,
-    );
+    let mut mesh = super::planform::mesh(half_width, 0.5 * BOWL_W.max(END), length, edge, sp);
     let mut tags = Vec::with_capacity(mesh.faces.len());
     for f in &mesh.faces {
         let c = f.iter().map(|&v| mesh.positions[v]).sum::<Vec3>() / 3.0;
