@@ -239,6 +239,18 @@ impl Settings {
             .validate(&self.growth, self.contact.enabled, mode)?;
         self.temperature
             .validate(&self.growth, self.moisture.enabled, mode)?;
+        let mo = &self.moisture;
+        if mo.enabled && self.material.density + mo.initial * mo.water_density <= 0.0 {
+            return Err(Invalid::new(
+                "moisture.initial",
+                format!(
+                    "{} leaves the sheet without mass: material.density + moisture.initial × \
+                     moisture.water_density = {} kg/m³ must stay positive",
+                    crate::math::human(mo.initial),
+                    crate::math::human(self.material.density + mo.initial * mo.water_density)
+                ),
+            ));
+        }
         self.time.validate()?;
         self.explicit.validate()?;
         self.dial.validate(

@@ -356,3 +356,43 @@ fn a_drying_sheet_loses_mass_and_the_log_reports_it() {
     }
     assert!(last < dry + 0.9 * 1000.0 * 0.5 * h * area.iter().sum::<Real>());
 }
+
+/// Losing more water than the material holds is diagnosed: an initial moisture that leaves the
+/// sheet without mass is exit 2 naming the key, with nothing written, and a sheet dried past it
+/// stops with exit 1, the reason naming the vertex, and finite frames up to there.
+#[test]
+fn water_loss_past_the_dry_mass_is_diagnosed() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    rectangle(d, 0.02, 0.005);
+    let scene = |initial: Real, ambient: Real| {
+        format!(
+            "[material]\nyoung = 1e7\nthickness = 2e-4\ndensity = 500\n[growth]\n\
+             law = \"linear_swelling\"\nmu = 0.01\n[moisture]\nenabled = true\n\
+             initial = {initial}\ndiffusivity_through = 1e-10\n\
+             [[moisture.boundary]]\nside = \"top\"\nkind = \"robin\"\nk = 1e-5\n\
+             ambient = {ambient}\n[solver]\nmode = \"dynamic\"\n[time]\ndt = 0.1\n\
+             dt_max = 10\nend = 400\noutput_interval = 50\n"
+        )
+    };
+    std::fs::write(d.join("a.toml"), scene(-0.6, 0.0)).unwrap();
+    let (code, _, err) = run_status(&["a.toml", "s.vtk", "--out", "a", "-q"], d);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("moisture.initial") && err.contains("mass"),
+        "{err}"
+    );
+    assert!(!d.join("a").exists(), "wrote output");
+    std::fs::write(d.join("b.toml"), scene(0.0, -2.0)).unwrap();
+    let (code, _, err) = run_status(&["b.toml", "s.vtk", "--out", "b", "-q"], d);
+    assert_eq!(code, 1, "{err}");
+    let reason = summary(&d.join("b"))["reason"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    assert!(
+        reason.contains("vertex") && reason.contains("mass"),
+        "{reason}"
+    );
+    finite_frames(&d.join("b"), "vtu", "dried past");
+}

@@ -301,6 +301,15 @@ pub(super) fn run_dynamic(
                 }
             }
             m.trial_mass = m.masses_of(&sc.body, &m.trial);
+            if let Some((vertex, &mass)) = m
+                .trial_mass
+                .iter()
+                .enumerate()
+                .find(|(_, &w)| !(w.is_finite() && w > 0.0))
+            {
+                failure = Some(RunFailure::Mass { t, vertex, mass });
+                break;
+            }
             s.summary.moisture_seconds += moisture_clock.elapsed().as_secs_f64();
         }
         let trial_mass = moisture

@@ -180,6 +180,20 @@ pub enum RunFailure {
         /// What went wrong.
         source: crate::rest::laws::GrowthError,
     },
+    /// Dynamics: the sheet lost more water than it holds, so a vertex's mass is not positive.
+    #[error(
+        "at t = {t_h}: vertex {vertex} would have mass {m_h} kg: the moisture fell below what \
+         the material holds (density + moisture × water_density must stay positive)",
+        t_h = crate::math::human(*.t), m_h = crate::math::human(*.mass)
+    )]
+    Mass {
+        /// The time reached (s).
+        t: Real,
+        /// The vertex.
+        vertex: usize,
+        /// Its mass (kg).
+        mass: Real,
+    },
 }
 
 /// The signal that asked the run to stop (0: none). Set by [`catch_signals`]' handler and read
