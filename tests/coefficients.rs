@@ -6,18 +6,9 @@
 
 mod common;
 
-use common::{finite_frames, run_status, shellsim, summary};
+use common::{finite_frames, run_settings as run, run_status, shellsim, summary};
 use shellsim::math::Real;
 use std::path::Path;
-
-/// Writes `settings` as `name.toml`, runs it on `mesh` into `name`, asserts convergence; the
-/// frames.
-fn run(dir: &Path, name: &str, settings: &str, mesh: &str) -> Vec<shellsim::mesh::Mesh> {
-    std::fs::write(dir.join(format!("{name}.toml")), settings).unwrap();
-    shellsim(&[&format!("{name}.toml"), mesh, "--out", name, "-q"], dir);
-    assert_eq!(summary(&dir.join(name))["converged"], true, "{name}");
-    finite_frames(&dir.join(name), "vtu", name)
-}
 
 /// Writes `s.vtk`, a rectangle `lx` × 1 cm with edges `edge` (m), centred on the origin.
 fn rectangle(dir: &Path, lx: Real, edge: Real) {

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{finite_frames, run_status, shellsim, summary};
+use common::{converged_frames, run_settings as run, run_status, shellsim};
 use shellsim::math::Real;
 use std::f64::consts::PI;
 use std::path::Path;
@@ -24,14 +24,6 @@ fn scene(extra: &str) -> String {
         "[material]\nyoung = 1.5e9\npoisson = 0.4\nthickness = {H}\ndensity = {RHO}\n\
          [solver]\nmode = \"dynamic\"\n[growth]\nlaw = \"thermal_shrink\"\n{extra}"
     )
-}
-
-/// Runs `settings` on `mesh` in `dir` into `out`; the frames.
-fn run(dir: &Path, name: &str, settings: &str, mesh: &str) -> Vec<shellsim::mesh::Mesh> {
-    std::fs::write(dir.join(format!("{name}.toml")), settings).unwrap();
-    shellsim(&[&format!("{name}.toml"), mesh, "--out", name, "-q"], dir);
-    assert_eq!(summary(&dir.join(name))["converged"], true, "{name}");
-    finite_frames(&dir.join(name), "vtu", name)
 }
 
 /// The face-mean of a frame's face field.
@@ -404,19 +396,13 @@ fn the_heated_spoon_shrinks_its_bowl_for_good() {
     let settings = root.join("settings/spoon_heated.toml");
     let mesh = root.join("meshes/spoon.vtk");
     let go = |out: &str, sets: &[&str]| {
-        let mut args = vec![
+        converged_frames(
+            d,
             settings.to_str().unwrap(),
             mesh.to_str().unwrap(),
-            "--out",
             out,
-            "-q",
-        ];
-        for s in sets {
-            args.extend(["--set", s]);
-        }
-        shellsim(&args, d);
-        assert_eq!(summary(&d.join(out))["converged"], true, "{out}");
-        finite_frames(&d.join(out), "vtu", out)
+            sets,
+        )
     };
     let iso = go("iso", &[]);
     let reference = &iso[0];

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{finite_frames, log_rows, shellsim, summary};
+use common::{converged_frames, log_rows, shellsim};
 use shellsim::math::Real;
 use shellsim::mesh::Mesh;
 use std::path::{Path, PathBuf};
@@ -16,19 +16,13 @@ fn root() -> PathBuf {
 
 /// Runs `settings` (a path) on `mesh` into `dir/out` with overrides `sets`; the frames.
 fn run(dir: &Path, settings: &Path, mesh: &Path, out: &str, sets: &[&str]) -> Vec<Mesh> {
-    let mut args = vec![
+    converged_frames(
+        dir,
         settings.to_str().unwrap(),
         mesh.to_str().unwrap(),
-        "--out",
         out,
-        "-q",
-    ];
-    for s in sets {
-        args.extend(["--set", s]);
-    }
-    shellsim(&args, dir);
-    assert_eq!(summary(&dir.join(out))["converged"], true, "{out}");
-    finite_frames(&dir.join(out), "vtu", out)
+        sets,
+    )
 }
 
 /// Writes `leaf.vtk`: the scene's leaf with 2.4 mm edges (728 faces).

@@ -15,7 +15,7 @@
 
 mod common;
 
-use common::{finite_frames, shellsim, summary};
+use common::{run_settings, shellsim};
 use shellsim::math::Real;
 use std::path::Path;
 
@@ -40,13 +40,7 @@ fn grow(dir: &Path, eps: Real, clamped: bool, tag: &str) -> Vec<Real> {
          {{ min = [{ex}, -1, -1], max = [1, 1, 1] }}]\n",
         mp = -NU
     );
-    std::fs::write(dir.join(format!("{tag}.toml")), settings).unwrap();
-    shellsim(
-        &[&format!("{tag}.toml"), "plate.vtk", "--out", tag, "-q"],
-        dir,
-    );
-    assert_eq!(summary(&dir.join(tag))["converged"], true, "{tag}");
-    let frames = finite_frames(&dir.join(tag), "vtu", tag);
+    let frames = run_settings(dir, tag, &settings, "plate.vtk");
     let (first, last) = (&frames[0], frames.last().unwrap());
     let mut line: Vec<(Real, Real)> = (0..first.positions.len())
         .filter(|&i| first.positions[i].y.abs() < 1e-9)

@@ -134,8 +134,9 @@ pub struct GrowthRegion {
 }
 
 impl GrowthRegion {
-    /// The coefficients' values as `(key, value)`, the given ones only.
-    pub fn given(&self) -> impl Iterator<Item = (&'static str, Real)> + '_ {
+    /// The coefficients as `(key, value)` in the order mu, mu_perp, mu_top, mu_bottom,
+    /// mu_through (`None`: not given).
+    pub fn values(&self) -> [(&'static str, Option<Real>); 5] {
         [
             ("mu", self.mu),
             ("mu_perp", self.mu_perp),
@@ -143,26 +144,18 @@ impl GrowthRegion {
             ("mu_bottom", self.mu_bottom),
             ("mu_through", self.mu_through),
         ]
-        .into_iter()
-        .filter_map(|(k, v)| v.map(|v| (k, v)))
     }
 
     fn validate(&self, i: usize) -> Result<(), Invalid> {
         let ck = Check;
-        ck.selection(
-            &format!("growth.regions[{i}]"),
-            &super::selection::Selection {
-                tags: self.tags.clone(),
-                inside: self.inside.clone(),
-            },
-        )?;
+        ck.inside(&format!("growth.regions[{i}]"), self.inside.as_ref())?;
         if self.tags.is_empty() && self.inside.is_none() {
             return ck.inv(
                 &format!("growth.regions[{i}]"),
                 "needs tags or inside (the uniform coefficients cover every face)".into(),
             );
         }
-        for (k, v) in self.given() {
+        for (k, v) in self.values().into_iter().filter_map(|(k, v)| Some((k, v?))) {
             if !v.is_finite() || v.abs() > MAX_MOISTURE {
                 return ck.inv(
                     &format!("growth.regions[{i}].{k}"),

@@ -150,12 +150,7 @@ pub(crate) fn check_region(
             "needs tags or inside (the uniform values cover every face)".into(),
         );
     }
-    if let Some(b) = inside {
-        if b.min.iter().chain(&b.max).any(|v| !v.is_finite()) || (0..3).any(|k| b.min[k] > b.max[k])
-        {
-            return ck.inv(&format!("{key}.inside"), "needs finite min ≤ max".into());
-        }
-    }
+    ck.inside(key, inside)?;
     for (n, v) in names.iter().zip(values) {
         if let Some(v) = v {
             ck.pos(&format!("{key}.{n}"), v)?;

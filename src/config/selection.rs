@@ -29,7 +29,12 @@ pub struct FixBox {
 impl Check {
     /// A selection's box must be finite with min ≤ max.
     pub(crate) fn selection(&self, key: &str, sel: &Selection) -> Result<(), Invalid> {
-        if let Some(b) = &sel.inside {
+        self.inside(key, sel.inside.as_ref())
+    }
+
+    /// A box `inside` (when given) must be finite with min ≤ max; the error is at `key.inside`.
+    pub(crate) fn inside(&self, key: &str, inside: Option<&FixBox>) -> Result<(), Invalid> {
+        if let Some(b) = inside {
             if b.min.iter().chain(b.max.iter()).any(|v| !v.is_finite())
                 || (0..3).any(|k| b.min[k] > b.max[k])
             {

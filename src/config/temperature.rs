@@ -299,13 +299,7 @@ impl Temperature {
         }
         for (i, b) in t.boundary.iter().enumerate() {
             let key = |k: &str| format!("temperature.boundary[{i}].{k}");
-            if let Some(bx) = &b.inside {
-                if bx.min.iter().chain(&bx.max).any(|v| !v.is_finite())
-                    || (0..3).any(|k| bx.min[k] > bx.max[k])
-                {
-                    return ck.inv(&key("inside"), "needs finite min ≤ max".into());
-                }
-            }
+            ck.inside(&format!("temperature.boundary[{i}]"), b.inside.as_ref())?;
             match b.kind {
                 SurfaceKind::Value => absolute(&key("value"), b.value)?,
                 SurfaceKind::Flux => {

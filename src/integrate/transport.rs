@@ -183,6 +183,28 @@ fn per_face_diffusivity(
         .collect())
 }
 
+/// The diffusion's condition of a settings one: `value` is the prescribed value or the flux,
+/// `k` the transfer coefficient; fluxes and transfer coefficients are divided by `scale` (ρc
+/// for heat, 1 for moisture).
+fn surface_bc(
+    kind: crate::settings::SurfaceKind,
+    value: Real,
+    k: Real,
+    ambient: Real,
+    scale: Real,
+) -> SurfaceBc {
+    use crate::settings::SurfaceKind;
+    match kind {
+        SurfaceKind::Sealed => SurfaceBc::Sealed,
+        SurfaceKind::Value => SurfaceBc::Value(value),
+        SurfaceKind::Flux => SurfaceBc::Flux(value / scale),
+        SurfaceKind::Robin => SurfaceBc::Robin {
+            k: k / scale,
+            ambient,
+        },
+    }
+}
+
 /// The diffusion's side of a settings side.
 fn side_of(s: crate::settings::SurfaceSide) -> Side {
     match s {
@@ -258,7 +280,6 @@ impl Transport {
     /// The moisture's diffusion, conditions, ground exchange and wet masses.
     fn moisture(sc: &Scene) -> Result<Self, RunError> {
         use crate::diffusion::Layering;
-        use crate::settings::SurfaceKind;
         let mo = &sc.settings.moisture;
         let regions: Vec<_> = mo
             .regions
@@ -293,15 +314,7 @@ impl Transport {
         )?;
         for b in &mo.boundary {
             let side = side_of(b.side);
-            let bc = match b.kind {
-                SurfaceKind::Sealed => SurfaceBc::Sealed,
-                SurfaceKind::Value => SurfaceBc::Value(b.value),
-                SurfaceKind::Flux => SurfaceBc::Flux(b.value),
-                SurfaceKind::Robin => SurfaceBc::Robin {
-                    k: b.k,
-                    ambient: b.ambient,
-                },
-            };
+            let bc = surface_bc(b.kind, b.value, b.k, b.ambient, 1.0);
             let faces = crate::body::region_faces(&sc.body.mesh, b)?;
             for f in faces {
                 m.diffusion.set_surface(f, side, bc)?;
@@ -333,11 +346,9 @@ impl Transport {
     }
 
     /// The heat conduction: diffusivities k/(ρc), the permanent conditions set at once, the
-    /// windowed ones kept for [`Self::update_windows`] (checked here: two conditions that
-    /// overlap in time on one face side contradict each other unless equal), the sources.
+    /// windowed ones kept for [`Self::update_windows`], the sources.
     fn temperature(sc: &Scene) -> Result<Self, RunError> {
         use crate::diffusion::Layering;
-        use crate::settings::SurfaceKind;
         let te = &sc.settings.temperature;
         let rc = sc.settings.material.density * te.specific_heat;
         let regions: Vec<_> = te
@@ -372,41 +383,29 @@ impl Transport {
             te.max_change,
         )?;
         m.heat_capacity = rc;
-        let mut windows: Vec<Window> = Vec::new();
+        // Overlapping windows were checked with the scene (`body::check_heat_regions`).
         for (i, b) in te.boundary.iter().enumerate() {
             let side = side_of(b.side);
             // The heat equation divided by ρc: h/(ρc) in m/s, q/(ρc) in K·m/s.
-            let bc = match b.kind {
-                SurfaceKind::Sealed => SurfaceBc::Sealed,
-                SurfaceKind::Value => SurfaceBc::Value(b.value),
-                SurfaceKind::Flux => SurfaceBc::Flux(b.value / rc),
-                SurfaceKind::Robin => SurfaceBc::Robin {
-                    k: b.h / rc,
-                    ambient: b.ambient,
-                },
-            };
+            let bc = surface_bc(b.kind, b.value, b.h, b.ambient, rc);
             let faces = crate::body::select::faces_matching(
                 &sc.body.mesh,
                 &b.tags,
                 b.inside.as_ref(),
                 &format!("temperature.boundary[{i}]"),
             )?;
-            windows.push(Window {
-                faces,
-                side,
-                bc,
-                from: b.from,
-                until: b.until.unwrap_or(Real::INFINITY),
-            });
-        }
-        // Overlapping windows were checked with the scene (`body::check_heat_regions`).
-        for w in windows {
-            if w.from <= 0.0 && w.until == Real::INFINITY {
-                for &f in &w.faces {
-                    m.diffusion.set_surface(f, w.side, w.bc)?;
+            if b.permanent() {
+                for &f in &faces {
+                    m.diffusion.set_surface(f, side, bc)?;
                 }
             } else {
-                m.windows.push(w);
+                m.windows.push(Window {
+                    faces,
+                    side,
+                    bc,
+                    from: b.from,
+                    until: b.until.unwrap_or(Real::INFINITY),
+                });
             }
         }
         m.keep_base();

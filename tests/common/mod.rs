@@ -169,3 +169,36 @@ pub fn barrier_gap(sigma: f64, k: f64, g_hat: f64) -> f64 {
     }
     0.5 * (lo + hi)
 }
+
+/// Runs `settings` on `mesh` (paths, or file names in `dir`) into `dir/out` with the `--set`
+/// overrides `sets`, asserts that it converged, and returns its frames (checked finite).
+#[allow(dead_code)] // not every test crate runs scenes this way
+pub fn converged_frames(
+    dir: &Path,
+    settings: &str,
+    mesh: &str,
+    out: &str,
+    sets: &[&str],
+) -> Vec<shellsim::mesh::Mesh> {
+    let mut args = vec![settings, mesh, "--out", out, "-q"];
+    for s in sets {
+        args.extend(["--set", s]);
+    }
+    shellsim(&args, dir);
+    assert_eq!(summary(&dir.join(out))["converged"], true, "{out}");
+    finite_frames(&dir.join(out), "vtu", out)
+}
+
+/// Writes `settings` (TOML text) as `dir/name.toml` and runs it on `mesh` into `dir/name`
+/// ([`converged_frames`]).
+#[allow(dead_code)] // not every test crate runs scenes this way
+pub fn run_settings(
+    dir: &Path,
+    name: &str,
+    settings: &str,
+    mesh: &str,
+) -> Vec<shellsim::mesh::Mesh> {
+    let file = format!("{name}.toml");
+    std::fs::write(dir.join(&file), settings).unwrap();
+    converged_frames(dir, &file, mesh, name, &[])
+}

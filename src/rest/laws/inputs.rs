@@ -113,7 +113,8 @@ impl GrowthInputs {
 /// Where a coefficient sits in [`super::Coefficients`].
 type Slot = fn(&mut super::Coefficients) -> &mut Real;
 
-/// The face fields of the per-face coefficients, and which coefficient each sets.
+/// The face fields of the per-face coefficients, and which coefficient each sets, in the order
+/// of [`crate::config::growth::GrowthRegion::values`].
 const COEFFICIENT_FIELDS: [(&str, Slot); 5] = [
     ("growth_mu", |c| &mut c.mu),
     ("growth_mu_perp", |c| &mut c.mu_perp),
@@ -148,12 +149,8 @@ fn per_face_coefficients(
             &format!("growth.regions[{i}]"),
         )?;
         for f in faces {
-            for (k, v) in r.given() {
-                let slot = COEFFICIENT_FIELDS
-                    .iter()
-                    .find(|(n, _)| n.strip_prefix("growth_") == Some(k))
-                    .map(|(_, s)| *s);
-                if let Some(slot) = slot {
+            for ((_, v), (_, slot)) in r.values().into_iter().zip(COEFFICIENT_FIELDS) {
+                if let Some(v) = v {
                     *slot(&mut coef[f]) = v;
                 }
             }
