@@ -205,6 +205,10 @@ enum Shape {
     /// (tri_tags 1 blade, 2 midrib, 3 veins; with --thickness H the veins 2H, the midrib 3H
     /// thick); Delaunay.
     Leaf,
+    /// Open: a flat film --lx × --ly with printed parallel strips at --strip-angle, --strip-width
+    /// wide every --strip-pitch (tri_tags 1 bare, 2 under a strip); the strips' edges are mesh
+    /// edges at any angle.
+    Film,
     /// Open: a plastic spoon of total length --size, an elliptical bowl 0.28 × size long and
     /// 0.044 × size deep and a curved, tapering handle (tri_tags 1 bowl, 2 handle); Delaunay.
     Spoon,
@@ -268,6 +272,15 @@ pub(crate) struct MeshArgs {
     /// hyperboloid, rhombus, cylinder, cone, gcm_cone, bilayer_strip, conformal_cap).
     #[arg(long)]
     program: Option<String>,
+    /// Film: angle of the strips to the x axis (degrees).
+    #[arg(long, default_value_t = 0.0)]
+    strip_angle: Real,
+    /// Film: width of a strip (m; default --ly / 10).
+    #[arg(long)]
+    strip_width: Option<Real>,
+    /// Film: distance between neighbouring strips' centre lines (m; default --ly / 5).
+    #[arg(long)]
+    strip_pitch: Option<Real>,
     /// Per-face thickness written as ref_thicknesses (m); a leaf's secondary veins get 2× and its
     /// midrib 3× it.
     #[arg(long)]
@@ -919,7 +932,13 @@ pub(crate) fn build_mesh(a: &MeshArgs, max_faces: Real) -> Result<crate::mesh::M
         a.shape,
         Shape::Sphere | Shape::Capsule | Shape::Peanut | Shape::Teddy | Shape::Torus
     );
-    if a.delaunay && (closed || matches!(a.shape, Shape::Disk | Shape::Spoon | Shape::Leaf)) {
+    if a.delaunay
+        && (closed
+            || matches!(
+                a.shape,
+                Shape::Disk | Shape::Spoon | Shape::Leaf | Shape::Film
+            ))
+    {
         bail!("--delaunay supports square, rectangle and annulus");
     }
     if closed && (a.jitter > 0.0 || a.grading != 1.0 || a.checkerboard || a.program.is_some()) {
@@ -932,6 +951,13 @@ pub(crate) fn build_mesh(a: &MeshArgs, max_faces: Real) -> Result<crate::mesh::M
         && (a.jitter > 0.0 || a.grading != 1.0 || a.checkerboard)
     {
         bail!("--jitter, --grading and --checkerboard apply to grid meshes; spoons and leaves are Delaunay meshes");
+    }
+    if matches!(a.shape, Shape::Film) && (a.jitter > 0.0 || a.grading != 1.0 || a.checkerboard) {
+        bail!("--jitter, --grading and --checkerboard do not apply to a film: its rows follow the strips");
+    }
+    let film_flags = a.strip_angle != 0.0 || a.strip_width.is_some() || a.strip_pitch.is_some();
+    if film_flags && !matches!(a.shape, Shape::Film) {
+        bail!("--strip-angle, --strip-width and --strip-pitch describe a film's strips");
     }
     let mut mesh = match a.shape {
         Shape::Square | Shape::Rectangle => {
@@ -1010,6 +1036,42 @@ pub(crate) fn build_mesh(a: &MeshArgs, max_faces: Real) -> Result<crate::mesh::M
             let name = format!("{:?}", a.shape).to_lowercase();
             crate::mesh::surfaces::closed_shape_within(&name, a.radius, a.edge, max_faces)
                 .map_err(|e| anyhow!("cannot mesh the {name}: {e}"))?
+        }
+        Shape::Film => {
+            pos("lx", a.lx)?;
+            pos("ly", a.ly)?;
+            let width = a.strip_width.unwrap_or(0.1 * a.ly);
+            let pitch = a.strip_pitch.unwrap_or(0.2 * a.ly);
+            pos("strip-width", width)?;
+            pos("strip-pitch", pitch)?;
+            if !a.strip_angle.is_finite() {
+                bail!("--strip-angle must be finite (degrees)");
+            }
+            if width >= pitch {
+                bail!(
+                    "--strip-width ({}) must be smaller than --strip-pitch ({}): strips that \
+                     touch cover the whole film",
+                    crate::math::human(width),
+                    crate::math::human(pitch)
+                );
+            }
+            if width < 0.5 * a.edge || pitch - width < 0.5 * a.edge {
+                bail!(
+                    "--edge ({}) must be at most twice the strip width ({}) and the gap between \
+                     strips ({}) to resolve the pattern",
+                    crate::math::human(a.edge),
+                    crate::math::human(width),
+                    crate::math::human(pitch - width)
+                );
+            }
+            let faces = crate::mesh::film::planned_faces(a.lx, a.ly, a.edge);
+            check_planned(faces, "faces", "--edge, --lx and --ly").map_err(|e| anyhow!(e))?;
+            let strips = crate::mesh::film::Strips {
+                angle: a.strip_angle.to_radians(),
+                width,
+                pitch,
+            };
+            crate::mesh::film::film(a.lx, a.ly, a.edge, strips).map_err(|e| anyhow!(e))?
         }
         Shape::Spoon => {
             pos("size", a.size)?;

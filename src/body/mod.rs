@@ -471,13 +471,27 @@ struct FaceMaterial {
 /// mesh's fields when the settings use them, else the settings' uniform values.
 fn face_material(mesh: &Mesh, m: &crate::settings::Material) -> Result<FaceMaterial, MeshError> {
     let nf = mesh.faces.len();
-    let thickness = positive_face_field(
+    // Uniform values, then regions, then the mesh's fields.
+    let (mut thickness, mut young) = (vec![m.thickness; nf], vec![m.young; nf]);
+    for (i, r) in m.regions.iter().enumerate() {
+        let what = format!("material.regions[{i}]");
+        for f in select::faces_matching(mesh, &r.tags, r.inside.as_ref(), &what)? {
+            if let Some(h) = r.thickness {
+                thickness[f] = h;
+            }
+            if let Some(e) = r.young {
+                young[f] = e;
+            }
+        }
+    }
+    if let Some(t) = positive_face_field(
         mesh,
         "ref_thicknesses",
         crate::mesh::MAX_COORDINATE,
         ("use_mesh_thickness", m.use_mesh_thickness),
-    )?
-    .unwrap_or_else(|| vec![m.thickness; nf]);
+    )? {
+        thickness = t;
+    }
     // A shell is thin: a thickness beyond 10× the sheet's size is no shell (and overflows).
     let size = mesh.bbox_diagonal();
     if let Some(f) = thickness.iter().position(|&h| h > 10.0 * size) {
@@ -488,15 +502,14 @@ fn face_material(mesh: &Mesh, m: &crate::settings::Material) -> Result<FaceMater
             size_h = crate::math::human(size)
         )));
     }
-    let young = match positive_face_field(
+    if let Some(mu) = positive_face_field(
         mesh,
         "ref_shear_moduli",
         crate::settings::MAX_MODULUS,
         ("use_mesh_shear_modulus", m.use_mesh_shear_modulus),
     )? {
-        Some(mu) => mu.iter().map(|mu| 2.0 * mu * (1.0 + m.poisson)).collect(),
-        None => vec![m.young; nf],
-    };
+        young = mu.iter().map(|mu| 2.0 * mu * (1.0 + m.poisson)).collect();
+    }
     let lame = young
         .iter()
         .map(|&e| Lame2d::from_young_poisson(e, m.poisson))

@@ -96,6 +96,8 @@ pub enum GrowthModel {
         mu_top: Real,
         /// Coefficient of the bottom layer (per unit moisture).
         mu_bottom: Real,
+        /// The layers' thicknesses and moduli.
+        laminate: Laminate,
     },
     /// Linear swelling with a machine direction.
     MachineDirection {
@@ -109,6 +111,28 @@ pub enum GrowthModel {
         /// Shrink against the highest temperature reached.
         table: ShrinkTable,
     },
+}
+
+/// The bilayer's two layers: their thicknesses, moduli and whether each swells through its
+/// thickness as it does in-plane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Laminate {
+    /// The top layer's share φ of the reference thickness, in (0, 1).
+    pub top_fraction: Real,
+    /// Young's modulus of the top layer over the bottom layer's, `n > 0`.
+    pub modulus_ratio: Real,
+    /// Each layer's thickness grows by its own in-plane stretch (a gel's isotropic swelling).
+    pub isotropic: bool,
+}
+
+impl Default for Laminate {
+    fn default() -> Self {
+        Laminate {
+            top_fraction: 0.5,
+            modulus_ratio: 1.0,
+            isotropic: false,
+        }
+    }
 }
 
 /// `[[growth.regions]]`: coefficients on the faces whose `tri_tags` is one of `tags` (any, when
@@ -131,18 +155,24 @@ pub struct GrowthRegion {
     pub mu_bottom: Option<Real>,
     /// See [`Growth::mu_through`].
     pub mu_through: Option<Real>,
+    /// See [`Growth::print_thickness`].
+    pub print_thickness: Option<Real>,
+    /// See [`Growth::print_modulus_ratio`].
+    pub print_modulus_ratio: Option<Real>,
 }
 
 impl GrowthRegion {
     /// The coefficients as `(key, value)` in the order mu, mu_perp, mu_top, mu_bottom,
-    /// mu_through (`None`: not given).
-    pub fn values(&self) -> [(&'static str, Option<Real>); 5] {
+    /// mu_through, print_thickness, print_modulus_ratio (`None`: not given).
+    pub fn values(&self) -> [(&'static str, Option<Real>); 7] {
         [
             ("mu", self.mu),
             ("mu_perp", self.mu_perp),
             ("mu_top", self.mu_top),
             ("mu_bottom", self.mu_bottom),
             ("mu_through", self.mu_through),
+            ("print_thickness", self.print_thickness),
+            ("print_modulus_ratio", self.print_modulus_ratio),
         ]
     }
 
@@ -156,7 +186,8 @@ impl GrowthRegion {
             );
         }
         for (k, v) in self.values().into_iter().filter_map(|(k, v)| Some((k, v?))) {
-            if !v.is_finite() || v.abs() > MAX_MOISTURE {
+            print_range(&format!("growth.regions[{i}].{k}"), k, v)?;
+            if !k.starts_with("print_") && (!v.is_finite() || v.abs() > MAX_MOISTURE) {
                 return ck.inv(
                     &format!("growth.regions[{i}].{k}"),
                     format!(
@@ -169,6 +200,29 @@ impl GrowthRegion {
         }
         Ok(())
     }
+}
+
+/// Checks a printed layer's thickness (≥ 0, m) or modulus ratio (in [1e-6, 1e6]) given under
+/// `key` (other coefficients pass).
+pub fn print_range(key: &str, name: &str, v: Real) -> Result<(), Invalid> {
+    let ok = match name {
+        "print_thickness" | "growth_print_thickness" => v.is_finite() && v >= 0.0,
+        "print_modulus_ratio" | "growth_print_modulus_ratio" => {
+            v.is_finite() && (1e-6..=1e6).contains(&v)
+        }
+        _ => true,
+    };
+    if ok {
+        return Ok(());
+    }
+    Check.inv(
+        key,
+        format!(
+            "a printed layer's thickness is ≥ 0 (m) and its modulus ratio lies in [1e-6, 1e6]; \
+             got {}",
+            crate::math::human(v)
+        ),
+    )
 }
 
 /// The thermal shrink law's table, validated ([`Growth::validate`]): at each temperature
@@ -247,6 +301,20 @@ pub struct Growth {
     /// Moisture–thickness coefficient of the moisture laws (per unit moisture, default `0`:
     /// the thickness is kept): the rest thickness is `h (1 + μ_n (m⁺ + m⁻)/2)`.
     pub mu_through: Option<Real>,
+    /// Bilayer: the top layer's share of the thickness, in (0, 1) (default `0.5`).
+    pub top_fraction: Option<Real>,
+    /// Bilayer: Young's modulus of the top layer over the bottom layer's (default `1`). The
+    /// rest forms are projected about the laminate's neutral plane; `material` gives the
+    /// stiffness of the shell as a whole.
+    pub modulus_ratio: Option<Real>,
+    /// Bilayer: each layer's thickness grows by the same stretch as its length (isotropic
+    /// swelling, as in a gel; default `false`: the thickness is kept). Excludes `mu_through`.
+    pub isotropic_layers: Option<bool>,
+    /// Bilayer: thickness of a printed layer on top that does not swell (m, default `0`: none),
+    /// included in the face's thickness (the film is the rest).
+    pub print_thickness: Option<Real>,
+    /// Bilayer: Young's modulus of the printed layer over the bottom layer's (default `1`).
+    pub print_modulus_ratio: Option<Real>,
     /// Coefficients on regions of faces (veins, a printed layer), over the uniform ones; the
     /// face fields `growth_mu`, `growth_mu_perp`, `growth_mu_top`, `growth_mu_bottom` and
     /// `growth_mu_through` take precedence over both.
@@ -280,6 +348,11 @@ impl Default for Growth {
             mu_top: None,
             mu_bottom: None,
             mu_through: None,
+            top_fraction: None,
+            modulus_ratio: None,
+            isotropic_layers: None,
+            print_thickness: None,
+            print_modulus_ratio: None,
             regions: Vec::new(),
             moisture_top: 0.0,
             moisture_bottom: 0.0,
@@ -306,6 +379,7 @@ impl Growth {
             GrowthLaw::Bilayer => GrowthModel::Bilayer {
                 mu_top: c(self.mu_top),
                 mu_bottom: c(self.mu_bottom),
+                laminate: self.laminate(),
             },
             GrowthLaw::MachineDirection => GrowthModel::MachineDirection {
                 mu: c(self.mu),
@@ -315,6 +389,97 @@ impl Growth {
                 table: self.shrink_table(),
             },
         }
+    }
+
+    /// The bilayer's layers (defaults where not given).
+    pub fn laminate(&self) -> Laminate {
+        let d = Laminate::default();
+        Laminate {
+            top_fraction: self.top_fraction.unwrap_or(d.top_fraction),
+            modulus_ratio: self.modulus_ratio.unwrap_or(d.modulus_ratio),
+            isotropic: self.isotropic_layers.unwrap_or(d.isotropic),
+        }
+    }
+
+    /// Checks the bilayer's layer keys: given only with `"bilayer"`, a fraction in (0, 1), a
+    /// positive finite modulus ratio, and isotropic layers without `mu_through`.
+    fn validate_laminate(&self) -> Result<(), Invalid> {
+        let ck = Check;
+        let region_print = self.regions.iter().enumerate().find_map(|(i, r)| {
+            (r.print_thickness.is_some() || r.print_modulus_ratio.is_some())
+                .then(|| format!("growth.regions[{i}]"))
+        });
+        let given = [
+            ("growth.top_fraction", self.top_fraction.is_some()),
+            ("growth.modulus_ratio", self.modulus_ratio.is_some()),
+            ("growth.isotropic_layers", self.isotropic_layers.is_some()),
+            ("growth.print_thickness", self.print_thickness.is_some()),
+            (
+                "growth.print_modulus_ratio",
+                self.print_modulus_ratio.is_some(),
+            ),
+            (
+                region_print.as_deref().unwrap_or(""),
+                region_print.is_some(),
+            ),
+        ];
+        if self.law != GrowthLaw::Bilayer {
+            if let Some((k, _)) = given.iter().find(|(_, g)| *g) {
+                return ck.inv(
+                    k,
+                    format!(
+                        "describes the layers of growth.law = \"bilayer\" (print keys too), not \
+                         of \"{}\"",
+                        self.law.name()
+                    ),
+                );
+            }
+            return Ok(());
+        }
+        for (k, v) in [
+            ("print_thickness", self.print_thickness),
+            ("print_modulus_ratio", self.print_modulus_ratio),
+        ] {
+            if let Some(v) = v {
+                print_range(&format!("growth.{k}"), k, v)?;
+            }
+        }
+        if let Some(f) = self.top_fraction {
+            if !(f > 0.0 && f < 1.0) {
+                return ck.inv(
+                    "growth.top_fraction",
+                    format!(
+                        "is the top layer's share of the thickness, in (0, 1); got {}",
+                        crate::math::human(f)
+                    ),
+                );
+            }
+        }
+        if let Some(n) = self.modulus_ratio {
+            if !(n.is_finite() && (1e-6..=1e6).contains(&n)) {
+                return ck.inv(
+                    "growth.modulus_ratio",
+                    format!(
+                        "is E_top / E_bottom, in [1e-6, 1e6]; got {}",
+                        crate::math::human(n)
+                    ),
+                );
+            }
+        }
+        let region = self
+            .regions
+            .iter()
+            .position(|r| r.mu_through.is_some())
+            .map(|i| format!("growth.regions[{i}].mu_through"));
+        if self.isotropic_layers == Some(true) && (self.mu_through.is_some() || region.is_some()) {
+            return ck.inv(
+                &region.unwrap_or_else(|| "growth.mu_through".into()),
+                "isotropic_layers already grows each layer's thickness by its own stretch; \
+                 give one or the other"
+                    .into(),
+            );
+        }
+        Ok(())
     }
 
     /// `shrink` as a table (empty when not given; validated settings have one).
@@ -357,7 +522,8 @@ impl Growth {
                 return ck.inv(
                     &key,
                     format!(
-                        "rows are [T (K), along, across] or [T, along, across, through], all of                          one length; this one has {} numbers, the first {width}",
+                        "rows are [T (K), along, across] or [T, along, across, through], all of \
+                         one length; this one has {} numbers, the first {width}",
                         r.len()
                     ),
                 );
@@ -367,7 +533,8 @@ impl Growth {
                 return ck.inv(
                     &key,
                     format!(
-                        "shrink strains are fractions in (−1, 1) (a length cannot vanish), got                          {}",
+                        "shrink strains are fractions in (−1, 1) (a length cannot vanish), got \
+                         {}",
                         crate::math::human(*v)
                     ),
                 );
@@ -376,7 +543,8 @@ impl Growth {
                 return ck.inv(
                     &key,
                     format!(
-                        "the table is not monotone in temperature: {} K after {} K (temperatures                          must increase strictly)",
+                        "the table is not monotone in temperature: {} K after {} K (temperatures \
+                         must increase strictly)",
                         crate::math::human(r[0]),
                         crate::math::human(rows[i - 1][0])
                     ),
@@ -392,7 +560,8 @@ impl Growth {
                     return ck.inv(
                         &format!("growth.shrink[{i}]"),
                         format!(
-                            "the {} shrink is not monotone in temperature: it turns at {} K                              (the shrink set free by heating cannot reverse on further heating)",
+                            "the {} shrink is not monotone in temperature: it turns at {} K \
+                             (the shrink set free by heating cannot reverse on further heating)",
                             names[c - 1],
                             crate::math::human(rows[i - 1][0])
                         ),
@@ -461,6 +630,7 @@ impl Growth {
             );
         }
         g.validate_shrink()?;
+        g.validate_laminate()?;
         super::temperature::absolute("growth.temperature_top", g.temperature_top)?;
         super::temperature::absolute("growth.temperature_bottom", g.temperature_bottom)?;
         match &g.s {

@@ -52,6 +52,60 @@ pub struct Material {
     pub baraff_witkin: BaraffWitkinSettings,
     /// The prism element's density law and thickness mode.
     pub prism: PrismSettings,
+    /// Young's modulus and thickness on regions of faces (a printed strip, a rib), over the
+    /// uniform ones; the mesh's `ref_thicknesses` and `ref_shear_moduli` take precedence.
+    pub regions: Vec<MaterialRegion>,
+}
+
+/// `[[material.regions]]`: Young's modulus and thickness on the faces whose `tri_tags` is one of
+/// `tags` (any, when empty) and whose reference centroid lies in `inside` (when given); each
+/// given value replaces the uniform one there (later regions over earlier ones).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MaterialRegion {
+    /// Tags (default: `[]`).
+    pub tags: Vec<i64>,
+    /// Box (m, default: none).
+    pub inside: Option<super::selection::FixBox>,
+    /// Young's modulus there (Pa).
+    pub young: Option<Real>,
+    /// Thickness there (m).
+    pub thickness: Option<Real>,
+}
+
+impl MaterialRegion {
+    fn validate(&self, i: usize) -> Result<(), Invalid> {
+        let ck = Check;
+        let key = format!("material.regions[{i}]");
+        ck.inside(&key, self.inside.as_ref())?;
+        if self.tags.is_empty() && self.inside.is_none() {
+            return ck.inv(
+                &key,
+                "needs tags or inside (the uniform values cover every face)".into(),
+            );
+        }
+        if self.young.is_none() && self.thickness.is_none() {
+            return ck.inv(&key, "gives neither young nor thickness".into());
+        }
+        for (k, v, max) in [
+            ("young", self.young, MAX_MODULUS),
+            ("thickness", self.thickness, crate::mesh::MAX_COORDINATE),
+        ] {
+            if let Some(v) = v {
+                if !(v.is_finite() && v > 0.0 && v <= max) {
+                    return ck.inv(
+                        &format!("{key}.{k}"),
+                        format!(
+                            "must lie in (0, {}], got {}",
+                            crate::math::human(max),
+                            crate::math::human(v)
+                        ),
+                    );
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The membrane material.
@@ -245,6 +299,7 @@ impl Default for Material {
             gent: Default::default(),
             baraff_witkin: BaraffWitkinSettings::default(),
             prism: PrismSettings::default(),
+            regions: Vec::new(),
         }
     }
 }
@@ -317,6 +372,9 @@ impl Material {
                     crate::math::human(m.poisson)
                 ),
             );
+        }
+        for (i, r) in m.regions.iter().enumerate() {
+            r.validate(i)?;
         }
         self.validate_model(mode)?;
         Ok(())

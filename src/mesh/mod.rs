@@ -6,6 +6,7 @@
 
 pub mod closed;
 pub mod delaunay;
+pub mod film;
 pub mod generate;
 pub mod io;
 pub mod leaf;

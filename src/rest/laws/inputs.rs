@@ -76,6 +76,8 @@ impl GrowthInputs {
                 mu_top: g.mu_top.unwrap_or(0.0),
                 mu_bottom: g.mu_bottom.unwrap_or(0.0),
                 mu_through: g.mu_through.unwrap_or(0.0),
+                print_thickness: g.print_thickness.unwrap_or(0.0),
+                print_modulus_ratio: g.print_modulus_ratio.unwrap_or(1.0),
             },
             which: g.law,
             law: law.clone(),
@@ -115,12 +117,14 @@ type Slot = fn(&mut super::Coefficients) -> &mut Real;
 
 /// The face fields of the per-face coefficients, and which coefficient each sets, in the order
 /// of [`crate::config::growth::GrowthRegion::values`].
-const COEFFICIENT_FIELDS: [(&str, Slot); 5] = [
+const COEFFICIENT_FIELDS: [(&str, Slot); 7] = [
     ("growth_mu", |c| &mut c.mu),
     ("growth_mu_perp", |c| &mut c.mu_perp),
     ("growth_mu_top", |c| &mut c.mu_top),
     ("growth_mu_bottom", |c| &mut c.mu_bottom),
     ("growth_mu_through", |c| &mut c.mu_through),
+    ("growth_print_thickness", |c| &mut c.print_thickness),
+    ("growth_print_modulus_ratio", |c| &mut c.print_modulus_ratio),
 ];
 
 /// Per-face coefficients: `uniform`, replaced on each `growth.regions` entry's faces by the
@@ -159,11 +163,14 @@ fn per_face_coefficients(
     let max = crate::config::limits::MAX_MOISTURE;
     for (name, slot, data) in fields {
         for (f, &v) in data.iter().enumerate() {
-            if !(v.is_finite() && v.abs() <= max) {
+            if !(name.starts_with("growth_print_") || v.is_finite() && v.abs() <= max) {
                 return Err(mesh.invalid(format!(
                     "face field '{name}' at face {f} is {v}: a swelling coefficient must be \
                      finite and within ±{max}"
                 )));
+            }
+            if let Err(e) = crate::config::growth::print_range(name, name, v) {
+                return Err(mesh.invalid(format!("face field '{name}' at face {f}: {}", e.reason)));
             }
             *slot(&mut coef[f]) = v;
         }

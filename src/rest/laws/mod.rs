@@ -39,10 +39,12 @@
 //!   term, opposite sign convention); the projection is the one consistent with the energy.
 //!   `m⁺ = m⁻` leaves a flat sheet flat; a wetter top (`m⁺ > m⁻`, μ > 0) gives `b̄ > 0`: the
 //!   sheet bulges toward the wet side's normal, i.e. curls away from the water.
-//! * **Piecewise-constant bilayer** (van Rees et al. 2017): the top half has metric
-//!   `(1 + μ⁺ m⁺)²(a⁰ + 2z b⁰)`, the bottom half `(1 + μ⁻ m⁻)²(a⁰ + 2z b⁰)`. For a flat
-//!   reference, `ā = (ḡ⁺ + ḡ⁻)/2`, `b̄ = 3(ḡ⁺ − ḡ⁻)/(4h)`: van Rees' equivalence, which with
-//!   equal layers reproduces Timoshenko's κ = 3Δε/(2h).
+//! * **Piecewise-constant bilayer** (van Rees et al. 2017): the top layer has metric
+//!   `(1 + μ⁺ m⁺)²(a⁰ + 2z b⁰)`, the bottom layer `(1 + μ⁻ m⁻)²(a⁰ + 2z b⁰)`. For equal halves
+//!   of one modulus on a flat reference, `ā = (ḡ⁺ + ḡ⁻)/2`, `b̄ = 3(ḡ⁺ − ḡ⁻)/(4h)`: van Rees'
+//!   equivalence, which reproduces Timoshenko's κ = 3Δε/(2h). Unequal layers, thickening
+//!   layers and a printed layer weight the projection by the modulus about the neutral plane
+//!   ([`bilayer`]).
 //! * **Linear differential swelling with a machine direction** `d` (a barycentric vector): with
 //!   `d⊥` its `a⁰`-orthogonal complement, `P = [d d⊥]` and
 //!   `M(z) = diag(1 + μ m(z), 1 + μ⊥ m(z))` in the `(d, d⊥)` basis,
@@ -129,6 +131,10 @@ pub struct Coefficients {
     pub mu_bottom: Real,
     /// μ_n through the thickness: `h̄ = h (1 + μ_n (m⁺ + m⁻)/2)`.
     pub mu_through: Real,
+    /// The bilayer's printed top layer: its thickness (m, 0: none), part of the face's.
+    pub print_thickness: Real,
+    /// The printed layer's Young's modulus over the bottom layer's.
+    pub print_modulus_ratio: Real,
 }
 
 /// The forms `(ā, b̄)` of a moisture law at the reference thickness, with the thickness grown
@@ -383,6 +389,21 @@ pub enum GrowthError {
         /// Moisture on the bottom side.
         bottom: Real,
     },
+    /// A printed layer as thick as the face or thicker.
+    #[error(
+        "growth at face {face}: the printed layer ({print_h} m) must be thinner than the face \
+         ({thickness_h} m), which includes it",
+        print_h = crate::math::human(*.print),
+        thickness_h = crate::math::human(*.thickness)
+    )]
+    Print {
+        /// The face.
+        face: usize,
+        /// The print's thickness (m).
+        print: Real,
+        /// The face's thickness (m).
+        thickness: Real,
+    },
     /// The law's `ā` is not positive definite (or `b̄` or the thickness is not finite).
     #[error(
         "growth at face {face}: growth.law {law:?} makes abar non-positive-definite (moisture \
@@ -429,7 +450,7 @@ pub(crate) fn check_stretch(
 }
 
 /// Gauss–Legendre nodes and weights on [−1, 1] (3 points, exact to degree 5).
-const GAUSS3: [(Real, Real); 3] = [
+pub(crate) const GAUSS3: [(Real, Real); 3] = [
     (-0.774_596_669_241_483_4, 5.0 / 9.0),
     (0.0, 8.0 / 9.0),
     (0.774_596_669_241_483_4, 5.0 / 9.0),
