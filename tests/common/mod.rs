@@ -202,3 +202,24 @@ pub fn run_settings(
     std::fs::write(dir.join(&file), settings).unwrap();
     converged_frames(dir, &file, mesh, name, &[])
 }
+
+/// Writes `dir/name`: `shellsim mesh rectangle` `lx` × `ly` (m) with edges `edge`, centred on the
+/// origin, with the further arguments `extra`.
+#[allow(dead_code)] // not every test crate meshes rectangles
+pub fn rectangle(dir: &Path, lx: f64, ly: f64, edge: f64, extra: &[&str], name: &str) {
+    let (lx, ly, edge) = (lx.to_string(), ly.to_string(), edge.to_string());
+    let mut args = vec![
+        "mesh",
+        "rectangle",
+        "--lx",
+        &lx,
+        "--ly",
+        &ly,
+        "--edge",
+        &edge,
+        "-o",
+        name,
+    ];
+    args.extend_from_slice(extra);
+    shellsim(&args, dir);
+}
