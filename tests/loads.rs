@@ -4,7 +4,7 @@
 //! closed form, and the bad-input errors of the loads, clamps and materials.
 
 mod common;
-use common::shellsim;
+use common::{rectangle, shellsim};
 use std::path::Path;
 use std::process::Command;
 
@@ -22,24 +22,6 @@ fn final_positions(dir: &Path, out: &str) -> Vec<[f64; 3]> {
     let s = summary(dir, out);
     assert_eq!(s["converged"], true, "{s}");
     read_positions(&dir.join(out).join(s["final_frame"].as_str().unwrap()))
-}
-
-fn rectangle(dir: &Path, lx: f64, ly: f64, edge: f64, extra: &[&str], name: &str) {
-    let (lx, ly, edge) = (lx.to_string(), ly.to_string(), edge.to_string());
-    let mut args = vec![
-        "mesh",
-        "rectangle",
-        "--lx",
-        &lx,
-        "--ly",
-        &ly,
-        "--edge",
-        &edge,
-        "-o",
-        name,
-    ];
-    args.extend_from_slice(extra);
-    shellsim(&args, dir);
 }
 
 /// A cantilever strip 1 m × 0.1 m, h = 1 cm, ν = 0, E = 10 GPa, clamped at x = −0.5, with a

@@ -4,7 +4,7 @@
 //! and the bad inputs of supports.
 
 mod common;
-use common::{cylinder_patch, graded_cylinder_patch, run_status, shellsim};
+use common::{cylinder_patch, graded_cylinder_patch, rectangle, run_status, shellsim};
 use shellsim::mesh::io::read_mesh;
 use shellsim::mesh::Mesh;
 use std::path::Path;
@@ -26,27 +26,6 @@ fn solved(dir: &Path, m: &str) -> (serde_json::Value, Mesh, Mesh) {
     let mesh = read_mesh(&dir.join(format!("{m}.vtk"))).unwrap();
     let frame = read_mesh(&dir.join(m).join(s["final_frame"].as_str().unwrap())).unwrap();
     (s, mesh, frame)
-}
-
-fn rectangle(dir: &Path, lx: f64, ly: f64, edge: f64, jitter: &str, name: &str) {
-    let (lx, ly, edge) = (lx.to_string(), ly.to_string(), edge.to_string());
-    shellsim(
-        &[
-            "mesh",
-            "rectangle",
-            "--lx",
-            &lx,
-            "--ly",
-            &ly,
-            "--edge",
-            &edge,
-            "--jitter",
-            jitter,
-            "-o",
-            name,
-        ],
-        dir,
-    );
 }
 
 /// The reaction of support `name` in a summary: (force, moment).
@@ -81,7 +60,7 @@ fn uniaxial_stretch(e: f64, p: f64) -> f64 {
 fn rollers_let_a_pulled_sheet_contract_exactly() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    rectangle(dir, 1.0, 1.0, 0.1, "0.25", "sq.vtk");
+    rectangle(dir, 1.0, 1.0, 0.1, &["--jitter", "0.25"], "sq.vtk");
     let (e, nu, h, t) = (1e6, 0.3, 0.01, 500.0);
     std::fs::write(
         dir.join("r.toml"),
@@ -151,7 +130,7 @@ fn rollers_let_a_pulled_sheet_contract_exactly() {
 fn a_partial_path_stretches_and_reports_its_force() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    rectangle(dir, 1.0, 1.0, 0.1, "0.25", "sq.vtk");
+    rectangle(dir, 1.0, 1.0, 0.1, &["--jitter", "0.25"], "sq.vtk");
     let (e, nu, h, delta) = (1e6, 0.3, 0.01, 0.02);
     std::fs::write(
         dir.join("p.toml"),
@@ -202,7 +181,7 @@ fn a_partial_path_stretches_and_reports_its_force() {
 fn a_clamp_reaction_balances_the_weight_and_the_load() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    rectangle(dir, 1.0, 0.1, 0.025, "0", "c.vtk");
+    rectangle(dir, 1.0, 0.1, 0.025, &[], "c.vtk");
     let (e, h, rho, g, p) = (1e7, 0.01, 100.0, 9.81, 0.05);
     std::fs::write(
         dir.join("c.toml"),
@@ -592,7 +571,7 @@ fn the_pinched_hemisphere_quarter_matches_the_reference() {
 fn bad_symmetry_planes_are_refused() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    rectangle(dir, 1.0, 0.5, 0.1, "0", "r.vtk");
+    rectangle(dir, 1.0, 0.5, 0.1, &[], "r.vtk");
     let cases: [(&str, &[&str]); 7] = [
         (
             "[[constraints.symmetry]]\naxis = \"x\"\nat = 0.123\n",
@@ -636,7 +615,7 @@ fn bad_symmetry_planes_are_refused() {
 fn bad_supports_are_refused() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    rectangle(dir, 1.0, 0.5, 0.1, "0", "r.vtk");
+    rectangle(dir, 1.0, 0.5, 0.1, &[], "r.vtk");
     let cases: [(&str, &[&str]); 7] = [
         (
             "[[constraints.support]]\ncomponents = [\"x\"]\ninside = { min = [5, 5, 5], max = [6, 6, 6] }\n",
