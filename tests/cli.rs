@@ -2158,6 +2158,23 @@ fn every_registered_model_and_law_restarts_exactly() {
         p,
     );
     assert_eq!(r.code, 0, "{}", r.stderr);
+    // A law that relaxes toward a stored shape reads it from `original_positions`: here a
+    // copy of the mesh raised by 1 mm (its forms equal the mesh's; other laws ignore the field).
+    let mut m = shellsim::mesh::io::read_mesh(&p.join("m.vtk")).unwrap();
+    let stored: Vec<f64> = m
+        .positions
+        .iter()
+        .flat_map(|x| [x.x, x.y, x.z + 1e-3])
+        .collect();
+    m.vertex_fields.insert(
+        "original_positions".into(),
+        shellsim::mesh::Field {
+            data: stored,
+            components: 3,
+        },
+    );
+    shellsim::mesh::io::write_mesh(&p.join("m.vtk"), &m, shellsim::mesh::io::Format::Vtk, "m")
+        .unwrap();
     let mut cases: Vec<(String, String)> = Vec::new();
     for m in MATERIALS {
         for (_, bend) in BENDINGS {

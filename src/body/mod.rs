@@ -558,14 +558,66 @@ fn rest_forms(
         rest.bbar1.clone_from(&b0);
         rest.bbar0 = b0;
     }
+    let relaxed = stored_forms(mesh, topo, settings, edge_normal)?;
     let (growth, grown_thickness) =
-        crate::rest::laws::targets(&mut rest, mesh, settings, thickness)?;
+        crate::rest::laws::targets(&mut rest, mesh, settings, thickness, relaxed)?;
     Ok(RestStage {
         rest,
         edge_sign,
         growth,
         grown_thickness,
     })
+}
+
+/// The forms `(â, b̂)` of the shape stored in the vertex field `original_positions`, in the
+/// bending model's own terms, for a growth law that relaxes toward them
+/// ([`crate::rest::laws::RestLaw::needs_stored_state`]); empty for other laws. Errors name the
+/// field, a non-finite vertex or a degenerate face.
+fn stored_forms(
+    mesh: &Mesh,
+    topo: &Topology,
+    settings: &Settings,
+    edge_normal: &[Option<crate::geometry::EdgeNormal>],
+) -> Result<Vec<(Sym2, Sym2)>, MeshError> {
+    let law = crate::rest::laws::law(&settings.growth.model());
+    if !law.is_some_and(|l| l.needs_stored_state()) {
+        return Ok(Vec::new());
+    }
+    let field = mesh.vertex_field("original_positions", 3)?.ok_or_else(|| {
+        mesh.invalid(format!(
+            "growth.law = \"{}\" needs its stored state: the vertex field \
+             'original_positions' (3 components), the sheet's shape before it was creased, \
+             with the mesh's connectivity",
+            settings.growth.law.name()
+        ))
+    })?;
+    let mut original = mesh.clone();
+    for (v, p) in original.positions.iter_mut().enumerate() {
+        let x = field.get(v);
+        if !x
+            .iter()
+            .all(|c| c.is_finite() && c.abs() <= crate::mesh::MAX_COORDINATE)
+        {
+            return Err(mesh.invalid(format!(
+                "vertex field 'original_positions' at vertex {v} is {x:?}: it must be finite \
+                 coordinates"
+            )));
+        }
+        *p = Vec3::new(x[0], x[1], x[2]);
+    }
+    let (a, mut b) = crate::rest::mesh_forms(&original.positions, &original, topo);
+    if let Some(variant) = settings.material.bending.angle_variant() {
+        b = midedge_angle_reference_b(&original, topo, variant, edge_normal);
+    }
+    if let Some(f) = a
+        .iter()
+        .position(|a| !(a[0] > 0.0 && crate::math::sym_det(a) > 0.0))
+    {
+        return Err(mesh.invalid(format!(
+            "vertex field 'original_positions': face {f} is degenerate in the stored shape"
+        )));
+    }
+    Ok(a.into_iter().zip(b).collect())
 }
 
 /// Lumped mass per vertex: Σ ρ h A / 3 over its faces, reference areas (kg).

@@ -31,11 +31,15 @@ pub enum GrowthLaw {
     /// Irreversible shrink set by the highest temperature reached, from the table `shrink`,
     /// along and across the machine direction and through the thickness.
     ThermalShrink,
+    /// Crease relaxation: rest forms blended from the mesh's creased state toward the stored
+    /// original shape (vertex field `original_positions`) as the moisture rises through
+    /// `relax_moisture`.
+    CreaseRelaxation,
 }
 
 impl GrowthLaw {
     /// Every law, `"none"` first (the registry in `rest::laws` has an entry for each other one).
-    pub const ALL: [GrowthLaw; 8] = [
+    pub const ALL: [GrowthLaw; 9] = [
         GrowthLaw::None,
         GrowthLaw::Isotropic,
         GrowthLaw::IsotropicInPlane,
@@ -44,6 +48,7 @@ impl GrowthLaw {
         GrowthLaw::Bilayer,
         GrowthLaw::MachineDirection,
         GrowthLaw::ThermalShrink,
+        GrowthLaw::CreaseRelaxation,
     ];
 
     /// The law's settings value, as in the settings file.
@@ -57,6 +62,7 @@ impl GrowthLaw {
             GrowthLaw::Bilayer => "bilayer",
             GrowthLaw::MachineDirection => "machine_direction",
             GrowthLaw::ThermalShrink => "thermal_shrink",
+            GrowthLaw::CreaseRelaxation => "crease_relaxation",
         }
     }
 
@@ -67,6 +73,7 @@ impl GrowthLaw {
             GrowthLaw::Bilayer => &["mu_top", "mu_bottom"],
             GrowthLaw::MachineDirection => &["mu", "mu_perp"],
             GrowthLaw::ThermalShrink => &["shrink"],
+            GrowthLaw::CreaseRelaxation => &["relax_moisture"],
             _ => &[],
         }
     }
@@ -105,6 +112,11 @@ pub enum GrowthModel {
         mu: Real,
         /// Coefficient across it (per unit moisture).
         mu_perp: Real,
+    },
+    /// Crease relaxation with moisture.
+    CreaseRelaxation {
+        /// The mean moisture where the creases start to relax and where they are fully relaxed.
+        relax: [Real; 2],
     },
     /// Irreversible thermal shrink.
     ThermalShrink {
@@ -276,6 +288,7 @@ impl GrowthModel {
             GrowthModel::Bilayer { .. } => GrowthLaw::Bilayer,
             GrowthModel::MachineDirection { .. } => GrowthLaw::MachineDirection,
             GrowthModel::ThermalShrink { .. } => GrowthLaw::ThermalShrink,
+            GrowthModel::CreaseRelaxation { .. } => GrowthLaw::CreaseRelaxation,
         }
     }
 }
@@ -315,6 +328,10 @@ pub struct Growth {
     pub print_thickness: Option<Real>,
     /// Bilayer: Young's modulus of the printed layer over the bottom layer's (default `1`).
     pub print_modulus_ratio: Option<Real>,
+    /// Crease relaxation (required by `"crease_relaxation"`): the mean moisture `[m₀, m₁]`
+    /// (m₀ < m₁) over which the rest forms go from the mesh's creased state to the stored
+    /// original one, linearly.
+    pub relax_moisture: Option<[Real; 2]>,
     /// Coefficients on regions of faces (veins, a printed layer), over the uniform ones; the
     /// face fields `growth_mu`, `growth_mu_perp`, `growth_mu_top`, `growth_mu_bottom` and
     /// `growth_mu_through` take precedence over both.
@@ -353,6 +370,7 @@ impl Default for Growth {
             isotropic_layers: None,
             print_thickness: None,
             print_modulus_ratio: None,
+            relax_moisture: None,
             regions: Vec::new(),
             moisture_top: 0.0,
             moisture_bottom: 0.0,
@@ -387,6 +405,9 @@ impl Growth {
             },
             GrowthLaw::ThermalShrink => GrowthModel::ThermalShrink {
                 table: self.shrink_table(),
+            },
+            GrowthLaw::CreaseRelaxation => GrowthModel::CreaseRelaxation {
+                relax: self.relax_moisture.unwrap_or([0.0, 1.0]),
             },
         }
     }
@@ -480,6 +501,47 @@ impl Growth {
             );
         }
         Ok(())
+    }
+
+    /// Checks `relax_moisture`: given exactly with `"crease_relaxation"`, two finite moistures
+    /// within ±`MAX_MOISTURE`, the first below the second.
+    fn validate_relax(&self) -> Result<(), Invalid> {
+        let ck = Check;
+        let key = "growth.relax_moisture";
+        match (self.law, self.relax_moisture) {
+            (GrowthLaw::CreaseRelaxation, None) => ck.inv(
+                key,
+                "growth.law = \"crease_relaxation\" needs relax_moisture = [m0, m1]: the mean \
+                 moisture where the creases start to relax and where they are fully relaxed"
+                    .into(),
+            ),
+            (GrowthLaw::CreaseRelaxation, Some([m0, m1])) => {
+                if !(m0.is_finite()
+                    && m1.is_finite()
+                    && m0.abs() <= MAX_MOISTURE
+                    && m1.abs() <= MAX_MOISTURE
+                    && m0 < m1)
+                {
+                    return ck.inv(
+                        key,
+                        format!(
+                            "needs finite moistures m0 < m1, got [{}, {}]",
+                            crate::math::human(m0),
+                            crate::math::human(m1)
+                        ),
+                    );
+                }
+                Ok(())
+            }
+            (_, Some(_)) => ck.inv(
+                key,
+                format!(
+                    "belongs to growth.law = \"crease_relaxation\", not \"{}\"",
+                    self.law.name()
+                ),
+            ),
+            _ => Ok(()),
+        }
     }
 
     /// `shrink` as a table (empty when not given; validated settings have one).
@@ -631,6 +693,7 @@ impl Growth {
         }
         g.validate_shrink()?;
         g.validate_laminate()?;
+        g.validate_relax()?;
         super::temperature::absolute("growth.temperature_top", g.temperature_top)?;
         super::temperature::absolute("growth.temperature_bottom", g.temperature_bottom)?;
         match &g.s {

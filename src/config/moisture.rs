@@ -305,13 +305,16 @@ impl Moisture {
             }
             if !matches!(
                 g.law,
-                GrowthLaw::LinearSwelling | GrowthLaw::Bilayer | GrowthLaw::MachineDirection
+                GrowthLaw::LinearSwelling
+                    | GrowthLaw::Bilayer
+                    | GrowthLaw::MachineDirection
+                    | GrowthLaw::CreaseRelaxation
             ) {
                 return ck.inv(
                     "moisture.enabled",
                     format!(
                         "moisture drives the rest forms through a swelling law; growth.law is \
-                         {:?} (use linear_swelling, bilayer or machine_direction)",
+                         {:?} (use linear_swelling, bilayer, machine_direction or crease_relaxation)",
                         g.law
                     ),
                 );

@@ -182,7 +182,7 @@ pub struct Mesh {
 pub const MAX_COORDINATE: Real = 1e30;
 
 /// The per-face fields shellsim reads from a mesh (docs/files.md describes each).
-pub const INPUT_FACE_FIELDS: [&str; 18] = [
+pub const INPUT_FACE_FIELDS: [&str; 20] = [
     "abar_info",
     "bbar_info",
     "ref_thicknesses",
@@ -198,13 +198,16 @@ pub const INPUT_FACE_FIELDS: [&str; 18] = [
     "growth_mu_top",
     "growth_mu_bottom",
     "growth_mu_through",
+    "growth_print_thickness",
+    "growth_print_modulus_ratio",
     "diffusivity_along",
     "diffusivity_across",
     "diffusivity_through",
 ];
 
 /// The per-vertex fields shellsim reads from a mesh.
-pub const INPUT_VERTEX_FIELDS: [&str; 2] = ["constraint_indicators", "node_tags"];
+pub const INPUT_VERTEX_FIELDS: [&str; 3] =
+    ["constraint_indicators", "node_tags", "original_positions"];
 
 /// The fields of shellsim's own frames that are not input fields, per face and per vertex: a
 /// frame read as a mesh carries them, and they are ignored without a word.

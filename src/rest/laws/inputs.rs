@@ -40,6 +40,9 @@ pub struct GrowthInputs {
     pub coef: Vec<super::Coefficients>,
     /// The uniform coefficients of `[growth]`.
     pub uniform: super::Coefficients,
+    /// Per face, the stored original forms `(â, b̂)` of a law that relaxes toward them (from the
+    /// vertex field `original_positions`), else empty.
+    pub relaxed: Vec<(crate::math::Sym2, crate::math::Sym2)>,
     /// `growth.law`.
     pub which: crate::settings::GrowthLaw,
     /// The growth law with its coefficients (`None`: no growth law).
@@ -81,6 +84,7 @@ impl GrowthInputs {
             },
             which: g.law,
             law: law.clone(),
+            relaxed: Vec::new(),
         };
         out.coef = per_face_coefficients(mesh, settings, out.uniform)?;
         if law.as_ref().is_some_and(|l| l.needs_direction())

@@ -72,6 +72,7 @@
 //! (seed 000 uses percent; shellsim uses fractions), `μ` per unit moisture.
 
 pub mod bilayer;
+pub mod crease_relaxation;
 pub mod inputs;
 pub mod isotropic;
 pub mod isotropic_in_plane;
@@ -115,6 +116,9 @@ pub struct FaceInput {
     pub heat: [Real; 6],
     /// The face's swelling coefficients.
     pub coef: Coefficients,
+    /// The stored original forms `(â, b̂)` of a law that relaxes toward them
+    /// ([`crease_relaxation`]), else `None`.
+    pub relaxed: Option<(Sym2, Sym2)>,
 }
 
 /// The swelling coefficients of one face (per unit moisture): the uniform `[growth]` ones, or a
@@ -190,6 +194,11 @@ impl Grown {
 pub trait RestLaw: Send + Sync + std::fmt::Debug {
     /// The grown forms of one face. Errors name the face.
     fn grow(&self, input: &FaceInput) -> Result<Grown, GrowthError>;
+    /// True when the law reads a stored original state (the vertex field
+    /// `original_positions`, [`GrowthInputs::relaxed`]).
+    fn needs_stored_state(&self) -> bool {
+        false
+    }
     /// True when the law reads the machine direction.
     fn needs_direction(&self) -> bool {
         false
@@ -223,6 +232,7 @@ pub const LAWS: &[LawEntry] = &[
     bilayer::ENTRY,
     machine_direction::ENTRY,
     thermal_shrink::ENTRY,
+    crease_relaxation::ENTRY,
 ];
 
 /// The law of `model` with its coefficients (`None` for `"none"`).
@@ -297,7 +307,8 @@ pub fn target_law(which: TargetForms) -> Option<&'static dyn TargetLaw> {
 
 /// The forms at dial 1: `rest`'s dial-0 forms replaced by the target law's, then transformed by
 /// the growth law face by face (at the reference thickness `thickness` and, with `[moisture]`,
-/// its initial moisture on both sides). Returns the growth inputs (the moisture driver grows
+/// its initial moisture on both sides), with the stored original forms `relaxed` of a law that
+/// needs them ([`RestLaw::needs_stored_state`], else empty). Returns the growth inputs (the moisture driver grows
 /// from them again each step) and, per face, the rest thickness over the reference one when
 /// the law scales it (else empty).
 pub fn targets(
@@ -305,6 +316,7 @@ pub fn targets(
     mesh: &Mesh,
     settings: &Settings,
     thickness: &[Real],
+    relaxed: Vec<(Sym2, Sym2)>,
 ) -> Result<(GrowthInputs, Vec<Real>), MeshError> {
     if let Some(law) = target_law(settings.rest.target) {
         let t = law.targets(mesh, &settings.rest)?;
@@ -313,7 +325,8 @@ pub fn targets(
         rest.lce = t.lce;
     }
     rest.order = settings.dial.order;
-    let growth = GrowthInputs::read(mesh, settings)?;
+    let mut growth = GrowthInputs::read(mesh, settings)?;
+    growth.relaxed = relaxed;
     let mut grown_thickness = Vec::new();
     if settings.growth.law != GrowthLaw::None {
         for (f, &h) in thickness.iter().enumerate() {
@@ -364,6 +377,7 @@ pub fn growth_face(
         direction: inputs.direction.get(f).map_or([1.0, 0.0], |d| d.0),
         heat,
         coef: inputs.coef.get(f).copied().unwrap_or(inputs.uniform),
+        relaxed: inputs.relaxed.get(f).copied(),
     };
     grow_face(inputs.law.as_deref(), inputs.which, &input)
 }

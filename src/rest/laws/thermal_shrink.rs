@@ -101,6 +101,7 @@ mod tests {
             direction,
             heat,
             coef: Default::default(),
+            relaxed: None,
         }
     }
 
