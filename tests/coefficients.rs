@@ -169,11 +169,7 @@ fn softening_scales_a_cantilevers_sag_as_its_modulus() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     rectangle(d, 0.1, 0.005);
-    let head = "[material]\nyoung = 1e9\npoisson = 0.3\nthickness = 1e-3\ndensity = 1000\n\
-                [solver]\nmode = \"dynamic\"\n[time]\ndt = 0.01\ndt_max = 0.5\nend = 40\n\
-                output_interval = 40\ndamping = 0.05\nstop_at_equilibrium = true\n\
-                [loads]\ngravity = [0, 0, -9.81]\n[constraints]\n\
-                fix_boxes = [{ min = [-1, -1, -1], max = [-0.0449, 1, 1] }]\n";
+    let head = common::SAGGING_CANTILEVER;
     let sag = |name: &str, extra: &str| -> Real {
         let frames = run(d, name, &format!("{head}{extra}"), "s.vtk");
         let last = frames.last().unwrap();

@@ -147,11 +147,7 @@ fn material_regions_set_the_modulus_and_thickness_of_their_faces() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     rectangle(d, 0.1, 0.01, 0.005, &[], "strip.vtk");
-    let head = "[material]\nyoung = 1e9\npoisson = 0.3\nthickness = 1e-3\ndensity = 1000\n\
-                [solver]\nmode = \"dynamic\"\n[time]\ndt = 0.01\ndt_max = 0.5\nend = 40\n\
-                output_interval = 40\ndamping = 0.05\nstop_at_equilibrium = true\n\
-                [loads]\ngravity = [0, 0, -9.81]\n[constraints]\n\
-                fix_boxes = [{ min = [-1, -1, -1], max = [-0.0449, 1, 1] }]\n";
+    let head = common::SAGGING_CANTILEVER;
     let all = "inside = { min = [-1, -1, -1], max = [1, 1, 1] }";
     let sag = |name: &str, extra: &str| -> Real {
         std::fs::write(d.join(format!("{name}.toml")), format!("{head}{extra}")).unwrap();

@@ -190,13 +190,11 @@ impl GrowthRegion {
 
     fn validate(&self, i: usize) -> Result<(), Invalid> {
         let ck = Check;
-        ck.inside(&format!("growth.regions[{i}]"), self.inside.as_ref())?;
-        if self.tags.is_empty() && self.inside.is_none() {
-            return ck.inv(
-                &format!("growth.regions[{i}]"),
-                "needs tags or inside (the uniform coefficients cover every face)".into(),
-            );
-        }
+        ck.region(
+            &format!("growth.regions[{i}]"),
+            &self.tags,
+            self.inside.as_ref(),
+        )?;
         for (k, v) in self.values().into_iter().filter_map(|(k, v)| Some((k, v?))) {
             print_range(&format!("growth.regions[{i}].{k}"), k, v)?;
             if !k.starts_with("print_") && (!v.is_finite() || v.abs() > MAX_MOISTURE) {
@@ -217,11 +215,10 @@ impl GrowthRegion {
 /// Checks a printed layer's thickness (≥ 0, m) or modulus ratio (in [1e-6, 1e6]) given under
 /// `key` (other coefficients pass).
 pub fn print_range(key: &str, name: &str, v: Real) -> Result<(), Invalid> {
-    let ok = match name {
-        "print_thickness" | "growth_print_thickness" => v.is_finite() && v >= 0.0,
-        "print_modulus_ratio" | "growth_print_modulus_ratio" => {
-            v.is_finite() && (1e-6..=1e6).contains(&v)
-        }
+    // A region's key or a face field's name (`growth_` before it).
+    let ok = match name.trim_start_matches("growth_") {
+        "print_thickness" => v.is_finite() && v >= 0.0,
+        "print_modulus_ratio" => v.is_finite() && (1e-6..=1e6).contains(&v),
         _ => true,
     };
     if ok {

@@ -77,13 +77,7 @@ impl MaterialRegion {
     fn validate(&self, i: usize) -> Result<(), Invalid> {
         let ck = Check;
         let key = format!("material.regions[{i}]");
-        ck.inside(&key, self.inside.as_ref())?;
-        if self.tags.is_empty() && self.inside.is_none() {
-            return ck.inv(
-                &key,
-                "needs tags or inside (the uniform values cover every face)".into(),
-            );
-        }
+        ck.region(&key, &self.tags, self.inside.as_ref())?;
         if self.young.is_none() && self.thickness.is_none() {
             return ck.inv(&key, "gives neither young nor thickness".into());
         }

@@ -144,13 +144,7 @@ pub(crate) fn check_region(
     values: [Option<Real>; 3],
 ) -> Result<(), Invalid> {
     let ck = Check;
-    if tags.is_empty() && inside.is_none() {
-        return ck.inv(
-            key,
-            "needs tags or inside (the uniform values cover every face)".into(),
-        );
-    }
-    ck.inside(key, inside)?;
+    ck.region(key, tags, inside)?;
     for (n, v) in names.iter().zip(values) {
         if let Some(v) = v {
             ck.pos(&format!("{key}.{n}"), v)?;

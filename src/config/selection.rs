@@ -32,6 +32,24 @@ impl Check {
         self.inside(key, sel.inside.as_ref())
     }
 
+    /// A region of faces with its own values (`[[growth.regions]]`, `[[moisture.regions]]`,
+    /// `[[material.regions]]`) selects by `tags` or a box `inside` (the uniform values cover
+    /// every face), and the box must be finite with min ≤ max.
+    pub(crate) fn region(
+        &self,
+        key: &str,
+        tags: &[i64],
+        inside: Option<&FixBox>,
+    ) -> Result<(), Invalid> {
+        if tags.is_empty() && inside.is_none() {
+            return self.inv(
+                key,
+                "needs tags or inside (the uniform values cover every face)".into(),
+            );
+        }
+        self.inside(key, inside)
+    }
+
     /// A box `inside` (when given) must be finite with min ≤ max; the error is at `key.inside`.
     pub(crate) fn inside(&self, key: &str, inside: Option<&FixBox>) -> Result<(), Invalid> {
         if let Some(b) = inside {

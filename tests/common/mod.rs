@@ -223,3 +223,14 @@ pub fn rectangle(dir: &Path, lx: f64, ly: f64, edge: f64, extra: &[&str], name: 
     args.extend_from_slice(extra);
     shellsim(&args, dir);
 }
+
+/// Settings of a 10 × 1 cm strip (`rectangle(dir, 0.1, 0.01, 0.005, ..)`) clamped by its first
+/// two rows of vertices (x < −0.0449), sagging under gravity to rest: E = 1 GPa, ν = 0.3,
+/// h = 1 mm, ρ = 1000 kg/m³, damped dynamics stopped at equilibrium. Small deflections, linear in
+/// weight / (E h³).
+#[allow(dead_code)] // not every test crate sags a cantilever
+pub const SAGGING_CANTILEVER: &str = "[material]\nyoung = 1e9\npoisson = 0.3\nthickness = 1e-3\n\
+    density = 1000\n[solver]\nmode = \"dynamic\"\n[time]\ndt = 0.01\ndt_max = 0.5\nend = 40\n\
+    output_interval = 40\ndamping = 0.05\nstop_at_equilibrium = true\n\
+    [loads]\ngravity = [0, 0, -9.81]\n[constraints]\n\
+    fix_boxes = [{ min = [-1, -1, -1], max = [-0.0449, 1, 1] }]\n";
