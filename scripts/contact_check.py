@@ -118,11 +118,17 @@ def segment_segment(a, b, c, d):
 
 
 def segment_crosses(p, q, a, b, c):
-    """Whether segments p-q cross triangles a-b-c (proper crossings, Möller–Trumbore)."""
+    """Whether segments p-q cross triangles a-b-c (proper crossings, Möller–Trumbore).
+
+    A segment within round-off of parallel to the triangle's plane (|det| at most 1e-12 of
+    |e1| |e2| |d|, an angle below 1e-12 rad) is not counted: its u, v, t are round-off over
+    round-off, and faces of one flat sheet would "cross" each other. A segment lying in an
+    overlapping face is at distance 0 from it, which the distance check reports."""
     e1, e2, d = b - a, c - a, q - p
     h = np.cross(d, e2)
     det = np.einsum("ij,ij->i", e1, h)
-    ok = np.abs(det) > 1e-300
+    scale = np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1) * np.linalg.norm(d, axis=1)
+    ok = np.abs(det) > 1e-12 * scale
     f = 1 / np.where(ok, det, 1)
     s = p - a
     u = f * np.einsum("ij,ij->i", s, h)
