@@ -212,6 +212,11 @@ enum Shape {
     /// Open: a plastic spoon of total length --size, an elliptical bowl 0.28 × size long and
     /// 0.044 × size deep and a curved, tapering handle (tri_tags 1 bowl, 2 handle); Delaunay.
     Spoon,
+    /// Open at both ends: a straw's paper wrapper of radius --radius and length --lx, flattened
+    /// and pushed into an accordion of --folds half turns, --bunching times shorter; the vertex
+    /// field original_positions holds the straight tube (for growth.law = "crease_relaxation").
+    /// Needs --thickness: no fold is tighter than it.
+    Wrapper,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug)]
@@ -281,6 +286,12 @@ pub(crate) struct MeshArgs {
     /// Film: distance between neighbouring strips' centre lines (m; default --ly / 5).
     #[arg(long)]
     strip_pitch: Option<Real>,
+    /// Wrapper: the accordion's number of half turns.
+    #[arg(long)]
+    folds: Option<usize>,
+    /// Wrapper: the tube's length over the accordion's.
+    #[arg(long)]
+    bunching: Option<Real>,
     /// Per-face thickness written as ref_thicknesses (m); a leaf's secondary veins get 2× and its
     /// midrib 3× it.
     #[arg(long)]
@@ -959,6 +970,9 @@ pub(crate) fn build_mesh(a: &MeshArgs, max_faces: Real) -> Result<crate::mesh::M
     if film_flags && !matches!(a.shape, Shape::Film) {
         bail!("--strip-angle, --strip-width and --strip-pitch describe a film's strips");
     }
+    if (a.folds.is_some() || a.bunching.is_some()) && !matches!(a.shape, Shape::Wrapper) {
+        bail!("--folds and --bunching describe a wrapper's accordion");
+    }
     let mut mesh = match a.shape {
         Shape::Square | Shape::Rectangle => {
             let (lx, ly) = match a.shape {
@@ -1104,6 +1118,28 @@ pub(crate) fn build_mesh(a: &MeshArgs, max_faces: Real) -> Result<crate::mesh::M
             }
             crate::mesh::leaf::leaf(a.size, a.edge, a.thickness, sp)
         }
+        Shape::Wrapper => {
+            pos("radius", a.radius)?;
+            pos("lx", a.lx)?;
+            let h = a.thickness.ok_or_else(|| {
+                anyhow!("a wrapper needs --thickness: none of its folds may be tighter than it")
+            })?;
+            pos("thickness", h)?;
+            let w = crate::mesh::wrapper::Wrapper {
+                radius: a.radius,
+                length: a.lx,
+                folds: a.folds.unwrap_or(8),
+                bunching: a.bunching.unwrap_or(8.0),
+            };
+            w.check(h).map_err(|e| anyhow!(e))?;
+            check_planned(
+                w.planned_faces(a.edge),
+                "faces",
+                "--edge, --lx, --radius and --folds",
+            )
+            .map_err(|e| anyhow!(e))?;
+            crate::mesh::wrapper::wrapper(w, a.edge, Some(h))
+        }
         Shape::Torus => {
             pos("radius", a.radius)?;
             pos("tube", a.tube)?;
@@ -1131,7 +1167,7 @@ pub(crate) fn build_mesh(a: &MeshArgs, max_faces: Real) -> Result<crate::mesh::M
         })?;
         case.program(&mut mesh);
     }
-    if let (Some(t), false) = (a.thickness, matches!(a.shape, Shape::Leaf)) {
+    if let (Some(t), false) = (a.thickness, matches!(a.shape, Shape::Leaf | Shape::Wrapper)) {
         pos("thickness", t)?;
         mesh.face_fields.insert(
             "ref_thicknesses".into(),

@@ -197,3 +197,82 @@ fn a_crease_law_without_its_stored_state_is_refused() {
         assert!(!d.join("bad").exists(), "{text}: wrote output");
     }
 }
+
+#[test]
+fn a_wrapper_with_folds_tighter_than_its_thickness_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = [
+        "mesh", "wrapper", "--lx", "0.012", "--edge", "4e-4", "-o", "w.vtk",
+    ];
+    for (extra, needle) in [
+        (&["--radius", "0.0025"][..], "--thickness"),
+        (
+            &["--thickness", "1e-4", "--radius", "0.0025"][..],
+            "twice the thickness",
+        ),
+        (
+            &[
+                "--thickness",
+                "5e-5",
+                "--bunching",
+                "1.2",
+                "--radius",
+                "0.0025",
+            ][..],
+            "--bunching",
+        ),
+        (
+            &["--thickness", "5e-5", "--folds", "0", "--radius", "0.0025"][..],
+            "--folds",
+        ),
+        (
+            &[
+                "--thickness",
+                "5e-5",
+                "--strip-angle",
+                "10",
+                "--radius",
+                "0.0025",
+            ][..],
+            "--strip-angle",
+        ),
+        (
+            &[
+                "--thickness",
+                "5e-5",
+                "--folds",
+                "2",
+                "--bunching",
+                "4",
+                "--radius",
+                "1e-4",
+            ][..],
+            "--radius",
+        ),
+    ] {
+        let mut args = base.to_vec();
+        args.extend_from_slice(extra);
+        let (code, _, err) = run_status(&args, d);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(!d.join("w.vtk").exists(), "{args:?}: wrote a mesh");
+    }
+    // The rectangle's flags do not take the wrapper's.
+    let (code, _, err) = run_status(
+        &[
+            "mesh",
+            "rectangle",
+            "--edge",
+            "0.1",
+            "--folds",
+            "3",
+            "-o",
+            "r.vtk",
+        ],
+        d,
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--folds"), "{err}");
+}

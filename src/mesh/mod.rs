@@ -17,6 +17,7 @@ pub mod spoon;
 pub mod surfaces;
 pub mod topology;
 pub mod vtu;
+pub mod wrapper;
 mod xml;
 
 pub use topology::Topology;
