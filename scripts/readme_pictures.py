@@ -46,6 +46,8 @@ SCENES = {
     "paper_walker": (0.4, "moisture_bottom", "-60,15", None),
     "spoon_heated": ("final", "temperature_max_top", "-50,35", None),
     "leaf_drying": ("final", "mean_curvature", "20,25", "-60,60"),
+    "gelatin_tube": ("final", "mean_curvature", "30,25", None),
+    "caterpillar": (0.25, "moisture_top", "-60,25", None),
 }
 
 

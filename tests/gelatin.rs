@@ -1,8 +1,10 @@
 //! Bilayer films, through the binary: unequal layers curl as Timoshenko's bimetal formula says;
 //! a gelatin-like bilayer strip with large, isotropic swelling against an independent
 //! volumetric finite-element computation of the same strip; material regions set the modulus and
-//! thickness of the faces they name; printed films mesh with their strips; and bad layer keys,
-//! regions and films are refused naming the key.
+//! thickness of the faces they name; printed films mesh with their strips; the gelatin film
+//! with printed strips (settings/gelatin_tube.toml) rolls into a closed tube of the radius the
+//! layered-beam closed forms bracket; and bad layer keys, regions and films are refused naming
+//! the key.
 
 mod common;
 
@@ -10,8 +12,19 @@ use common::{converged_frames, rectangle, run_status, shellsim};
 use shellsim::math::{Mat3, Real, Vec3};
 use std::path::Path;
 
+/// The reference y of the row of vertices nearest the centre line y = 0 (on it, for a strip
+/// meshed with one; a film's rows follow its strips).
+fn centre_row(reference: &shellsim::mesh::Mesh) -> Real {
+    reference
+        .positions
+        .iter()
+        .map(|p| p.y)
+        .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+        .unwrap()
+}
+
 /// The curvature of the circle fitted (least squares, in the points' best-fit plane) to the
-/// deformed centre line (reference y = 0) over the middle half of the strip's length, signed
+/// deformed centre line (the row of vertices nearest reference y = 0) over the middle half of the strip's length, signed
 /// positive when the strip bulges toward its top (the normal side), and the fit's largest
 /// residual over the radius.
 fn centre_line_curvature(
@@ -24,10 +37,11 @@ fn centre_line_curvature(
         .map(|p| p.x.abs())
         .fold(0.0, Real::max)
         * 2.0;
+    let row = centre_row(reference);
     let on: Vec<usize> = (0..reference.positions.len())
         .filter(|&v| {
             let p = reference.positions[v];
-            p.y.abs() < 1e-9 && p.x.abs() <= 0.25 * lx + 1e-12
+            (p.y - row).abs() < 1e-9 && p.x.abs() <= 0.25 * lx + 1e-12
         })
         .collect();
     assert!(on.len() >= 5, "{} centre-line points", on.len());
@@ -446,4 +460,99 @@ fn bilayer_strip_against_the_volumetric_fem() {
             "ε = {eps}: kept thickness {kept}"
         );
     }
+}
+
+/// The curvature of a free layered strip (a multilayer bimetal, Timoshenko's analysis): layers
+/// `(thickness, modulus, eigenstrain)` from the bottom up, the strain ε₀ + κz minimising
+/// ∫E (ε₀ + κz − ε*)² dz, κ returned per length of the neutral plane (stretched by its strain
+/// 1 + ε₀ + κ z_n) and its magnitude.
+fn layered_curvature(layers: &[(Real, Real, Real)]) -> Real {
+    let (mut s0, mut s1, mut s2, mut f0, mut f1, mut z) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for &(t, e, strain) in layers {
+        let (a, b) = (z, z + t);
+        s0 += e * t;
+        s1 += e * (b * b - a * a) / 2.0;
+        s2 += e * (b * b * b - a * a * a) / 3.0;
+        f0 += e * strain * t;
+        f1 += e * strain * (b * b - a * a) / 2.0;
+        z = b;
+    }
+    let det = s0 * s2 - s1 * s1;
+    let (e0, k) = ((f0 * s2 - f1 * s1) / det, (s0 * f1 - s1 * f0) / det);
+    let zn = s1 / s0;
+    (k / (1.0 + e0 + k * zn)).abs()
+}
+
+/// settings/gelatin_tube.toml on its mesh (1160 faces, an hour in water): the film rolls along
+/// its printed strips into a closed tube, its ends lying on each other. The tube's curvature is
+/// bracketed by closed forms of its two kinds of bands side by side along the roll, each a
+/// layered strip with its own natural curvature κ_p (the bare bilayer at its grown heights, its
+/// bottom swelling 8%, its top 2%; under a print the 40 µm print, 100× as stiff, on top),
+/// averaged with the bands' bending stiffnesses D_p = E_p h_p³ and widths: κ̄ = Σ w D κ / Σ w D.
+/// Bands free to curl across (a beam) roll to κ̄; bands held straight across (a plate) to
+/// (1 + ν) κ̄. The 2 mm strips are about √(R h) wide, between the two: measured R = 5.20 mm,
+/// 8.9% above the plate's 4.75 mm and below the beam's 6.9 mm.
+#[test]
+fn a_gelatin_film_with_printed_strips_rolls_into_a_closed_tube() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let d = tempfile::tempdir().unwrap();
+    let mesh = root.join("meshes/gelatin_film.vtk");
+    let settings = root.join("settings/gelatin_tube.toml");
+    shellsim(
+        &[
+            settings.to_str().unwrap(),
+            mesh.to_str().unwrap(),
+            "--out",
+            "out",
+            "-q",
+        ],
+        d.path(),
+    );
+    let s = common::summary(&d.path().join("out"));
+    assert_eq!(s["converged"], true, "{s}");
+    let frames = common::finite_frames(&d.path().join("out"), "vtu", "gelatin");
+    let reference = shellsim::mesh::io::read_mesh(&mesh).unwrap();
+    let last = frames.last().unwrap();
+    let (kappa, residual) = centre_line_curvature(&reference, last);
+    let radius = 1.0 / kappa.abs();
+    // The scene's layers (settings/gelatin_tube.toml).
+    let (h, nu, phi, n, et, eb, tp, ep) = (6e-4, 0.45, 0.5, 0.8, 0.02, 0.08, 4e-5, 100.0);
+    let bare = [
+        (h * (1.0 - phi) * (1.0 + eb), 1.0, 0.0),
+        (h * phi * (1.0 + et), n, (1.0 + et) / (1.0 + eb) - 1.0),
+    ];
+    let printed = [bare[0], bare[1], (tp, ep, 1.0 / (1.0 + eb) - 1.0)];
+    let (kg, ks) = (layered_curvature(&bare), layered_curvature(&printed));
+    let (dg, ds) = (4.52e5 * 6e-4_f64.powi(3), 1.614e6 * 6.4e-4_f64.powi(3));
+    let (wg, ws) = (0.6, 0.4);
+    let kbar = (wg * dg * kg + ws * ds * ks) / (wg * dg + ws * ds);
+    let (plate, beam) = (1.0 / ((1.0 + nu) * kbar), 1.0 / kbar);
+    // The length of the film's centre row, rolled, over the tube's circumference.
+    let row = centre_row(&reference);
+    let mut on: Vec<usize> = (0..reference.positions.len())
+        .filter(|&v| (reference.positions[v].y - row).abs() < 1e-9)
+        .collect();
+    on.sort_by(|&a, &b| {
+        reference.positions[a]
+            .x
+            .total_cmp(&reference.positions[b].x)
+    });
+    let length: Real = on
+        .windows(2)
+        .map(|w| (last.positions[w[1]] - last.positions[w[0]]).norm())
+        .sum();
+    let turns = length / (2.0 * std::f64::consts::PI * radius);
+    println!(
+        "gelatin tube: R = {:.4} mm (fit residual {residual:.2e} R), {turns:.3} turns; plate \
+         {:.3} mm, beam {:.3} mm (bare κ {kg:.1}, printed κ {ks:.1} 1/m)",
+        radius * 1e3,
+        plate * 1e3,
+        beam * 1e3
+    );
+    assert!(residual < 0.1, "{residual}");
+    assert!(
+        plate < radius && radius < beam,
+        "{plate} < {radius} < {beam}"
+    );
+    assert!(turns > 1.0, "the tube closes: {turns} turns");
 }

@@ -3,7 +3,8 @@
 //! self-contact (`scripts/elastica_roll.py`); a stack of sheets sinks into its offset by
 //! the penalty's closed form; a sheet dropped onto another lands without crossing it; a sheet
 //! on an inclined sheet slides or sticks by Coulomb's law; random thrusts on a folded sheet
-//! never carry one layer through the other; bad input is named. Frames
+//! never carry one layer through the other; a bunched straw wrapper wetted at one end unfolds
+//! into its tube without crossing itself; bad input is named. Frames
 //! are checked by an independent script (`scripts/contact_check.py`: VTK's readers and a
 //! brute-force numpy search over every pair of faces, none of shellsim's code) for crossing
 //! faces and for the smallest distance between mid-surfaces; the rolled strip without
@@ -1472,4 +1473,117 @@ fn a_wide_paper_ring_soaked_on_top_rolls_up_past_a_full_turn() {
     );
     println!("wide paper ring: {turns:.2} turns");
     assert!(turns > 1.2, "{turns} turns");
+}
+
+/// The tube's length between its end rings in `m` over the tube's length: the distance between
+/// the centroids of the vertices whose stored tube position (`original`, the wrapper mesh's
+/// `original_positions`) lies at x = 0 and at x = L, and the length of the polyline through
+/// the centroids of every ring of constant x.
+fn tube_length(m: &shellsim::mesh::Mesh, original: &[[f64; 3]]) -> (f64, f64) {
+    let length = original.iter().map(|p| p[0]).fold(0.0, f64::max);
+    let mut stations: Vec<f64> = original.iter().map(|p| p[0]).collect();
+    stations.sort_by(f64::total_cmp);
+    stations.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+    let centroids: Vec<shellsim::math::Vec3> = stations
+        .iter()
+        .map(|&x| {
+            let ring: Vec<_> = (0..original.len())
+                .filter(|&v| (original[v][0] - x).abs() < 1e-12)
+                .map(|v| m.positions[v])
+                .collect();
+            ring.iter().sum::<shellsim::math::Vec3>() / ring.len() as f64
+        })
+        .collect();
+    let ends = (centroids[centroids.len() - 1] - centroids[0]).norm();
+    let arc: f64 = centroids.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+    (ends / length, arc / length)
+}
+
+#[test]
+fn a_straw_wrapper_wetted_at_one_end_unbunches_into_its_tube_without_crossing() {
+    // settings/caterpillar.toml on a wrapper 3 mm across and 4 mm long, bunched 8 times into
+    // 2 folds (952 faces): the drop on its first panel wicks along it within a tenth of a
+    // second, and the accordion opens.
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::fs::copy(
+        root.join("settings/caterpillar.toml"),
+        dir.join("scene.toml"),
+    )
+    .unwrap();
+    let h = 5e-5;
+    shellsim(
+        &[
+            "mesh",
+            "wrapper",
+            "--radius",
+            "0.0015",
+            "--lx",
+            "0.004",
+            "--folds",
+            "2",
+            "--bunching",
+            "8",
+            "--thickness",
+            "5e-5",
+            "--edge",
+            "4e-4",
+            "-o",
+            "wrapper.vtk",
+        ],
+        dir,
+    );
+    let reference = shellsim::mesh::io::read_mesh(&dir.join("wrapper.vtk")).unwrap();
+    let field = &reference.vertex_fields["original_positions"];
+    let original: Vec<[f64; 3]> = (0..reference.positions.len())
+        .map(|v| {
+            let p = field.get(v);
+            [p[0], p[1], p[2]]
+        })
+        .collect();
+    let run = |out: &str, sets: &[&str]| {
+        let mut args = vec!["scene.toml", "wrapper.vtk", "--out", out, "-q"];
+        for s in sets {
+            args.extend_from_slice(&["--set", s]);
+        }
+        shellsim(&args, dir);
+        let s = common::summary(&dir.join(out));
+        assert_eq!(s["converged"], true, "{out}: {s}");
+        common::finite_frames(&dir.join(out), "vtu", out)
+    };
+    let drop = ["time.end=0.2", "time.output_interval=0.02"];
+    let frames = run("drop", &drop);
+    let extension: Vec<f64> = frames.iter().map(|m| tube_length(m, &original).0).collect();
+    println!("caterpillar: end to end over the tube's length every 0.02 s: {extension:.4?}");
+    // Bunched 8 times into U-turns: the ends start 2Nρ + (the first and last panels' offset)
+    // apart, a third of the tube; the wetted wrapper reaches its tube within the run.
+    assert!(extension[0] < 0.35, "{extension:?}");
+    assert!(*extension.last().unwrap() > 0.95, "{extension:?}");
+    let pressing = log_rows(&dir.join("drop"))
+        .iter()
+        .map(|r| r["self_contact_pairs"])
+        .fold(0.0, f64::max);
+    assert!(pressing > 0.0, "the unbunching folds press on each other");
+    let r = 2.0 * (h + h / 100.0);
+    let c = check(dir, "wrapper.vtk", "drop", r);
+    println!("caterpillar: {pressing} pairs pressing at most: {c}");
+    assert_eq!(c["crossing_pairs"], 0, "{c}");
+    let dmin = c["min_distance"].as_f64().unwrap();
+    assert!(dmin >= 0.1 * h, "{dmin}");
+    // The control: without self-contact the opening folds pass through each other.
+    let mut off = drop.to_vec();
+    off.push("self_contact.enabled=false");
+    run("off", &off);
+    let c = check(dir, "wrapper.vtk", "off", r);
+    assert!(c["crossing_pairs"].as_u64().unwrap() > 0, "{c}");
+    // Soaked through at once (moisture 0.3 everywhere, past relax_moisture's 0.2): every
+    // crease relaxes fully, and the rest state is the stored tube grown by 1 + μ m = 1.009,
+    // stress-free, so the wrapper recovers that length between its ends and along its axis.
+    let frames = run("wet", &["moisture.initial=0.3", "time.end=0.3"]);
+    let (ends, arc) = tube_length(frames.last().unwrap(), &original);
+    println!("caterpillar soaked: end to end {ends:.6}, along the axis {arc:.6} × the tube");
+    for v in [ends, arc] {
+        assert!((v - 1.009).abs() < 1e-5, "{v}");
+    }
 }
