@@ -116,36 +116,40 @@ impl Wrapper {
         Ok(())
     }
 
+    /// How many pieces of about `edge` each part is cut into, in floating point (planned before
+    /// anything is allocated): a flat sheet (at least 2), a crease (at least 3), a panel (at
+    /// least 2) and a turn (at least 4).
+    fn pieces(&self, edge: Real) -> Pieces {
+        let rho = self.turn_radius();
+        Pieces {
+            flat: (self.flat() / edge).round().max(2.0),
+            crease: (PI * self.half_gap() / edge).ceil().max(3.0),
+            panel: (self.panel() / edge).round().max(2.0),
+            turn: (PI * rho / edge).ceil().max(4.0),
+        }
+    }
+
     /// The cuts of the section by arc length, `(s, Y, Z)`, open at 2πR: bottom sheet, crease,
     /// top sheet, crease. `edge` sets the pieces.
     fn section(&self, edge: Real) -> Vec<(Real, Real, Real)> {
         let (r, l) = (self.half_gap(), self.flat());
-        let nf = ((l / edge).round() as usize).max(2);
-        let nc = ((PI * r / edge).ceil() as usize).max(3);
+        let pieces = self.pieces(edge);
+        let (nf, nc) = (pieces.flat as usize, pieces.crease as usize);
         let mut cuts = Vec::with_capacity(2 * (nf + nc));
         // Counter-clockwise in (Y, Z), as (y, z) = R (cos θ, sin θ) on the tube: from the
-        // bottom sheet's end at Y = −ℓ/2 along +Y, the crease at +Y up, the top sheet back along
-        // −Y, the crease at −Y down.
+        // bottom sheet's end at Y = −ℓ/2 along +Y, the crease at +Y up, then (`side` = −1, the
+        // same cuts mirrored) the top sheet back along −Y and the crease at −Y down.
         let mut s = 0.0;
-        for k in 0..nf {
-            let y = -0.5 * l + l * k as Real / nf as Real;
-            cuts.push((s, y, -r));
-            s += l / nf as Real;
-        }
-        for k in 0..nc {
-            let a = -0.5 * PI + PI * k as Real / nc as Real;
-            cuts.push((s, 0.5 * l + r * a.cos(), r * a.sin()));
-            s += PI * r / nc as Real;
-        }
-        for k in 0..nf {
-            let y = 0.5 * l - l * k as Real / nf as Real;
-            cuts.push((s, y, r));
-            s += l / nf as Real;
-        }
-        for k in 0..nc {
-            let a = 0.5 * PI + PI * k as Real / nc as Real;
-            cuts.push((s, -0.5 * l + r * a.cos(), r * a.sin()));
-            s += PI * r / nc as Real;
+        for side in [1.0, -1.0] {
+            for k in 0..nf {
+                cuts.push((s, side * (-0.5 * l + l * k as Real / nf as Real), -side * r));
+                s += l / nf as Real;
+            }
+            for k in 0..nc {
+                let a = -0.5 * PI * side + PI * k as Real / nc as Real;
+                cuts.push((s, side * 0.5 * l + r * a.cos(), r * a.sin()));
+                s += PI * r / nc as Real;
+            }
         }
         cuts
     }
@@ -153,8 +157,8 @@ impl Wrapper {
     /// The cuts of the centre line by arc length, `(x, c(x), ψ)`, from 0 to L inclusive.
     fn centre_line(&self, edge: Real) -> Vec<(Real, [Real; 2], Real)> {
         let (rho, p) = (self.turn_radius(), self.panel());
-        let np = ((p / edge).round() as usize).max(2);
-        let nt = ((PI * rho / edge).ceil() as usize).max(4);
+        let pieces = self.pieces(edge);
+        let (np, nt) = (pieces.panel as usize, pieces.turn as usize);
         let mut cuts = Vec::new();
         // (x, z) of the centre line and its angle ψ (0 = up along +z).
         let (mut x, mut at, mut psi) = (0.0, [0.0, 0.0], 0.0_f64);
@@ -203,13 +207,20 @@ impl Wrapper {
     /// The number of faces [`wrapper`] makes with pieces of about `edge`, in floating point
     /// (for planning; a wrapper that fails [`Wrapper::check`] gives an estimate).
     pub fn planned_faces(&self, edge: Real) -> Real {
-        let rho = self.turn_radius().max(0.0);
-        let (r, l, p) = (0.5 * rho, self.flat().max(0.0), self.panel().max(0.0));
-        let around = 2.0 * ((l / edge).round().max(2.0) + (PI * r / edge).ceil().max(3.0));
-        let along = (self.folds as Real + 1.0) * (p / edge).round().max(2.0)
-            + self.folds as Real * (PI * rho / edge).ceil().max(4.0);
+        let n = self.pieces(edge);
+        let folds = self.folds as Real;
+        let around = 2.0 * (n.flat + n.crease);
+        let along = (folds + 1.0) * n.panel + folds * n.turn;
         2.0 * around * along
     }
+}
+
+/// The pieces of each part of a wrapper ([`Wrapper::pieces`]).
+struct Pieces {
+    flat: Real,
+    crease: Real,
+    panel: Real,
+    turn: Real,
 }
 
 /// The bunched wrapper `w` with pieces of about `edge` (m) and, when given, `ref_thicknesses`
