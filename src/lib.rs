@@ -61,6 +61,8 @@ pub mod cli;
 #[doc(hidden)]
 pub mod contact;
 #[doc(hidden)]
+pub mod design;
+#[doc(hidden)]
 pub mod diffusion;
 #[doc(hidden)]
 pub mod elements;

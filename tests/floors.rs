@@ -41,6 +41,7 @@ const FLOORS: &[(&str, u32)] = &[
     ("solve", 7),
     // 8: drivers.
     ("integrate", 8),
+    ("design", 8),
     // 9: output and what reads it back.
     ("output", 9),
     ("provenance", 9),

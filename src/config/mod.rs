@@ -28,6 +28,7 @@
 
 pub mod constraints;
 pub mod contact;
+pub mod design;
 pub mod dial;
 pub mod explicit;
 pub mod gas;

@@ -19,6 +19,7 @@
 //! * [`slides`]: MorphoShell's glass slides, fixed or pressed, with stick/slip friction.
 //! * [`stiffening`]: MorphoShell's bend stiffening, `W_b + W_b²/(γ μ t)`.
 //! * [`gas`]: an enclosed gas (amount, pressure or volume control) with its rank-one stiffness.
+//! * [`sensitivity`]: the shell's rest sensitivities `λᵀ ∂g/∂(ā, b̄, h̄)` (inverse design).
 //! * [`projection`]: optional per-element projection of a Hessian to positive semi-definite.
 
 pub mod bending;
@@ -34,6 +35,7 @@ pub mod potential;
 pub use crate::elements::projection;
 pub mod registry;
 pub mod self_contact;
+pub mod sensitivity;
 pub mod shell;
 pub mod slides;
 pub mod stiffening;

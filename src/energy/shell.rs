@@ -368,6 +368,69 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> super::
     fn reports(&self) -> Option<&dyn Reports> {
         Some(self)
     }
+
+    fn rest_sensitivity(&self) -> Option<&dyn super::term::RestSensitivity> {
+        Some(self)
+    }
+}
+
+impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize>
+    super::term::RestSensitivity for Shell<M, B, N, S>
+{
+    /// Per face: `λ` gathered over the stencil (slots 0..6 three DOFs each, edge slots one),
+    /// `δa = Ja λ`, `δb_q = ∇b_qᵀ λ` (the bending model's gradient with `W_b` the unit
+    /// vector `e_q`), then [`super::sensitivity::koiter_rest_adjoint`]. In parallel, in face
+    /// order.
+    fn rest_adjoint(
+        &self,
+        pot: &Potential,
+        x: &[Vec3],
+        phi: &[Real],
+        lambda: &[Real],
+    ) -> Result<Vec<super::sensitivity::RestAdjoint>, String> {
+        use rayon::prelude::*;
+        let pattern = pot.pattern.faces();
+        (0..pot.body.num_faces())
+            .into_par_iter()
+            .map(|f| {
+                let nodes = pattern.element(f);
+                let xs = gather(nodes, x);
+                let face = self.bending.face(pot.body, f, nodes, phi);
+                let rest = self.membrane.rest_face(pot, f)?;
+                let mut l = SVec::<N>::zeros();
+                let mut k = 0;
+                for (s, &u) in nodes.iter().enumerate().take(S) {
+                    let nd = if s < 6 { 3 } else { 1 };
+                    if u != NONE && k + nd <= N {
+                        let (d0, _) = pot.pattern.node_dofs(u);
+                        for c in 0..nd {
+                            l[k + c] = lambda[d0 + c];
+                        }
+                    }
+                    k += nd;
+                }
+                let xf = [xs[0], xs[1], xs[2]];
+                let a = first_fundamental_form(&xf);
+                let da: Sym2 = first_fundamental_form_jacobian(&xf) * l.fixed_rows::<9>(0);
+                let (b, db) = if N > 9 && rest.bending {
+                    let ev = self.bending.eval(&face, &xs, true, false);
+                    let mut db = Sym2::zeros();
+                    for q in 0..3 {
+                        let mut g = SVec::<N>::zeros();
+                        self.bending
+                            .add_gradient(&face, &ev, &Sym2::ith(q, 1.0), &mut g);
+                        db[q] = g.dot(&l);
+                    }
+                    (ev.b, db)
+                } else {
+                    (Sym2::zeros(), Sym2::zeros())
+                };
+                Ok(super::sensitivity::koiter_rest_adjoint(
+                    &rest, &a, &b, &da, &db,
+                ))
+            })
+            .collect()
+    }
 }
 
 impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Reports

@@ -164,6 +164,28 @@ pub trait Term: Send + Sync {
     fn step_limit(&self) -> Option<&dyn StepLimit> {
         None
     }
+
+    /// A term whose energy depends on the faces' rest data (ā, b̄, h̄) declares its rest
+    /// sensitivities here, for inverse design (default: none, an energy that does not read
+    /// them).
+    fn rest_sensitivity(&self) -> Option<&dyn RestSensitivity> {
+        None
+    }
+}
+
+/// The mixed derivatives of a term's gradient with respect to each face's rest data
+/// ([`super::sensitivity`]).
+pub trait RestSensitivity {
+    /// `λᵀ ∂g/∂r_f` for every face `f` at positions `x`, scalar DOFs `phi`, with `λ` in the
+    /// global DOF order; an error names what has no sensitivity (a membrane material other
+    /// than Koiter's, bend stiffening).
+    fn rest_adjoint(
+        &self,
+        pot: &Potential,
+        x: &[Vec3],
+        phi: &[Real],
+        lambda: &[Real],
+    ) -> Result<Vec<super::sensitivity::RestAdjoint>, String>;
 }
 
 /// How far a Newton step may go ([`StepLimit::max_fraction`]).

@@ -16,4 +16,29 @@ impl Membrane for Koiter {
     fn density(&self, pot: &Potential, f: usize) -> KoiterDensity {
         pot.density(f)
     }
+
+    fn rest_face(
+        &self,
+        pot: &Potential,
+        f: usize,
+    ) -> Result<crate::energy::sensitivity::KoiterFace, String> {
+        let body = pot.body;
+        if body.bend_stiffening.is_some() {
+            return Err(
+                "bend stiffening (material.bend_stiffening) has no rest sensitivities".into(),
+            );
+        }
+        if pot.damping.is_some() || pot.frozen.is_some() {
+            return Err("rest sensitivities are taken at a static equilibrium".into());
+        }
+        let (abar, bbar) = pot.rest_forms(f);
+        Ok(crate::energy::sensitivity::KoiterFace {
+            abar,
+            bbar,
+            h: pot.thickness(f),
+            lame: pot.lame(f),
+            stretch: body.stretch_factor * pot.stretch_scale,
+            bending: body.has_bending,
+        })
+    }
 }

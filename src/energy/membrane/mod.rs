@@ -72,6 +72,21 @@ pub trait Membrane: Send + Sync + 'static {
         None
     }
 
+    /// The rest data of face `f` for the rest sensitivities
+    /// ([`crate::energy::sensitivity`]), or an error naming why the material has none
+    /// (default: none; the Koiter membrane has them).
+    fn rest_face(
+        &self,
+        _pot: &Potential,
+        _f: usize,
+    ) -> Result<crate::energy::sensitivity::KoiterFace, String> {
+        Err(
+            "its rest sensitivities are derived for the Koiter membrane only \
+             (material.membrane = \"koiter\")"
+                .into(),
+        )
+    }
+
     /// Checks a state read from a restart (default: anything goes).
     fn check_state(&self, _state: &[Real]) -> Result<(), StateError> {
         Ok(())

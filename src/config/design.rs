@@ -1,0 +1,201 @@
+//! `[design]`: inverse design (`shellsim design DESIGN.toml MESH TARGET`): which per-face
+//! rest-form variable is designed, its bounds and smoothness, the objective and the optimiser's
+//! controls. The rest of a design file is an ordinary settings file: the scene every design
+//! iterate is solved in.
+
+use super::{Check, Invalid};
+use crate::math::Real;
+use serde::{Deserialize, Serialize};
+
+/// The designed variable, one or more numbers per face.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Variable {
+    /// The conformal growth factor `s` of the isotropic growth law in `growth.law`
+    /// (`isotropic`, `isotropic_in_plane` or `isotropic_metric_only`), dimensionless.
+    #[default]
+    Growth,
+    /// The liquid-crystal director angle θ (rad, from the reference x axis), with the stretch
+    /// λ and ratio ν of `[rest.lce]` (or of the mesh's `abar_info`) kept.
+    Director,
+    /// The rest forms themselves: ā (dimensionless) and b̄ (1/m) in reference Cartesian
+    /// coordinates, `[xx, xy, yy]` each, six numbers per face.
+    Forms,
+}
+
+impl Variable {
+    /// The settings name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Variable::Growth => "growth",
+            Variable::Director => "director",
+            Variable::Forms => "forms",
+        }
+    }
+}
+
+/// What the objective measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Objective {
+    /// Point to point: the target has the design mesh's connectivity; each vertex is compared
+    /// with its own.
+    #[default]
+    Points,
+}
+
+/// The `[design]` section.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Design {
+    /// The designed variable: `"growth"` (default), `"director"` or `"forms"`.
+    pub variable: Variable,
+    /// The lower bound on every designed number (the variable's unit; default: none).
+    pub lower: Option<Real>,
+    /// The upper bound (default: none).
+    pub upper: Option<Real>,
+    /// Where the design starts (the variable's unit): the neutral design by default (s = 0,
+    /// θ = 0, or the reference forms).
+    pub start: Option<Real>,
+    /// Weight of the smoothness term `w/2 Σ_edges (|e|/d) Δp²` (the discrete `∫|∇p|² dA`
+    /// of the piecewise-constant design; dimensionless; default 0).
+    pub smoothness: Real,
+    /// The objective: `"points"` (default).
+    pub objective: Objective,
+    /// Whether the shape is compared after the best rigid motion (default: true).
+    pub align: bool,
+    /// The most design iterations (default 200).
+    pub max_iterations: usize,
+    /// Stop when the objective changes by less than this, relative, over one iteration
+    /// (default 1e-9).
+    pub tolerance: Real,
+    /// Stop when the RMS distance to the target, over the target's size, is below this
+    /// (default 0: off).
+    pub target_distance: Real,
+    /// The largest change of a designed number in the first iteration (the variable's unit,
+    /// default 0.1); later steps are sized by the quasi-Newton model.
+    pub first_step: Real,
+    /// The quasi-Newton memory: pairs kept by L-BFGS (default 10).
+    pub memory: usize,
+    /// A frame of the shape every this many iterations (default 1; 0: the first and last only).
+    pub frames_every: usize,
+}
+
+impl Default for Design {
+    fn default() -> Self {
+        Design {
+            variable: Variable::Growth,
+            lower: None,
+            upper: None,
+            start: None,
+            smoothness: 0.0,
+            objective: Objective::Points,
+            align: true,
+            max_iterations: 200,
+            tolerance: 1e-9,
+            target_distance: 0.0,
+            first_step: 0.1,
+            memory: 10,
+            frames_every: 1,
+        }
+    }
+}
+
+/// The most design iterations accepted.
+pub const MAX_ITERATIONS: usize = 100_000;
+
+impl Design {
+    /// Validates `[design]`: finite bounds with lower ≤ upper, a start within them, positive
+    /// step, tolerance and memory.
+    pub fn validate(&self) -> Result<(), Invalid> {
+        let ck = Check;
+        for (k, v) in [
+            ("design.lower", self.lower),
+            ("design.upper", self.upper),
+            ("design.start", self.start),
+        ] {
+            if let Some(v) = v {
+                if !v.is_finite() {
+                    return ck.inv(
+                        k,
+                        format!("must be a finite number, got {}", crate::math::human(v)),
+                    );
+                }
+            }
+        }
+        if let (Some(lo), Some(hi)) = (self.lower, self.upper) {
+            if lo > hi {
+                return ck.inv(
+                    "design.lower",
+                    format!(
+                        "the lower bound {} is above the upper bound {}",
+                        crate::math::human(lo),
+                        crate::math::human(hi)
+                    ),
+                );
+            }
+        }
+        if let Some(s) = self.start {
+            if self.lower.is_some_and(|lo| s < lo) || self.upper.is_some_and(|hi| s > hi) {
+                return ck.inv(
+                    "design.start",
+                    format!("{} is outside the bounds", crate::math::human(s)),
+                );
+            }
+        }
+        if self.variable == Variable::Forms && (self.lower.is_some() || self.upper.is_some()) {
+            return ck.inv(
+                "design.lower",
+                "bounds apply to a growth factor or a director angle; rest forms have none (their \
+                 metric must stay positive definite, which the design keeps)"
+                    .into(),
+            );
+        }
+        ck.nonneg("design.smoothness", self.smoothness)?;
+        ck.pos("design.tolerance", self.tolerance)?;
+        ck.nonneg("design.target_distance", self.target_distance)?;
+        ck.pos("design.first_step", self.first_step)?;
+        if self.memory == 0 || self.memory > 100 {
+            return ck.inv(
+                "design.memory",
+                format!("must be 1 to 100, got {}", self.memory),
+            );
+        }
+        if self.max_iterations == 0 || self.max_iterations > MAX_ITERATIONS {
+            return ck.inv(
+                "design.max_iterations",
+                format!("must be 1 to {MAX_ITERATIONS}, got {}", self.max_iterations),
+            );
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bounds_with_lower_above_upper_are_refused() {
+        let d = Design {
+            lower: Some(1.0),
+            upper: Some(-1.0),
+            ..Default::default()
+        };
+        let e = d.validate().unwrap_err();
+        assert_eq!(e.key, "design.lower");
+        assert!(e.reason.contains("above the upper bound"), "{}", e.reason);
+        assert!(Design::default().validate().is_ok());
+    }
+
+    #[test]
+    fn a_start_outside_the_bounds_is_refused() {
+        let d = Design {
+            lower: Some(-0.5),
+            upper: Some(0.5),
+            start: Some(0.7),
+            ..Default::default()
+        };
+        assert_eq!(d.validate().unwrap_err().key, "design.start");
+    }
+}

@@ -1,0 +1,361 @@
+//! Inverse design: the per-face rest-form variables that make a sheet's static equilibrium take
+//! a target shape, by exact adjoint sensitivities and projected L-BFGS.
+//!
+//! ## The sensitivities
+//! A design `p` (numbers per face, [`variables`]) gives each face its rest data
+//! `r_f(p_f) = (ā, b̄, h̄)`; the equilibrium `x*(p)` solves `g(x*, r) = 0`. For the objective
+//! `J(p) = J_d(x*(p)) + J_s(p)` ([`objective`]), differentiating `g = 0` gives
+//! `H dx*/dp = −∂g/∂r · ∂r/∂p`, so
+//!
+//! `dJ/dp_f = −(∂r_f/∂p_f)ᵀ (λᵀ ∂g/∂r_f) + ∂J_s/∂p_f`,   `H λ = ∂J_d/∂x`,
+//!
+//! with `H` the exact Hessian at `x*` (its sparse part factorised once, the rank-one gas part by
+//! Woodbury, held DOFs and rigid pins masked: their rows of `H` are the identity and of the
+//! right-hand side zero) and `λᵀ ∂g/∂r_f` from the shell kernels
+//! ([`crate::energy::sensitivity`]). Edge DOFs and other scalar DOFs are part of `x` with a zero
+//! right-hand side. One design iteration is thus the equilibrium's re-solve (Newton, warm
+//! started from the last accepted equilibrium), one Hessian assembly and factorisation, one
+//! solve and one pass over the faces.
+//!
+//! ## Stability and branches
+//! The factorisation of the exact Hessian doubles as the stability check: a design whose
+//! equilibrium is not a minimum (the flat sheet once its metric asks it to buckle) is pushed
+//! toward the target, `x ← x + η (Rᵀ(y − t) − x)` (the target seen in the shape's own frame,
+//! η = 0.05, 0.2, 0.5), and solved again. A trial design whose equilibrium cannot be found or
+//! stays unstable is refused, and the optimiser cuts its step ([`lbfgs`]): the design moves by
+//! continuation, never further than the equilibrium follows.
+
+pub mod lbfgs;
+pub mod objective;
+pub mod variables;
+
+use crate::assembly::{Pattern, Want};
+use crate::energy::{HessianProjection, Potential};
+use crate::math::{Real, Sym2, Vec3};
+use crate::model::Scene;
+use crate::solve::newton::Workspace;
+use crate::solve::{newton, LinearSolver, NewtonOptions, State};
+use objective::{Points, Smoothness};
+use std::time::Instant;
+use variables::Chain;
+
+/// The push toward the target that frees an unstable equilibrium, as fractions of the way.
+const ESCAPES: [Real; 3] = [0.05, 0.2, 0.5];
+
+/// The smallest continuation step between two designs' rest data.
+const MIN_CONTINUATION_STEP: Real = 1.0 / 1024.0;
+
+/// Where the time of the evaluations went (s).
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct DesignTiming {
+    /// Newton's re-solves of the equilibrium.
+    pub equilibrium: f64,
+    /// The adjoint: the exact Hessian's assembly, factorisation and solve.
+    pub adjoint: f64,
+    /// The rest sensitivities' pass over the faces and the chain to the design.
+    pub sensitivities: f64,
+    /// Newton iterations of the re-solves.
+    pub newton_iterations: usize,
+    /// Evaluations (accepted or not).
+    pub evaluations: usize,
+    /// Evaluations refused (no equilibrium, or an unstable one).
+    pub refused: usize,
+}
+
+/// An evaluated design: its equilibrium and objective parts.
+#[derive(Clone, Debug)]
+pub struct Evaluated {
+    /// The equilibrium.
+    pub state: State,
+    /// The rest forms `(ā, b̄)` per face (barycentric).
+    pub forms: Vec<(Sym2, Sym2)>,
+    /// `h̄/h` per face.
+    pub ratio: Vec<Real>,
+    /// The distance term `J_d`.
+    pub distance: Real,
+    /// The smoothness term `J_s`.
+    pub smoothness: Real,
+    /// The alignment `(R, t)` of the shape onto the target.
+    pub alignment: (crate::math::Mat3, Vec3),
+}
+
+/// An inverse-design problem on a scene: the chain, the objective and the equilibrium solver.
+pub struct Problem<'s> {
+    scene: &'s Scene,
+    /// The design chain.
+    pub chain: Chain,
+    /// The distance term.
+    pub points: Points,
+    /// The smoothness term.
+    pub smoothness: Smoothness,
+    pattern: Pattern,
+    lin: LinearSolver,
+    ws: Workspace,
+    opts: NewtonOptions,
+    gravity: Vec3,
+    /// The last accepted evaluation (the warm start).
+    pub current: Option<Evaluated>,
+    trial: Option<Evaluated>,
+    /// Time and counts.
+    pub timing: DesignTiming,
+}
+
+impl<'s> Problem<'s> {
+    /// The problem of `scene` with `chain`, `points` and `smoothness`.
+    pub fn new(
+        scene: &'s Scene,
+        chain: Chain,
+        points: Points,
+        smoothness: Smoothness,
+    ) -> Result<Self, String> {
+        let pattern = Pattern::for_scene(scene);
+        let mut lin = LinearSolver::new(&pattern).map_err(|e| e.to_string())?;
+        lin.analyse().map_err(|e| e.to_string())?;
+        let ws = Workspace::new(&pattern);
+        let st = &scene.settings.solver;
+        Ok(Problem {
+            scene,
+            chain,
+            points,
+            smoothness,
+            pattern,
+            lin,
+            ws,
+            opts: NewtonOptions {
+                tol: st.tolerance,
+                max_iter: st.max_newton_iterations,
+                projection: st.hessian_projection,
+                chord: false,
+            },
+            gravity: Vec3::from(scene.settings.loads.gravity),
+            current: None,
+            trial: None,
+            timing: DesignTiming::default(),
+        })
+    }
+
+    /// The rest data of every face at design `p`, with the Jacobians.
+    fn rest(&self, p: &[Real]) -> Vec<variables::FaceRest> {
+        let k = self.chain.per_face();
+        (0..self.scene.body.num_faces())
+            .map(|f| self.chain.face(f, &p[k * f..k * (f + 1)]))
+            .collect()
+    }
+
+    /// The equilibrium at rest data `(forms, ratio)` from `state`: Newton, and the stability
+    /// check by the exact Hessian's factorisation, with the escapes toward the target. On
+    /// success the factorisation of the exact Hessian at the equilibrium is kept in `lin`.
+    fn equilibrium(
+        &mut self,
+        forms: &[(Sym2, Sym2)],
+        ratio: &[Real],
+        state: &mut State,
+    ) -> Result<(), String> {
+        let mut escapes = ESCAPES.iter();
+        loop {
+            let clock = Instant::now();
+            let pot = Potential {
+                rest_override: Some(forms),
+                thickness_override: Some(ratio),
+                gravity: self.gravity,
+                ..Potential::new(self.scene, &self.pattern)
+            };
+            let rep = newton(&pot, &mut self.lin, &mut self.ws, state, self.opts);
+            self.timing.equilibrium += clock.elapsed().as_secs_f64();
+            self.timing.newton_iterations += rep.iterations;
+            if !rep.converged {
+                return Err(format!(
+                    "the equilibrium was not found ({})",
+                    rep.failure_text()
+                ));
+            }
+            let clock = Instant::now();
+            let mut grad = vec![0.0; self.pattern.n];
+            let mut values = vec![0.0; self.pattern.row_idx.len()];
+            pot.eval_projected(
+                &state.x,
+                &state.dofs,
+                Want::Hessian,
+                HessianProjection::None,
+                &mut grad,
+                &mut values,
+            );
+            let lr = pot.low_rank(&state.x, &state.dofs);
+            let stable = self.lin.factor(&values).is_ok()
+                && crate::solve::low_rank::Woodbury::new(&mut self.lin, &lr)
+                    .keeps_positive_definite();
+            self.timing.adjoint += clock.elapsed().as_secs_f64();
+            if stable {
+                return Ok(());
+            }
+            let Some(&eta) = escapes.next() else {
+                return Err("the equilibrium stays unstable after pushes toward the target".into());
+            };
+            let (r, t) = self.points.alignment(&state.x);
+            for (x, y) in state.x.iter_mut().zip(&self.points.target) {
+                let seen = r.transpose() * (y - t);
+                *x += (seen - *x) * eta;
+            }
+        }
+    }
+
+    /// The equilibrium at rest data `to` from `state`, the equilibrium at `from`: directly, or
+    /// when that fails by continuation along `(1 − τ) from + τ to` (a convex combination, so ā
+    /// stays positive definite), τ's step halved on a failure and doubled after a success, down
+    /// to [`MIN_CONTINUATION_STEP`].
+    fn continuation(
+        &mut self,
+        from: &(Vec<(Sym2, Sym2)>, Vec<Real>),
+        to: (&[(Sym2, Sym2)], &[Real]),
+        state: &mut State,
+    ) -> Result<(), String> {
+        let mut trial = state.clone();
+        let first = match self.equilibrium(to.0, to.1, &mut trial) {
+            Ok(()) => {
+                *state = trial;
+                return Ok(());
+            }
+            Err(e) => e,
+        };
+        let (mut tau, mut step): (Real, Real) = (0.0, 0.5);
+        while tau < 1.0 {
+            let next = (tau + step).min(1.0);
+            let blend = |a: Real, b: Real| (1.0 - next) * a + next * b;
+            let forms: Vec<(Sym2, Sym2)> = from
+                .0
+                .iter()
+                .zip(to.0)
+                .map(|(a, b)| {
+                    (
+                        a.0 * (1.0 - next) + b.0 * next,
+                        a.1 * (1.0 - next) + b.1 * next,
+                    )
+                })
+                .collect();
+            let ratio: Vec<Real> = from
+                .1
+                .iter()
+                .zip(to.1)
+                .map(|(a, b)| blend(*a, *b))
+                .collect();
+            trial.clone_from(state);
+            match self.equilibrium(&forms, &ratio, &mut trial) {
+                Ok(()) => {
+                    std::mem::swap(state, &mut trial);
+                    tau = next;
+                    step *= 2.0;
+                }
+                Err(e) => {
+                    step *= 0.5;
+                    if step < MIN_CONTINUATION_STEP {
+                        return Err(format!(
+                            "{first}; continuation from the last design stalled at {:.4} of the \
+                             way ({e})",
+                            tau
+                        ));
+                    }
+                }
+            }
+        }
+        // The last blend was `to` itself: the factorisation held is the equilibrium's.
+        Ok(())
+    }
+
+    /// Evaluates design `p`: the equilibrium from the current one (or the reference), `J` and
+    /// `dJ/dp`.
+    pub fn evaluate(&mut self, p: &[Real]) -> Result<(Real, Vec<Real>, Evaluated), String> {
+        self.timing.evaluations += 1;
+        let rest = self.rest(p);
+        let forms: Vec<(Sym2, Sym2)> = rest.iter().map(|r| r.forms).collect();
+        let ratio: Vec<Real> = rest.iter().map(|r| r.ratio).collect();
+        let (mut state, from) = match &self.current {
+            Some(c) => (c.state.clone(), (c.forms.clone(), c.ratio.clone())),
+            None => {
+                let mut st = State::reference(self.scene);
+                self.scene.body.prescribe(&mut st.x, 1.0);
+                let b = &self.scene.body.rest;
+                let forms = (0..forms.len()).map(|f| (b.abar0[f], b.bbar0[f])).collect();
+                (st, (forms, vec![1.0; ratio.len()]))
+            }
+        };
+        if let Err(e) = self.continuation(&from, (&forms, &ratio), &mut state) {
+            self.timing.refused += 1;
+            return Err(e);
+        }
+        let clock = Instant::now();
+        let d = self.points.eval(&state.x);
+        let mut lambda = vec![0.0; self.pattern.n];
+        for (v, g) in d.gradient.iter().enumerate() {
+            lambda[3 * v..3 * v + 3].copy_from_slice(g.as_slice());
+        }
+        let pot = Potential {
+            rest_override: Some(&forms),
+            thickness_override: Some(&ratio),
+            gravity: self.gravity,
+            ..Potential::new(self.scene, &self.pattern)
+        };
+        pot.mask_fixed(&mut lambda);
+        let lr = pot.low_rank(&state.x, &state.dofs);
+        let wb = crate::solve::low_rank::Woodbury::new(&mut self.lin, &lr);
+        if !wb.solve_in_place(&mut self.lin, &mut lambda) {
+            self.timing.refused += 1;
+            return Err("the Hessian with its low-rank part is singular at the equilibrium".into());
+        }
+        pot.mask_fixed(&mut lambda);
+        self.timing.adjoint += clock.elapsed().as_secs_f64();
+        let clock = Instant::now();
+        let mut w = vec![[0.0; crate::energy::sensitivity::REST_DATA]; forms.len()];
+        for t in self.scene.terms.iter() {
+            if let Some(s) = t.rest_sensitivity() {
+                let part = s.rest_adjoint(&pot, &state.x, &state.dofs, &lambda)?;
+                for (a, b) in w.iter_mut().zip(part) {
+                    for (x, y) in a.iter_mut().zip(b) {
+                        *x += y;
+                    }
+                }
+            }
+        }
+        let k = self.chain.per_face();
+        let mut grad = vec![0.0; p.len()];
+        for (f, r) in rest.iter().enumerate() {
+            let h = self.scene.body.thickness[f];
+            for (j, row) in r.jac.iter().enumerate() {
+                let mut s = 0.0;
+                for i in 0..6 {
+                    s += row[i] * w[f][i];
+                }
+                s += row[6] * h * w[f][6];
+                grad[k * f + j] = -s;
+            }
+        }
+        let js = self.smoothness.eval(p, &mut grad);
+        self.timing.sensitivities += clock.elapsed().as_secs_f64();
+        let value = d.value + js;
+        Ok((
+            value,
+            grad,
+            Evaluated {
+                state,
+                forms,
+                ratio,
+                distance: d.value,
+                smoothness: js,
+                alignment: (d.rotation, d.translation),
+            },
+        ))
+    }
+}
+
+impl lbfgs::Problem for Problem<'_> {
+    fn eval(&mut self, p: &[Real]) -> Result<(Real, Vec<Real>), String> {
+        let (v, g, e) = self.evaluate(p)?;
+        self.trial = Some(e);
+        Ok((v, g))
+    }
+
+    fn accept(&mut self) {
+        if let Some(t) = self.trial.take() {
+            self.current = Some(t);
+        }
+    }
+}
