@@ -289,20 +289,10 @@ impl Case {
             a.extend_from_slice(crate::rest::push_forward(&t, &bary(0)).as_slice());
             b.extend_from_slice(crate::rest::push_forward(&t, &bary(1)).as_slice());
         }
-        mesh.face_fields.insert(
-            "abar_info".into(),
-            Field {
-                components: 3,
-                data: a,
-            },
-        );
-        mesh.face_fields.insert(
-            "bbar_info".into(),
-            Field {
-                components: 3,
-                data: b,
-            },
-        );
+        mesh.face_fields
+            .insert("abar_info".into(), Field::triples(a));
+        mesh.face_fields
+            .insert("bbar_info".into(), Field::triples(b));
     }
 }
 

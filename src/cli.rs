@@ -94,6 +94,34 @@ pub(crate) enum Command {
     Render(RenderArgs),
     /// Plot columns of a run's log.csv over time, dial or frame into a PNG.
     Plot(PlotArgs),
+    /// Inverse design: find the growth factors, director angles or rest forms per face that
+    /// make MESH take the shape TARGET at equilibrium (see docs/design.md).
+    Design(DesignArgs),
+}
+
+#[derive(clap::Args, Debug)]
+pub(crate) struct DesignArgs {
+    /// Design file: a settings file (the scene) with a [design] section.
+    design: PathBuf,
+    /// The mesh to design (its reference shape).
+    mesh: PathBuf,
+    /// The target shape: a mesh with MESH's connectivity.
+    target: PathBuf,
+    /// Output folder (created if needed).
+    #[arg(long, default_value = "design")]
+    out: PathBuf,
+    /// Replace an earlier design's output in --out.
+    #[arg(long)]
+    overwrite: bool,
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Override a key of the scene's settings, e.g. --set material.thickness=0.002.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// No line per iteration on stderr.
+    #[arg(long, short)]
+    quiet: bool,
 }
 
 #[derive(clap::Args, Debug)]
@@ -331,6 +359,7 @@ fn dispatch(cli: Cli) -> Result<u8> {
         Some(Command::Sweep(a)) => sweep_cmd(a),
         Some(Command::Render(a)) => render_cmd(a).map(|_| 0),
         Some(Command::Plot(a)) => plot_cmd(a).map(|_| 0),
+        Some(Command::Design(a)) => design_cmd(a),
         Some(Command::Collect(a)) => {
             let table = crate::sweep::collect(&a.dirs)?;
             match a.out {
@@ -347,6 +376,57 @@ fn dispatch(cli: Cli) -> Result<u8> {
             run_cmd(&cli, settings, mesh)
         }
     }
+}
+
+/// `shellsim design`: exit 0 when the design converged, 1 when it stopped without (the
+/// objective reached and the reason on stderr), 2 for bad input.
+fn design_cmd(a: DesignArgs) -> Result<u8> {
+    let threads = thread_count(a.threads)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| anyhow!("cannot start {threads} threads: {e}"))?;
+    let req = crate::design::run::Request {
+        design: a.design,
+        mesh: a.mesh,
+        target: a.target,
+        out: a.out,
+        overwrite: a.overwrite,
+        set: a.set,
+        quiet: a.quiet,
+    };
+    let o = pool.install(|| crate::design::run::run(&req))?;
+    let line = format!(
+        "{} iterations, distance to the target {} of its size, objective {}",
+        o.iterations,
+        crate::math::human(o.distance),
+        crate::math::human(o.objective)
+    );
+    if o.converged {
+        if !req.quiet {
+            eprintln!("shellsim design: converged ({}): {line}", o.reason);
+        }
+        Ok(0)
+    } else {
+        eprintln!("shellsim design: did not converge: {}; {line}", o.reason);
+        Ok(1)
+    }
+}
+
+/// The worker threads of `--threads`: at most the cores here (results do not depend on it).
+fn thread_count(asked: Option<usize>) -> Result<usize> {
+    let cores = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
+    Ok(match asked {
+        Some(0) => bail!("--threads must be at least 1"),
+        Some(n) if n > cores => {
+            eprintln!("warning: --threads {n} is more than the {cores} cores here; using {cores}");
+            cores
+        }
+        Some(n) => n,
+        None => cores,
+    })
 }
 
 /// `--size WIDTHxHEIGHT`.
@@ -713,19 +793,7 @@ fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> 
     for w in &scene.body.warnings {
         eprintln!("warning: {w}");
     }
-    let cores = std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1);
-    let threads = match cli.threads {
-        Some(0) => bail!("--threads must be at least 1"),
-        Some(n) if n > cores => {
-            // Results do not depend on the thread count, so more threads than cores only cost.
-            eprintln!("warning: --threads {n} is more than the {cores} cores here; using {cores}");
-            cores
-        }
-        Some(n) => n,
-        None => cores,
-    };
+    let threads = thread_count(cli.threads)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()

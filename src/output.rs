@@ -845,16 +845,7 @@ impl Writer {
     }
 
     fn write_series(&self) -> Result<(), OutputError> {
-        let mut s = String::from(
-            "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n",
-        );
-        for (t, name) in &self.frames {
-            // Shortest round-trip digits: a restart reads the exact time back.
-            s.push_str(&format!(
-                "    <DataSet timestep=\"{t}\" group=\"\" part=\"0\" file=\"{name}\"/>\n"
-            ));
-        }
-        s.push_str("  </Collection>\n</VTKFile>\n");
+        let s = crate::mesh::io::series_xml(&self.frames);
         let path = self.dir.join("series.pvd");
         write_atomic(&path, s.as_bytes()).map_err(|e| ioerr(&path, e))
     }

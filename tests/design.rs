@@ -1,5 +1,11 @@
 //! Inverse design: adjoint sensitivities against finite differences of re-solved equilibria,
-//! and designs recovered from the shapes they make.
+//! designs recovered from the shapes they make, and `shellsim design` end to end with its
+//! refusals.
+
+mod common;
+
+use common::run_status;
+use std::path::Path;
 
 use shellsim::config::growth::GrowthLaw;
 use shellsim::design::objective::{Points, Smoothness};
@@ -229,4 +235,246 @@ fn director_forms_and_gas_sensitivities_match_differences() {
     let mut prob = growth_problem(&sc, target, 0.0);
     let worst = worst_difference(&mut prob, &p, &spread(p.len()), 1e-5, "gas");
     assert!(worst < 1e-6, "gas: worst relative error {worst:e}");
+}
+
+/// Recovering a known design from its shape: the disk grown by the stereographic factor
+/// `s(r) = ln(2/(1 + r²))` takes (nearly) the unit sphere's hemisphere; designing from the
+/// neutral `s = 0` toward that shape recovers `s` within 1% (RMS, relative) and the shape
+/// within 0.1% of its size.
+#[test]
+fn the_stereographic_growth_is_recovered_from_its_cap() {
+    use shellsim::design::lbfgs::{minimise, Options};
+    let mesh = disk(0.2);
+    let sc = scene(
+        mesh.clone(),
+        &growth_settings("midedge_sin", "")
+            .replace("0.04", "0.01")
+            .replace("1e-13", "1e-10"),
+    );
+    let truth = stereographic(&mesh, 1.0);
+    let target = {
+        // The unit sphere by the inverse stereographic projection guides the first solve.
+        let sphere = mesh
+            .positions
+            .iter()
+            .map(|q| {
+                let r2 = q.x * q.x + q.y * q.y;
+                Vec3::new(2.0 * q.x, 2.0 * q.y, 1.0 - r2) / (1.0 + r2)
+            })
+            .collect();
+        let mut prob = growth_problem(&sc, sphere, 0.0);
+        prob.evaluate(&truth).unwrap().2.state.x
+    };
+    let mut prob = growth_problem(&sc, target, 0.0);
+    // The optimiser's steps in the Sobolev metric, as `shellsim design` takes them by default.
+    let topo = Topology::build(&sc.body.mesh).unwrap();
+    let ell = 0.05 * prob.points.size;
+    prob.metric = Some(shellsim::design::objective::Sobolev::new(
+        &sc.body.mesh,
+        &topo,
+        ell,
+        1,
+    ));
+    let o = Options {
+        memory: 10,
+        max_iterations: 400,
+        tolerance: 1e-12,
+        first_step: 0.1,
+        lower: -2.0,
+        upper: 2.0,
+    };
+    let clock = std::time::Instant::now();
+    let mut iterations = 0;
+    let (stop, p, f) = minimise(&mut prob, vec![0.0; truth.len()], &o, &mut |it, _| {
+        iterations = it.iteration;
+        // Stop at a shape within 1e-4 of its size, ten times closer than asked.
+        (Points::relative_rms(it.value) < 1e-4).then(|| "close enough".to_string())
+    })
+    .unwrap();
+    let rms = |v: &[Real]| (v.iter().map(|x| x * x).sum::<Real>() / v.len() as Real).sqrt();
+    let diff: Vec<Real> = p.iter().zip(&truth).map(|(a, b)| a - b).collect();
+    let err = rms(&diff) / rms(&truth);
+    let dist = Points::relative_rms(prob.current.as_ref().unwrap().distance);
+    println!(
+        "{stop:?} after {iterations} iterations: J {f:.3e}, s error {err:.2e} (RMS, relative), shape {dist:.2e} of its size, {:?}, {:.2} s",
+        prob.timing,
+        clock.elapsed().as_secs_f64()
+    );
+    assert!(err < 0.01, "s recovered to {err:e}");
+    assert!(dist < 1e-3, "shape within {dist:e} of its size");
+}
+
+fn write(dir: &Path, name: &str, text: &str) {
+    std::fs::write(dir.join(name), text).unwrap();
+}
+
+/// `shellsim design` on the example files at a small size: the stereographic cap from a
+/// forward run is designed back from s = 0 to within 0.1% of its size (exit 0), with its log,
+/// frames and summary; the designed mesh with the written settings grows into the designed
+/// shape (the forward run of the output reproduces `shape.vtk` within 1e-6 of the size).
+#[test]
+fn shellsim_design_designs_the_cap_and_its_output_reproduces_the_shape() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let ok = |args: &[&str]| {
+        let (code, _, err) = run_status(args, d);
+        assert_eq!(code, 0, "shellsim {args:?}: {err}");
+    };
+    ok(&[
+        "mesh", "disk", "--radius", "1", "--edge", "0.2", "-o", "disk.vtk",
+    ]);
+    let fwd = root.join("designs/cap_forward.toml");
+    ok(&[fwd.to_str().unwrap(), "disk.vtk", "--out", "target", "-q"]);
+    let cap = root.join("designs/cap.toml");
+    ok(&[
+        "design",
+        cap.to_str().unwrap(),
+        "disk.vtk",
+        "target/frame_00001.vtu",
+        "--out",
+        "des",
+        "-q",
+    ]);
+    let sum: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("des/design_summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(sum["converged"], true, "{sum}");
+    assert!(sum["distance"].as_f64().unwrap() <= 1e-3, "{sum}");
+    let log = std::fs::read_to_string(d.join("des/design_log.csv")).unwrap();
+    let rows = log.lines().count() - 1;
+    assert_eq!(
+        rows as u64,
+        sum["iterations"].as_u64().unwrap() + 1,
+        "{log}"
+    );
+    let pvd = std::fs::read_to_string(d.join("des/iterations.pvd")).unwrap();
+    assert!(pvd.contains("iterations/iteration_00000.vtk"));
+    // The design reproduces through the ordinary run.
+    ok(&[
+        "des/settings.toml",
+        "des/designed.vtk",
+        "--out",
+        "again",
+        "-q",
+    ]);
+    let shape = shellsim::mesh::io::read_mesh(&d.join("des/shape.vtk")).unwrap();
+    let again = shellsim::mesh::io::read_mesh(&d.join("again/frame_00001.vtu")).unwrap();
+    let pts = Points::new(&shape, shape.positions.clone(), true);
+    let rep = Points::relative_rms(pts.eval(&again.positions).value);
+    assert!(
+        rep < 1e-6,
+        "the designed mesh grows {rep:e} of the size away from the designed shape"
+    );
+}
+
+/// Bad design input: exit 2 naming the file and the key or face, and nothing written.
+#[test]
+fn bad_design_input_is_refused_and_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    run_status(
+        &[
+            "mesh", "disk", "--radius", "1", "--edge", "0.25", "-o", "disk.vtk",
+        ],
+        d,
+    );
+    run_status(
+        &[
+            "mesh",
+            "disk",
+            "--radius",
+            "1",
+            "--edge",
+            "0.3",
+            "-o",
+            "other.vtk",
+        ],
+        d,
+    );
+    let scene = "[material]\nyoung = 1e4\npoisson = 0.4\nthickness = 0.01\n\
+                 [growth]\nlaw = \"isotropic\"\ns = 0.0\n[solver]\nmode = \"static\"\n";
+    write(
+        d,
+        "good.toml",
+        &format!("{scene}[design]\nvariable = \"growth\"\n"),
+    );
+    write(
+        d,
+        "director.toml",
+        &format!("{scene}[design]\nvariable = \"director\"\n"),
+    );
+    write(
+        d,
+        "bounds.toml",
+        &format!("{scene}[design]\nlower = 1.0\nupper = -1.0\n"),
+    );
+    write(
+        d,
+        "typo.toml",
+        &format!("{scene}[design]\nvariabel = \"growth\"\n"),
+    );
+    write(d, "empty.vtk", "# vtk DataFile Version 4.2\nempty\nASCII\nDATASET POLYDATA\nPOINTS 0 double\nPOLYGONS 0 0\n");
+    let cases: [(&str, &str, &[&str]); 5] = [
+        ("good.toml", "other.vtk", &["other.vtk", "connectivity"]),
+        (
+            "director.toml",
+            "disk.vtk",
+            &["director.toml", "design.variable", "isotropic"],
+        ),
+        (
+            "bounds.toml",
+            "disk.vtk",
+            &["bounds.toml", "design.lower", "above the upper bound"],
+        ),
+        ("typo.toml", "disk.vtk", &["typo.toml", "variabel"]),
+        ("good.toml", "empty.vtk", &["empty.vtk"]),
+    ];
+    for (file, target, words) in cases {
+        let (code, _, err) = run_status(&["design", file, "disk.vtk", target, "--out", "out"], d);
+        assert_eq!(code, 2, "{file} {target}: {err}");
+        for w in words {
+            assert!(err.contains(w), "{file} {target}: '{w}' not in: {err}");
+        }
+        assert!(!d.join("out").exists(), "{file} {target} wrote output");
+    }
+    // A design that runs out of iterations stops with exit 1, the objective and the reason.
+    write(
+        d,
+        "short.toml",
+        &format!("{scene}[design]\nmax_iterations = 1\n"),
+    );
+    let target: Vec<Vec3> = {
+        let m = shellsim::mesh::io::read_mesh(&d.join("disk.vtk")).unwrap();
+        m.positions
+            .iter()
+            .map(|p| Vec3::new(p.x, p.y, 0.3 * (p.x * p.x + p.y * p.y)))
+            .collect()
+    };
+    let mut m = shellsim::mesh::io::read_mesh(&d.join("disk.vtk")).unwrap();
+    m.positions = target;
+    shellsim::mesh::io::write_mesh(
+        &d.join("bowl.vtk"),
+        &m,
+        shellsim::mesh::io::Format::Vtk,
+        "bowl",
+    )
+    .unwrap();
+    let (code, _, err) = run_status(
+        &[
+            "design",
+            "short.toml",
+            "disk.vtk",
+            "bowl.vtk",
+            "--out",
+            "out",
+            "-q",
+        ],
+        d,
+    );
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("design.max_iterations") && err.contains("objective"),
+        "{err}"
+    );
 }

@@ -60,6 +60,11 @@ pub struct Design {
     /// Weight of the smoothness term `w/2 Σ_edges (|e|/d) Δp²` (the discrete `∫|∇p|² dA`
     /// of the piecewise-constant design; dimensionless; default 0).
     pub smoothness: Real,
+    /// The smoothing length ℓ of the optimiser's steps, over the target's size: steps follow
+    /// the Sobolev gradient `(A + ℓ² K)⁻¹ ∇J`, smooth over ℓ, which keeps a thin sheet from
+    /// crumpling on the way (default 0.05; 0: the plain per-face gradient). It changes the
+    /// path, not the optimum.
+    pub smoothing_length: Real,
     /// The objective: `"points"` (default).
     pub objective: Objective,
     /// Whether the shape is compared after the best rigid motion (default: true).
@@ -89,6 +94,7 @@ impl Default for Design {
             upper: None,
             start: None,
             smoothness: 0.0,
+            smoothing_length: 0.05,
             objective: Objective::Points,
             align: true,
             max_iterations: 200,
@@ -152,6 +158,7 @@ impl Design {
             );
         }
         ck.nonneg("design.smoothness", self.smoothness)?;
+        ck.nonneg("design.smoothing_length", self.smoothing_length)?;
         ck.pos("design.tolerance", self.tolerance)?;
         ck.nonneg("design.target_distance", self.target_distance)?;
         ck.pos("design.first_step", self.first_step)?;
@@ -171,9 +178,82 @@ impl Design {
     }
 }
 
+/// The `[design]` section of a design file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DesignFile {
+    #[serde(default)]
+    design: Design,
+}
+
+/// The table header a line opens (`[name]` or `[[name]]`, with an optional comment), if any.
+fn header(line: &str) -> Option<&str> {
+    let t = line.trim_start();
+    let body = t.strip_prefix("[[").or_else(|| t.strip_prefix('['))?;
+    let end = body.find(']')?;
+    let name = body[..end].trim();
+    let rest = body[end..].trim_start_matches(']').trim();
+    let keyish = !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | '"' | ' '));
+    (keyish && (rest.is_empty() || rest.starts_with('#'))).then_some(name)
+}
+
+/// Splits a design file into its settings part and its `[design]` part (the `[design]` and
+/// `[design.*]` tables), each the whole file with the other's lines blanked, so that both
+/// parsers' line numbers are the file's.
+pub fn split(text: &str) -> (String, String) {
+    let (mut settings, mut design) = (String::new(), String::new());
+    let mut inside = false;
+    for line in text.lines() {
+        if let Some(name) = header(line) {
+            let name = name.trim_matches('"');
+            inside = name == "design" || name.starts_with("design.");
+        }
+        let (to, blank) = if inside {
+            (&mut design, &mut settings)
+        } else {
+            (&mut settings, &mut design)
+        };
+        to.push_str(line);
+        to.push('\n');
+        blank.push('\n');
+    }
+    (settings, design)
+}
+
+/// Parses and validates the `[design]` part of a design file (from [`split`]). The error is the
+/// message to print after the file's name: the TOML parser's (with its line and key) or the
+/// invalid key's.
+pub fn parse(design_part: &str) -> Result<Design, String> {
+    let file: DesignFile = toml::from_str(design_part).map_err(|e| e.to_string())?;
+    file.design
+        .validate()
+        .map_err(|e| format!("invalid '{}': {}", e.key, e.reason))?;
+    Ok(file.design)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_design_file_splits_into_its_parts_keeping_line_numbers() {
+        let text = "[material]\nyoung = 1.0\nfix = [\n  [0.1, 0.2],\n]\n[design]\nvariable = \"director\"\n\
+                    smoothness = 0.5 # w\n[solver]\nmode = \"static\"\n";
+        let (s, d) = split(text);
+        assert_eq!(s.lines().count(), text.lines().count());
+        assert_eq!(d.lines().count(), text.lines().count());
+        assert!(s.contains("[0.1, 0.2]") && s.contains("[solver]") && !s.contains("director"));
+        let design = parse(&d).unwrap();
+        assert_eq!(design.variable, Variable::Director);
+        assert_eq!(design.smoothness, 0.5);
+        let e = parse("[design]\n\nvariabel = 1\n").unwrap_err();
+        assert!(e.contains("line 3") && e.contains("variabel"), "{e}");
+        let e = parse("[design]\nlower = 2.0\nupper = 1.0\n").unwrap_err();
+        assert!(e.contains("design.lower"), "{e}");
+    }
 
     #[test]
     fn bounds_with_lower_above_upper_are_refused() {

@@ -32,6 +32,16 @@ impl TargetForms {
         TargetForms::Mesh,
         TargetForms::Lce,
     ];
+
+    /// The settings name.
+    pub fn name(self) -> &'static str {
+        match self {
+            TargetForms::None => "none",
+            TargetForms::Uniform => "uniform",
+            TargetForms::Mesh => "mesh",
+            TargetForms::Lce => "lce",
+        }
+    }
 }
 
 /// The director law's per-face values, numbers or expressions of the reference x, y (m) at each

@@ -3,7 +3,8 @@
 //! Each iteration takes the variables at a bound whose gradient pushes outward as fixed (their
 //! projected gradient is 0), forms the L-BFGS direction on the free ones with the two-loop
 //! recursion (Nocedal & Wright, *Numerical Optimization*, 2nd ed., Algorithm 7.4, with the
-//! initial scaling `γ = sᵀy / yᵀy` of their eq. 7.20), projects each trial point onto the box
+//! initial inverse Hessian `γ P`, `γ = sᵀy / yᵀPy`, their eq. 7.20 with a preconditioner `P`),
+//! projects each trial point onto the box
 //! and backtracks (halving) until the Armijo condition `f(p_t) ≤ f(p) + 10⁻⁴ ∇f·(p_t − p)`
 //! holds. A trial whose evaluation fails (the equilibrium could not be found there) is cut like
 //! one that does not descend: this is the design's continuation, which never jumps further than
@@ -26,6 +27,9 @@ pub trait Problem {
     fn eval(&mut self, p: &[Real]) -> Result<(Real, Vec<Real>), String>;
     /// The last trial is accepted (the problem warm-starts from it from now on).
     fn accept(&mut self);
+    /// Applies the preconditioner `P ≈ (∇²f)⁻¹` (symmetric positive definite) to `v` in place:
+    /// the initial inverse Hessian of the two-loop recursion is `γ P` (default: `P = I`).
+    fn precondition(&self, _v: &mut [Real]) {}
 }
 
 /// The optimiser's controls.
@@ -97,25 +101,28 @@ fn amax(a: &[Real]) -> Real {
 /// and after every accepted iteration; `report` returning `true` stops (converged: a target
 /// reached). Returns the stop, the final variables and objective; `Err` when the start
 /// cannot be evaluated.
-pub fn minimise(
-    problem: &mut dyn Problem,
+pub fn minimise<P: Problem>(
+    problem: &mut P,
     p: Vec<Real>,
     o: &Options,
-    report: &mut dyn FnMut(&Iterate) -> Option<String>,
+    report: &mut dyn FnMut(&Iterate, &P) -> Option<String>,
 ) -> Result<(Stop, Vec<Real>, Real), String> {
     let mut p: Vec<Real> = p.iter().map(|x| x.clamp(o.lower, o.upper)).collect();
     let (mut f, mut g) = problem.eval(&p)?;
     problem.accept();
     let mut pairs: VecDeque<(Vec<Real>, Vec<Real>, Real)> = VecDeque::new();
     let pg = projected(&p, &g, o);
-    if let Some(why) = report(&Iterate {
-        iteration: 0,
-        p: &p,
-        value: f,
-        gradient: amax(&pg),
-        step: 0.0,
-        trials: 1,
-    }) {
+    if let Some(why) = report(
+        &Iterate {
+            iteration: 0,
+            p: &p,
+            value: f,
+            gradient: amax(&pg),
+            step: 0.0,
+            trials: 1,
+        },
+        problem,
+    ) {
         return Ok((Stop::Converged(why), p, f));
     }
     for it in 1..=o.max_iterations {
@@ -132,11 +139,20 @@ pub fn minimise(
             .zip(&g)
             .map(|(a, b)| *a != 0.0 || *b == 0.0)
             .collect();
-        let mut d = two_loop(&pg, &pairs, &free);
+        let mut d = two_loop(&pg, &pairs, &free, &|v: &mut [Real]| {
+            problem.precondition(v)
+        });
         if pairs.is_empty() || dot(&d, &pg) >= 0.0 {
             pairs.clear();
-            let s = o.first_step / amax(&pg);
-            d = pg.iter().map(|x| -x * s).collect();
+            let mut pd = pg.clone();
+            problem.precondition(&mut pd);
+            for (x, &f) in pd.iter_mut().zip(&free) {
+                if !f {
+                    *x = 0.0;
+                }
+            }
+            let s = o.first_step / amax(&pd).max(Real::MIN_POSITIVE);
+            d = pd.iter().map(|x| -x * s).collect();
         }
         let mut alpha = 1.0;
         let mut trials = 0;
@@ -188,14 +204,17 @@ pub fn minimise(
         f = ft;
         g = gt;
         let pg = projected(&p, &g, o);
-        if let Some(why) = report(&Iterate {
-            iteration: it,
-            p: &p,
-            value: f,
-            gradient: amax(&pg),
-            step: alpha,
-            trials,
-        }) {
+        if let Some(why) = report(
+            &Iterate {
+                iteration: it,
+                p: &p,
+                value: f,
+                gradient: amax(&pg),
+                step: alpha,
+                trials,
+            },
+            problem,
+        ) {
             return Ok((Stop::Converged(why), p, f));
         }
         if change < o.tolerance {
@@ -212,11 +231,13 @@ pub fn minimise(
     Ok((Stop::Limit, p, f))
 }
 
-/// `−H g` by the two-loop recursion over the stored pairs, on the free variables.
+/// `−H g` by the two-loop recursion over the stored pairs, on the free variables, with the
+/// initial inverse Hessian `γ P`, `γ = sᵀy / yᵀPy` of the newest pair.
 fn two_loop(
     g: &[Real],
     pairs: &VecDeque<(Vec<Real>, Vec<Real>, Real)>,
     free: &[bool],
+    precondition: &dyn Fn(&mut [Real]),
 ) -> Vec<Real> {
     let mask = |v: &[Real]| -> Vec<Real> {
         v.iter()
@@ -235,7 +256,11 @@ fn two_loop(
         alphas.push(a);
     }
     if let Some((s, y, _)) = pairs.back() {
-        let gamma = dot(s, y) / dot(y, y).max(Real::MIN_POSITIVE);
+        let mut py = mask(y);
+        precondition(&mut py);
+        let gamma = dot(s, y) / dot(&mask(y), &py).max(Real::MIN_POSITIVE);
+        precondition(&mut q);
+        q = mask(&q);
         for qi in &mut q {
             *qi *= gamma;
         }
@@ -288,7 +313,7 @@ mod tests {
             &mut Rosen(vec![]),
             vec![-1.2, 1.0, -1.2, 1.0, -1.2, 1.0],
             &o,
-            &mut |it| {
+            &mut |it, _| {
                 iterations = it.iteration;
                 None
             },
@@ -303,7 +328,7 @@ mod tests {
         assert!(iterations < 150, "{iterations} iterations");
         // With every variable at most 0.5, the first sits on its bound.
         let o = Options { upper: 0.5, ..o };
-        let (_, p, _) = minimise(&mut Rosen(vec![]), vec![0.0; 4], &o, &mut |_| None).unwrap();
+        let (_, p, _) = minimise(&mut Rosen(vec![]), vec![0.0; 4], &o, &mut |_, _| None).unwrap();
         assert!(p.iter().all(|&x| x <= 0.5));
         assert_eq!(p[0], 0.5, "{p:?}");
     }

@@ -27,6 +27,7 @@
 
 pub mod lbfgs;
 pub mod objective;
+pub mod run;
 pub mod variables;
 
 use crate::assembly::{Pattern, Want};
@@ -35,7 +36,7 @@ use crate::math::{Real, Sym2, Vec3};
 use crate::model::Scene;
 use crate::solve::newton::Workspace;
 use crate::solve::{newton, LinearSolver, NewtonOptions, State};
-use objective::{Points, Smoothness};
+use objective::{Points, Smoothness, Sobolev};
 use std::time::Instant;
 use variables::Chain;
 
@@ -60,6 +61,8 @@ pub struct DesignTiming {
     pub evaluations: usize,
     /// Evaluations refused (no equilibrium, or an unstable one).
     pub refused: usize,
+    /// The predictor of the warm starts.
+    pub predictor: f64,
 }
 
 /// An evaluated design: its equilibrium and objective parts.
@@ -88,6 +91,8 @@ pub struct Problem<'s> {
     pub points: Points,
     /// The smoothness term.
     pub smoothness: Smoothness,
+    /// The Sobolev metric of the optimiser's steps (`None`: the plain gradient).
+    pub metric: Option<Sobolev>,
     pattern: Pattern,
     lin: LinearSolver,
     ws: Workspace,
@@ -95,7 +100,13 @@ pub struct Problem<'s> {
     gravity: Vec3,
     /// The last accepted evaluation (the warm start).
     pub current: Option<Evaluated>,
-    trial: Option<Evaluated>,
+    /// The design of [`Problem::current`].
+    current_p: Vec<Real>,
+    trial: Option<(Evaluated, Vec<Real>)>,
+    /// Whether `lin` holds the factorisation at the current equilibrium.
+    factor_current: bool,
+    /// The last predictor: a design change and the equilibrium's first-order response to it.
+    predicted: Option<(Vec<Real>, Vec<Real>)>,
     /// Time and counts.
     pub timing: DesignTiming,
 }
@@ -118,6 +129,7 @@ impl<'s> Problem<'s> {
             chain,
             points,
             smoothness,
+            metric: None,
             pattern,
             lin,
             ws,
@@ -129,7 +141,10 @@ impl<'s> Problem<'s> {
             },
             gravity: Vec3::from(scene.settings.loads.gravity),
             current: None,
+            current_p: Vec::new(),
             trial: None,
+            factor_current: false,
+            predicted: None,
             timing: DesignTiming::default(),
         })
     }
@@ -261,6 +276,87 @@ impl<'s> Problem<'s> {
         Ok(())
     }
 
+    /// The first-order response of the current equilibrium to the design change `dp`,
+    /// `δx = −H⁻¹ ∂g/∂p δp`, with `∂g/∂p δp` by central differences of the gradient over the
+    /// rest data at `p ± ε δp` (a predictor needs no more) and `H` the factorisation held at the
+    /// current equilibrium. Along one direction the response scales: a shorter step of the line
+    /// search reuses it. `None` when there is no current factorisation.
+    fn predict(&mut self, p: &[Real]) -> Option<Vec<Real>> {
+        let cur = self.current.as_ref()?;
+        if self.current_p.len() != p.len() {
+            return None;
+        }
+        let dp: Vec<Real> = p.iter().zip(&self.current_p).map(|(a, b)| a - b).collect();
+        let norm = |v: &[Real]| v.iter().map(|x| x * x).sum::<Real>().sqrt();
+        let n = norm(&dp);
+        if n == 0.0 {
+            return None;
+        }
+        if let Some((d0, x0)) = &self.predicted {
+            let alpha = dp.iter().zip(d0).map(|(a, b)| a * b).sum::<Real>()
+                / d0.iter()
+                    .map(|x| x * x)
+                    .sum::<Real>()
+                    .max(Real::MIN_POSITIVE);
+            let off: Vec<Real> = dp.iter().zip(d0).map(|(a, b)| a - alpha * b).collect();
+            if norm(&off) <= 1e-10 * n {
+                return Some(x0.iter().map(|x| x * alpha).collect());
+            }
+        }
+        if !self.factor_current {
+            return None;
+        }
+        let amax = dp.iter().fold(0.0 as Real, |m, x| m.max(x.abs()));
+        let eps = 1e-6 / amax.max(1e-300);
+        let mut grads = Vec::new();
+        for sign in [1.0, -1.0] {
+            let q: Vec<Real> = self
+                .current_p
+                .iter()
+                .zip(&dp)
+                .map(|(a, d)| a + sign * eps * d)
+                .collect();
+            let rest = self.rest(&q);
+            let forms: Vec<(Sym2, Sym2)> = rest.iter().map(|r| r.forms).collect();
+            let ratio: Vec<Real> = rest.iter().map(|r| r.ratio).collect();
+            let pot = Potential {
+                rest_override: Some(&forms),
+                thickness_override: Some(&ratio),
+                gravity: self.gravity,
+                ..Potential::new(self.scene, &self.pattern)
+            };
+            let mut g = vec![0.0; self.pattern.n];
+            pot.eval(
+                &cur.state.x,
+                &cur.state.dofs,
+                Want::Gradient,
+                &mut g,
+                &mut [],
+            );
+            grads.push(g);
+        }
+        let mut dx: Vec<Real> = grads[0]
+            .iter()
+            .zip(&grads[1])
+            .map(|(a, b)| -(a - b) / (2.0 * eps))
+            .collect();
+        let pot = Potential {
+            rest_override: Some(&cur.forms),
+            thickness_override: Some(&cur.ratio),
+            gravity: self.gravity,
+            ..Potential::new(self.scene, &self.pattern)
+        };
+        pot.mask_fixed(&mut dx);
+        let lr = pot.low_rank(&cur.state.x, &cur.state.dofs);
+        let wb = crate::solve::low_rank::Woodbury::new(&mut self.lin, &lr);
+        if !wb.solve_in_place(&mut self.lin, &mut dx) {
+            return None;
+        }
+        pot.mask_fixed(&mut dx);
+        self.predicted = Some((dp, dx.clone()));
+        Some(dx)
+    }
+
     /// Evaluates design `p`: the equilibrium from the current one (or the reference), `J` and
     /// `dJ/dp`.
     pub fn evaluate(&mut self, p: &[Real]) -> Result<(Real, Vec<Real>, Evaluated), String> {
@@ -268,6 +364,31 @@ impl<'s> Problem<'s> {
         let rest = self.rest(p);
         let forms: Vec<(Sym2, Sym2)> = rest.iter().map(|r| r.forms).collect();
         let ratio: Vec<Real> = rest.iter().map(|r| r.ratio).collect();
+        let clock = Instant::now();
+        let prediction = self.predict(p);
+        self.timing.predictor += clock.elapsed().as_secs_f64();
+        self.factor_current = false;
+        if let (Some(dx), Some(c)) = (&prediction, &self.current) {
+            let mut state = c.state.clone();
+            state.set_step(&c.state, dx, 1.0);
+            let guess = state.x.clone();
+            let from_x = c.state.x.clone();
+            // An equilibrium further from the prediction than the prediction is from the
+            // current one is another branch: the linear response did not hold; go on from the
+            // current equilibrium instead.
+            let moved = |a: &[Vec3], b: &[Vec3]| {
+                a.iter()
+                    .zip(b)
+                    .map(|(p, q)| (p - q).norm_squared())
+                    .sum::<Real>()
+                    .sqrt()
+            };
+            if self.equilibrium(&forms, &ratio, &mut state).is_ok()
+                && moved(&state.x, &guess) <= moved(&guess, &from_x)
+            {
+                return self.finish(p, rest, forms, ratio, state);
+            }
+        }
         let (mut state, from) = match &self.current {
             Some(c) => (c.state.clone(), (c.forms.clone(), c.ratio.clone())),
             None => {
@@ -282,6 +403,19 @@ impl<'s> Problem<'s> {
             self.timing.refused += 1;
             return Err(e);
         }
+        self.finish(p, rest, forms, ratio, state)
+    }
+
+    /// `J` and `dJ/dp` at the equilibrium `state` of design `p` (whose exact Hessian `lin`
+    /// holds factorised).
+    fn finish(
+        &mut self,
+        p: &[Real],
+        rest: Vec<variables::FaceRest>,
+        forms: Vec<(Sym2, Sym2)>,
+        ratio: Vec<Real>,
+        state: State,
+    ) -> Result<(Real, Vec<Real>, Evaluated), String> {
         let clock = Instant::now();
         let d = self.points.eval(&state.x);
         let mut lambda = vec![0.0; self.pattern.n];
@@ -349,13 +483,23 @@ impl<'s> Problem<'s> {
 impl lbfgs::Problem for Problem<'_> {
     fn eval(&mut self, p: &[Real]) -> Result<(Real, Vec<Real>), String> {
         let (v, g, e) = self.evaluate(p)?;
-        self.trial = Some(e);
+        self.trial = Some((e, p.to_vec()));
         Ok((v, g))
     }
 
     fn accept(&mut self) {
-        if let Some(t) = self.trial.take() {
+        if let Some((t, p)) = self.trial.take() {
             self.current = Some(t);
+            self.current_p = p;
+            // The accepted trial was the last evaluated: its factorisation is held.
+            self.factor_current = true;
+            self.predicted = None;
+        }
+    }
+
+    fn precondition(&self, v: &mut [Real]) {
+        if let Some(m) = &self.metric {
+            m.solve(v);
         }
     }
 }

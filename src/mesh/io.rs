@@ -11,6 +11,7 @@
 //! always through a temporary file renamed into place, so a reader never sees half a file.
 
 use super::{Field, Mesh, MeshError, RawMesh};
+use crate::math::Real;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -263,6 +264,21 @@ fn legacy_bytes(mesh: &Mesh, title: &str, binary: bool, single: &dyn Fn(&str) ->
         &mesh.vertex_fields,
     );
     out
+}
+
+/// A ParaView series (`.pvd`) of `(timestep, file)` entries; the timesteps are written with the
+/// shortest digits that read back exactly (a restart reads the exact time back).
+pub fn series_xml(frames: &[(Real, String)]) -> String {
+    let mut s = String::from(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n",
+    );
+    for (t, name) in frames {
+        s.push_str(&format!(
+            "    <DataSet timestep=\"{t}\" group=\"\" part=\"0\" file=\"{name}\"/>\n"
+        ));
+    }
+    s.push_str("  </Collection>\n</VTKFile>\n");
+    s
 }
 
 /// Writes bytes atomically: a temporary file in the same folder, then a rename.

@@ -43,6 +43,14 @@ impl Field {
             data,
         }
     }
+    /// A field of three components per entry (`data.len()` a multiple of 3): symmetric
+    /// tensors `[xx, xy, yy]`, vectors.
+    pub fn triples(data: Vec<Real>) -> Self {
+        Field {
+            components: 3,
+            data,
+        }
+    }
     /// Number of entries (faces or vertices).
     pub fn len(&self) -> usize {
         self.data.len().checked_div(self.components).unwrap_or(0)

@@ -1,0 +1,689 @@
+//! `shellsim design DESIGN.toml MESH TARGET --out DIR`: reads and checks everything first
+//! (nothing is written for bad input), designs, and writes
+//!
+//! * `designed.vtk`: the input mesh with the designed fields, and `settings.toml`: the scene
+//!   that reproduces the designed shape with `shellsim settings.toml designed.vtk`;
+//! * `shape.vtk`: the designed equilibrium, aligned onto the target;
+//! * `iterations/iteration_NNNNN.vtk` and `iterations.pvd`: the shape per iteration (aligned),
+//!   with the design and each vertex's distance to the target;
+//! * `design_log.csv`: the objective per iteration; `design_summary.json`: how it ended, the
+//!   numbers and where the time went.
+
+use super::lbfgs::{minimise, Iterate, Options, Stop};
+use super::objective::{Points, Smoothness, Sobolev};
+use super::variables::Chain;
+use super::{DesignTiming, Evaluated, Problem};
+use crate::config::design::{Design, Variable};
+use crate::config::growth::GrowthLaw;
+use crate::math::{sym_det, Real, Vec3};
+use crate::mesh::io::{read_mesh, series_xml, write_atomic, write_mesh, Format};
+use crate::mesh::{Field, Mesh, Topology};
+use crate::model::Scene;
+use crate::rest::push_forward;
+use crate::settings::{Settings, TargetForms};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// A design's bad input or failed output (exit 2), with the file, key or face it concerns.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct DesignError(pub String);
+
+impl DesignError {
+    fn at(path: &Path, reason: impl std::fmt::Display) -> Self {
+        DesignError(format!("{}: {reason}", path.display()))
+    }
+}
+
+/// What `shellsim design` was asked.
+#[derive(Clone, Debug)]
+pub struct Request {
+    /// The design file (a settings file with a `[design]` section).
+    pub design: PathBuf,
+    /// The flat (or curved) reference mesh to design.
+    pub mesh: PathBuf,
+    /// The target shape.
+    pub target: PathBuf,
+    /// The output folder.
+    pub out: PathBuf,
+    /// Replace an earlier design's output.
+    pub overwrite: bool,
+    /// `--set` overrides of the settings part.
+    pub set: Vec<String>,
+    /// No line per iteration on stderr.
+    pub quiet: bool,
+}
+
+/// How a design ended.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// Whether it converged (tolerance, target distance or a zero projected gradient).
+    pub converged: bool,
+    /// Why it stopped.
+    pub reason: String,
+    /// Design iterations.
+    pub iterations: usize,
+    /// The objective reached.
+    pub objective: Real,
+    /// The RMS distance to the target over its size.
+    pub distance: Real,
+}
+
+/// Everything read and checked: the scene, the design, the chain, the start and the target.
+pub struct Prepared {
+    /// The scene every design is solved in.
+    pub scene: Scene,
+    /// The `[design]` section.
+    pub design: Design,
+    /// The input mesh as read (the designed mesh keeps its fields).
+    pub input: Mesh,
+    /// The target's positions.
+    pub target: Vec<Vec3>,
+    /// The settings part of the design file, as TOML.
+    pub settings_table: toml::Table,
+    chain: Chain,
+    start: Vec<Real>,
+}
+
+/// The designs a growth chain accepts.
+const GROWTH_LAWS: [GrowthLaw; 3] = [
+    GrowthLaw::Isotropic,
+    GrowthLaw::IsotropicInPlane,
+    GrowthLaw::IsotropicMetricOnly,
+];
+
+/// Reads and checks the design file, the mesh and the target; nothing is written.
+pub fn prepare(req: &Request) -> Result<Prepared, DesignError> {
+    let name = req.design.display().to_string();
+    let text = std::fs::read_to_string(&req.design)
+        .map_err(|e| DesignError::at(&req.design, format!("cannot read the design file: {e}")))?;
+    let (settings_text, design_text) = crate::config::design::split(&text);
+    let design = crate::config::design::parse(&design_text)
+        .map_err(|e| DesignError(format!("{name}: {e}")))?;
+    if !design_text.contains("[design") {
+        return Err(DesignError::at(
+            &req.design,
+            "a design file needs a [design] section (see docs/design.md); to run a scene use \
+             `shellsim SETTINGS MESH`",
+        ));
+    }
+    let settings = Settings::from_str_with(&settings_text, &name, &req.set)
+        .map_err(|e| DesignError(e.to_string()))?;
+    let mut settings_table: toml::Table =
+        toml::from_str(&settings_text).map_err(|e| DesignError::at(&req.design, e.to_string()))?;
+    crate::settings::apply_overrides(&mut settings_table, &req.set)
+        .map_err(|e| DesignError(e.to_string()))?;
+    designable(&settings, &design)
+        .map_err(|(k, r)| DesignError(format!("{name}: invalid '{k}': {r}")))?;
+    let input = read_mesh(&req.mesh).map_err(|e| DesignError(e.to_string()))?;
+    let scene = Scene::build(input.clone(), settings).map_err(|e| DesignError(e.to_string()))?;
+    let target = read_target(&req.target, &scene)?;
+    let (chain, start) = chain_and_start(&scene, &design)
+        .map_err(|(k, r)| DesignError(format!("{name}: invalid '{k}': {r}")))?;
+    Ok(Prepared {
+        scene,
+        design,
+        input,
+        target,
+        settings_table,
+        chain,
+        start,
+    })
+}
+
+/// The scenes a design can be solved in: static, with the Koiter membrane, without contact,
+/// obstacles or the diffusion fields (whose states are not design data). Errors: (key, why).
+fn designable(s: &Settings, d: &Design) -> Result<(), (String, String)> {
+    let no = |k: &str, why: &str| Err((k.to_string(), why.to_string()));
+    if s.solver.mode != crate::settings::Mode::Static {
+        return no(
+            "solver.mode",
+            "a design is made of static equilibria: solver.mode = \"static\"",
+        );
+    }
+    if s.material.model != crate::config::material::MaterialModel::Koiter {
+        return no(
+            "material.model",
+            "the rest sensitivities are derived for the Koiter membrane (material.model = \"koiter\")",
+        );
+    }
+    if s.material.bend_stiffening.is_some() {
+        return no(
+            "material.bend_stiffening",
+            "bend stiffening has no rest sensitivities",
+        );
+    }
+    for (on, key) in [
+        (s.contact.enabled, "contact.enabled"),
+        (s.self_contact.enabled, "self_contact.enabled"),
+        (s.slides.enabled, "slides.enabled"),
+        (s.moisture.enabled, "moisture.enabled"),
+        (s.temperature.enabled, "temperature.enabled"),
+        (!s.obstacles.is_empty(), "obstacles"),
+    ] {
+        if on {
+            return no(
+                key,
+                "a design solves the sheet alone: contact, obstacles, slides and the moisture \
+                 and temperature fields are not designed through",
+            );
+        }
+    }
+    let (law, target) = (s.growth.law, s.rest.target);
+    let ok = match d.variable {
+        Variable::Growth => GROWTH_LAWS.contains(&law) && target == TargetForms::None,
+        Variable::Director => law == GrowthLaw::None && target == TargetForms::Lce,
+        Variable::Forms => {
+            law == GrowthLaw::None
+                && matches!(
+                    target,
+                    TargetForms::None | TargetForms::Uniform | TargetForms::Mesh
+                )
+        }
+    };
+    if !ok {
+        let needs = match d.variable {
+            Variable::Growth => {
+                "the growth factor of growth.law = \"isotropic\", \"isotropic_in_plane\" or \
+                 \"isotropic_metric_only\" (with rest.target = \"none\")"
+            }
+            Variable::Director => {
+                "the director angle of rest.target = \"lce\" (with growth.law = \"none\")"
+            }
+            Variable::Forms => {
+                "the rest forms of rest.target = \"none\", \"uniform\" or \"mesh\" (with \
+                 growth.law = \"none\")"
+            }
+        };
+        return Err((
+            "design.variable".into(),
+            format!(
+                "\"{}\" designs {needs}; this file has growth.law = \"{}\" and rest.target = \"{}\", \
+                 whose law has no such variable",
+                d.variable.name(),
+                law.name(),
+                target.name()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The target's positions: a mesh with the design mesh's connectivity (point to point).
+fn read_target(path: &Path, scene: &Scene) -> Result<Vec<Vec3>, DesignError> {
+    let t = read_mesh(path).map_err(|e| DesignError(e.to_string()))?;
+    if t.positions.is_empty() || t.faces.is_empty() {
+        return Err(DesignError::at(
+            path,
+            "the target is empty: it has no faces",
+        ));
+    }
+    let nv = scene.body.num_vertices();
+    let faces = scene.body.input_faces();
+    if t.positions.len() != nv || t.faces.len() != faces.len() {
+        return Err(DesignError::at(
+            path,
+            format!(
+                "design.objective = \"points\" compares each vertex with its own, which needs the \
+                 design mesh's connectivity: the target has {} vertices and {} faces, the mesh {} \
+                 and {}",
+                t.positions.len(),
+                t.faces.len(),
+                nv,
+                faces.len()
+            ),
+        ));
+    }
+    for (f, (a, b)) in faces.iter().zip(&t.faces).enumerate() {
+        let same = (0..3).any(|k| (0..3).all(|i| a[i] == b[(i + k) % 3]));
+        if !same {
+            return Err(DesignError::at(
+                path,
+                format!(
+                    "the target's face {f} is {b:?}, the mesh's {a:?}: point to point needs the \
+                     same connectivity"
+                ),
+            ));
+        }
+    }
+    Ok(t.positions)
+}
+
+/// The chain of the design's variable and where it starts: `design.start` everywhere, or the
+/// scene's own design (its growth factor, director or rest forms).
+fn chain_and_start(scene: &Scene, d: &Design) -> Result<(Chain, Vec<Real>), (String, String)> {
+    let body = &scene.body;
+    let nf = body.num_faces();
+    let rest = &body.rest;
+    let flat = || {
+        if body.mesh.is_flat_xy() {
+            Ok(())
+        } else {
+            Err((
+                "design.variable".to_string(),
+                format!(
+                    "\"{}\" is given in reference Cartesian (x, y) coordinates, which needs a flat \
+                     mesh in a plane z = const",
+                    d.variable.name()
+                ),
+            ))
+        }
+    };
+    let (chain, own): (Chain, Vec<Real>) = match d.variable {
+        Variable::Growth => {
+            let reference = (0..nf).map(|f| (rest.abar0[f], rest.bbar0[f])).collect();
+            // Every isotropic law has ā = e^{2s} a⁰.
+            let s = (0..nf)
+                .map(|f| 0.25 * (sym_det(&rest.abar1[f]) / sym_det(&rest.abar0[f])).ln())
+                .collect();
+            (Chain::growth(scene.settings.growth.law, reference), s)
+        }
+        Variable::Director => {
+            flat()?;
+            let frames = Chain::frames(&body.mesh);
+            let theta = rest
+                .lce
+                .iter()
+                .zip(&frames)
+                .map(|(l, t)| {
+                    let m = push_forward(t, &l.p);
+                    0.5 * (2.0 * m[1]).atan2(m[0] - m[2])
+                })
+                .collect();
+            let stretch = rest.lce.iter().map(|l| (l.lambda, l.nu)).collect();
+            (Chain::Director { stretch, frames }, theta)
+        }
+        Variable::Forms => {
+            flat()?;
+            let frames = Chain::frames(&body.mesh);
+            let p = (0..nf)
+                .flat_map(|f| {
+                    let a = push_forward(&frames[f], &rest.abar1[f]);
+                    let b = push_forward(&frames[f], &rest.bbar1[f]);
+                    [a[0], a[1], a[2], b[0], b[1], b[2]]
+                })
+                .collect();
+            (Chain::Forms { frames }, p)
+        }
+    };
+    let start = match d.start {
+        Some(v) => vec![v; own.len()],
+        None => own,
+    };
+    if let Some(i) = start.iter().position(|v| !v.is_finite()) {
+        return Err((
+            "design.start".into(),
+            format!(
+                "face {}: the scene's own design is not finite there",
+                i / chain.per_face()
+            ),
+        ));
+    }
+    Ok((chain, start))
+}
+
+/// The Cartesian ā and b̄ of a forms design (six numbers per face), as two fields' data.
+fn split_forms(p: &[Real]) -> (Vec<Real>, Vec<Real>) {
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    for c in p.chunks_exact(6) {
+        a.extend_from_slice(&c[..3]);
+        b.extend_from_slice(&c[3..]);
+    }
+    (a, b)
+}
+
+/// The names and values of the design's face fields for frames (one entry per field).
+fn design_fields(chain: &Chain, p: &[Real]) -> Vec<(String, Field)> {
+    match chain.variable() {
+        Variable::Growth => vec![("growth_factor".into(), Field::scalar(p.to_vec()))],
+        Variable::Director => vec![("director_angle".into(), Field::scalar(p.to_vec()))],
+        Variable::Forms => {
+            let (a, b) = split_forms(p);
+            vec![
+                ("abar_cartesian".into(), Field::triples(a)),
+                ("bbar_cartesian".into(), Field::triples(b)),
+            ]
+        }
+    }
+}
+
+/// A frame of the shape `e` at design `p`: positions aligned onto the target, the design's
+/// fields, and each vertex's distance to its target point (m).
+fn shape_mesh(prep: &Prepared, chain: &Chain, p: &[Real], e: &Evaluated) -> Mesh {
+    let (r, t) = e.alignment;
+    let positions: Vec<Vec3> = e.state.x.iter().map(|x| r * x + t).collect();
+    let dist = positions
+        .iter()
+        .zip(&prep.target)
+        .map(|(x, y)| (x - y).norm())
+        .collect();
+    let mut m = Mesh {
+        positions,
+        faces: prep.scene.body.input_faces(),
+        face_fields: Default::default(),
+        vertex_fields: Default::default(),
+        source: None,
+    };
+    for (k, f) in design_fields(chain, p) {
+        m.face_fields.insert(k, f);
+    }
+    m.vertex_fields
+        .insert("target_distance".into(), Field::scalar(dist));
+    m
+}
+
+/// The input mesh with the fields that reproduce the design, and the settings table that
+/// reads them.
+fn designed(prep: &Prepared, p: &[Real]) -> (Mesh, toml::Table) {
+    let mut mesh = prep.input.clone();
+    let mut table = prep.settings_table.clone();
+    let sub = |t: &mut toml::Table, k: &str| -> toml::Table {
+        match t.remove(k) {
+            Some(toml::Value::Table(x)) => x,
+            _ => toml::Table::new(),
+        }
+    };
+    match &prep.chain {
+        Chain::Growth { .. } => {
+            mesh.face_fields
+                .insert("growth_factor".into(), Field::scalar(p.to_vec()));
+            let mut g = sub(&mut table, "growth");
+            g.remove("s");
+            table.insert("growth".into(), toml::Value::Table(g));
+        }
+        Chain::Director { stretch, .. } => {
+            let data = p
+                .iter()
+                .zip(stretch)
+                .flat_map(|(th, (l, n))| [*th, *l, *n])
+                .collect();
+            mesh.face_fields.insert(
+                "abar_info".into(),
+                Field {
+                    components: 3,
+                    data,
+                },
+            );
+            let mut r = sub(&mut table, "rest");
+            r.remove("lce");
+            r.insert("target".into(), "lce".into());
+            table.insert("rest".into(), toml::Value::Table(r));
+        }
+        Chain::Forms { .. } => {
+            let (a, b) = split_forms(p);
+            mesh.face_fields
+                .insert("abar_info".into(), Field::triples(a));
+            mesh.face_fields
+                .insert("bbar_info".into(), Field::triples(b));
+            let mut r = sub(&mut table, "rest");
+            r.remove("abar");
+            r.remove("bbar");
+            r.insert("target".into(), "mesh".into());
+            table.insert("rest".into(), toml::Value::Table(r));
+        }
+    }
+    // The thickness a growth law grows is the law's own: the mesh's thickness stays.
+    (mesh, table)
+}
+
+/// One row of `design_log.csv`.
+struct Row {
+    iteration: usize,
+    objective: Real,
+    distance: Real,
+    smoothness: Real,
+    gradient: Real,
+    step: Real,
+    trials: usize,
+    timing: DesignTiming,
+    wall: f64,
+}
+
+const LOG_HEADER: &str = "iteration,objective,distance,distance_m,smoothness,projected_gradient,\
+                          step,trials,evaluations,refused,newton_iterations,wall_seconds\n";
+
+impl Row {
+    fn csv(&self, size: Real) -> String {
+        let t = &self.timing;
+        format!(
+            "{},{:e},{:e},{:e},{:e},{:e},{},{},{},{},{},{:.3}\n",
+            self.iteration,
+            self.objective,
+            self.distance,
+            self.distance * size,
+            self.smoothness,
+            self.gradient,
+            self.step,
+            self.trials,
+            t.evaluations,
+            t.refused,
+            t.newton_iterations,
+            self.wall
+        )
+    }
+}
+
+fn write(path: &Path, bytes: &[u8]) -> Result<(), DesignError> {
+    write_atomic(path, bytes).map_err(|e| DesignError::at(path, format!("cannot write: {e}")))
+}
+
+/// The files of an earlier design in `out`.
+const OUTPUTS: [&str; 6] = [
+    "design_summary.json",
+    "design_log.csv",
+    "designed.vtk",
+    "settings.toml",
+    "shape.vtk",
+    "iterations.pvd",
+];
+
+/// Designs: `prepare`d input, the optimiser, and the files. `Ok` with the outcome (converged
+/// or not); `Err` for bad input or a failed write.
+pub fn run(req: &Request) -> Result<Outcome, DesignError> {
+    let clock = Instant::now();
+    let prep = prepare(req)?;
+    if !req.overwrite {
+        if let Some(f) = OUTPUTS.iter().find(|f| req.out.join(f).exists()) {
+            return Err(DesignError::at(
+                &req.out,
+                format!("holds an earlier design ({f}); give --overwrite to replace it"),
+            ));
+        }
+    }
+    let frames_dir = req.out.join("iterations");
+    std::fs::create_dir_all(&frames_dir)
+        .map_err(|e| DesignError::at(&frames_dir, format!("cannot create: {e}")))?;
+    let body = &prep.scene.body;
+    let topo = Topology::build(&body.mesh).map_err(|e| DesignError(e.to_string()))?;
+    let d = &prep.design;
+    let points = Points::new(&body.mesh, prep.target.clone(), d.align);
+    let size = points.size;
+    let scale = match d.variable {
+        Variable::Forms => vec![1.0, 1.0, 1.0, size, size, size],
+        _ => vec![1.0],
+    };
+    let smooth = Smoothness::new(
+        &body.mesh,
+        &topo,
+        d.smoothness,
+        d.variable == Variable::Director,
+        scale,
+    );
+    let chain = prep.chain.clone();
+    let mut problem =
+        Problem::new(&prep.scene, chain.clone(), points, smooth).map_err(DesignError)?;
+    if d.smoothing_length > 0.0 {
+        problem.metric = Some(Sobolev::new(
+            &body.mesh,
+            &topo,
+            d.smoothing_length * size,
+            chain.per_face(),
+        ));
+    }
+    let opts = Options {
+        memory: d.memory,
+        max_iterations: d.max_iterations,
+        tolerance: d.tolerance,
+        first_step: d.first_step,
+        lower: d.lower.unwrap_or(Real::NEG_INFINITY),
+        upper: d.upper.unwrap_or(Real::INFINITY),
+    };
+    let mut log = String::from(LOG_HEADER);
+    let mut series: Vec<(Real, String)> = Vec::new();
+    let mut io_error: Option<DesignError> = None;
+    let every = d.frames_every;
+    let result = {
+        let mut report = |it: &Iterate, prob: &Problem| -> Option<String> {
+            let e = prob.current.as_ref()?;
+            let distance = Points::relative_rms(e.distance);
+            let row = Row {
+                iteration: it.iteration,
+                objective: it.value,
+                distance,
+                smoothness: e.smoothness,
+                gradient: it.gradient,
+                step: it.step,
+                trials: it.trials,
+                timing: prob.timing,
+                wall: clock.elapsed().as_secs_f64(),
+            };
+            log.push_str(&row.csv(size));
+            if !req.quiet {
+                eprintln!(
+                    "design: iteration {}, distance {} of the target's size, objective {}, {:.1} s",
+                    it.iteration,
+                    crate::math::human(distance),
+                    crate::math::human(it.value),
+                    row.wall
+                );
+            }
+            if (every > 0 && it.iteration.is_multiple_of(every)) || it.iteration == 0 {
+                let name = format!("iteration_{:05}.vtk", it.iteration);
+                let m = shape_mesh(&prep, &chain, it.p, e);
+                if let Err(err) =
+                    write_mesh(&frames_dir.join(&name), &m, Format::Vtk, "shellsim design")
+                {
+                    io_error = Some(DesignError(err.to_string()));
+                    return Some("output failed".into());
+                }
+                series.push((it.iteration as Real, format!("iterations/{name}")));
+            }
+            (d.target_distance > 0.0 && distance <= d.target_distance).then(|| {
+                format!(
+                    "the distance to the target, {} of its size, is within design.target_distance",
+                    crate::math::human(distance)
+                )
+            })
+        };
+        minimise(&mut problem, prep.start.clone(), &opts, &mut report)
+    };
+    if let Some(e) = io_error {
+        return Err(e);
+    }
+    let (stop, p, value) = result.map_err(|e| {
+        DesignError(format!(
+            "{}: the starting design has no equilibrium: {e}",
+            req.design.display()
+        ))
+    })?;
+    let e = problem
+        .current
+        .clone()
+        .ok_or_else(|| DesignError("no design was evaluated".into()))?;
+    let iterations = log.lines().count().saturating_sub(2);
+    let (converged, reason) = match &stop {
+        Stop::Converged(w) => (true, w.clone()),
+        Stop::Stalled(w) => (false, format!("the design cannot improve: {w}")),
+        Stop::Limit => (
+            false,
+            format!("design.max_iterations ({}) reached", d.max_iterations),
+        ),
+    };
+    // The last iteration's frame, when `frames_every` skipped it.
+    let last = format!("iterations/iteration_{iterations:05}.vtk");
+    if series.last().map(|s| &s.1) != Some(&last) {
+        let m = shape_mesh(&prep, &chain, &p, &e);
+        write_mesh(&req.out.join(&last), &m, Format::Vtk, "shellsim design")
+            .map_err(|e| DesignError(e.to_string()))?;
+        series.push((iterations as Real, last));
+    }
+    write(
+        &req.out.join("iterations.pvd"),
+        series_xml(&series).as_bytes(),
+    )?;
+    write(&req.out.join("design_log.csv"), log.as_bytes())?;
+    let shape = shape_mesh(&prep, &chain, &p, &e);
+    write_mesh(
+        &req.out.join("shape.vtk"),
+        &shape,
+        Format::Vtk,
+        "shellsim design",
+    )
+    .map_err(|e| DesignError(e.to_string()))?;
+    let (mesh, table) = designed(&prep, &p);
+    write_mesh(
+        &req.out.join("designed.vtk"),
+        &mesh,
+        Format::Vtk,
+        "shellsim design",
+    )
+    .map_err(|e| DesignError(e.to_string()))?;
+    let settings = format!(
+        "# The scene of {} with the design of `shellsim design` as mesh fields: run it with\n\
+         # shellsim settings.toml designed.vtk\n{}",
+        req.design.display(),
+        toml::to_string(&table).map_err(|e| DesignError(e.to_string()))?
+    );
+    write(&req.out.join("settings.toml"), settings.as_bytes())?;
+    let distance = Points::relative_rms(e.distance);
+    let t = problem.timing;
+    let per_newton = if t.newton_iterations > 0 {
+        t.equilibrium / t.newton_iterations as f64
+    } else {
+        0.0
+    };
+    let per_adjoint = (t.adjoint + t.sensitivities) / t.evaluations.max(1) as f64;
+    let summary = serde_json::json!({
+        "converged": converged,
+        "reason": reason,
+        "variable": d.variable.name(),
+        "faces": body.num_faces(),
+        "design_numbers": p.len(),
+        "iterations": iterations,
+        "objective": finite(value),
+        "distance": finite(distance),
+        "distance_m": finite(distance * size),
+        "target_size_m": finite(size),
+        "smoothness": finite(e.smoothness),
+        "evaluations": t.evaluations,
+        "refused_evaluations": t.refused,
+        "newton_iterations": t.newton_iterations,
+        "wall_seconds": clock.elapsed().as_secs_f64(),
+        "timing": {
+            "equilibrium": t.equilibrium,
+            "adjoint": t.adjoint,
+            "sensitivities": t.sensitivities,
+            "seconds_per_newton_iteration": per_newton,
+            "seconds_per_gradient": per_adjoint,
+            "gradient_over_newton_iteration": if per_newton > 0.0 { per_adjoint / per_newton } else { 0.0 },
+        },
+    });
+    let text = serde_json::to_string_pretty(&summary).map_err(|e| DesignError(e.to_string()))?;
+    write(&req.out.join("design_summary.json"), text.as_bytes())?;
+    Ok(Outcome {
+        converged,
+        reason,
+        iterations,
+        objective: value,
+        distance,
+    })
+}
+
+/// A number for the summary: finite values as they are, anything else as 0 (never NaN).
+fn finite(x: Real) -> Real {
+    if x.is_finite() {
+        x
+    } else {
+        0.0
+    }
+}
