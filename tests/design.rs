@@ -478,3 +478,81 @@ fn bad_design_input_is_refused_and_nothing_is_written() {
         "{err}"
     );
 }
+
+/// Recovering the circumferential director of the +1 defect from its cone (λ = 0.9, ν = 0.5:
+/// half-angle asin(λ^(1+ν))), from the neutral design θ = 0 (a uniformly stretched flat disk):
+/// the angles within 2° away from the tip (r > 0.3, as nematic directors: θ ≡ θ + π).
+///
+/// Not reached yet, so ignored (run it with `--ignored`): the design stalls with the shape at
+/// 0.36% of its size and directors up to 74° off (Sobolev steps over 0.2 of the size; 0.9% and
+/// 90° over 0.05), its trial equilibria failing to converge.
+#[test]
+#[ignore]
+fn the_circumferential_director_is_recovered_from_its_cone() {
+    use shellsim::design::lbfgs::{minimise, Options};
+    let mesh = disk(0.2);
+    let text = "[material]\nyoung = 3.0\npoisson = 0.5\nthickness = 0.02\n\
+                [rest]\ntarget = \"lce\"\n[rest.lce]\ntheta = 0.0\nlambda = 0.9\nnu = 0.5\n\
+                [solver]\nmode = \"static\"\ntolerance = 1e-10\n";
+    let sc = scene(mesh, text);
+    let m = &sc.body.mesh;
+    let topo = Topology::build(m).unwrap();
+    let centroids: Vec<Vec3> = m
+        .faces
+        .iter()
+        .map(|f| f.iter().map(|&v| m.positions[v]).sum::<Vec3>() / 3.0)
+        .collect();
+    let truth: Vec<Real> = centroids
+        .iter()
+        .map(|c| c.y.atan2(c.x) + std::f64::consts::FRAC_PI_2)
+        .collect();
+    let chain = || Chain::Director {
+        stretch: vec![(0.9, 0.5); m.faces.len()],
+        frames: Chain::frames(m),
+    };
+    // The cone guides the first solve of the truth.
+    let cone: Vec<Vec3> = m
+        .positions
+        .iter()
+        .map(|q| Vec3::new(0.9 * q.x, 0.9 * q.y, -0.4 * q.x.hypot(q.y)))
+        .collect();
+    let smooth = || Smoothness::new(m, &topo, 0.0, true, vec![1.0]);
+    let target = Problem::new(&sc, chain(), Points::new(m, cone, true), smooth())
+        .unwrap()
+        .evaluate(&truth)
+        .unwrap()
+        .2
+        .state
+        .x;
+    let mut prob = Problem::new(&sc, chain(), Points::new(m, target, true), smooth()).unwrap();
+    prob.metric = Some(shellsim::design::objective::Sobolev::new(
+        m,
+        &topo,
+        0.2 * prob.points.size,
+        1,
+    ));
+    let o = Options {
+        memory: 10,
+        max_iterations: 400,
+        tolerance: 1e-12,
+        first_step: 0.1,
+        lower: Real::NEG_INFINITY,
+        upper: Real::INFINITY,
+    };
+    let mut iterations = 0;
+    let (stop, p, _) = minimise(&mut prob, vec![0.0; truth.len()], &o, &mut |it, _| {
+        iterations = it.iteration;
+        (Points::relative_rms(it.value) < 1e-5).then(|| "close enough".to_string())
+    })
+    .unwrap();
+    let mut worst: Real = 0.0;
+    for (f, c) in centroids.iter().enumerate() {
+        if c.x.hypot(c.y) > 0.3 {
+            let d = (p[f] - truth[f]).sin().abs().asin().to_degrees();
+            worst = worst.max(d);
+        }
+    }
+    let dist = Points::relative_rms(prob.current.as_ref().unwrap().distance);
+    println!("{stop:?} after {iterations} iterations: worst director error {worst:.3}° (r > 0.3), shape {dist:.2e}, {:?}", prob.timing);
+    assert!(worst < 2.0, "director recovered to {worst}°");
+}
