@@ -311,7 +311,8 @@ fn write(dir: &Path, name: &str, text: &str) {
 /// `shellsim design` on the example files at a small size: the stereographic cap from a
 /// forward run is designed back from s = 0 to within 0.1% of its size (exit 0), with its log,
 /// frames and summary; the designed mesh with the written settings grows into the designed
-/// shape (the forward run of the output reproduces `shape.vtk` within 1e-6 of the size).
+/// shape (the forward run of the output reproduces `shape.vtk` within 1e-6 of the size); the
+/// same design on 1 thread and on 2 writes the same bytes.
 #[test]
 fn shellsim_design_designs_the_cap_and_its_output_reproduces_the_shape() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -327,15 +328,31 @@ fn shellsim_design_designs_the_cap_and_its_output_reproduces_the_shape() {
     let fwd = root.join("designs/cap_forward.toml");
     ok(&[fwd.to_str().unwrap(), "disk.vtk", "--out", "target", "-q"]);
     let cap = root.join("designs/cap.toml");
-    ok(&[
-        "design",
-        cap.to_str().unwrap(),
-        "disk.vtk",
-        "target/frame_00001.vtu",
-        "--out",
-        "des",
-        "-q",
-    ]);
+    for (out, threads) in [("des", "2"), ("des1", "1")] {
+        ok(&[
+            "design",
+            cap.to_str().unwrap(),
+            "disk.vtk",
+            "target/frame_00001.vtu",
+            "--out",
+            out,
+            "--threads",
+            threads,
+            "-q",
+        ]);
+    }
+    // The design does not depend on the thread count, to the bit.
+    for f in [
+        "designed.vtk",
+        "shape.vtk",
+        "iterations/iteration_00000.vtk",
+    ] {
+        let (a, b) = (d.join("des").join(f), d.join("des1").join(f));
+        assert!(
+            std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
+            "{f} differs between 2 threads and 1"
+        );
+    }
     let sum: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(d.join("des/design_summary.json")).unwrap())
             .unwrap();
