@@ -455,6 +455,14 @@ fn bad_design_input_is_refused_and_nothing_is_written() {
         }
         assert!(!d.join("out").exists(), "{file} {target} wrote output");
     }
+    // A design file given to the scene runner is refused, pointing to `shellsim design`.
+    let (code, _, err) = run_status(&["good.toml", "disk.vtk", "--out", "out"], d);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("good.toml") && err.contains("shellsim design"),
+        "{err}"
+    );
+    assert!(!d.join("out").exists());
     // A design that runs out of iterations stops with exit 1, the objective and the reason.
     write(
         d,
