@@ -34,6 +34,7 @@ use crate::assembly::{Pattern, Want};
 use crate::energy::{HessianProjection, Potential};
 use crate::math::{Real, Sym2, Vec3};
 use crate::model::Scene;
+use crate::solve::low_rank::Woodbury;
 use crate::solve::newton::Workspace;
 use crate::solve::{newton, LinearSolver, NewtonOptions, State};
 use objective::{Points, Smoothness, Sobolev};
@@ -45,6 +46,23 @@ const ESCAPES: [Real; 3] = [0.05, 0.2, 0.5];
 
 /// The smallest continuation step between two designs' rest data.
 const MIN_CONTINUATION_STEP: Real = 1.0 / 1024.0;
+
+/// The static potential of `scene` on `pattern` at rest data `(forms, ratio)`: the rest forms
+/// and thickness ratios of a design replace the scene's, at dial 1, with the scene's gravity.
+fn potential<'p>(
+    scene: &'p Scene,
+    pattern: &'p Pattern,
+    gravity: Vec3,
+    forms: &'p [(Sym2, Sym2)],
+    ratio: &'p [Real],
+) -> Potential<'p> {
+    Potential {
+        rest_override: Some(forms),
+        thickness_override: Some(ratio),
+        gravity,
+        ..Potential::new(scene, pattern)
+    }
+}
 
 /// Where the time of the evaluations went (s).
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
@@ -103,7 +121,10 @@ pub struct Problem<'s> {
     /// The design of [`Problem::current`].
     current_p: Vec<Real>,
     trial: Option<(Evaluated, Vec<Real>)>,
-    /// Whether `lin` holds the factorisation at the current equilibrium.
+    /// The low-rank (Woodbury) part of the exact Hessian factorised in `lin`, prepared by the
+    /// stability check and reused by the adjoint and the predictor at the same equilibrium.
+    held: Option<Woodbury>,
+    /// Whether `lin` and `held` are the factorisation at the current equilibrium.
     factor_current: bool,
     /// The last predictor: a design change and the equilibrium's first-order response to it.
     predicted: Option<(Vec<Real>, Vec<Real>)>,
@@ -143,6 +164,7 @@ impl<'s> Problem<'s> {
             current: None,
             current_p: Vec::new(),
             trial: None,
+            held: None,
             factor_current: false,
             predicted: None,
             timing: DesignTiming::default(),
@@ -169,12 +191,7 @@ impl<'s> Problem<'s> {
         let mut escapes = ESCAPES.iter();
         loop {
             let clock = Instant::now();
-            let pot = Potential {
-                rest_override: Some(forms),
-                thickness_override: Some(ratio),
-                gravity: self.gravity,
-                ..Potential::new(self.scene, &self.pattern)
-            };
+            let pot = potential(self.scene, &self.pattern, self.gravity, forms, ratio);
             let rep = newton(&pot, &mut self.lin, &mut self.ws, state, self.opts);
             self.timing.equilibrium += clock.elapsed().as_secs_f64();
             self.timing.newton_iterations += rep.iterations;
@@ -195,12 +212,16 @@ impl<'s> Problem<'s> {
                 &mut grad,
                 &mut values,
             );
-            let lr = pot.low_rank(&state.x, &state.dofs);
-            let stable = self.lin.factor(&values).is_ok()
-                && crate::solve::low_rank::Woodbury::new(&mut self.lin, &lr)
-                    .keeps_positive_definite();
+            self.held = None;
+            if self.lin.factor(&values).is_ok() {
+                let lr = pot.low_rank(&state.x, &state.dofs);
+                let wb = Woodbury::new(&mut self.lin, &lr);
+                if wb.keeps_positive_definite() {
+                    self.held = Some(wb);
+                }
+            }
             self.timing.adjoint += clock.elapsed().as_secs_f64();
-            if stable {
+            if self.held.is_some() {
                 return Ok(());
             }
             let Some(&eta) = escapes.next() else {
@@ -235,23 +256,17 @@ impl<'s> Problem<'s> {
         let (mut tau, mut step): (Real, Real) = (0.0, 0.5);
         while tau < 1.0 {
             let next = (tau + step).min(1.0);
-            let blend = |a: Real, b: Real| (1.0 - next) * a + next * b;
             let forms: Vec<(Sym2, Sym2)> = from
                 .0
                 .iter()
                 .zip(to.0)
-                .map(|(a, b)| {
-                    (
-                        a.0 * (1.0 - next) + b.0 * next,
-                        a.1 * (1.0 - next) + b.1 * next,
-                    )
-                })
+                .map(|(a, b)| (a.0.lerp(&b.0, next), a.1.lerp(&b.1, next)))
                 .collect();
             let ratio: Vec<Real> = from
                 .1
                 .iter()
                 .zip(to.1)
-                .map(|(a, b)| blend(*a, *b))
+                .map(|(a, b)| (1.0 - next) * a + next * b)
                 .collect();
             trial.clone_from(state);
             match self.equilibrium(&forms, &ratio, &mut trial) {
@@ -319,12 +334,7 @@ impl<'s> Problem<'s> {
             let rest = self.rest(&q);
             let forms: Vec<(Sym2, Sym2)> = rest.iter().map(|r| r.forms).collect();
             let ratio: Vec<Real> = rest.iter().map(|r| r.ratio).collect();
-            let pot = Potential {
-                rest_override: Some(&forms),
-                thickness_override: Some(&ratio),
-                gravity: self.gravity,
-                ..Potential::new(self.scene, &self.pattern)
-            };
+            let pot = potential(self.scene, &self.pattern, self.gravity, &forms, &ratio);
             let mut g = vec![0.0; self.pattern.n];
             pot.eval(
                 &cur.state.x,
@@ -340,16 +350,15 @@ impl<'s> Problem<'s> {
             .zip(&grads[1])
             .map(|(a, b)| -(a - b) / (2.0 * eps))
             .collect();
-        let pot = Potential {
-            rest_override: Some(&cur.forms),
-            thickness_override: Some(&cur.ratio),
-            gravity: self.gravity,
-            ..Potential::new(self.scene, &self.pattern)
-        };
+        let pot = potential(
+            self.scene,
+            &self.pattern,
+            self.gravity,
+            &cur.forms,
+            &cur.ratio,
+        );
         pot.mask_fixed(&mut dx);
-        let lr = pot.low_rank(&cur.state.x, &cur.state.dofs);
-        let wb = crate::solve::low_rank::Woodbury::new(&mut self.lin, &lr);
-        if !wb.solve_in_place(&mut self.lin, &mut dx) {
+        if !self.held.as_ref()?.solve_in_place(&mut self.lin, &mut dx) {
             return None;
         }
         pot.mask_fixed(&mut dx);
@@ -372,7 +381,6 @@ impl<'s> Problem<'s> {
             let mut state = c.state.clone();
             state.set_step(&c.state, dx, 1.0);
             let guess = state.x.clone();
-            let from_x = c.state.x.clone();
             // An equilibrium further from the prediction than the prediction is from the
             // current one is another branch: the linear response did not hold; go on from the
             // current equilibrium instead.
@@ -383,8 +391,9 @@ impl<'s> Problem<'s> {
                     .sum::<Real>()
                     .sqrt()
             };
+            let predicted = moved(&guess, &c.state.x);
             if self.equilibrium(&forms, &ratio, &mut state).is_ok()
-                && moved(&state.x, &guess) <= moved(&guess, &from_x)
+                && moved(&state.x, &guess) <= predicted
             {
                 return self.finish(p, rest, forms, ratio, state);
             }
@@ -422,16 +431,13 @@ impl<'s> Problem<'s> {
         for (v, g) in d.gradient.iter().enumerate() {
             lambda[3 * v..3 * v + 3].copy_from_slice(g.as_slice());
         }
-        let pot = Potential {
-            rest_override: Some(&forms),
-            thickness_override: Some(&ratio),
-            gravity: self.gravity,
-            ..Potential::new(self.scene, &self.pattern)
-        };
+        let pot = potential(self.scene, &self.pattern, self.gravity, &forms, &ratio);
         pot.mask_fixed(&mut lambda);
-        let lr = pot.low_rank(&state.x, &state.dofs);
-        let wb = crate::solve::low_rank::Woodbury::new(&mut self.lin, &lr);
-        if !wb.solve_in_place(&mut self.lin, &mut lambda) {
+        let solved = match &self.held {
+            Some(wb) => wb.solve_in_place(&mut self.lin, &mut lambda),
+            None => false,
+        };
+        if !solved {
             self.timing.refused += 1;
             return Err("the Hessian with its low-rank part is singular at the equilibrium".into());
         }

@@ -55,9 +55,8 @@ impl Points {
     /// reference areas.
     pub fn new(mesh: &Mesh, target: Vec<Vec3>, align: bool) -> Points {
         let mut w = vec![0.0; mesh.positions.len()];
-        for face in &mesh.faces {
-            let [a, b, c] = face.map(|v| mesh.positions[v]);
-            let area = 0.5 * (b - a).cross(&(c - a)).norm();
+        for (f, face) in mesh.faces.iter().enumerate() {
+            let area = mesh.face_area(f);
             for &v in face {
                 w[v] += area / 3.0;
             }
@@ -230,14 +229,7 @@ pub struct Sobolev {
 impl Sobolev {
     /// The metric on `mesh` with smoothing length `ell` (m), for `per_face` numbers per face.
     pub fn new(mesh: &Mesh, topo: &Topology, ell: Real, per_face: usize) -> Sobolev {
-        let area: Vec<Real> = mesh
-            .faces
-            .iter()
-            .map(|f| {
-                let [a, b, c] = f.map(|v| mesh.positions[v]);
-                0.5 * (b - a).cross(&(c - a)).norm()
-            })
-            .collect();
+        let area: Vec<Real> = (0..mesh.faces.len()).map(|f| mesh.face_area(f)).collect();
         let total: Real = area.iter().sum::<Real>().max(Real::MIN_POSITIVE);
         let edges = Smoothness::new(mesh, topo, 1.0, false, vec![1.0])
             .edges
