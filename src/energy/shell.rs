@@ -282,13 +282,14 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Shell<M
         }
     }
 
-    /// `out(density, a, b)` of every face at `x`, `phi` (in parallel, in face order).
-    fn per_face<T: Send>(
+    /// `out(f, stencil, positions, bending input)` of every face at `x`, `phi` (in parallel, in
+    /// face order).
+    fn each_face<T: Send>(
         &self,
         pot: &Potential,
         x: &[Vec3],
         phi: &[Real],
-        out: impl Fn(&M::Density, &Sym2, &Sym2) -> T + Sync,
+        out: impl Fn(usize, &[usize], &[Vec3; 6], &B::Face) -> T + Sync,
     ) -> Vec<T> {
         use rayon::prelude::*;
         let pattern = pot.pattern.faces();
@@ -298,16 +299,29 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize> Shell<M
                 let nodes = pattern.element(f);
                 let xs = gather(nodes, x);
                 let face = self.bending.face(pot.body, f, nodes, phi);
-                let dens = self.membrane.density(pot, f);
-                let a = first_fundamental_form(&[xs[0], xs[1], xs[2]]);
-                let b = if N > 9 {
-                    self.bending.eval(&face, &xs, false, false).b
-                } else {
-                    Sym2::zeros()
-                };
-                out(&dens, &a, &b)
+                out(f, nodes, &xs, &face)
             })
             .collect()
+    }
+
+    /// `out(density, a, b)` of every face at `x`, `phi` (in parallel, in face order).
+    fn per_face<T: Send>(
+        &self,
+        pot: &Potential,
+        x: &[Vec3],
+        phi: &[Real],
+        out: impl Fn(&M::Density, &Sym2, &Sym2) -> T + Sync,
+    ) -> Vec<T> {
+        self.each_face(pot, x, phi, |f, _, xs, face| {
+            let dens = self.membrane.density(pot, f);
+            let a = first_fundamental_form(&[xs[0], xs[1], xs[2]]);
+            let b = if N > 9 {
+                self.bending.eval(face, xs, false, false).b
+            } else {
+                Sym2::zeros()
+            };
+            out(&dens, &a, &b)
+        })
     }
 
     /// Per-face elastic (stretching, bending) energies (J) at `x`, `phi`, without damping.
@@ -388,48 +402,42 @@ impl<M: Membrane, B: BendingModel<N, S>, const N: usize, const S: usize>
         phi: &[Real],
         lambda: &[Real],
     ) -> Result<Vec<super::sensitivity::RestAdjoint>, String> {
-        use rayon::prelude::*;
-        let pattern = pot.pattern.faces();
-        (0..pot.body.num_faces())
-            .into_par_iter()
-            .map(|f| {
-                let nodes = pattern.element(f);
-                let xs = gather(nodes, x);
-                let face = self.bending.face(pot.body, f, nodes, phi);
-                let rest = self.membrane.rest_face(pot, f)?;
-                let mut l = SVec::<N>::zeros();
-                let mut k = 0;
-                for (s, &u) in nodes.iter().enumerate().take(S) {
-                    let nd = if s < 6 { 3 } else { 1 };
-                    if u != NONE && k + nd <= N {
-                        let (d0, _) = pot.pattern.node_dofs(u);
-                        for c in 0..nd {
-                            l[k + c] = lambda[d0 + c];
-                        }
+        self.each_face(pot, x, phi, |f, nodes, xs, face| {
+            let rest = self.membrane.rest_face(pot, f)?;
+            let mut l = SVec::<N>::zeros();
+            let mut k = 0;
+            for (s, &u) in nodes.iter().enumerate().take(S) {
+                let nd = if s < 6 { 3 } else { 1 };
+                if u != NONE && k + nd <= N {
+                    let (d0, _) = pot.pattern.node_dofs(u);
+                    for c in 0..nd {
+                        l[k + c] = lambda[d0 + c];
                     }
-                    k += nd;
                 }
-                let xf = [xs[0], xs[1], xs[2]];
-                let a = first_fundamental_form(&xf);
-                let da: Sym2 = first_fundamental_form_jacobian(&xf) * l.fixed_rows::<9>(0);
-                let (b, db) = if N > 9 && rest.bending {
-                    let ev = self.bending.eval(&face, &xs, true, false);
-                    let mut db = Sym2::zeros();
-                    for q in 0..3 {
-                        let mut g = SVec::<N>::zeros();
-                        self.bending
-                            .add_gradient(&face, &ev, &Sym2::ith(q, 1.0), &mut g);
-                        db[q] = g.dot(&l);
-                    }
-                    (ev.b, db)
-                } else {
-                    (Sym2::zeros(), Sym2::zeros())
-                };
-                Ok(super::sensitivity::koiter_rest_adjoint(
-                    &rest, &a, &b, &da, &db,
-                ))
-            })
-            .collect()
+                k += nd;
+            }
+            let xf = [xs[0], xs[1], xs[2]];
+            let a = first_fundamental_form(&xf);
+            let da: Sym2 = first_fundamental_form_jacobian(&xf) * l.fixed_rows::<9>(0);
+            let (b, db) = if N > 9 && rest.bending {
+                let ev = self.bending.eval(face, xs, true, false);
+                let mut db = Sym2::zeros();
+                for q in 0..3 {
+                    let mut g = SVec::<N>::zeros();
+                    self.bending
+                        .add_gradient(face, &ev, &Sym2::ith(q, 1.0), &mut g);
+                    db[q] = g.dot(&l);
+                }
+                (ev.b, db)
+            } else {
+                (Sym2::zeros(), Sym2::zeros())
+            };
+            Ok(super::sensitivity::koiter_rest_adjoint(
+                &rest, &a, &b, &da, &db,
+            ))
+        })
+        .into_iter()
+        .collect()
     }
 }
 
