@@ -760,15 +760,6 @@ fn continue_from(out: &std::path::Path, restart: Option<&PathBuf>) -> Result<Pat
 fn run_cmd(cli: &Cli, settings_path: PathBuf, mesh_path: PathBuf) -> Result<u8> {
     let clock = std::time::Instant::now();
     let started = crate::provenance::now();
-    if let Ok(text) = std::fs::read_to_string(&settings_path) {
-        if crate::config::design::split(&text).1.contains("[design") {
-            bail!(
-                "{p}: this is a design file (it has a [design] section): design with \
-                 `shellsim design {p} MESH TARGET`, or remove the section to run the scene",
-                p = settings_path.display()
-            );
-        }
-    }
     let settings = Settings::load(&settings_path, &cli.set)?;
     let mesh = read_mesh(&mesh_path)?;
     let mut scene = Scene::build(mesh, settings)?;

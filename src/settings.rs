@@ -200,6 +200,12 @@ impl Settings {
             path: name.to_string(),
             reason,
         };
+        if crate::config::design::is_design_file(text) {
+            return Err(perr(format!(
+                "this is a design file (it has a [design] section): design with \
+                 `shellsim design {name} MESH TARGET`, or remove the section to run the scene"
+            )));
+        }
         // Parse directly first, for messages with line numbers.
         let direct: Result<Settings, _> = toml::from_str(text);
         let settings = if overrides.is_empty() {

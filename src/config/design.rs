@@ -223,6 +223,11 @@ pub fn split(text: &str) -> (String, String) {
     (settings, design)
 }
 
+/// Whether a settings text is a design file: it has a `[design]` (or `[design.*]`) table.
+pub fn is_design_file(text: &str) -> bool {
+    !split(text).1.trim().is_empty()
+}
+
 /// Parses and validates the `[design]` part of a design file (from [`split`]). The error is the
 /// message to print after the file's name: the TOML parser's (with its line and key) or the
 /// invalid key's.

@@ -100,7 +100,7 @@ pub fn prepare(req: &Request) -> Result<Prepared, DesignError> {
     let (settings_text, design_text) = crate::config::design::split(&text);
     let design = crate::config::design::parse(&design_text)
         .map_err(|e| DesignError(format!("{name}: {e}")))?;
-    if !design_text.contains("[design") {
+    if design_text.trim().is_empty() {
         return Err(DesignError::at(
             &req.design,
             "a design file needs a [design] section (see docs/design.md); to run a scene use \
