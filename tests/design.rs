@@ -8,7 +8,9 @@ use common::run_status;
 use std::path::Path;
 
 use shellsim::config::growth::GrowthLaw;
-use shellsim::design::objective::{Points, Smoothness};
+use shellsim::design::curvature::Curvature;
+use shellsim::design::objective::{DistanceTerm, Points, Shape, Smoothness};
+use shellsim::design::surface::Surface;
 use shellsim::design::variables::Chain;
 use shellsim::design::Problem;
 use shellsim::math::{Real, Vec3};
@@ -57,7 +59,29 @@ fn growth_problem<'s>(scene: &'s Scene, target: Vec<Vec3>, smooth: Real) -> Prob
     let chain = Chain::growth(GrowthLaw::Isotropic, reference);
     let points = Points::new(mesh, target, true);
     let smoothness = Smoothness::new(mesh, &topo, smooth, false, vec![1.0]);
-    Problem::new(scene, chain, points, smoothness).unwrap()
+    Problem::new(
+        scene,
+        chain,
+        distance(DistanceTerm::Points(points)),
+        smoothness,
+    )
+    .unwrap()
+}
+
+/// The shape objective of a distance term alone.
+fn distance(term: DistanceTerm) -> Shape {
+    Shape {
+        distance: Some((1.0, term)),
+        curvature: None,
+    }
+}
+
+/// The growth chain of a scene's reference forms under the isotropic law.
+fn growth_chain(scene: &Scene) -> Chain {
+    let reference = (0..scene.body.num_faces())
+        .map(|f| (scene.body.rest.abar0[f], scene.body.rest.bbar0[f]))
+        .collect();
+    Chain::growth(GrowthLaw::Isotropic, reference)
 }
 
 /// Central differences of `J` over fully re-solved equilibria (from the equilibrium at `p`)
@@ -168,7 +192,7 @@ fn director_forms_and_gas_sensitivities_match_differences() {
     let mut prob = Problem::new(
         &sc,
         chain,
-        Points::new(&mesh, cone, true),
+        distance(DistanceTerm::Points(Points::new(&mesh, cone, true))),
         Smoothness::new(&mesh, &topo, 0.1, true, vec![1.0]),
     )
     .unwrap();
@@ -197,7 +221,7 @@ fn director_forms_and_gas_sensitivities_match_differences() {
     let mut prob = Problem::new(
         &sc,
         chain,
-        Points::new(&mesh, target, false),
+        distance(DistanceTerm::Points(Points::new(&mesh, target, false))),
         Smoothness::new(
             &mesh,
             &topo,
@@ -237,6 +261,75 @@ fn director_forms_and_gas_sensitivities_match_differences() {
     assert!(worst < 1e-6, "gas: worst relative error {worst:e}");
 }
 
+/// The surface-to-surface distance (to a target of another triangulation, after the ICP
+/// alignment) and the curvature terms: adjoint gradients against central differences of
+/// re-solved equilibria, 1e-6 of the largest entry, for growth on a free disk that buckles
+/// into a dome. The target is a cap meshed afresh (another disk's vertices lifted onto the
+/// sphere of radius 1.3), tilted and moved.
+#[test]
+fn surface_and_curvature_sensitivities_match_differences() {
+    let mesh = disk(0.25);
+    let sc = scene(mesh.clone(), &growth_settings("midedge_average", ""));
+    let p: Vec<Real> = stereographic(&mesh, 0.8)
+        .iter()
+        .enumerate()
+        .map(|(f, s)| 0.8 * s + 0.02 * (f as Real).sin())
+        .collect();
+    let other = disk(0.17);
+    let rot = nalgebra::Rotation3::from_euler_angles(0.1, -0.05, 0.2);
+    let cap: Vec<Vec3> = other
+        .positions
+        .iter()
+        .map(|q| {
+            let r2 = q.x * q.x + q.y * q.y;
+            let z = (1.69 - r2).sqrt() - 1.3;
+            rot * Vec3::new(q.x, q.y, z) + Vec3::new(0.05, 0.02, -0.1)
+        })
+        .collect();
+    let surface = Surface::new(&mesh, &cap, &other.faces, true);
+    let mut prob = Problem::new(
+        &sc,
+        growth_chain(&sc),
+        distance(DistanceTerm::Surface(Box::new(surface))),
+        Smoothness::new(
+            &mesh,
+            &Topology::build(&mesh).unwrap(),
+            0.0,
+            false,
+            vec![1.0],
+        ),
+    )
+    .unwrap();
+    let worst = worst_difference(&mut prob, &p, &spread(p.len()), 1e-5, "surface");
+    assert!(worst < 1e-6, "surface: worst relative error {worst:e}");
+
+    // Mean and Gauss curvature fields of a sphere of radius 1.2 with a variation, weighed
+    // together with the point distance.
+    let topo = Topology::build(&mesh).unwrap();
+    let nf = mesh.faces.len();
+    let mean: Vec<Real> = (0..nf)
+        .map(|f| 1.0 / 1.2 + 0.05 * (f as Real).cos())
+        .collect();
+    let gauss: Vec<Real> = mean.iter().map(|h| h * h).collect();
+    let curvature = Curvature::new(&mesh, &topo, 2.0, Some((0.3, mean)), Some((0.2, gauss)));
+    let shape = Shape {
+        distance: Some((
+            1.0,
+            DistanceTerm::Points(Points::new(&mesh, bumpy(&mesh, 0.3), true)),
+        )),
+        curvature: Some(curvature),
+    };
+    let mut prob = Problem::new(
+        &sc,
+        growth_chain(&sc),
+        shape,
+        Smoothness::new(&mesh, &topo, 0.0, false, vec![1.0]),
+    )
+    .unwrap();
+    let worst = worst_difference(&mut prob, &p, &spread(p.len()), 1e-5, "curvature");
+    assert!(worst < 1e-6, "curvature: worst relative error {worst:e}");
+}
+
 /// Recovering a known design from its shape: the disk grown by the stereographic factor
 /// `s(r) = ln(2/(1 + r²))` takes (nearly) the unit sphere's hemisphere; designing from the
 /// neutral `s = 0` toward that shape recovers `s` within 1% (RMS, relative) and the shape
@@ -265,10 +358,11 @@ fn the_stereographic_growth_is_recovered_from_its_cap() {
         let mut prob = growth_problem(&sc, sphere, 0.0);
         prob.evaluate(&truth).unwrap().2.state.x
     };
+    let size = shellsim::design::objective::bounding_diagonal(&target);
     let mut prob = growth_problem(&sc, target, 0.0);
     // The optimiser's steps in the Sobolev metric, as `shellsim design` takes them by default.
     let topo = Topology::build(&sc.body.mesh).unwrap();
-    let ell = 0.05 * prob.points.size;
+    let ell = 0.05 * size;
     prob.metric = Some(shellsim::design::objective::Sobolev::new(
         &sc.body.mesh,
         &topo,
@@ -304,6 +398,31 @@ fn the_stereographic_growth_is_recovered_from_its_cap() {
     assert!(dist < 1e-3, "shape within {dist:e} of its size");
 }
 
+/// A folder with `disk.vtk` (the unit disk, edge 0.2) and `same/`, the forward run of
+/// `designs/cap_forward.toml` on it: the stereographic cap.
+fn cap_dir() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    succeeds(
+        d,
+        &[
+            "mesh", "disk", "--radius", "1", "--edge", "0.2", "-o", "disk.vtk",
+        ],
+    );
+    let fwd = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/cap_forward.toml");
+    succeeds(
+        d,
+        &[fwd.to_str().unwrap(), "disk.vtk", "--out", "same", "-q"],
+    );
+    dir
+}
+
+/// Runs `shellsim args` in `dir` and asserts exit 0.
+fn succeeds(dir: &Path, args: &[&str]) {
+    let (code, _, err) = run_status(args, dir);
+    assert_eq!(code, 0, "shellsim {args:?}: {err}");
+}
+
 fn write(dir: &Path, name: &str, text: &str) {
     std::fs::write(dir.join(name), text).unwrap();
 }
@@ -316,24 +435,16 @@ fn write(dir: &Path, name: &str, text: &str) {
 #[test]
 fn shellsim_design_designs_the_cap_and_its_output_reproduces_the_shape() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let dir = tempfile::tempdir().unwrap();
+    let dir = cap_dir();
     let d = dir.path();
-    let ok = |args: &[&str]| {
-        let (code, _, err) = run_status(args, d);
-        assert_eq!(code, 0, "shellsim {args:?}: {err}");
-    };
-    ok(&[
-        "mesh", "disk", "--radius", "1", "--edge", "0.2", "-o", "disk.vtk",
-    ]);
-    let fwd = root.join("designs/cap_forward.toml");
-    ok(&[fwd.to_str().unwrap(), "disk.vtk", "--out", "target", "-q"]);
+    let ok = |args: &[&str]| succeeds(d, args);
     let cap = root.join("designs/cap.toml");
     for (out, threads) in [("des", "2"), ("des1", "1")] {
         ok(&[
             "design",
             cap.to_str().unwrap(),
             "disk.vtk",
-            "target/frame_00001.vtu",
+            "same/frame_00001.vtu",
             "--out",
             out,
             "--threads",
@@ -383,6 +494,99 @@ fn shellsim_design_designs_the_cap_and_its_output_reproduces_the_shape() {
         rep < 1e-6,
         "the designed mesh grows {rep:e} of the size away from the designed shape"
     );
+}
+
+/// `shellsim design` with the two other objectives for a few iterations: a surface target on
+/// another triangulation (the cap grown on a coarser disk), and the curvature fields that a
+/// frame of the forward run carries as face fields (`mean_curvature`, `gauss_curvature`),
+/// weighed with a fifth of the point distance (from the flat start alone, curvature has a zero
+/// gradient, and the design stops at once with exit 1 saying so). Each lowers its own error in
+/// the log (a distance, the Gauss curvature error) by a third at least within 6 iterations, and
+/// stops at the limit (exit 1).
+#[test]
+fn shellsim_design_reaches_for_a_surface_and_for_curvature_fields() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = cap_dir();
+    let d = dir.path();
+    let ok = |args: &[&str]| succeeds(d, args);
+    ok(&[
+        "mesh",
+        "disk",
+        "--radius",
+        "1",
+        "--edge",
+        "0.25",
+        "-o",
+        "coarse.vtk",
+    ]);
+    let fwd = root.join("designs/cap_forward.toml");
+    ok(&[fwd.to_str().unwrap(), "coarse.vtk", "--out", "target", "-q"]);
+    let cap = std::fs::read_to_string(root.join("designs/cap.toml")).unwrap();
+    write(
+        d,
+        "surface.toml",
+        &format!("{cap}objective = \"surface\"\nmax_iterations = 6\n"),
+    );
+    write(
+        d,
+        "curvature.toml",
+        &format!(
+            "{}distance_weight = 0.2\ngauss_curvature_weight = 1.0\n\
+             mean_curvature_weight = 1.0\nmax_iterations = 6\n",
+            cap.replace("target_distance", "# target_distance")
+        ),
+    );
+    for (file, target, column) in [
+        ("surface.toml", "target/frame_00001.vtu", 2),
+        ("curvature.toml", "same/frame_00001.vtu", 5),
+    ] {
+        let (code, _, err) = run_status(
+            &[
+                "design",
+                file,
+                "disk.vtk",
+                target,
+                "--out",
+                &format!("{file}.out"),
+                "-q",
+            ],
+            d,
+        );
+        assert_eq!(code, 1, "{file}: {err}");
+        let log = std::fs::read_to_string(d.join(format!("{file}.out/design_log.csv"))).unwrap();
+        let values: Vec<Real> = log
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(column).unwrap().parse().unwrap())
+            .collect();
+        let (first, last) = (values[0], *values.last().unwrap());
+        println!(
+            "{file}: {first:.4e} → {last:.4e} in {} iterations",
+            values.len() - 1
+        );
+        assert!(last < first / 1.5, "{file}: {first} → {last}\n{log}");
+    }
+    write(
+        d,
+        "flat.toml",
+        &format!(
+            "{}distance_weight = 0.0\ngauss_curvature_weight = 1.0\n",
+            cap.replace("target_distance", "# target_distance")
+        ),
+    );
+    let (code, _, err) = run_status(
+        &[
+            "design",
+            "flat.toml",
+            "disk.vtk",
+            "same/frame_00001.vtu",
+            "--out",
+            "flat",
+        ],
+        d,
+    );
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("critical point"), "{err}");
 }
 
 /// Bad design input: exit 2 naming the file and the key or face, and nothing written.
@@ -542,18 +746,20 @@ fn the_circumferential_director_is_recovered_from_its_cone() {
         .map(|q| Vec3::new(0.9 * q.x, 0.9 * q.y, -0.4 * q.x.hypot(q.y)))
         .collect();
     let smooth = || Smoothness::new(m, &topo, 0.0, true, vec![1.0]);
-    let target = Problem::new(&sc, chain(), Points::new(m, cone, true), smooth())
+    let points = |t: Vec<Vec3>| distance(DistanceTerm::Points(Points::new(m, t, true)));
+    let target = Problem::new(&sc, chain(), points(cone), smooth())
         .unwrap()
         .evaluate(&truth)
         .unwrap()
         .2
         .state
         .x;
-    let mut prob = Problem::new(&sc, chain(), Points::new(m, target, true), smooth()).unwrap();
+    let size = shellsim::design::objective::bounding_diagonal(&target);
+    let mut prob = Problem::new(&sc, chain(), points(target), smooth()).unwrap();
     prob.metric = Some(shellsim::design::objective::Sobolev::new(
         m,
         &topo,
-        0.2 * prob.points.size,
+        0.2 * size,
         1,
     ));
     let o = Options {

@@ -42,6 +42,19 @@ pub enum Objective {
     /// with its own.
     #[default]
     Points,
+    /// Surface to surface: the target is any triangle mesh; each point of either surface is
+    /// compared with its closest point on the other.
+    Surface,
+}
+
+impl Objective {
+    /// The settings name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Objective::Points => "points",
+            Objective::Surface => "surface",
+        }
+    }
 }
 
 /// The `[design]` section.
@@ -65,8 +78,15 @@ pub struct Design {
     /// crumpling on the way (default 0.05; 0: the plain per-face gradient). It changes the
     /// path, not the optimum.
     pub smoothing_length: Real,
-    /// The objective: `"points"` (default).
+    /// How the distance to the target is measured: `"points"` (default; the target has the
+    /// mesh's connectivity) or `"surface"` (any target mesh).
     pub objective: Objective,
+    /// Weight of the distance term (default 1; 0: no distance term).
+    pub distance_weight: Real,
+    /// Weight of the mean curvature term `½ Σ w_f (H − H*)² L²` (default 0: none).
+    pub mean_curvature_weight: Real,
+    /// Weight of the Gauss curvature term `½ Σ w_f (K − K*)² L⁴` (default 0: none).
+    pub gauss_curvature_weight: Real,
     /// Whether the shape is compared after the best rigid motion (default: true).
     pub align: bool,
     /// The most design iterations (default 200).
@@ -96,6 +116,9 @@ impl Default for Design {
             smoothness: 0.0,
             smoothing_length: 0.05,
             objective: Objective::Points,
+            distance_weight: 1.0,
+            mean_curvature_weight: 0.0,
+            gauss_curvature_weight: 0.0,
             align: true,
             max_iterations: 200,
             tolerance: 1e-9,
@@ -158,9 +181,28 @@ impl Design {
             );
         }
         ck.nonneg("design.smoothness", self.smoothness)?;
+        ck.nonneg("design.distance_weight", self.distance_weight)?;
+        ck.nonneg("design.mean_curvature_weight", self.mean_curvature_weight)?;
+        ck.nonneg("design.gauss_curvature_weight", self.gauss_curvature_weight)?;
+        if self.distance_weight + self.mean_curvature_weight + self.gauss_curvature_weight <= 0.0 {
+            return ck.inv(
+                "design.distance_weight",
+                "the objective has no term: give design.distance_weight, \
+                 design.mean_curvature_weight or design.gauss_curvature_weight a positive weight"
+                    .into(),
+            );
+        }
         ck.nonneg("design.smoothing_length", self.smoothing_length)?;
         ck.pos("design.tolerance", self.tolerance)?;
         ck.nonneg("design.target_distance", self.target_distance)?;
+        if self.target_distance > 0.0 && self.distance_weight == 0.0 {
+            return ck.inv(
+                "design.target_distance",
+                "stops on the distance to the target, which this objective does not have \
+                 (design.distance_weight = 0)"
+                    .into(),
+            );
+        }
         ck.pos("design.first_step", self.first_step)?;
         if self.memory == 0 || self.memory > 100 {
             return ck.inv(

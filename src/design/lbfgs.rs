@@ -128,6 +128,21 @@ pub fn minimise<P: Problem>(
     for it in 1..=o.max_iterations {
         let pg = projected(&p, &g, o);
         if amax(&pg) == 0.0 {
+            // At the start with something left to gain, a zero gradient is a critical point
+            // the design cannot leave by descent (a flat sheet's curvature does not change to
+            // first order), not an optimum.
+            if it == 1 && f > 0.0 {
+                return Ok((
+                    Stop::Stalled(
+                        "the gradient is zero at the starting design, a critical point that \
+                         is not the target (a flat start changes no curvature to first order: \
+                         add a distance term or start from a curved design)"
+                            .into(),
+                    ),
+                    p,
+                    f,
+                ));
+            }
             return Ok((
                 Stop::Converged("the projected gradient is zero".into()),
                 p,

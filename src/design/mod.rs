@@ -25,9 +25,11 @@
 //! stays unstable is refused, and the optimiser cuts its step ([`lbfgs`]): the design moves by
 //! continuation, never further than the equilibrium follows.
 
+pub mod curvature;
 pub mod lbfgs;
 pub mod objective;
 pub mod run;
+pub mod surface;
 pub mod variables;
 
 use crate::assembly::{Pattern, Want};
@@ -37,7 +39,7 @@ use crate::model::Scene;
 use crate::solve::low_rank::Woodbury;
 use crate::solve::newton::Workspace;
 use crate::solve::{newton, LinearSolver, NewtonOptions, State};
-use objective::{Points, Smoothness, Sobolev};
+use objective::{Shape, Smoothness, Sobolev};
 use std::time::Instant;
 use variables::Chain;
 
@@ -92,8 +94,14 @@ pub struct Evaluated {
     pub forms: Vec<(Sym2, Sym2)>,
     /// `h̄/h` per face.
     pub ratio: Vec<Real>,
-    /// The distance term `J_d`.
+    /// The distance term `J_d` (unweighted; 0 without it).
     pub distance: Real,
+    /// The mean curvature term `J_H` (unweighted).
+    pub mean: Real,
+    /// The Gauss curvature term `J_K` (unweighted).
+    pub gauss: Real,
+    /// The target point each vertex is compared with (target frame), with a distance term.
+    pub nearest: Option<Vec<Vec3>>,
     /// The smoothness term `J_s`.
     pub smoothness: Real,
     /// The alignment `(R, t)` of the shape onto the target.
@@ -105,8 +113,8 @@ pub struct Problem<'s> {
     scene: &'s Scene,
     /// The design chain.
     pub chain: Chain,
-    /// The distance term.
-    pub points: Points,
+    /// The shape terms.
+    pub shape: Shape,
     /// The smoothness term.
     pub smoothness: Smoothness,
     /// The Sobolev metric of the optimiser's steps (`None`: the plain gradient).
@@ -133,11 +141,11 @@ pub struct Problem<'s> {
 }
 
 impl<'s> Problem<'s> {
-    /// The problem of `scene` with `chain`, `points` and `smoothness`.
+    /// The problem of `scene` with `chain`, the shape terms and `smoothness`.
     pub fn new(
         scene: &'s Scene,
         chain: Chain,
-        points: Points,
+        shape: Shape,
         smoothness: Smoothness,
     ) -> Result<Self, String> {
         let pattern = Pattern::for_scene(scene);
@@ -148,7 +156,7 @@ impl<'s> Problem<'s> {
         Ok(Problem {
             scene,
             chain,
-            points,
+            shape,
             smoothness,
             metric: None,
             pattern,
@@ -227,8 +235,16 @@ impl<'s> Problem<'s> {
             let Some(&eta) = escapes.next() else {
                 return Err("the equilibrium stays unstable after pushes toward the target".into());
             };
-            let (r, t) = self.points.alignment(&state.x);
-            for (x, y) in state.x.iter_mut().zip(&self.points.target) {
+            let seen = self.shape.eval(&state.x);
+            let Some(near) = seen.nearest else {
+                return Err(
+                    "the equilibrium is unstable, and without a distance term there is \
+                            no target to push it toward"
+                        .into(),
+                );
+            };
+            let (r, t) = seen.alignment;
+            for (x, y) in state.x.iter_mut().zip(&near) {
                 let seen = r.transpose() * (y - t);
                 *x += (seen - *x) * eta;
             }
@@ -426,7 +442,7 @@ impl<'s> Problem<'s> {
         state: State,
     ) -> Result<(Real, Vec<Real>, Evaluated), String> {
         let clock = Instant::now();
-        let d = self.points.eval(&state.x);
+        let d = self.shape.eval(&state.x);
         let mut lambda = vec![0.0; self.pattern.n];
         for (v, g) in d.gradient.iter().enumerate() {
             lambda[3 * v..3 * v + 3].copy_from_slice(g.as_slice());
@@ -478,9 +494,12 @@ impl<'s> Problem<'s> {
                 state,
                 forms,
                 ratio,
-                distance: d.value,
+                distance: d.distance,
+                mean: d.mean,
+                gauss: d.gauss,
                 smoothness: js,
-                alignment: (d.rotation, d.translation),
+                alignment: d.alignment,
+                nearest: d.nearest,
             },
         ))
     }

@@ -48,36 +48,77 @@ pub struct Distance {
     pub rotation: Mat3,
     /// The translation `t` (m).
     pub translation: Vec3,
+    /// The target point each vertex is compared with (m, the target's frame).
+    pub nearest: Vec<Vec3>,
+}
+
+/// The lumped reference areas of `mesh`'s vertices (a third of each face's), summing to 1.
+pub fn lumped_weights(mesh: &Mesh) -> Vec<Real> {
+    let mut w = vec![0.0; mesh.positions.len()];
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let area = mesh.face_area(f);
+        for &v in face {
+            w[v] += area / 3.0;
+        }
+    }
+    let total: Real = w.iter().sum();
+    if total > 0.0 {
+        for x in &mut w {
+            *x /= total;
+        }
+    }
+    w
+}
+
+/// The diagonal of the bounding box of `points` (m): a shape's size.
+pub fn bounding_diagonal(points: &[Vec3]) -> Real {
+    let (lo, hi) = points.iter().fold(
+        (
+            Vec3::repeat(Real::INFINITY),
+            Vec3::repeat(Real::NEG_INFINITY),
+        ),
+        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+    );
+    (hi - lo).norm()
+}
+
+/// The rigid motion `(R, t)` minimising `Σ w |R p + t − q|²` over weighted pairs `(p, q, w)`:
+/// the weighted Kabsch–Umeyama rotation. With the weighted centroids `p̄`, `q̄` and
+/// `K = Σ w (p − p̄)(q − q̄)ᵀ = U Σ Vᵀ`, `R = V diag(1, 1, det(V Uᵀ)) Uᵀ` and `t = q̄ − R p̄`.
+pub fn kabsch(pairs: impl Iterator<Item = (Vec3, Vec3, Real)> + Clone) -> (Mat3, Vec3) {
+    let (mut cp, mut cq, mut total) = (Vec3::zeros(), Vec3::zeros(), 0.0);
+    for (p, q, w) in pairs.clone() {
+        cp += p * w;
+        cq += q * w;
+        total += w;
+    }
+    if total <= 0.0 {
+        return (Mat3::identity(), Vec3::zeros());
+    }
+    cp /= total;
+    cq /= total;
+    let mut k = Mat3::zeros();
+    for (p, q, w) in pairs {
+        k += (p - cp) * (q - cq).transpose() * w;
+    }
+    let svd = k.svd(true, true);
+    let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
+        return (Mat3::identity(), cq - cp);
+    };
+    let v = vt.transpose();
+    let sign = (v * u.transpose()).determinant().signum();
+    let r = v * Mat3::from_diagonal(&Vec3::new(1.0, 1.0, sign)) * u.transpose();
+    (r, cq - r * cp)
 }
 
 impl Points {
     /// The objective of `target` on `mesh`'s connectivity; the weights are `mesh`'s lumped
     /// reference areas.
     pub fn new(mesh: &Mesh, target: Vec<Vec3>, align: bool) -> Points {
-        let mut w = vec![0.0; mesh.positions.len()];
-        for (f, face) in mesh.faces.iter().enumerate() {
-            let area = mesh.face_area(f);
-            for &v in face {
-                w[v] += area / 3.0;
-            }
-        }
-        let total: Real = w.iter().sum();
-        if total > 0.0 {
-            for x in &mut w {
-                *x /= total;
-            }
-        }
-        let (lo, hi) = target.iter().fold(
-            (
-                Vec3::repeat(Real::INFINITY),
-                Vec3::repeat(Real::NEG_INFINITY),
-            ),
-            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
-        );
         Points {
-            size: (hi - lo).norm(),
+            size: bounding_diagonal(&target),
+            weights: lumped_weights(mesh),
             target,
-            weights: w,
             align,
         }
     }
@@ -87,25 +128,12 @@ impl Points {
         if !self.align {
             return (Mat3::identity(), Vec3::zeros());
         }
-        let cx: Vec3 = x.iter().zip(&self.weights).map(|(p, w)| p * *w).sum();
-        let cy: Vec3 = self
-            .target
-            .iter()
-            .zip(&self.weights)
-            .map(|(p, w)| p * *w)
-            .sum();
-        let mut k = Mat3::zeros();
-        for ((p, q), w) in x.iter().zip(&self.target).zip(&self.weights) {
-            k += (p - cx) * (q - cy).transpose() * *w;
-        }
-        let svd = k.svd(true, true);
-        let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
-            return (Mat3::identity(), cy - cx);
-        };
-        let v = vt.transpose();
-        let sign = (v * u.transpose()).determinant().signum();
-        let r = v * Mat3::from_diagonal(&Vec3::new(1.0, 1.0, sign)) * u.transpose();
-        (r, cy - r * cx)
+        kabsch(
+            x.iter()
+                .zip(&self.target)
+                .zip(&self.weights)
+                .map(|((p, q), w)| (*p, *q, *w)),
+        )
     }
 
     /// `J_d` and its gradient at `x`.
@@ -128,12 +156,90 @@ impl Points {
             gradient,
             rotation: r,
             translation: t,
+            nearest: self.target.clone(),
         }
     }
 
     /// The RMS distance over the target's size of an objective value.
     pub fn relative_rms(value: Real) -> Real {
         (2.0 * value.max(0.0)).sqrt()
+    }
+}
+
+/// How the shape's distance to the target is measured.
+#[derive(Debug)]
+pub enum DistanceTerm {
+    /// Vertex to vertex, on the design mesh's connectivity.
+    Points(Points),
+    /// Surface to surface, any triangulation ([`super::surface`]).
+    Surface(Box<super::surface::Surface>),
+}
+
+/// The shape part of the objective: `μ_d J_d + μ_H J_H + μ_K J_K`, each term present when its
+/// weight is set ([`super::curvature`] for the curvature terms).
+#[derive(Debug)]
+pub struct Shape {
+    /// The distance term and its weight `μ_d`.
+    pub distance: Option<(Real, DistanceTerm)>,
+    /// The curvature terms with their weights.
+    pub curvature: Option<super::curvature::Curvature>,
+}
+
+/// The shape terms at a shape.
+#[derive(Clone, Debug)]
+pub struct ShapeValue {
+    /// The weighted sum.
+    pub value: Real,
+    /// `J_d`, unweighted (0 without the term).
+    pub distance: Real,
+    /// `J_H`, unweighted.
+    pub mean: Real,
+    /// `J_K`, unweighted.
+    pub gauss: Real,
+    /// The weighted sum's gradient per vertex (1/m).
+    pub gradient: Vec<Vec3>,
+    /// The alignment `(R, t)` (identity without a distance term or alignment).
+    pub alignment: (Mat3, Vec3),
+    /// The target point each vertex is compared with (the target's frame), with a distance term.
+    pub nearest: Option<Vec<Vec3>>,
+}
+
+impl Shape {
+    /// The terms and their gradient at `x`.
+    pub fn eval(&self, x: &[Vec3]) -> ShapeValue {
+        let mut out = ShapeValue {
+            value: 0.0,
+            distance: 0.0,
+            mean: 0.0,
+            gauss: 0.0,
+            gradient: vec![Vec3::zeros(); x.len()],
+            alignment: (Mat3::identity(), Vec3::zeros()),
+            nearest: None,
+        };
+        if let Some((mu, term)) = &self.distance {
+            let d = match term {
+                DistanceTerm::Points(p) => p.eval(x),
+                DistanceTerm::Surface(s) => s.eval(x),
+            };
+            out.distance = d.value;
+            out.value += mu * d.value;
+            for (g, h) in out.gradient.iter_mut().zip(&d.gradient) {
+                *g += h * *mu;
+            }
+            out.alignment = (d.rotation, d.translation);
+            out.nearest = Some(d.nearest);
+        }
+        if let Some(c) = &self.curvature {
+            let v = c.eval(x);
+            out.mean = v.mean;
+            out.gauss = v.gauss;
+            out.value += c.mean.as_ref().map_or(0.0, |m| m.0) * v.mean
+                + c.gauss.as_ref().map_or(0.0, |m| m.0) * v.gauss;
+            for (g, h) in out.gradient.iter_mut().zip(&v.gradient) {
+                *g += h;
+            }
+        }
+        out
     }
 }
 

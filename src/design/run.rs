@@ -9,11 +9,13 @@
 //! * `design_log.csv`: the objective per iteration; `design_summary.json`: how it ended, the
 //!   numbers and where the time went.
 
+use super::curvature::{face_fields, Curvature};
 use super::lbfgs::{minimise, Iterate, Options, Stop};
-use super::objective::{Points, Smoothness, Sobolev};
+use super::objective::{bounding_diagonal, DistanceTerm, Points, Shape, Smoothness, Sobolev};
+use super::surface::Surface;
 use super::variables::Chain;
 use super::{DesignTiming, Evaluated, Problem};
-use crate::config::design::{Design, Variable};
+use crate::config::design::{Design, Objective, Variable};
 use crate::config::growth::GrowthLaw;
 use crate::math::{sym_det, Real, Vec3};
 use crate::mesh::io::{read_mesh, series_xml, write_atomic, write_mesh, Format};
@@ -77,8 +79,11 @@ pub struct Prepared {
     pub design: Design,
     /// The input mesh as read (the designed mesh keeps its fields).
     pub input: Mesh,
-    /// The target's positions.
-    pub target: Vec<Vec3>,
+    /// The target mesh.
+    pub target: Mesh,
+    /// The target mean and Gauss curvature per face of the design mesh (1/m, 1/m²), when the
+    /// objective has those terms.
+    pub curvature_targets: (Option<Vec<Real>>, Option<Vec<Real>>),
     /// The settings part of the design file, as TOML.
     pub settings_table: toml::Table,
     chain: Chain,
@@ -117,7 +122,8 @@ pub fn prepare(req: &Request) -> Result<Prepared, DesignError> {
         .map_err(|(k, r)| DesignError(format!("{name}: invalid '{k}': {r}")))?;
     let input = read_mesh(&req.mesh).map_err(|e| DesignError(e.to_string()))?;
     let scene = Scene::build(input.clone(), settings).map_err(|e| DesignError(e.to_string()))?;
-    let target = read_target(&req.target, &scene)?;
+    let target = read_target(&req.target, &scene, &design)?;
+    let curvature_targets = curvature_targets(&req.target, &target, &scene, &design)?;
     let (chain, start) = chain_and_start(&scene, &design)
         .map_err(|(k, r)| DesignError(format!("{name}: invalid '{k}': {r}")))?;
     Ok(Prepared {
@@ -125,6 +131,7 @@ pub fn prepare(req: &Request) -> Result<Prepared, DesignError> {
         design,
         input,
         target,
+        curvature_targets,
         settings_table,
         chain,
         start,
@@ -209,8 +216,9 @@ fn designable(s: &Settings, d: &Design) -> Result<(), (String, String)> {
     Ok(())
 }
 
-/// The target's positions: a mesh with the design mesh's connectivity (point to point).
-fn read_target(path: &Path, scene: &Scene) -> Result<Vec<Vec3>, DesignError> {
+/// The target mesh: not empty, and with the design mesh's connectivity when the objective
+/// compares vertices (point to point, or curvatures computed from the target's geometry).
+fn read_target(path: &Path, scene: &Scene, d: &Design) -> Result<Mesh, DesignError> {
     let t = read_mesh(path).map_err(|e| DesignError(e.to_string()))?;
     if t.positions.is_empty() || t.faces.is_empty() {
         return Err(DesignError::at(
@@ -218,15 +226,27 @@ fn read_target(path: &Path, scene: &Scene) -> Result<Vec<Vec3>, DesignError> {
             "the target is empty: it has no faces",
         ));
     }
+    if d.distance_weight > 0.0 && d.objective == Objective::Points {
+        same_connectivity(
+            path,
+            &t,
+            scene,
+            "design.objective = \"points\" compares each vertex with its own",
+        )?;
+    }
+    Ok(t)
+}
+
+/// Checks that the target `t` has the design mesh's connectivity, which `why` needs.
+fn same_connectivity(path: &Path, t: &Mesh, scene: &Scene, why: &str) -> Result<(), DesignError> {
     let nv = scene.body.num_vertices();
     let faces = scene.body.input_faces();
     if t.positions.len() != nv || t.faces.len() != faces.len() {
         return Err(DesignError::at(
             path,
             format!(
-                "design.objective = \"points\" compares each vertex with its own, which needs the \
-                 design mesh's connectivity: the target has {} vertices and {} faces, the mesh {} \
-                 and {}",
+                "{why}, which needs the design mesh's connectivity: the target has {} vertices \
+                 and {} faces, the mesh {} and {}",
                 t.positions.len(),
                 t.faces.len(),
                 nv,
@@ -240,13 +260,81 @@ fn read_target(path: &Path, scene: &Scene) -> Result<Vec<Vec3>, DesignError> {
             return Err(DesignError::at(
                 path,
                 format!(
-                    "the target's face {f} is {b:?}, the mesh's {a:?}: point to point needs the \
+                    "the target's face {f} is {b:?}, the mesh's {a:?}: {why}, which needs the \
                      same connectivity"
                 ),
             ));
         }
     }
-    Ok(t.positions)
+    Ok(())
+}
+
+/// The target curvatures per face of the design mesh for the curvature terms the design
+/// weighs: the target's face fields `mean_curvature` (1/m) and `gauss_curvature` (1/m²) when it
+/// has them, else the curvatures of the target's own geometry (which then needs the design
+/// mesh's connectivity).
+#[allow(clippy::type_complexity)]
+fn curvature_targets(
+    path: &Path,
+    t: &Mesh,
+    scene: &Scene,
+    d: &Design,
+) -> Result<(Option<Vec<Real>>, Option<Vec<Real>>), DesignError> {
+    let nf = scene.body.num_faces();
+    let mut geometry: Option<Vec<Option<(Real, Real)>>> = None;
+    let mut field =
+        |name: &str, weight: Real, which: usize| -> Result<Option<Vec<Real>>, DesignError> {
+            if weight <= 0.0 {
+                return Ok(None);
+            }
+            if let Some(f) = t.face_fields.get(name) {
+                if f.components != 1 {
+                    return Err(DesignError::at(
+                        path,
+                        format!("the face field '{name}' must have one number per face"),
+                    ));
+                }
+                let v = &f.data;
+                if v.len() != nf {
+                    return Err(DesignError::at(
+                        path,
+                        format!(
+                            "the face field '{name}' has {} values; the design mesh has {nf} faces",
+                            v.len()
+                        ),
+                    ));
+                }
+                if let Some(face) = v.iter().position(|x| !x.is_finite()) {
+                    return Err(DesignError::at(
+                        path,
+                        format!("the face field '{name}' is not finite at face {face}"),
+                    ));
+                }
+                return Ok(Some(v.to_vec()));
+            }
+            if geometry.is_none() {
+                same_connectivity(
+                    path,
+                    t,
+                    scene,
+                    &format!(
+                        "the target has no face field '{name}', so its curvatures come from its \
+                     geometry face by face"
+                    ),
+                )?;
+                let topo = Topology::build(t).map_err(|e| DesignError(e.to_string()))?;
+                geometry = Some(face_fields(t, &topo, &t.positions));
+            }
+            let g = geometry.as_ref().expect("computed above");
+            Ok(Some(
+                g.iter()
+                    .map(|c| c.map_or(0.0, |c| if which == 0 { c.0 } else { c.1 }))
+                    .collect(),
+            ))
+        };
+    let mean = field("mean_curvature", d.mean_curvature_weight, 0)?;
+    let gauss = field("gauss_curvature", d.gauss_curvature_weight, 1)?;
+    Ok((mean, gauss))
 }
 
 /// The chain of the design's variable and where it starts: `design.start` everywhere, or the
@@ -352,11 +440,13 @@ fn design_fields(chain: &Chain, p: &[Real]) -> Vec<(String, Field)> {
 fn shape_mesh(prep: &Prepared, chain: &Chain, p: &[Real], e: &Evaluated) -> Mesh {
     let (r, t) = e.alignment;
     let positions: Vec<Vec3> = e.state.x.iter().map(|x| r * x + t).collect();
-    let dist = positions
-        .iter()
-        .zip(&prep.target)
-        .map(|(x, y)| (x - y).norm())
-        .collect();
+    let dist: Option<Vec<Real>> = e.nearest.as_ref().map(|near| {
+        positions
+            .iter()
+            .zip(near)
+            .map(|(x, y)| (x - y).norm())
+            .collect()
+    });
     let mut m = Mesh {
         positions,
         faces: prep.scene.body.input_faces(),
@@ -367,8 +457,10 @@ fn shape_mesh(prep: &Prepared, chain: &Chain, p: &[Real], e: &Evaluated) -> Mesh
     for (k, f) in design_fields(chain, p) {
         m.face_fields.insert(k, f);
     }
-    m.vertex_fields
-        .insert("target_distance".into(), Field::scalar(dist));
+    if let Some(dist) = dist {
+        m.vertex_fields
+            .insert("target_distance".into(), Field::scalar(dist));
+    }
     m
 }
 
@@ -431,6 +523,8 @@ struct Row {
     iteration: usize,
     objective: Real,
     distance: Real,
+    mean: Real,
+    gauss: Real,
     smoothness: Real,
     gradient: Real,
     step: Real,
@@ -439,18 +533,21 @@ struct Row {
     wall: f64,
 }
 
-const LOG_HEADER: &str = "iteration,objective,distance,distance_m,smoothness,projected_gradient,\
-                          step,trials,evaluations,refused,newton_iterations,wall_seconds\n";
+const LOG_HEADER: &str = "iteration,objective,distance,distance_m,mean_curvature_error,\
+                          gauss_curvature_error,smoothness,projected_gradient,step,trials,\
+                          evaluations,refused,newton_iterations,wall_seconds\n";
 
 impl Row {
     fn csv(&self, size: Real) -> String {
         let t = &self.timing;
         format!(
-            "{},{:e},{:e},{:e},{:e},{:e},{},{},{},{},{},{:.3}\n",
+            "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{},{},{:.3}\n",
             self.iteration,
             self.objective,
             self.distance,
             self.distance * size,
+            self.mean,
+            self.gauss,
             self.smoothness,
             self.gradient,
             self.step,
@@ -496,8 +593,37 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
     let body = &prep.scene.body;
     let topo = Topology::build(&body.mesh).map_err(|e| DesignError(e.to_string()))?;
     let d = &prep.design;
-    let points = Points::new(&body.mesh, prep.target.clone(), d.align);
-    let size = points.size;
+    let size = bounding_diagonal(&prep.target.positions);
+    let distance = (d.distance_weight > 0.0).then(|| {
+        let term = match d.objective {
+            Objective::Points => DistanceTerm::Points(Points::new(
+                &body.mesh,
+                prep.target.positions.clone(),
+                d.align,
+            )),
+            Objective::Surface => DistanceTerm::Surface(Box::new(Surface::new(
+                &body.mesh,
+                &prep.target.positions,
+                &prep.target.faces,
+                d.align,
+            ))),
+        };
+        (d.distance_weight, term)
+    });
+    let (mean, gauss) = prep.curvature_targets.clone();
+    let curvature = (mean.is_some() || gauss.is_some()).then(|| {
+        Curvature::new(
+            &body.mesh,
+            &topo,
+            size,
+            mean.map(|m| (d.mean_curvature_weight, m)),
+            gauss.map(|g| (d.gauss_curvature_weight, g)),
+        )
+    });
+    let shape = Shape {
+        distance,
+        curvature,
+    };
     let scale = match d.variable {
         Variable::Forms => vec![1.0, 1.0, 1.0, size, size, size],
         _ => vec![1.0],
@@ -511,7 +637,7 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
     );
     let chain = prep.chain.clone();
     let mut problem =
-        Problem::new(&prep.scene, chain.clone(), points, smooth).map_err(DesignError)?;
+        Problem::new(&prep.scene, chain.clone(), shape, smooth).map_err(DesignError)?;
     if d.smoothing_length > 0.0 {
         problem.metric = Some(Sobolev::new(
             &body.mesh,
@@ -540,6 +666,8 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
                 iteration: it.iteration,
                 objective: it.value,
                 distance,
+                mean: Points::relative_rms(e.mean),
+                gauss: Points::relative_rms(e.gauss),
                 smoothness: e.smoothness,
                 gradient: it.gradient,
                 step: it.step,
@@ -654,6 +782,8 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
         "distance": finite(distance),
         "distance_m": finite(distance * size),
         "target_size_m": finite(size),
+        "mean_curvature_error": finite(Points::relative_rms(e.mean)),
+        "gauss_curvature_error": finite(Points::relative_rms(e.gauss)),
         "smoothness": finite(e.smoothness),
         "evaluations": t.evaluations,
         "refused_evaluations": t.refused,
