@@ -21,6 +21,11 @@ pub enum Variable {
     /// The rest forms themselves: ā (dimensionless) and b̄ (1/m) in reference Cartesian
     /// coordinates, `[xx, xy, yy]` each, six numbers per face.
     Forms,
+    /// The in-plane strains `ε⁺`, `ε⁻` of the top and bottom layers of `growth.law =
+    /// "bilayer"` (dimensionless, two numbers per face: the stretches are `1 + ε±`).
+    Swelling,
+    /// The rest thickness h̄ (m), with the scene's own rest forms.
+    Thickness,
 }
 
 impl Variable {
@@ -30,6 +35,8 @@ impl Variable {
             Variable::Growth => "growth",
             Variable::Director => "director",
             Variable::Forms => "forms",
+            Variable::Swelling => "swelling",
+            Variable::Thickness => "thickness",
         }
     }
 }
@@ -178,6 +185,18 @@ impl Design {
                 "bounds apply to a growth factor or a director angle; rest forms have none (their \
                  metric must stay positive definite, which the design keeps)"
                     .into(),
+            );
+        }
+        if self.variable == Variable::Thickness && self.lower.is_some_and(|l| l <= 0.0) {
+            return ck.inv(
+                "design.lower",
+                "a designed thickness must stay positive: give a positive lower bound (m)".into(),
+            );
+        }
+        if self.variable == Variable::Swelling && self.lower.is_some_and(|l| l <= -1.0) {
+            return ck.inv(
+                "design.lower",
+                "a layer's stretch 1 + ε must stay positive: give a lower bound above −1".into(),
             );
         }
         ck.nonneg("design.smoothness", self.smoothness)?;

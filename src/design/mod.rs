@@ -49,18 +49,19 @@ const ESCAPES: [Real; 3] = [0.05, 0.2, 0.5];
 /// The smallest continuation step between two designs' rest data.
 const MIN_CONTINUATION_STEP: Real = 1.0 / 1024.0;
 
-/// The static potential of `scene` on `pattern` at rest data `(forms, ratio)`: the rest forms
-/// and thickness ratios of a design replace the scene's, at dial 1, with the scene's gravity.
+/// The static potential of `scene` on `pattern` at rest data `(forms, ratio, mass)`: the rest
+/// forms, thickness ratios and lumped masses of a design replace the scene's, at dial 1, with the
+/// scene's gravity.
 fn potential<'p>(
     scene: &'p Scene,
     pattern: &'p Pattern,
     gravity: Vec3,
-    forms: &'p [(Sym2, Sym2)],
-    ratio: &'p [Real],
+    (forms, ratio, mass): (&'p [(Sym2, Sym2)], &'p [Real], &'p [Real]),
 ) -> Potential<'p> {
     Potential {
         rest_override: Some(forms),
         thickness_override: Some(ratio),
+        mass,
         gravity,
         ..Potential::new(scene, pattern)
     }
@@ -187,6 +188,45 @@ impl<'s> Problem<'s> {
             .collect()
     }
 
+    /// The lumped vertex masses at thickness ratios `ratio`: the scene's, except for a designed
+    /// thickness in a scene with weight, where each face's share `ρ A_f h̄_f/(3 ρ_law)` follows
+    /// the thickness written (the reference thickness `h̄/ρ_law` the law scales).
+    fn mass(&self, ratio: &[Real]) -> std::borrow::Cow<'s, [Real]> {
+        let body = &self.scene.body;
+        let Some(dm) = self.mass_per_thickness() else {
+            return std::borrow::Cow::Borrowed(&body.mass[..]);
+        };
+        let mut m = body.mass.clone();
+        for (f, face) in body.mesh.faces.iter().enumerate() {
+            // The change from the scene's own thickness h ρ_law.
+            let Chain::Thickness { law_ratio, .. } = &self.chain else {
+                unreachable!("only a thickness design has a mass per thickness")
+            };
+            let dh = body.thickness[f] * (ratio[f] - law_ratio[f]);
+            for &v in face {
+                m[v] += dm[f] * dh;
+            }
+        }
+        std::borrow::Cow::Owned(m)
+    }
+
+    /// `∂m_v/∂h̄_f = ρ A_f/(3 ρ_law)` per face (the same for its three vertices), for a
+    /// designed thickness in a scene with weight; else `None`.
+    fn mass_per_thickness(&self) -> Option<Vec<Real>> {
+        let Chain::Thickness { law_ratio, .. } = &self.chain else {
+            return None;
+        };
+        let body = &self.scene.body;
+        if body.density == 0.0 || self.gravity == Vec3::zeros() {
+            return None;
+        }
+        Some(
+            (0..body.mesh.faces.len())
+                .map(|f| body.density * body.mesh.face_area(f) / (3.0 * law_ratio[f]))
+                .collect(),
+        )
+    }
+
     /// The equilibrium at rest data `(forms, ratio)` from `state`: Newton, and the stability
     /// check by the exact Hessian's factorisation, with the escapes toward the target. On
     /// success the factorisation of the exact Hessian at the equilibrium is kept in `lin`.
@@ -199,7 +239,13 @@ impl<'s> Problem<'s> {
         let mut escapes = ESCAPES.iter();
         loop {
             let clock = Instant::now();
-            let pot = potential(self.scene, &self.pattern, self.gravity, forms, ratio);
+            let mass = self.mass(ratio);
+            let pot = potential(
+                self.scene,
+                &self.pattern,
+                self.gravity,
+                (forms, ratio, &mass),
+            );
             let rep = newton(&pot, &mut self.lin, &mut self.ws, state, self.opts);
             self.timing.equilibrium += clock.elapsed().as_secs_f64();
             self.timing.newton_iterations += rep.iterations;
@@ -350,7 +396,13 @@ impl<'s> Problem<'s> {
             let rest = self.rest(&q);
             let forms: Vec<(Sym2, Sym2)> = rest.iter().map(|r| r.forms).collect();
             let ratio: Vec<Real> = rest.iter().map(|r| r.ratio).collect();
-            let pot = potential(self.scene, &self.pattern, self.gravity, &forms, &ratio);
+            let mass = self.mass(&ratio);
+            let pot = potential(
+                self.scene,
+                &self.pattern,
+                self.gravity,
+                (&forms, &ratio, &mass),
+            );
             let mut g = vec![0.0; self.pattern.n];
             pot.eval(
                 &cur.state.x,
@@ -366,12 +418,12 @@ impl<'s> Problem<'s> {
             .zip(&grads[1])
             .map(|(a, b)| -(a - b) / (2.0 * eps))
             .collect();
+        let mass = self.mass(&cur.ratio);
         let pot = potential(
             self.scene,
             &self.pattern,
             self.gravity,
-            &cur.forms,
-            &cur.ratio,
+            (&cur.forms, &cur.ratio, &mass),
         );
         pot.mask_fixed(&mut dx);
         if !self.held.as_ref()?.solve_in_place(&mut self.lin, &mut dx) {
@@ -447,7 +499,13 @@ impl<'s> Problem<'s> {
         for (v, g) in d.gradient.iter().enumerate() {
             lambda[3 * v..3 * v + 3].copy_from_slice(g.as_slice());
         }
-        let pot = potential(self.scene, &self.pattern, self.gravity, &forms, &ratio);
+        let mass = self.mass(&ratio);
+        let pot = potential(
+            self.scene,
+            &self.pattern,
+            self.gravity,
+            (&forms, &ratio, &mass),
+        );
         pot.mask_fixed(&mut lambda);
         let solved = match &self.held {
             Some(wb) => wb.solve_in_place(&mut self.lin, &mut lambda),
@@ -482,6 +540,20 @@ impl<'s> Problem<'s> {
                 }
                 s += row[6] * h * w[f][6];
                 grad[k * f + j] = -s;
+            }
+        }
+        // A designed thickness carries the weight with it: the gravity part of the residual,
+        // −m_v g, has ∂/∂h̄_f = −(∂m_v/∂h̄_f) g on the face's vertices.
+        if let Some(dm) = self.mass_per_thickness() {
+            let g = self.gravity;
+            for (f, face) in self.scene.body.mesh.faces.iter().enumerate() {
+                let s: Real = face
+                    .iter()
+                    .map(|&v| {
+                        Vec3::new(lambda[3 * v], lambda[3 * v + 1], lambda[3 * v + 2]).dot(&g)
+                    })
+                    .sum();
+                grad[f] += dm[f] * s;
             }
         }
         let js = self.smoothness.eval(p, &mut grad);

@@ -187,6 +187,8 @@ fn designable(s: &Settings, d: &Design) -> Result<(), (String, String)> {
                     TargetForms::None | TargetForms::Uniform | TargetForms::Mesh
                 )
         }
+        Variable::Swelling => law == GrowthLaw::Bilayer && target == TargetForms::None,
+        Variable::Thickness => law == GrowthLaw::None || GROWTH_LAWS.contains(&law),
     };
     if !ok {
         let needs = match d.variable {
@@ -200,6 +202,14 @@ fn designable(s: &Settings, d: &Design) -> Result<(), (String, String)> {
             Variable::Forms => {
                 "the rest forms of rest.target = \"none\", \"uniform\" or \"mesh\" (with \
                  growth.law = \"none\")"
+            }
+            Variable::Swelling => {
+                "the layer strains of growth.law = \"bilayer\" (with rest.target = \"none\")"
+            }
+            Variable::Thickness => {
+                "the rest thickness under growth.law = \"none\", \"isotropic\", \
+                 \"isotropic_in_plane\" or \"isotropic_metric_only\" (laws whose forms do not \
+                 depend on the thickness)"
             }
         };
         return Err((
@@ -393,6 +403,72 @@ fn chain_and_start(scene: &Scene, d: &Design) -> Result<(Chain, Vec<Real>), (Str
                 .collect();
             (Chain::Forms { frames }, p)
         }
+        Variable::Swelling => {
+            let crate::config::growth::GrowthModel::Bilayer { laminate, .. } =
+                scene.settings.growth.model()
+            else {
+                unreachable!("designable() checked the law")
+            };
+            if laminate.isotropic {
+                return Err((
+                    "growth.isotropic_layers".into(),
+                    "\"swelling\" designs layers that keep their thickness (the forms are then \
+                     exactly quadratic in the stretches); layers that swell through their \
+                     thickness too are not designed"
+                        .into(),
+                ));
+            }
+            let g = &body.growth;
+            let mut basis = Vec::with_capacity(nf);
+            let mut ratio = Vec::with_capacity(nf);
+            let mut own = Vec::with_capacity(2 * nf);
+            for f in 0..nf {
+                let c = g.coef.get(f).copied().unwrap_or(g.uniform);
+                let (mt, mb) = (g.moisture_top[f], g.moisture_bottom[f]);
+                if mt == 0.0 || mb == 0.0 {
+                    return Err((
+                        "growth.moisture_top".into(),
+                        format!(
+                            "face {f} has moisture {} on top and {} below: the design is written \
+                             as growth_mu_top = ε⁺/moisture_top and growth_mu_bottom = \
+                             ε⁻/moisture_bottom, which needs moisture on both sides of every face",
+                            crate::math::human(mt),
+                            crate::math::human(mb)
+                        ),
+                    ));
+                }
+                let print =
+                    (c.print_thickness > 0.0).then_some(crate::rest::laws::bilayer::Print {
+                        thickness: c.print_thickness,
+                        modulus_ratio: c.print_modulus_ratio,
+                    });
+                let lambda = 1.0 + c.mu_through * 0.5 * (mt + mb);
+                basis.push(Chain::swelling_basis(
+                    &rest.abar0[f],
+                    &rest.bbar0[f],
+                    body.thickness[f],
+                    &laminate,
+                    print,
+                    lambda,
+                ));
+                ratio.push(lambda);
+                own.extend([c.mu_top * mt, c.mu_bottom * mb]);
+            }
+            (Chain::Swelling { basis, ratio }, own)
+        }
+        Variable::Thickness => {
+            let law_ratio = |f: usize| body.grown_thickness.get(f).copied().unwrap_or(1.0);
+            let forms = (0..nf).map(|f| (rest.abar1[f], rest.bbar1[f])).collect();
+            let own = (0..nf).map(|f| body.thickness[f] * law_ratio(f)).collect();
+            (
+                Chain::Thickness {
+                    forms,
+                    reference: body.thickness.clone(),
+                    law_ratio: (0..nf).map(law_ratio).collect(),
+                },
+                own,
+            )
+        }
     };
     let start = match d.start {
         Some(v) => vec![v; own.len()],
@@ -410,6 +486,16 @@ fn chain_and_start(scene: &Scene, d: &Design) -> Result<(Chain, Vec<Real>), (Str
     Ok((chain, start))
 }
 
+/// The lower bound of a variable without `design.lower`: none, except where the law needs one:
+/// a layer's stretch `1 + ε` at least 0.5, a thickness at least 1% of the thinnest start.
+fn default_lower(v: Variable, start: &[Real]) -> Real {
+    match v {
+        Variable::Swelling => -0.5,
+        Variable::Thickness => 0.01 * start.iter().copied().fold(Real::INFINITY, Real::min),
+        _ => Real::NEG_INFINITY,
+    }
+}
+
 /// The Cartesian ā and b̄ of a forms design (six numbers per face), as two fields' data.
 fn split_forms(p: &[Real]) -> (Vec<Real>, Vec<Real>) {
     let (mut a, mut b) = (Vec::new(), Vec::new());
@@ -425,6 +511,14 @@ fn design_fields(chain: &Chain, p: &[Real]) -> Vec<(String, Field)> {
     match chain.variable() {
         Variable::Growth => vec![("growth_factor".into(), Field::scalar(p.to_vec()))],
         Variable::Director => vec![("director_angle".into(), Field::scalar(p.to_vec()))],
+        Variable::Swelling => {
+            let (t, b): (Vec<Real>, Vec<Real>) = p.chunks_exact(2).map(|c| (c[0], c[1])).unzip();
+            vec![
+                ("swelling_top".into(), Field::scalar(t)),
+                ("swelling_bottom".into(), Field::scalar(b)),
+            ]
+        }
+        Variable::Thickness => vec![("rest_thickness".into(), Field::scalar(p.to_vec()))],
         Variable::Forms => {
             let (a, b) = split_forms(p);
             vec![
@@ -512,6 +606,31 @@ fn designed(prep: &Prepared, p: &[Real]) -> (Mesh, toml::Table) {
             r.remove("bbar");
             r.insert("target".into(), "mesh".into());
             table.insert("rest".into(), toml::Value::Table(r));
+        }
+        Chain::Swelling { .. } => {
+            // The strains as the law's face coefficients over the scene's own moisture (the
+            // face fields take precedence over [growth]'s and the regions' coefficients).
+            let g = &prep.scene.body.growth;
+            let (mut top, mut bottom) = (Vec::new(), Vec::new());
+            for (f, c) in p.chunks_exact(2).enumerate() {
+                top.push(c[0] / g.moisture_top[f]);
+                bottom.push(c[1] / g.moisture_bottom[f]);
+            }
+            mesh.face_fields
+                .insert("growth_mu_top".into(), Field::scalar(top));
+            mesh.face_fields
+                .insert("growth_mu_bottom".into(), Field::scalar(bottom));
+        }
+        Chain::Thickness { .. } => {
+            // The reference thickness the law scales into the designed one.
+            let body = &prep.scene.body;
+            let h = p
+                .iter()
+                .enumerate()
+                .map(|(f, v)| v / body.grown_thickness.get(f).copied().unwrap_or(1.0))
+                .collect();
+            mesh.face_fields
+                .insert("ref_thicknesses".into(), Field::scalar(h));
         }
     }
     // The thickness a growth law grows is the law's own: the mesh's thickness stays.
@@ -626,6 +745,12 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
     };
     let scale = match d.variable {
         Variable::Forms => vec![1.0, 1.0, 1.0, size, size, size],
+        Variable::Swelling => vec![1.0, 1.0],
+        Variable::Thickness => {
+            // Thickness differences relative to the mean thickness.
+            let mean = prep.start.iter().sum::<Real>() / prep.start.len().max(1) as Real;
+            vec![1.0 / mean]
+        }
         _ => vec![1.0],
     };
     let smooth = Smoothness::new(
@@ -651,7 +776,9 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
         max_iterations: d.max_iterations,
         tolerance: d.tolerance,
         first_step: d.first_step,
-        lower: d.lower.unwrap_or(Real::NEG_INFINITY),
+        lower: d
+            .lower
+            .unwrap_or_else(|| default_lower(d.variable, &prep.start)),
         upper: d.upper.unwrap_or(Real::INFINITY),
     };
     let mut log = String::from(LOG_HEADER);

@@ -11,8 +11,18 @@
 //!   `d⊥ = (−sin θ, cos θ)`, so `∂ā/∂θ = (λ² − λ^{−2ν}) Tᵀ(d⊥ dᵀ + d d⊥ᵀ)T`.
 //! * **Forms** (six per face): ā and b̄ in reference Cartesian coordinates, pulled back by the
 //!   face's frame `T` (`ā = Tᵀ ā_c T`, linear), `h̄ = h`.
+//! * **Swelling** (`ε⁺`, `ε⁻`, two per face), the bilayer law ([`crate::rest::laws::bilayer`])
+//!   with layers that keep their thickness: each layer's metric is its stretch `s± = 1 + ε±`
+//!   squared times the reference one, and the projection's weights and heights do not depend on
+//!   `s±`, so the forms are exactly quadratic in the stretches,
+//!   `r(s⁺, s⁻) = r₀₀ + s⁺²(r₁₀ − r₀₀) + s⁻²(r₀₁ − r₀₀)` with `r_ab` the law's forms at
+//!   stretches `(a, b)` (the printed layer, which does not swell, is in `r₀₀`), and
+//!   `∂r/∂ε± = 2 s± (r₁₀ − r₀₀)` or `2 s⁻ (r₀₁ − r₀₀)`. The through-thickness swelling `λ` of the
+//!   face's own moisture divides `b̄` and sets `h̄ = λ h`, both fixed.
+//! * **Thickness** (`h̄`, one per face): the rest forms are the scene's own, `∂h̄/∂h̄ = 1`.
 //!
-//! Units: s dimensionless, θ in rad, Cartesian ā dimensionless, Cartesian b̄ in 1/m.
+//! Units: s dimensionless, θ in rad, Cartesian ā dimensionless, Cartesian b̄ in 1/m, ε±
+//! dimensionless, h̄ in m.
 
 use crate::config::design::Variable;
 use crate::config::growth::GrowthLaw;
@@ -41,6 +51,24 @@ pub enum Chain {
     Forms {
         /// The reference frame `T` per face.
         frames: Vec<Mat2>,
+    },
+    /// The bilayer's layer strains: per face `r₀₀`, `r₁₀ − r₀₀`, `r₀₁ − r₀₀` (forms, with `b̄`
+    /// already over λ) and the fixed thickness ratio λ.
+    Swelling {
+        /// The three bases per face.
+        basis: Vec<[(Sym2, Sym2); 3]>,
+        /// `h̄/h` per face.
+        ratio: Vec<Real>,
+    },
+    /// The rest thickness, with the scene's own forms.
+    Thickness {
+        /// The forms per face.
+        forms: Vec<(Sym2, Sym2)>,
+        /// The reference thickness `h` per face (m).
+        reference: Vec<Real>,
+        /// The scene's growth law's thickness ratio per face (1 without one): the written
+        /// reference thickness is `h̄` over it, and the mass follows the written thickness.
+        law_ratio: Vec<Real>,
     },
 }
 
@@ -71,6 +99,7 @@ impl Chain {
     pub fn per_face(&self) -> usize {
         match self {
             Chain::Forms { .. } => 6,
+            Chain::Swelling { .. } => 2,
             _ => 1,
         }
     }
@@ -81,6 +110,8 @@ impl Chain {
             Chain::Growth { .. } => Variable::Growth,
             Chain::Director { .. } => Variable::Director,
             Chain::Forms { .. } => Variable::Forms,
+            Chain::Swelling { .. } => Variable::Swelling,
+            Chain::Thickness { .. } => Variable::Thickness,
         }
     }
 
@@ -148,7 +179,53 @@ impl Chain {
                     jac,
                 }
             }
+            Chain::Swelling { basis, ratio } => {
+                let [(a0, b0), (at, bt), (ab, bb)] = basis[f];
+                let (st, sb) = (1.0 + p[0], 1.0 + p[1]);
+                FaceRest {
+                    forms: (
+                        a0 + at * (st * st) + ab * (sb * sb),
+                        b0 + bt * (st * st) + bb * (sb * sb),
+                    ),
+                    ratio: ratio[f],
+                    jac: vec![
+                        sym_row(at * (2.0 * st), bt * (2.0 * st), 0.0),
+                        sym_row(ab * (2.0 * sb), bb * (2.0 * sb), 0.0),
+                    ],
+                }
+            }
+            Chain::Thickness {
+                forms, reference, ..
+            } => FaceRest {
+                forms: forms[f],
+                ratio: p[0] / reference[f],
+                jac: vec![sym_row(Sym2::zeros(), Sym2::zeros(), 1.0 / reference[f])],
+            },
         }
+    }
+
+    /// The swelling chain of a bilayer face: the law's forms at stretches (0, 0), (1, 0) and
+    /// (0, 1) of its layers, over the face's through-thickness swelling `lambda`.
+    pub fn swelling_basis(
+        a0: &Sym2,
+        b0: &Sym2,
+        h: Real,
+        laminate: &crate::config::growth::Laminate,
+        print: Option<crate::rest::laws::bilayer::Print>,
+        lambda: Real,
+    ) -> [(Sym2, Sym2); 3] {
+        let at = |st: Real, sb: Real| {
+            let (a, b, _) = crate::rest::laws::bilayer::bilayer(a0, b0, h, st, sb, laminate, print);
+            (a, b / lambda)
+        };
+        let r00 = at(0.0, 0.0);
+        let r10 = at(1.0, 0.0);
+        let r01 = at(0.0, 1.0);
+        [
+            r00,
+            (r10.0 - r00.0, r10.1 - r00.1),
+            (r01.0 - r00.0, r01.1 - r00.1),
+        ]
     }
 }
 
@@ -186,6 +263,35 @@ mod tests {
                 Chain::Forms { frames: vec![t] },
                 vec![1.1, 0.2, 0.9, 3.0, -1.0, 2.0],
             ),
+            (
+                Chain::Swelling {
+                    basis: vec![Chain::swelling_basis(
+                        &a0,
+                        &b0,
+                        0.01,
+                        &crate::config::growth::Laminate {
+                            top_fraction: 0.3,
+                            modulus_ratio: 2.0,
+                            isotropic: false,
+                        },
+                        Some(crate::rest::laws::bilayer::Print {
+                            thickness: 0.001,
+                            modulus_ratio: 5.0,
+                        }),
+                        1.1,
+                    )],
+                    ratio: vec![1.1],
+                },
+                vec![0.04, -0.02],
+            ),
+            (
+                Chain::Thickness {
+                    forms: vec![(a0, b0)],
+                    reference: vec![0.02],
+                    law_ratio: vec![1.0],
+                },
+                vec![0.015],
+            ),
         ];
         for (chain, p) in chains {
             let at = chain.face(0, &p);
@@ -207,6 +313,40 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    /// The swelling chain gives the bilayer law's own forms at any stretches.
+    #[test]
+    fn the_swelling_chain_is_the_bilayer_law() {
+        let a0 = Sym2::new(1.2, 0.1, 0.9);
+        let b0 = Sym2::new(0.3, 0.0, -0.1);
+        let lam = crate::config::growth::Laminate {
+            top_fraction: 0.4,
+            modulus_ratio: 3.0,
+            isotropic: false,
+        };
+        let print = Some(crate::rest::laws::bilayer::Print {
+            thickness: 0.002,
+            modulus_ratio: 4.0,
+        });
+        let chain = Chain::Swelling {
+            basis: vec![Chain::swelling_basis(&a0, &b0, 0.01, &lam, print, 1.0)],
+            ratio: vec![1.0],
+        };
+        for (et, eb) in [(0.05, -0.03), (0.2, 0.1), (-0.1, 0.0)] {
+            let got = chain.face(0, &[et, eb]).forms;
+            let (a, b, _) = crate::rest::laws::bilayer::bilayer(
+                &a0,
+                &b0,
+                0.01,
+                1.0 + et,
+                1.0 + eb,
+                &lam,
+                print,
+            );
+            assert!((got.0 - a).amax() < 1e-14 * a.amax(), "{got:?} {a:?}");
+            assert!((got.1 - b).amax() < 1e-12 * b.amax(), "{got:?} {b:?}");
         }
     }
 
