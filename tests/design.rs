@@ -797,6 +797,95 @@ fn shellsim_design_writes_swelling_and_thickness_designs_that_reproduce() {
     }
 }
 
+/// b̄ recovered from the Gauss–Codazzi–Mainardi cone (MorphoShell's curvature-programmed cone:
+/// the flat sector with ā = I and b̄ = θ̂θ̂ᵀ/(2r) closes into a cone of half-angle atan 2):
+/// designing b̄ alone (ā kept flat) from b̄ = 0 toward the cone of `settings/gcm_cone.toml`
+/// on a 539-face sector. b̄ is seen only through the bending energy, h² weaker than the
+/// stretching that the shape's metric pins, so it converges slowly behind the shape: at the
+/// shape within 1e-4 of its size b̄ is 15% off, at 1e-6 (3010 iterations, 30 s) 4.8%
+/// (RMS of the Frobenius norm, relative, away from the sector's edges, 1.05 < r < 1.35). The
+/// test asks for 6% at 1e-6.
+#[test]
+fn bbar_is_recovered_from_the_gcm_cone() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sector = |extra: &[&str], out: &str| {
+        let mut args = vec![
+            "mesh",
+            "annulus",
+            "--inner",
+            "1",
+            "--radius",
+            "1.4",
+            "--sweep",
+            "321.9937887599697",
+            "--edge",
+            "0.1",
+            "-o",
+            out,
+        ];
+        args.extend_from_slice(extra);
+        succeeds(d, &args);
+    };
+    sector(&["--program", "gcm_cone"], "cone.vtk");
+    sector(&[], "flat.vtk");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let fwd = std::fs::read_to_string(root.join("settings/gcm_cone.toml")).unwrap();
+    write(
+        d,
+        "cone.toml",
+        &fwd.replace("meshes/gcm_cone_jittered.vtk", "cone.vtk"),
+    );
+    succeeds(d, &["cone.toml", "cone.vtk", "--out", "cone", "-q"]);
+    let design = fwd
+        .replace("target = \"mesh\"", "target = \"none\"")
+        .replace("# mesh: meshes/gcm_cone_jittered.vtk", "")
+        + "[design]\nvariable = \"bbar\"\nmax_iterations = 5000\ntarget_distance = 1e-6\n";
+    write(d, "design.toml", &design);
+    succeeds(
+        d,
+        &[
+            "design",
+            "design.toml",
+            "flat.vtk",
+            "cone/frame_00001.vtu",
+            "--out",
+            "des",
+            "-q",
+        ],
+    );
+    let m = shellsim::mesh::io::read_mesh(&d.join("des/designed.vtk")).unwrap();
+    let b = &m.face_fields["bbar_info"];
+    let (mut err, mut norm) = (0.0, 0.0);
+    for f in 0..m.faces.len() {
+        let c = m.faces[f].iter().map(|&v| m.positions[v]).sum::<Vec3>() / 3.0;
+        let r = c.x.hypot(c.y);
+        if r > 1.05 && r < 1.35 {
+            let (sn, cs) = (c.y / r, c.x / r);
+            let truth = [
+                sn * sn / (2.0 * r),
+                -sn * cs / (2.0 * r),
+                cs * cs / (2.0 * r),
+            ];
+            // Frobenius norms: the off-diagonal counts twice.
+            for (k, w) in [1.0, 2.0, 1.0].iter().enumerate() {
+                err += w * (b.get(f)[k] - truth[k]).powi(2);
+                norm += w * truth[k].powi(2);
+            }
+        }
+    }
+    let rel = (err / norm).sqrt();
+    let sum: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("des/design_summary.json")).unwrap())
+            .unwrap();
+    println!(
+        "b̄ recovered within {rel:.3e} (RMS, relative), {} iterations, shape {}",
+        sum["iterations"], sum["distance"]
+    );
+    assert_eq!(sum["converged"], true, "{sum}");
+    assert!(rel < 0.06, "b̄ recovered to {rel:e}");
+}
+
 /// Bad design input: exit 2 naming the file and the key or face, and nothing written.
 #[test]
 fn bad_design_input_is_refused_and_nothing_is_written() {
@@ -917,81 +1006,74 @@ fn bad_design_input_is_refused_and_nothing_is_written() {
 }
 
 /// Recovering the circumferential director of the +1 defect from its cone (λ = 0.9, ν = 0.5:
-/// half-angle asin(λ^(1+ν))), from the neutral design θ = 0 (a uniformly stretched flat disk):
-/// the angles within 2° away from the tip (r > 0.3, as nematic directors: θ ≡ θ + π).
-///
-/// Not reached yet, so ignored (run it with `--ignored`): the design stalls with the shape at
-/// 0.36% of its size and directors up to 74° off (Sobolev steps over 0.2 of the size; 0.9% and
-/// 90° over 0.05), its trial equilibria failing to converge.
+/// half-angle asin(λ^(1+ν))) with `shellsim design` at its default settings, from the neutral
+/// design θ = 0 (a uniformly stretched flat disk) on a 294-face disk 5% of its radius thick:
+/// the shape to within 1e-6 of its size and the angles within 2° away from the tip (r > 0.3,
+/// as nematic directors: θ ≡ θ + π). Measured: 678 iterations, 0.19° worst for r > 0.2 (0.81°
+/// at the tip), 7.8 s. A sheet 2% thick stalls instead (0.47% of its size, directors up to 87°
+/// off: its trial equilibria fold onto other branches); docs/design.md, Limits.
 #[test]
-#[ignore]
 fn the_circumferential_director_is_recovered_from_its_cone() {
-    use shellsim::design::lbfgs::{minimise, Options};
-    let mesh = disk(0.2);
-    let text = "[material]\nyoung = 3.0\npoisson = 0.5\nthickness = 0.02\n\
-                [rest]\ntarget = \"lce\"\n[rest.lce]\ntheta = 0.0\nlambda = 0.9\nnu = 0.5\n\
-                [solver]\nmode = \"static\"\ntolerance = 1e-10\n";
-    let sc = scene(mesh, text);
-    let m = &sc.body.mesh;
-    let topo = Topology::build(m).unwrap();
-    let centroids: Vec<Vec3> = m
-        .faces
-        .iter()
-        .map(|f| f.iter().map(|&v| m.positions[v]).sum::<Vec3>() / 3.0)
-        .collect();
-    let truth: Vec<Real> = centroids
-        .iter()
-        .map(|c| c.y.atan2(c.x) + std::f64::consts::FRAC_PI_2)
-        .collect();
-    let chain = || Chain::Director {
-        stretch: vec![(0.9, 0.5); m.faces.len()],
-        frames: Chain::frames(m),
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    succeeds(
+        d,
+        &[
+            "mesh", "disk", "--radius", "1", "--edge", "0.15", "-o", "disk.vtk",
+        ],
+    );
+    let scene = |theta: &str| {
+        format!(
+            "[material]\nyoung = 3.0\npoisson = 0.5\nthickness = 0.05\n\
+             [rest]\ntarget = \"lce\"\n[rest.lce]\ntheta = {theta}\nlambda = 0.9\nnu = 0.5\n\
+             [solver]\nmode = \"static\"\n"
+        )
     };
-    // The cone guides the first solve of the truth.
-    let cone: Vec<Vec3> = m
-        .positions
-        .iter()
-        .map(|q| Vec3::new(0.9 * q.x, 0.9 * q.y, -0.4 * q.x.hypot(q.y)))
-        .collect();
-    let smooth = || Smoothness::new(m, &topo, 0.0, true, vec![1.0]);
-    let points = |t: Vec<Vec3>| distance(DistanceTerm::Points(Points::new(m, t, true)));
-    let target = Problem::new(&sc, chain(), points(cone), smooth())
-        .unwrap()
-        .evaluate(&truth)
-        .unwrap()
-        .2
-        .state
-        .x;
-    let size = shellsim::design::objective::bounding_diagonal(&target);
-    let mut prob = Problem::new(&sc, chain(), points(target), smooth()).unwrap();
-    prob.metric = Some(shellsim::design::objective::Sobolev::new(
-        m,
-        &topo,
-        0.2 * size,
-        1,
-    ));
-    let o = Options {
-        memory: 10,
-        max_iterations: 400,
-        tolerance: 1e-12,
-        first_step: 0.1,
-        lower: Real::NEG_INFINITY,
-        upper: Real::INFINITY,
-    };
-    let mut iterations = 0;
-    let (stop, p, _) = minimise(&mut prob, vec![0.0; truth.len()], &o, &mut |it, _| {
-        iterations = it.iteration;
-        (Points::relative_rms(it.value) < 1e-5).then(|| "close enough".to_string())
-    })
-    .unwrap();
+    write(
+        d,
+        "cone.toml",
+        &format!("# mesh: disk.vtk\n{}", scene("\"atan2(y, x) + pi/2\"")),
+    );
+    succeeds(d, &["cone.toml", "disk.vtk", "--out", "cone", "-q"]);
+    write(
+        d,
+        "design.toml",
+        &format!(
+            "{}[design]\nvariable = \"director\"\nmax_iterations = 2000\n\
+             target_distance = 1e-6\n",
+            scene("0.0")
+        ),
+    );
+    succeeds(
+        d,
+        &[
+            "design",
+            "design.toml",
+            "disk.vtk",
+            "cone/frame_00001.vtu",
+            "--out",
+            "des",
+            "-q",
+        ],
+    );
+    let m = shellsim::mesh::io::read_mesh(&d.join("des/designed.vtk")).unwrap();
+    let info = &m.face_fields["abar_info"];
     let mut worst: Real = 0.0;
-    for (f, c) in centroids.iter().enumerate() {
+    for f in 0..m.faces.len() {
+        let c = m.faces[f].iter().map(|&v| m.positions[v]).sum::<Vec3>() / 3.0;
         if c.x.hypot(c.y) > 0.3 {
-            let d = (p[f] - truth[f]).sin().abs().asin().to_degrees();
-            worst = worst.max(d);
+            let truth = c.y.atan2(c.x) + std::f64::consts::FRAC_PI_2;
+            let e = (info.get(f)[0] - truth).sin().abs().asin().to_degrees();
+            worst = worst.max(e);
         }
     }
-    let dist = Points::relative_rms(prob.current.as_ref().unwrap().distance);
-    println!("{stop:?} after {iterations} iterations: worst director error {worst:.3}° (r > 0.3), shape {dist:.2e}, {:?}", prob.timing);
+    let sum: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("des/design_summary.json")).unwrap())
+            .unwrap();
+    println!(
+        "director recovered: worst {worst:.3}° (r > 0.3), {} iterations, shape {}",
+        sum["iterations"], sum["distance"]
+    );
+    assert_eq!(sum["converged"], true, "{sum}");
     assert!(worst < 2.0, "director recovered to {worst}°");
 }

@@ -21,6 +21,9 @@ pub enum Variable {
     /// The rest forms themselves: ā (dimensionless) and b̄ (1/m) in reference Cartesian
     /// coordinates, `[xx, xy, yy]` each, six numbers per face.
     Forms,
+    /// The rest second fundamental form b̄ alone (1/m, reference Cartesian `[xx, xy, yy]`,
+    /// three numbers per face), with the scene's own ā kept.
+    Bbar,
     /// The in-plane strains `ε⁺`, `ε⁻` of the top and bottom layers of `growth.law =
     /// "bilayer"` (dimensionless, two numbers per face: the stretches are `1 + ε±`).
     Swelling,
@@ -35,6 +38,7 @@ impl Variable {
             Variable::Growth => "growth",
             Variable::Director => "director",
             Variable::Forms => "forms",
+            Variable::Bbar => "bbar",
             Variable::Swelling => "swelling",
             Variable::Thickness => "thickness",
         }
@@ -179,7 +183,9 @@ impl Design {
                 );
             }
         }
-        if self.variable == Variable::Forms && (self.lower.is_some() || self.upper.is_some()) {
+        if matches!(self.variable, Variable::Forms | Variable::Bbar)
+            && (self.lower.is_some() || self.upper.is_some())
+        {
             return ck.inv(
                 "design.lower",
                 "bounds apply to a growth factor or a director angle; rest forms have none (their \

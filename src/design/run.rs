@@ -187,6 +187,13 @@ fn designable(s: &Settings, d: &Design) -> Result<(), (String, String)> {
                     TargetForms::None | TargetForms::Uniform | TargetForms::Mesh
                 )
         }
+        Variable::Bbar => {
+            law == GrowthLaw::None
+                && matches!(
+                    target,
+                    TargetForms::None | TargetForms::Uniform | TargetForms::Mesh
+                )
+        }
         Variable::Swelling => law == GrowthLaw::Bilayer && target == TargetForms::None,
         Variable::Thickness => law == GrowthLaw::None || GROWTH_LAWS.contains(&law),
     };
@@ -201,6 +208,10 @@ fn designable(s: &Settings, d: &Design) -> Result<(), (String, String)> {
             }
             Variable::Forms => {
                 "the rest forms of rest.target = \"none\", \"uniform\" or \"mesh\" (with \
+                 growth.law = \"none\")"
+            }
+            Variable::Bbar => {
+                "the rest b̄ of rest.target = \"none\", \"uniform\" or \"mesh\" (with \
                  growth.law = \"none\")"
             }
             Variable::Swelling => {
@@ -403,6 +414,18 @@ fn chain_and_start(scene: &Scene, d: &Design) -> Result<(Chain, Vec<Real>), (Str
                 .collect();
             (Chain::Forms { frames }, p)
         }
+        Variable::Bbar => {
+            flat()?;
+            let frames = Chain::frames(&body.mesh);
+            let p = (0..nf)
+                .flat_map(|f| {
+                    let b = push_forward(&frames[f], &rest.bbar1[f]);
+                    [b[0], b[1], b[2]]
+                })
+                .collect();
+            let abar = rest.abar1.clone();
+            (Chain::Bbar { frames, abar }, p)
+        }
         Variable::Swelling => {
             let crate::config::growth::GrowthModel::Bilayer { laminate, .. } =
                 scene.settings.growth.model()
@@ -511,6 +534,7 @@ fn design_fields(chain: &Chain, p: &[Real]) -> Vec<(String, Field)> {
     match chain.variable() {
         Variable::Growth => vec![("growth_factor".into(), Field::scalar(p.to_vec()))],
         Variable::Director => vec![("director_angle".into(), Field::scalar(p.to_vec()))],
+        Variable::Bbar => vec![("bbar_cartesian".into(), Field::triples(p.to_vec()))],
         Variable::Swelling => {
             let (t, b): (Vec<Real>, Vec<Real>) = p.chunks_exact(2).map(|c| (c[0], c[1])).unzip();
             vec![
@@ -601,6 +625,25 @@ fn designed(prep: &Prepared, p: &[Real]) -> (Mesh, toml::Table) {
                 .insert("abar_info".into(), Field::triples(a));
             mesh.face_fields
                 .insert("bbar_info".into(), Field::triples(b));
+            let mut r = sub(&mut table, "rest");
+            r.remove("abar");
+            r.remove("bbar");
+            r.insert("target".into(), "mesh".into());
+            table.insert("rest".into(), toml::Value::Table(r));
+        }
+        Chain::Bbar { frames, abar } => {
+            let a = abar
+                .iter()
+                .zip(frames)
+                .flat_map(|(a, t)| {
+                    let c = push_forward(t, a);
+                    [c[0], c[1], c[2]]
+                })
+                .collect();
+            mesh.face_fields
+                .insert("abar_info".into(), Field::triples(a));
+            mesh.face_fields
+                .insert("bbar_info".into(), Field::triples(p.to_vec()));
             let mut r = sub(&mut table, "rest");
             r.remove("abar");
             r.remove("bbar");
@@ -745,6 +788,7 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
     };
     let scale = match d.variable {
         Variable::Forms => vec![1.0, 1.0, 1.0, size, size, size],
+        Variable::Bbar => vec![size, size, size],
         Variable::Swelling => vec![1.0, 1.0],
         Variable::Thickness => {
             // Thickness differences relative to the mean thickness.

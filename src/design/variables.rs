@@ -11,6 +11,7 @@
 //!   `d⊥ = (−sin θ, cos θ)`, so `∂ā/∂θ = (λ² − λ^{−2ν}) Tᵀ(d⊥ dᵀ + d d⊥ᵀ)T`.
 //! * **Forms** (six per face): ā and b̄ in reference Cartesian coordinates, pulled back by the
 //!   face's frame `T` (`ā = Tᵀ ā_c T`, linear), `h̄ = h`.
+//! * **Bbar** (three per face): b̄ alone in reference Cartesian coordinates, each face's ā kept.
 //! * **Swelling** (`ε⁺`, `ε⁻`, two per face), the bilayer law ([`crate::rest::laws::bilayer`])
 //!   with layers that keep their thickness: each layer's metric is its stretch `s± = 1 + ε±`
 //!   squared times the reference one, and the projection's weights and heights do not depend on
@@ -51,6 +52,13 @@ pub enum Chain {
     Forms {
         /// The reference frame `T` per face.
         frames: Vec<Mat2>,
+    },
+    /// The Cartesian b̄ alone, with each face's ā kept.
+    Bbar {
+        /// The reference frame `T` per face.
+        frames: Vec<Mat2>,
+        /// The kept ā per face (barycentric, m²).
+        abar: Vec<Sym2>,
     },
     /// The bilayer's layer strains: per face `r₀₀`, `r₁₀ − r₀₀`, `r₀₁ − r₀₀` (forms, with `b̄`
     /// already over λ) and the fixed thickness ratio λ.
@@ -99,6 +107,7 @@ impl Chain {
     pub fn per_face(&self) -> usize {
         match self {
             Chain::Forms { .. } => 6,
+            Chain::Bbar { .. } => 3,
             Chain::Swelling { .. } => 2,
             _ => 1,
         }
@@ -110,6 +119,7 @@ impl Chain {
             Chain::Growth { .. } => Variable::Growth,
             Chain::Director { .. } => Variable::Director,
             Chain::Forms { .. } => Variable::Forms,
+            Chain::Bbar { .. } => Variable::Bbar,
             Chain::Swelling { .. } => Variable::Swelling,
             Chain::Thickness { .. } => Variable::Thickness,
         }
@@ -175,6 +185,18 @@ impl Chain {
                     .collect();
                 FaceRest {
                     forms: (pull_back(t, &ac), pull_back(t, &bc)),
+                    ratio: 1.0,
+                    jac,
+                }
+            }
+            Chain::Bbar { frames, abar } => {
+                let t = &frames[f];
+                let bc = Sym2::new(p[0], p[1], p[2]);
+                let jac = (0..3)
+                    .map(|k| sym_row(Sym2::zeros(), pull_back(t, &Sym2::ith(k, 1.0)), 0.0))
+                    .collect();
+                FaceRest {
+                    forms: (abar[f], pull_back(t, &bc)),
                     ratio: 1.0,
                     jac,
                 }
@@ -283,6 +305,13 @@ mod tests {
                     ratio: vec![1.1],
                 },
                 vec![0.04, -0.02],
+            ),
+            (
+                Chain::Bbar {
+                    frames: vec![t],
+                    abar: vec![a0],
+                },
+                vec![3.0, -1.0, 2.0],
             ),
             (
                 Chain::Thickness {
