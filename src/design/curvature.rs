@@ -128,11 +128,6 @@ impl Curvature {
         }
     }
 
-    /// Whether any face has all three neighbours.
-    pub fn has_interior(&self) -> bool {
-        self.stencils.iter().any(Option::is_some)
-    }
-
     /// The terms and their weighted gradient at `x`.
     pub fn eval(&self, x: &[Vec3]) -> CurvatureValue {
         let l2 = self.size * self.size;

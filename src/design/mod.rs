@@ -193,15 +193,12 @@ impl<'s> Problem<'s> {
     /// the thickness written (the reference thickness `h̄/ρ_law` the law scales).
     fn mass(&self, ratio: &[Real]) -> std::borrow::Cow<'s, [Real]> {
         let body = &self.scene.body;
-        let Some(dm) = self.mass_per_thickness() else {
+        let Some((dm, law_ratio)) = self.mass_per_thickness() else {
             return std::borrow::Cow::Borrowed(&body.mass[..]);
         };
         let mut m = body.mass.clone();
         for (f, face) in body.mesh.faces.iter().enumerate() {
             // The change from the scene's own thickness h ρ_law.
-            let Chain::Thickness { law_ratio, .. } = &self.chain else {
-                unreachable!("only a thickness design has a mass per thickness")
-            };
             let dh = body.thickness[f] * (ratio[f] - law_ratio[f]);
             for &v in face {
                 m[v] += dm[f] * dh;
@@ -211,8 +208,9 @@ impl<'s> Problem<'s> {
     }
 
     /// `∂m_v/∂h̄_f = ρ A_f/(3 ρ_law)` per face (the same for its three vertices), for a
-    /// designed thickness in a scene with weight; else `None`.
-    fn mass_per_thickness(&self) -> Option<Vec<Real>> {
+    /// designed thickness in a scene with weight, with the law's thickness ratios `ρ_law`;
+    /// else `None`.
+    fn mass_per_thickness(&self) -> Option<(Vec<Real>, &[Real])> {
         let Chain::Thickness { law_ratio, .. } = &self.chain else {
             return None;
         };
@@ -220,11 +218,10 @@ impl<'s> Problem<'s> {
         if body.density == 0.0 || self.gravity == Vec3::zeros() {
             return None;
         }
-        Some(
-            (0..body.mesh.faces.len())
-                .map(|f| body.density * body.mesh.face_area(f) / (3.0 * law_ratio[f]))
-                .collect(),
-        )
+        let dm = (0..body.mesh.faces.len())
+            .map(|f| body.density * body.mesh.face_area(f) / (3.0 * law_ratio[f]))
+            .collect();
+        Some((dm, law_ratio))
     }
 
     /// The equilibrium at rest data `(forms, ratio)` from `state`: Newton, and the stability
@@ -544,7 +541,7 @@ impl<'s> Problem<'s> {
         }
         // A designed thickness carries the weight with it: the gravity part of the residual,
         // −m_v g, has ∂/∂h̄_f = −(∂m_v/∂h̄_f) g on the face's vertices.
-        if let Some(dm) = self.mass_per_thickness() {
+        if let Some((dm, _)) = self.mass_per_thickness() {
             let g = self.gravity;
             for (f, face) in self.scene.body.mesh.faces.iter().enumerate() {
                 let s: Real = face

@@ -52,11 +52,11 @@ pub struct Distance {
     pub nearest: Vec<Vec3>,
 }
 
-/// The lumped reference areas of `mesh`'s vertices (a third of each face's), summing to 1.
-pub fn lumped_weights(mesh: &Mesh) -> Vec<Real> {
-    let mut w = vec![0.0; mesh.positions.len()];
-    for (f, face) in mesh.faces.iter().enumerate() {
-        let area = mesh.face_area(f);
+/// The lumped areas of a triangle mesh's vertices (a third of each face's), summing to 1.
+pub fn lumped_weights(positions: &[Vec3], faces: &[[usize; 3]]) -> Vec<Real> {
+    let mut w = vec![0.0; positions.len()];
+    for face in faces {
+        let area = 0.5 * crate::geometry::area_normal(&face.map(|v| positions[v])).norm();
         for &v in face {
             w[v] += area / 3.0;
         }
@@ -117,7 +117,7 @@ impl Points {
     pub fn new(mesh: &Mesh, target: Vec<Vec3>, align: bool) -> Points {
         Points {
             size: bounding_diagonal(&target),
-            weights: lumped_weights(mesh),
+            weights: lumped_weights(&mesh.positions, &mesh.faces),
             target,
             align,
         }

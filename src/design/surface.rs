@@ -256,19 +256,12 @@ impl Surface {
         target_faces: &[[usize; 3]],
         align: bool,
     ) -> Surface {
-        let target_mesh = crate::mesh::Mesh {
-            positions: target_positions.to_vec(),
-            faces: target_faces.to_vec(),
-            face_fields: Default::default(),
-            vertex_fields: Default::default(),
-            source: None,
-        };
-        let tw = lumped_weights(&target_mesh);
+        let tw = lumped_weights(target_positions, target_faces);
         Surface {
             target: Tree::new(target_positions, target_faces),
             target_points: target_positions.iter().copied().zip(tw).collect(),
             faces: mesh.faces.clone(),
-            weights: lumped_weights(mesh),
+            weights: lumped_weights(&mesh.positions, &mesh.faces),
             size: super::objective::bounding_diagonal(target_positions),
             align,
             last: Mutex::new(None),
