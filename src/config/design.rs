@@ -68,6 +68,67 @@ impl Objective {
     }
 }
 
+/// The optimiser.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// Projected L-BFGS on the objective's gradient.
+    #[default]
+    Lbfgs,
+    /// Damped Gauss–Newton on the distance term's least squares, through the equilibrium's
+    /// linear response.
+    GaussNewton,
+}
+
+/// Where a design starts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Start {
+    /// This value for every designed number (the variable's unit).
+    Value(Real),
+    /// Each face's numbers fitted to the target's own fundamental forms there (the target has
+    /// the mesh's connectivity).
+    Target,
+}
+
+impl Serialize for Start {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Start::Value(v) => s.serialize_f64(*v),
+            Start::Target => s.serialize_str("target"),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Start {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = Start;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number or \"target\"")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Start, E> {
+                Ok(Start::Value(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Start, E> {
+                Ok(Start::Value(v as Real))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Start, E> {
+                Ok(Start::Value(v as Real))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Start, E> {
+                match v {
+                    "target" => Ok(Start::Target),
+                    _ => Err(E::custom(format!(
+                        "expected a number or \"target\", got \"{v}\""
+                    ))),
+                }
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
 /// The `[design]` section.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -78,9 +139,10 @@ pub struct Design {
     pub lower: Option<Real>,
     /// The upper bound (default: none).
     pub upper: Option<Real>,
-    /// Where the design starts (the variable's unit): the neutral design by default (s = 0,
-    /// θ = 0, or the reference forms).
-    pub start: Option<Real>,
+    /// Where the design starts: the scene's own design by default (its growth factor,
+    /// director or rest forms), a value everywhere (the variable's unit), or `"target"`: each
+    /// face's numbers fitted to the target's own fundamental forms.
+    pub start: Option<Start>,
     /// Weight of the smoothness term `w/2 Σ_edges (|e|/d) Δp²` (the discrete `∫|∇p|² dA`
     /// of the piecewise-constant design; dimensionless; default 0).
     pub smoothness: Real,
@@ -111,6 +173,12 @@ pub struct Design {
     /// The largest change of a designed number in the first iteration (the variable's unit,
     /// default 0.1); later steps are sized by the quasi-Newton model.
     pub first_step: Real,
+    /// Run the written design forward (as `shellsim settings.toml designed.vtk` does) when the
+    /// optimiser stops; when it ends on another equilibrium, design on from that one (up to
+    /// three checks in all), and report the forward run's distance (default true).
+    pub forward_check: bool,
+    /// The optimiser: `"lbfgs"` (default) or `"gauss_newton"` (needs a distance term).
+    pub method: Method,
     /// The quasi-Newton memory: pairs kept by L-BFGS (default 10).
     pub memory: usize,
     /// A frame of the shape every this many iterations (default 1; 0: the first and last only).
@@ -135,6 +203,8 @@ impl Default for Design {
             tolerance: 1e-9,
             target_distance: 0.0,
             first_step: 0.1,
+            method: Method::Lbfgs,
+            forward_check: true,
             memory: 10,
             frames_every: 1,
         }
@@ -152,7 +222,13 @@ impl Design {
         for (k, v) in [
             ("design.lower", self.lower),
             ("design.upper", self.upper),
-            ("design.start", self.start),
+            (
+                "design.start",
+                match self.start {
+                    Some(Start::Value(v)) => Some(v),
+                    _ => None,
+                },
+            ),
         ] {
             if let Some(v) = v {
                 if !v.is_finite() {
@@ -175,13 +251,21 @@ impl Design {
                 );
             }
         }
-        if let Some(s) = self.start {
+        if let Some(Start::Value(s)) = self.start {
             if self.lower.is_some_and(|lo| s < lo) || self.upper.is_some_and(|hi| s > hi) {
                 return ck.inv(
                     "design.start",
                     format!("{} is outside the bounds", crate::math::human(s)),
                 );
             }
+        }
+        if self.start == Some(Start::Target) && self.variable == Variable::Thickness {
+            return ck.inv(
+                "design.start",
+                "\"target\" fits each face's rest forms to the target's, and a designed \
+                 thickness does not change them: give a thickness (m) or leave the scene's own"
+                    .into(),
+            );
         }
         if matches!(self.variable, Variable::Forms | Variable::Bbar)
             && (self.lower.is_some() || self.upper.is_some())
@@ -225,6 +309,14 @@ impl Design {
                 "design.target_distance",
                 "stops on the distance to the target, which this objective does not have \
                  (design.distance_weight = 0)"
+                    .into(),
+            );
+        }
+        if self.method == Method::GaussNewton && self.distance_weight == 0.0 {
+            return ck.inv(
+                "design.method",
+                "\"gauss_newton\" models the distance term's least squares, which this \
+                 objective does not have (design.distance_weight = 0): use \"lbfgs\""
                     .into(),
             );
         }
@@ -345,9 +437,28 @@ mod tests {
         let d = Design {
             lower: Some(-0.5),
             upper: Some(0.5),
-            start: Some(0.7),
+            start: Some(Start::Value(0.7)),
             ..Default::default()
         };
         assert_eq!(d.validate().unwrap_err().key, "design.start");
+    }
+
+    #[test]
+    fn a_start_is_a_number_or_the_target() {
+        let d = parse("[design]\nstart = 0.25\n").unwrap();
+        assert_eq!(d.start, Some(Start::Value(0.25)));
+        let d = parse("[design]\nstart = -1\n").unwrap();
+        assert_eq!(d.start, Some(Start::Value(-1.0)));
+        let d = parse("[design]\nstart = \"target\"\n").unwrap();
+        assert_eq!(d.start, Some(Start::Target));
+        let e = parse("[design]\nstart = \"flat\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("design.start") || e.contains("start"), "{e}");
+        assert!(e.contains("\"target\""), "{e}");
+        let e = parse("[design]\nvariable = \"thickness\"\nstart = \"target\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("design.start"), "{e}");
     }
 }

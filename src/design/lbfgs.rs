@@ -76,7 +76,24 @@ pub struct Iterate<'a> {
     pub trials: usize,
 }
 
-fn projected(p: &[Real], g: &[Real], o: &Options) -> Vec<Real> {
+/// How a zero projected gradient at iteration `it` with objective `f` ends the design: at the
+/// start with something left to gain it is a critical point the design cannot leave by descent
+/// (a flat sheet's curvature does not change to first order), not an optimum.
+pub(super) fn zero_gradient(it: usize, f: Real) -> Stop {
+    if it == 1 && f > 0.0 {
+        Stop::Stalled(
+            "the gradient is zero at the starting design, a critical point that is not the \
+             target (a flat start changes no curvature to first order: add a distance term or \
+             start from a curved design)"
+                .into(),
+        )
+    } else {
+        Stop::Converged("the projected gradient is zero".into())
+    }
+}
+
+/// The gradient with the entries of variables held at a bound (pushed outward) set to zero.
+pub(super) fn projected(p: &[Real], g: &[Real], o: &Options) -> Vec<Real> {
     p.iter()
         .zip(g)
         .map(|(&x, &gi)| {
@@ -89,11 +106,11 @@ fn projected(p: &[Real], g: &[Real], o: &Options) -> Vec<Real> {
         .collect()
 }
 
-fn dot(a: &[Real], b: &[Real]) -> Real {
+pub(super) fn dot(a: &[Real], b: &[Real]) -> Real {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-fn amax(a: &[Real]) -> Real {
+pub(super) fn amax(a: &[Real]) -> Real {
     a.iter().fold(0.0, |m: Real, x| m.max(x.abs()))
 }
 
@@ -128,26 +145,7 @@ pub fn minimise<P: Problem>(
     for it in 1..=o.max_iterations {
         let pg = projected(&p, &g, o);
         if amax(&pg) == 0.0 {
-            // At the start with something left to gain, a zero gradient is a critical point
-            // the design cannot leave by descent (a flat sheet's curvature does not change to
-            // first order), not an optimum.
-            if it == 1 && f > 0.0 {
-                return Ok((
-                    Stop::Stalled(
-                        "the gradient is zero at the starting design, a critical point that \
-                         is not the target (a flat start changes no curvature to first order: \
-                         add a distance term or start from a curved design)"
-                            .into(),
-                    ),
-                    p,
-                    f,
-                ));
-            }
-            return Ok((
-                Stop::Converged("the projected gradient is zero".into()),
-                p,
-                f,
-            ));
+            return Ok((zero_gradient(it, f), p, f));
         }
         let free: Vec<bool> = pg
             .iter()
@@ -169,40 +167,9 @@ pub fn minimise<P: Problem>(
             let s = o.first_step / amax(&pd).max(Real::MIN_POSITIVE);
             d = pd.iter().map(|x| -x * s).collect();
         }
-        let mut alpha = 1.0;
-        let mut trials = 0;
-        let mut last_failure = String::new();
-        let mut accepted = None;
-        while trials < 40 {
-            let trial: Vec<Real> = p
-                .iter()
-                .zip(&d)
-                .map(|(x, di)| (x + alpha * di).clamp(o.lower, o.upper))
-                .collect();
-            let dp: Vec<Real> = trial.iter().zip(&p).map(|(a, b)| a - b).collect();
-            if amax(&dp) <= 1e-15 * (1.0 + amax(&p)) {
-                break;
-            }
-            trials += 1;
-            match problem.eval(&trial) {
-                Ok((ft, gt)) if ft.is_finite() && ft <= f + 1e-4 * dot(&g, &dp) => {
-                    accepted = Some((trial, ft, gt));
-                    break;
-                }
-                Ok((ft, _)) => {
-                    last_failure = format!("the objective went to {ft:e} from {f:e}");
-                }
-                Err(e) => last_failure = e,
-            }
-            alpha *= 0.5;
-        }
-        let Some((trial, ft, gt)) = accepted else {
-            let why = if last_failure.is_empty() {
-                "the step became too small to change the design".to_string()
-            } else {
-                format!("no step along the descent direction lowers the objective ({last_failure})")
-            };
-            return Ok((Stop::Stalled(why), p, f));
+        let (trial, ft, gt, alpha, trials) = match backtrack(problem, &p, &d, f, &g, o, 40) {
+            Ok(a) => a,
+            Err(why) => return Ok((Stop::Stalled(why), p, f)),
         };
         problem.accept();
         let s: Vec<Real> = trial.iter().zip(&p).map(|(a, b)| a - b).collect();
@@ -218,32 +185,92 @@ pub fn minimise<P: Problem>(
         p = trial;
         f = ft;
         g = gt;
-        let pg = projected(&p, &g, o);
-        if let Some(why) = report(
-            &Iterate {
-                iteration: it,
-                p: &p,
-                value: f,
-                gradient: amax(&pg),
-                step: alpha,
-                trials,
-            },
-            problem,
-        ) {
-            return Ok((Stop::Converged(why), p, f));
-        }
-        if change < o.tolerance {
-            return Ok((
-                Stop::Converged(format!(
-                    "the objective changed by {change:.1e} (relative) in the last iteration, below \
-                     design.tolerance"
-                )),
-                p,
-                f,
-            ));
+        if let Some(stop) = after_step(problem, report, o, (it, &p, f, &g), (alpha, trials), change)
+        {
+            return Ok((stop, p, f));
         }
     }
     Ok((Stop::Limit, p, f))
+}
+
+/// The accepted trial of a backtracking line search: the variables, objective, gradient, the
+/// step length and the trials evaluated.
+pub(super) type Accepted = (Vec<Real>, Real, Vec<Real>, Real, usize);
+
+/// Backtracks along `d` from `p` (objective `f`, gradient `g`), halving from the full step, each
+/// trial projected onto the box, until the Armijo condition holds (at most `max_trials`
+/// evaluations); a trial whose evaluation fails counts as one that does not descend. `Err` says
+/// why no step was accepted.
+pub(super) fn backtrack<P: Problem>(
+    problem: &mut P,
+    p: &[Real],
+    d: &[Real],
+    f: Real,
+    g: &[Real],
+    o: &Options,
+    max_trials: usize,
+) -> Result<Accepted, String> {
+    let mut alpha = 1.0;
+    let mut trials = 0;
+    let mut last_failure = String::new();
+    while trials < max_trials {
+        let trial: Vec<Real> = p
+            .iter()
+            .zip(d)
+            .map(|(x, di)| (x + alpha * di).clamp(o.lower, o.upper))
+            .collect();
+        let dp: Vec<Real> = trial.iter().zip(p).map(|(a, b)| a - b).collect();
+        if amax(&dp) <= 1e-15 * (1.0 + amax(p)) {
+            break;
+        }
+        trials += 1;
+        match problem.eval(&trial) {
+            Ok((ft, gt)) if ft.is_finite() && ft <= f + 1e-4 * dot(g, &dp) => {
+                return Ok((trial, ft, gt, alpha, trials));
+            }
+            Ok((ft, _)) => last_failure = format!("the objective went to {ft:e} from {f:e}"),
+            Err(e) => last_failure = e,
+        }
+        alpha *= 0.5;
+    }
+    Err(if last_failure.is_empty() {
+        "the step became too small to change the design".to_string()
+    } else {
+        format!("no step along the descent direction lowers the objective ({last_failure})")
+    })
+}
+
+/// Reports accepted iteration `it` (variables `p`, objective `f`, gradient `g`, step length and
+/// trials) and decides whether to stop: the report's own reason, or a relative `change` of the
+/// objective below the tolerance.
+pub(super) fn after_step<P: Problem>(
+    problem: &P,
+    report: &mut dyn FnMut(&Iterate, &P) -> Option<String>,
+    o: &Options,
+    (it, p, f, g): (usize, &[Real], Real, &[Real]),
+    (step, trials): (Real, usize),
+    change: Real,
+) -> Option<Stop> {
+    let pg = projected(p, g, o);
+    if let Some(why) = report(
+        &Iterate {
+            iteration: it,
+            p,
+            value: f,
+            gradient: amax(&pg),
+            step,
+            trials,
+        },
+        problem,
+    ) {
+        return Some(Stop::Converged(why));
+    }
+    (change < o.tolerance).then(|| {
+        Stop::Converged(format!(
+            "the objective changed by {change:.1e} (relative) in the last iteration, below \
+             design.tolerance"
+        ))
+    })
 }
 
 /// `−H g` by the two-loop recursion over the stored pairs, on the free variables, with the

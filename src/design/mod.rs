@@ -26,6 +26,7 @@
 //! continuation, never further than the equilibrium follows.
 
 pub mod curvature;
+pub mod gauss_newton;
 pub mod lbfgs;
 pub mod objective;
 pub mod run;
@@ -65,6 +66,26 @@ fn potential<'p>(
         gravity,
         ..Potential::new(scene, pattern)
     }
+}
+
+/// Factorises the exact Hessian of `pot` at `state` in `lin`, with its low-rank part: the
+/// Woodbury solver when the whole is positive definite (a stable equilibrium), else `None`.
+fn factor_exact(pot: &Potential, lin: &mut LinearSolver, state: &State) -> Option<Woodbury> {
+    let n = pot.pattern.n;
+    let mut grad = vec![0.0; n];
+    let mut values = vec![0.0; pot.pattern.row_idx.len()];
+    pot.eval_projected(
+        &state.x,
+        &state.dofs,
+        Want::Hessian,
+        HessianProjection::None,
+        &mut grad,
+        &mut values,
+    );
+    lin.factor(&values).ok()?;
+    let lr = pot.low_rank(&state.x, &state.dofs);
+    let wb = Woodbury::new(lin, &lr);
+    wb.keeps_positive_definite().then_some(wb)
 }
 
 /// Where the time of the evaluations went (s).
@@ -253,24 +274,7 @@ impl<'s> Problem<'s> {
                 ));
             }
             let clock = Instant::now();
-            let mut grad = vec![0.0; self.pattern.n];
-            let mut values = vec![0.0; self.pattern.row_idx.len()];
-            pot.eval_projected(
-                &state.x,
-                &state.dofs,
-                Want::Hessian,
-                HessianProjection::None,
-                &mut grad,
-                &mut values,
-            );
-            self.held = None;
-            if self.lin.factor(&values).is_ok() {
-                let lr = pot.low_rank(&state.x, &state.dofs);
-                let wb = Woodbury::new(&mut self.lin, &lr);
-                if wb.keeps_positive_definite() {
-                    self.held = Some(wb);
-                }
-            }
+            self.held = factor_exact(&pot, &mut self.lin, state);
             self.timing.adjoint += clock.elapsed().as_secs_f64();
             if self.held.is_some() {
                 return Ok(());
@@ -356,8 +360,7 @@ impl<'s> Problem<'s> {
     /// current equilibrium. Along one direction the response scales: a shorter step of the line
     /// search reuses it. `None` when there is no current factorisation.
     fn predict(&mut self, p: &[Real]) -> Option<Vec<Real>> {
-        let cur = self.current.as_ref()?;
-        if self.current_p.len() != p.len() {
+        if self.current.is_none() || self.current_p.len() != p.len() {
             return None;
         }
         let dp: Vec<Real> = p.iter().zip(&self.current_p).map(|(a, b)| a - b).collect();
@@ -380,14 +383,32 @@ impl<'s> Problem<'s> {
         if !self.factor_current {
             return None;
         }
+        let dx = self.tangent(&dp)?;
+        self.predicted = Some((dp, dx.clone()));
+        Some(dx)
+    }
+
+    /// The first-order response `S v = −H⁻¹ ∂g/∂p v` of the current equilibrium to the design
+    /// change `v` (m per design unit), with `∂g/∂p v` by central differences of the gradient
+    /// over the rest data at `p ± ε v` and `H` the factorisation held at the current
+    /// equilibrium (refactorised there when a trial replaced it). `None` without a current
+    /// equilibrium, or when its Hessian is no longer positive definite.
+    fn tangent(&mut self, dp: &[Real]) -> Option<Vec<Real>> {
+        if !self.refactor_current() {
+            return None;
+        }
+        let cur = self.current.as_ref()?;
         let amax = dp.iter().fold(0.0 as Real, |m, x| m.max(x.abs()));
-        let eps = 1e-6 / amax.max(1e-300);
+        if amax == 0.0 {
+            return Some(vec![0.0; self.pattern.n]);
+        }
+        let eps = 1e-6 / amax;
         let mut grads = Vec::new();
         for sign in [1.0, -1.0] {
             let q: Vec<Real> = self
                 .current_p
                 .iter()
-                .zip(&dp)
+                .zip(dp)
                 .map(|(a, d)| a + sign * eps * d)
                 .collect();
             let rest = self.rest(&q);
@@ -427,8 +448,121 @@ impl<'s> Problem<'s> {
             return None;
         }
         pot.mask_fixed(&mut dx);
-        self.predicted = Some((dp, dx.clone()));
         Some(dx)
+    }
+
+    /// Makes `lin` and `held` the factorisation at the current equilibrium again (after a trial
+    /// replaced it); false without a current equilibrium or when it is not positive definite.
+    fn refactor_current(&mut self) -> bool {
+        if self.factor_current {
+            return true;
+        }
+        let Some(cur) = self.current.as_ref() else {
+            return false;
+        };
+        let clock = Instant::now();
+        let mass = self.mass(&cur.ratio);
+        let pot = potential(
+            self.scene,
+            &self.pattern,
+            self.gravity,
+            (&cur.forms, &cur.ratio, &mass),
+        );
+        self.held = factor_exact(&pot, &mut self.lin, &cur.state);
+        self.factor_current = self.held.is_some();
+        self.timing.adjoint += clock.elapsed().as_secs_f64();
+        self.factor_current
+    }
+
+    /// `Sᵀ u = −(∂g/∂p)ᵀ H⁻¹ u` at the current equilibrium (per design number, for `u` per DOF):
+    /// the adjoint of [`Problem::tangent`], by the same pass as the gradient.
+    fn pullback(&mut self, mut u: Vec<Real>) -> Option<Vec<Real>> {
+        if !self.refactor_current() {
+            return None;
+        }
+        let cur = self.current.as_ref()?;
+        let mass = self.mass(&cur.ratio);
+        let pot = potential(
+            self.scene,
+            &self.pattern,
+            self.gravity,
+            (&cur.forms, &cur.ratio, &mass),
+        );
+        pot.mask_fixed(&mut u);
+        if !self.held.as_ref()?.solve_in_place(&mut self.lin, &mut u) {
+            return None;
+        }
+        pot.mask_fixed(&mut u);
+        let rest = self.rest(&self.current_p);
+        self.rest_gradient(&pot, &cur.state, &rest, &u).ok()
+    }
+
+    /// `−(∂r/∂p)ᵀ (λᵀ ∂g/∂r)` per design number, with the designed mass's weight: the design
+    /// gradient of an adjoint state `λ` at the equilibrium `state` of `pot`.
+    fn rest_gradient(
+        &self,
+        pot: &Potential,
+        state: &State,
+        rest: &[variables::FaceRest],
+        lambda: &[Real],
+    ) -> Result<Vec<Real>, String> {
+        let mut w = vec![[0.0; crate::energy::sensitivity::REST_DATA]; rest.len()];
+        for t in self.scene.terms.iter() {
+            if let Some(s) = t.rest_sensitivity() {
+                let part = s.rest_adjoint(pot, &state.x, &state.dofs, lambda)?;
+                for (a, b) in w.iter_mut().zip(part) {
+                    for (x, y) in a.iter_mut().zip(b) {
+                        *x += y;
+                    }
+                }
+            }
+        }
+        let k = self.chain.per_face();
+        let mut grad = vec![0.0; k * rest.len()];
+        for (f, r) in rest.iter().enumerate() {
+            let h = self.scene.body.thickness[f];
+            for (j, row) in r.jac.iter().enumerate() {
+                let mut s = 0.0;
+                for i in 0..6 {
+                    s += row[i] * w[f][i];
+                }
+                s += row[6] * h * w[f][6];
+                grad[k * f + j] = -s;
+            }
+        }
+        // A designed thickness carries the weight with it: the gravity part of the residual,
+        // −m_v g, has ∂/∂h̄_f = −(∂m_v/∂h̄_f) g on the face's vertices.
+        if let Some((dm, _)) = self.mass_per_thickness() {
+            let g = self.gravity;
+            for (f, face) in self.scene.body.mesh.faces.iter().enumerate() {
+                let s: Real = face
+                    .iter()
+                    .map(|&v| {
+                        Vec3::new(lambda[3 * v], lambda[3 * v + 1], lambda[3 * v + 2]).dot(&g)
+                    })
+                    .sum();
+                grad[f] += dm[f] * s;
+            }
+        }
+        Ok(grad)
+    }
+
+    /// Makes the equilibrium `state` (solved again from there, which a converged state needs
+    /// no step for) of design `p` the current one: the optimiser goes on from another branch,
+    /// the one a forward run of the design found.
+    pub fn restart_from(&mut self, p: &[Real], mut state: State) -> Result<(), String> {
+        let rest = self.rest(p);
+        let forms: Vec<(Sym2, Sym2)> = rest.iter().map(|r| r.forms).collect();
+        let ratio: Vec<Real> = rest.iter().map(|r| r.ratio).collect();
+        self.factor_current = false;
+        self.predicted = None;
+        self.equilibrium(&forms, &ratio, &mut state)?;
+        let (_, _, e) = self.finish(p, rest, forms, ratio, state)?;
+        self.current = Some(e);
+        self.current_p = p.to_vec();
+        self.factor_current = true;
+        self.trial = None;
+        Ok(())
     }
 
     /// Evaluates design `p`: the equilibrium from the current one (or the reference), `J` and
@@ -515,44 +649,7 @@ impl<'s> Problem<'s> {
         pot.mask_fixed(&mut lambda);
         self.timing.adjoint += clock.elapsed().as_secs_f64();
         let clock = Instant::now();
-        let mut w = vec![[0.0; crate::energy::sensitivity::REST_DATA]; forms.len()];
-        for t in self.scene.terms.iter() {
-            if let Some(s) = t.rest_sensitivity() {
-                let part = s.rest_adjoint(&pot, &state.x, &state.dofs, &lambda)?;
-                for (a, b) in w.iter_mut().zip(part) {
-                    for (x, y) in a.iter_mut().zip(b) {
-                        *x += y;
-                    }
-                }
-            }
-        }
-        let k = self.chain.per_face();
-        let mut grad = vec![0.0; p.len()];
-        for (f, r) in rest.iter().enumerate() {
-            let h = self.scene.body.thickness[f];
-            for (j, row) in r.jac.iter().enumerate() {
-                let mut s = 0.0;
-                for i in 0..6 {
-                    s += row[i] * w[f][i];
-                }
-                s += row[6] * h * w[f][6];
-                grad[k * f + j] = -s;
-            }
-        }
-        // A designed thickness carries the weight with it: the gravity part of the residual,
-        // −m_v g, has ∂/∂h̄_f = −(∂m_v/∂h̄_f) g on the face's vertices.
-        if let Some((dm, _)) = self.mass_per_thickness() {
-            let g = self.gravity;
-            for (f, face) in self.scene.body.mesh.faces.iter().enumerate() {
-                let s: Real = face
-                    .iter()
-                    .map(|&v| {
-                        Vec3::new(lambda[3 * v], lambda[3 * v + 1], lambda[3 * v + 2]).dot(&g)
-                    })
-                    .sum();
-                grad[f] += dm[f] * s;
-            }
-        }
+        let mut grad = self.rest_gradient(&pot, &state, &rest, &lambda)?;
         let js = self.smoothness.eval(p, &mut grad);
         self.timing.sensitivities += clock.elapsed().as_secs_f64();
         let value = d.value + js;
@@ -595,5 +692,73 @@ impl lbfgs::Problem for Problem<'_> {
         if let Some(m) = &self.metric {
             m.solve(v);
         }
+    }
+}
+
+impl gauss_newton::Model for Problem<'_> {
+    fn model_product(&mut self, v: &[Real]) -> Option<Vec<Real>> {
+        let (mu, term) = self.shape.distance.as_ref()?;
+        let c: Vec<Real> = term.model_weights().iter().map(|w| mu * w).collect();
+        let aligns = term.aligns();
+        let mut u = self.tangent(v)?;
+        let nv = c.len();
+        let mut dx: Vec<Vec3> = (0..nv)
+            .map(|k| Vec3::new(u[3 * k], u[3 * k + 1], u[3 * k + 2]))
+            .collect();
+        if aligns {
+            // The alignment takes up the response's rigid part.
+            let x = &self.current.as_ref()?.state.x;
+            objective::remove_rigid_motion(x, &c, &mut dx);
+        }
+        u.iter_mut().for_each(|x| *x = 0.0);
+        for (k, d) in dx.iter().enumerate() {
+            let d = d * c[k];
+            u[3 * k..3 * k + 3].copy_from_slice(d.as_slice());
+        }
+        let mut out = self.pullback(u)?;
+        if self.smoothness.weight > 0.0 {
+            // The smoothness term's Hessian along v, by central differences of its gradient
+            // (exact for the quadratic term up to round-off).
+            let eps = 1e-6 / lbfgs::amax(v).max(Real::MIN_POSITIVE);
+            let mut hi = vec![0.0; v.len()];
+            let mut lo = vec![0.0; v.len()];
+            let at = |sign: Real| -> Vec<Real> {
+                self.current_p
+                    .iter()
+                    .zip(v)
+                    .map(|(a, b)| a + sign * eps * b)
+                    .collect()
+            };
+            self.smoothness.eval(&at(1.0), &mut hi);
+            self.smoothness.eval(&at(-1.0), &mut lo);
+            for ((o, a), b) in out.iter_mut().zip(&hi).zip(&lo) {
+                *o += (a - b) / (2.0 * eps);
+            }
+        }
+        Some(out)
+    }
+
+    fn metric_product(&self, v: &[Real]) -> Vec<Real> {
+        let mut out = vec![0.0; v.len()];
+        match &self.metric {
+            Some(m) => m.apply(v, &mut out),
+            None => {
+                let n = self.scene.body.num_faces().max(1) as Real;
+                out.iter_mut().zip(v).for_each(|(o, x)| *o = x / n);
+            }
+        }
+        out
+    }
+
+    fn response_size(&mut self, v: &[Real]) -> Option<Real> {
+        let size = self.shape.distance.as_ref()?.1.size();
+        let dx = self.tangent(v)?;
+        let nv = self.scene.body.num_vertices();
+        let worst = dx
+            .chunks_exact(3)
+            .take(nv)
+            .map(|d| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt())
+            .fold(0.0 as Real, Real::max);
+        Some(worst / size)
     }
 }

@@ -204,6 +204,64 @@ pub struct ShapeValue {
     pub nearest: Option<Vec<Vec3>>,
 }
 
+impl DistanceTerm {
+    /// The weights `c_v` of the Gauss–Newton model of the term,
+    /// `J_d(x + δx) ≈ J_d + ∇J_d·δx + ½ Σ_v c_v |δx_v|²` with the alignment and the closest
+    /// points held (1/m²): `w_v/L²` for points; for a surface, the shape side's `½ w_v/L²` of
+    /// its `¼(…)/L²` (the target side, whose points move with the shape's faces, is left out of
+    /// the model; the gradient keeps it).
+    pub fn model_weights(&self) -> Vec<Real> {
+        match self {
+            DistanceTerm::Points(p) => {
+                let l2 = p.size * p.size;
+                p.weights.iter().map(|w| w / l2).collect()
+            }
+            DistanceTerm::Surface(s) => s.model_weights(),
+        }
+    }
+
+    /// Whether the shape is compared after the best rigid motion.
+    pub fn aligns(&self) -> bool {
+        match self {
+            DistanceTerm::Points(p) => p.align,
+            DistanceTerm::Surface(s) => s.aligns(),
+        }
+    }
+
+    /// The target's size `L` (m).
+    pub fn size(&self) -> Real {
+        match self {
+            DistanceTerm::Points(p) => p.size,
+            DistanceTerm::Surface(s) => s.size,
+        }
+    }
+}
+
+/// Removes from the displacement `dx` (per vertex) its best infinitesimal rigid motion about
+/// the shape `x` in the weights `c`: `dx_v − τ − ω × (x_v − x̄)`, with `x̄` the weighted
+/// centroid, `τ` the weighted mean of `dx` and `(Σ c_v (|r_v|² I − r_v r_vᵀ)) ω = Σ c_v r_v × dx_v`.
+/// This is the `c`-orthogonal projection onto the displacements an alignment cannot absorb: the
+/// linearised Kabsch–Umeyama fit.
+pub fn remove_rigid_motion(x: &[Vec3], c: &[Real], dx: &mut [Vec3]) {
+    let total: Real = c.iter().sum();
+    if total <= 0.0 {
+        return;
+    }
+    let centre = x.iter().zip(c).map(|(p, w)| p * *w).sum::<Vec3>() / total;
+    let tau = dx.iter().zip(c).map(|(d, w)| d * *w).sum::<Vec3>() / total;
+    let mut a = Mat3::zeros();
+    let mut b = Vec3::zeros();
+    for ((p, d), w) in x.iter().zip(dx.iter()).zip(c) {
+        let r = p - centre;
+        a += (Mat3::identity() * r.norm_squared() - r * r.transpose()) * *w;
+        b += r.cross(d) * *w;
+    }
+    let omega = a.try_inverse().map_or(Vec3::zeros(), |inv| inv * b);
+    for (p, d) in x.iter().zip(dx.iter_mut()) {
+        *d -= tau + omega.cross(&(p - centre));
+    }
+}
+
 impl Shape {
     /// The terms and their gradient at `x`.
     pub fn eval(&self, x: &[Vec3]) -> ShapeValue {
@@ -350,7 +408,7 @@ impl Sobolev {
     }
 
     /// `y = M x`.
-    fn apply(&self, x: &[Real], y: &mut [Real]) {
+    pub fn apply(&self, x: &[Real], y: &mut [Real]) {
         let k = self.per_face;
         for (f, a) in self.area.iter().enumerate() {
             for i in 0..k {

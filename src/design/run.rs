@@ -15,7 +15,7 @@ use super::objective::{bounding_diagonal, DistanceTerm, Points, Shape, Smoothnes
 use super::surface::Surface;
 use super::variables::Chain;
 use super::{DesignTiming, Evaluated, Problem};
-use crate::config::design::{Design, Objective, Variable};
+use crate::config::design::{Design, Method, Objective, Start, Variable};
 use crate::config::growth::GrowthLaw;
 use crate::math::{sym_det, Real, Vec3};
 use crate::mesh::io::{read_mesh, series_xml, write_atomic, write_mesh, Format};
@@ -123,9 +123,27 @@ pub fn prepare(req: &Request) -> Result<Prepared, DesignError> {
     let input = read_mesh(&req.mesh).map_err(|e| DesignError(e.to_string()))?;
     let scene = Scene::build(input.clone(), settings).map_err(|e| DesignError(e.to_string()))?;
     let target = read_target(&req.target, &scene, &design)?;
+    let interior = |o: &[usize; 3]| !o.contains(&crate::mesh::topology::NONE);
+    if design.mean_curvature_weight + design.gauss_curvature_weight > 0.0
+        && !scene.body.topo.opposite_vertex.iter().any(interior)
+    {
+        let key = if design.mean_curvature_weight > 0.0 {
+            "design.mean_curvature_weight"
+        } else {
+            "design.gauss_curvature_weight"
+        };
+        return Err(DesignError(format!(
+            "{name}: invalid '{key}': the curvature terms compare the faces with three \
+             neighbours, and no face of {} has three",
+            req.mesh.display()
+        )));
+    }
     let curvature_targets = curvature_targets(&req.target, &target, &scene, &design)?;
-    let (chain, start) = chain_and_start(&scene, &design)
+    let (chain, mut start) = chain_and_start(&scene, &design)
         .map_err(|(k, r)| DesignError(format!("{name}: invalid '{k}': {r}")))?;
+    if design.start == Some(Start::Target) {
+        start = fitted_start(&req.target, &target, &scene, &design, &chain, &start)?;
+    }
     Ok(Prepared {
         scene,
         design,
@@ -494,8 +512,8 @@ fn chain_and_start(scene: &Scene, d: &Design) -> Result<(Chain, Vec<Real>), (Str
         }
     };
     let start = match d.start {
-        Some(v) => vec![v; own.len()],
-        None => own,
+        Some(Start::Value(v)) => vec![v; own.len()],
+        _ => own,
     };
     if let Some(i) = start.iter().position(|v| !v.is_finite()) {
         return Err((
@@ -507,6 +525,57 @@ fn chain_and_start(scene: &Scene, d: &Design) -> Result<(Chain, Vec<Real>), (Str
         ));
     }
     Ok((chain, start))
+}
+
+/// The start of `design.start = "target"`: each face's numbers fitted to the target's own
+/// fundamental forms there ([`Chain::fit`], from the scene's own design `own`, within the
+/// bounds): `a` of the target face's edges, `b` the mid-edge average over its neighbours (the
+/// shell's own forms of the target shape). The target needs the mesh's connectivity and faces
+/// of positive area.
+fn fitted_start(
+    path: &Path,
+    target: &Mesh,
+    scene: &Scene,
+    d: &Design,
+    chain: &Chain,
+    own: &[Real],
+) -> Result<Vec<Real>, DesignError> {
+    same_connectivity(
+        path,
+        target,
+        scene,
+        "design.start = \"target\" fits each face's rest forms to the target's there",
+    )?;
+    let body = &scene.body;
+    let x = &target.positions;
+    let k = chain.per_face();
+    let bounds = (
+        d.lower.unwrap_or_else(|| default_lower(d.variable, own)),
+        d.upper.unwrap_or(Real::INFINITY),
+    );
+    let mut start = Vec::with_capacity(own.len());
+    for (f, face) in body.mesh.faces.iter().enumerate() {
+        let o = body.topo.opposite_vertex[f];
+        let has = o.map(|v| v != crate::mesh::topology::NONE);
+        let at = |i: usize| if has[i] { x[o[i]] } else { x[face[0]] };
+        let stencil = [x[face[0]], x[face[1]], x[face[2]], at(0), at(1), at(2)];
+        let forms = crate::energy::shell::face_forms(&stencil, has);
+        let det = sym_det(&forms.0);
+        if det.is_nan() || det <= 0.0 {
+            return Err(DesignError::at(
+                path,
+                format!(
+                    "the target's face {} has no area, so design.start = \"target\" has no \
+                     metric to fit there",
+                    f
+                ),
+            ));
+        }
+        let h = body.thickness[f];
+        let (p, _) = chain.fit(f, &own[k * f..k * (f + 1)], &forms, h * h / 12.0, bounds);
+        start.extend(p);
+    }
+    Ok(start)
 }
 
 /// The lower bound of a variable without `design.lower`: none, except where the law needs one:
@@ -829,52 +898,112 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
     let mut series: Vec<(Real, String)> = Vec::new();
     let mut io_error: Option<DesignError> = None;
     let every = d.frames_every;
-    let result = {
-        let mut report = |it: &Iterate, prob: &Problem| -> Option<String> {
-            let e = prob.current.as_ref()?;
-            let distance = Points::relative_rms(e.distance);
-            let row = Row {
-                iteration: it.iteration,
-                objective: it.value,
-                distance,
-                mean: Points::relative_rms(e.mean),
-                gauss: Points::relative_rms(e.gauss),
-                smoothness: e.smoothness,
-                gradient: it.gradient,
-                step: it.step,
-                trials: it.trials,
-                timing: prob.timing,
-                wall: clock.elapsed().as_secs_f64(),
-            };
-            log.push_str(&row.csv(size));
-            if !req.quiet {
-                eprintln!(
-                    "design: iteration {}, distance {} of the target's size, objective {}, {:.1} s",
-                    it.iteration,
-                    crate::math::human(distance),
-                    crate::math::human(it.value),
-                    row.wall
-                );
-            }
-            if (every > 0 && it.iteration.is_multiple_of(every)) || it.iteration == 0 {
-                let name = format!("iteration_{:05}.vtk", it.iteration);
-                let m = shape_mesh(&prep, &chain, it.p, e);
-                if let Err(err) =
-                    write_mesh(&frames_dir.join(&name), &m, Format::Vtk, "shellsim design")
-                {
-                    io_error = Some(DesignError(err.to_string()));
-                    return Some("output failed".into());
-                }
-                series.push((it.iteration as Real, format!("iterations/{name}")));
-            }
-            (d.target_distance > 0.0 && distance <= d.target_distance).then(|| {
-                format!(
-                    "the distance to the target, {} of its size, is within design.target_distance",
-                    crate::math::human(distance)
-                )
-            })
+    // The iterations before the current round, the last iteration reported, the forward
+    // checks made and the last one.
+    let (mut offset, mut last_iteration, mut rounds) = (0usize, 0usize, 0usize);
+    let mut check: Option<ForwardCheck> = None;
+    let mut from = prep.start.clone();
+    let result = loop {
+        let round_opts = Options {
+            max_iterations: d.max_iterations.saturating_sub(offset).max(1),
+            ..opts.clone()
         };
-        minimise(&mut problem, prep.start.clone(), &opts, &mut report)
+        let round = {
+            let mut report = |it: &Iterate, prob: &Problem| -> Option<String> {
+                let e = prob.current.as_ref()?;
+                let iteration = it.iteration + offset;
+                last_iteration = iteration;
+                let distance = Points::relative_rms(e.distance);
+                let row = Row {
+                    iteration,
+                    objective: it.value,
+                    distance,
+                    mean: Points::relative_rms(e.mean),
+                    gauss: Points::relative_rms(e.gauss),
+                    smoothness: e.smoothness,
+                    gradient: it.gradient,
+                    step: it.step,
+                    trials: it.trials,
+                    timing: prob.timing,
+                    wall: clock.elapsed().as_secs_f64(),
+                };
+                log.push_str(&row.csv(size));
+                if !req.quiet {
+                    eprintln!(
+                        "design: iteration {iteration}, distance {} of the target's size, \
+                         objective {}, {:.1} s",
+                        crate::math::human(distance),
+                        crate::math::human(it.value),
+                        row.wall
+                    );
+                }
+                if (every > 0 && iteration.is_multiple_of(every)) || it.iteration == 0 {
+                    let name = format!("iteration_{iteration:05}.vtk");
+                    let m = shape_mesh(&prep, &chain, it.p, e);
+                    if let Err(err) =
+                        write_mesh(&frames_dir.join(&name), &m, Format::Vtk, "shellsim design")
+                    {
+                        io_error = Some(DesignError(err.to_string()));
+                        return Some("output failed".into());
+                    }
+                    series.push((iteration as Real, format!("iterations/{name}")));
+                }
+                (d.target_distance > 0.0 && distance <= d.target_distance).then(|| {
+                    format!(
+                        "the distance to the target, {} of its size, is within \
+                         design.target_distance",
+                        crate::math::human(distance)
+                    )
+                })
+            };
+            match d.method {
+                Method::Lbfgs => minimise(&mut problem, from.clone(), &round_opts, &mut report),
+                Method::GaussNewton => super::gauss_newton::minimise(
+                    &mut problem,
+                    from.clone(),
+                    &round_opts,
+                    &mut report,
+                ),
+            }
+        };
+        let Ok((stop, p, value)) = round else {
+            break round;
+        };
+        if io_error.is_some() || !d.forward_check {
+            break Ok((stop, p, value));
+        }
+        // The written design, run forward as `shellsim settings.toml designed.vtk` runs it.
+        let mut c = forward_check(&prep, &problem, &p);
+        rounds += 1;
+        c.rounds = rounds;
+        let far = |c: &ForwardCheck| {
+            c.distance
+                .is_none_or(|x| d.target_distance == 0.0 || x > d.target_distance)
+        };
+        let again = !c.reproduces
+            && far(&c)
+            && rounds < FORWARD_ROUNDS
+            && stop != Stop::Limit
+            && last_iteration + 1 < d.max_iterations;
+        if again {
+            if let Some(state) = c.state.take() {
+                if problem.restart_from(&p, state).is_ok() {
+                    if !req.quiet {
+                        eprintln!(
+                            "design: the forward run of the design found another equilibrium, \
+                             {} of the size from the designed one; designing on from it",
+                            crate::math::human(c.offset.unwrap_or(0.0))
+                        );
+                    }
+                    offset = last_iteration + 1;
+                    from = p;
+                    check = Some(c);
+                    continue;
+                }
+            }
+        }
+        check = Some(c);
+        break Ok((stop, p, value));
     };
     if let Some(e) = io_error {
         return Err(e);
@@ -889,8 +1018,8 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
         .current
         .clone()
         .ok_or_else(|| DesignError("no design was evaluated".into()))?;
-    let iterations = log.lines().count().saturating_sub(2);
-    let (converged, reason) = match &stop {
+    let iterations = last_iteration;
+    let (mut converged, mut reason) = match &stop {
         Stop::Converged(w) => (true, w.clone()),
         Stop::Stalled(w) => (false, format!("the design cannot improve: {w}")),
         Stop::Limit => (
@@ -898,6 +1027,12 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
             format!("design.max_iterations ({}) reached", d.max_iterations),
         ),
     };
+    if let Some(c) = &check {
+        if let Some(why) = c.failure(d.target_distance) {
+            converged = false;
+            reason = format!("{reason}; but {why}");
+        }
+    }
     // The last iteration's frame, when `frames_every` skipped it.
     let last = format!("iterations/iteration_{iterations:05}.vtk");
     if series.last().map(|s| &s.1) != Some(&last) {
@@ -956,6 +1091,7 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
         "mean_curvature_error": finite(Points::relative_rms(e.mean)),
         "gauss_curvature_error": finite(Points::relative_rms(e.gauss)),
         "smoothness": finite(e.smoothness),
+        "forward_check": check.as_ref().map_or(serde_json::json!(false), ForwardCheck::json),
         "evaluations": t.evaluations,
         "refused_evaluations": t.refused,
         "newton_iterations": t.newton_iterations,
@@ -978,6 +1114,166 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
         objective: value,
         distance,
     })
+}
+
+/// The most forward checks of one design: after each but the last, a design whose forward run
+/// finds another equilibrium goes on from that one.
+const FORWARD_ROUNDS: usize = 3;
+
+/// A forward run's equilibrium within this much of the designed one (RMS over the size, after
+/// alignment) is the designed one: the solver's own tolerance is far below.
+const REPRODUCES: Real = 1e-5;
+
+/// What the forward run of a written design found.
+struct ForwardCheck {
+    /// Whether it ends on the designed equilibrium (within [`REPRODUCES`]).
+    reproduces: bool,
+    /// Its distance to the target, over the target's size (with a distance term).
+    distance: Option<Real>,
+    /// Its distance from the designed equilibrium, over the size.
+    offset: Option<Real>,
+    /// Why it failed, when it did.
+    error: Option<String>,
+    /// Its equilibrium.
+    state: Option<crate::solve::State>,
+    /// The checks made so far.
+    rounds: usize,
+}
+
+impl ForwardCheck {
+    /// Its record in the summary (the keys without a value left out: no nulls).
+    fn json(&self) -> serde_json::Value {
+        let mut m = serde_json::Map::new();
+        m.insert("reproduces".into(), self.reproduces.into());
+        m.insert("rounds".into(), self.rounds.into());
+        if let Some(x) = self.distance {
+            m.insert("distance".into(), finite(x).into());
+        }
+        if let Some(x) = self.offset {
+            m.insert("offset_from_designed".into(), finite(x).into());
+        }
+        if let Some(e) = &self.error {
+            m.insert("error".into(), e.clone().into());
+        }
+        serde_json::Value::Object(m)
+    }
+
+    /// Why the design does not stand, if it does not: the forward run failed, or ended on
+    /// another equilibrium that is not within `target_distance` (when set) of the target.
+    fn failure(&self, target_distance: Real) -> Option<String> {
+        if let Some(e) = &self.error {
+            return Some(format!("the forward run of the written design failed: {e}"));
+        }
+        if self.reproduces {
+            return None;
+        }
+        let distance = self.distance.unwrap_or(Real::INFINITY);
+        if target_distance > 0.0 && distance <= target_distance {
+            return None;
+        }
+        Some(format!(
+            "the written design run forward from the mesh (`shellsim settings.toml designed.vtk`) \
+             ends on another equilibrium, {} of the size from the designed one and {} from the \
+             target",
+            crate::math::human(self.offset.unwrap_or(0.0)),
+            crate::math::human(distance)
+        ))
+    }
+}
+
+/// The sink of a forward check: keeps the last frame's state, writes nothing.
+#[derive(Default)]
+struct LastFrame {
+    state: Option<crate::solve::State>,
+    frames: usize,
+    faces: usize,
+}
+
+impl crate::integrate::Sink for LastFrame {
+    fn frame(
+        &mut self,
+        _: &crate::energy::Potential,
+        state: &crate::solve::State,
+        _: &[Vec3],
+        _: crate::integrate::report::LogRow,
+        _: Option<&crate::integrate::DriverState>,
+    ) -> Result<(), crate::integrate::OutputError> {
+        self.state = Some(state.clone());
+        self.frames += 1;
+        Ok(())
+    }
+    fn set_face_field(&mut self, _: &str, _: Vec<Real>) {}
+    fn num_faces(&self) -> usize {
+        self.faces
+    }
+    fn num_frames(&self) -> usize {
+        self.frames
+    }
+    fn last_frame(&self) -> String {
+        String::new()
+    }
+    fn release_reserve(&mut self) {}
+    fn summary(&self, _: &crate::integrate::Summary) -> Result<(), crate::integrate::OutputError> {
+        Ok(())
+    }
+}
+
+/// Runs the written design of `p` forward, as `shellsim settings.toml designed.vtk` would (the
+/// designed mesh and settings, from the flat sheet, on the design's thread count), and compares
+/// its equilibrium with the designed one (`problem`'s current) and with the target.
+fn forward_check(prep: &Prepared, problem: &Problem, p: &[Real]) -> ForwardCheck {
+    let mut c = ForwardCheck {
+        reproduces: false,
+        distance: None,
+        offset: None,
+        error: None,
+        state: None,
+        rounds: 0,
+    };
+    let run = || -> Result<crate::solve::State, String> {
+        let (mesh, table) = designed(prep, p);
+        let text = toml::to_string(&table).map_err(|e| e.to_string())?;
+        let settings =
+            Settings::from_str_with(&text, "the designed scene", &[]).map_err(|e| e.to_string())?;
+        let faces = mesh.faces.len();
+        let scene = Scene::build(mesh, settings).map_err(|e| e.to_string())?;
+        let mut sink = LastFrame {
+            faces,
+            ..LastFrame::default()
+        };
+        let summary = crate::integrate::run(
+            &scene,
+            &mut sink,
+            &mut crate::integrate::Quiet,
+            rayon::current_num_threads(),
+            None,
+        )
+        .map_err(|e| e.to_string())?;
+        if !summary.converged {
+            return Err(summary.reason);
+        }
+        sink.state.ok_or_else(|| "it wrote no frame".to_string())
+    };
+    let state = match run() {
+        Ok(s) => s,
+        Err(e) => {
+            c.error = Some(e);
+            return c;
+        }
+    };
+    let seen = problem.shape.eval(&state.x);
+    if problem.shape.distance.is_some() {
+        c.distance = Some(Points::relative_rms(seen.distance));
+    }
+    if let Some(e) = &problem.current {
+        let mesh = &prep.scene.body.mesh;
+        let designed = Points::new(mesh, e.state.x.clone(), true);
+        let offset = Points::relative_rms(designed.eval(&state.x).value);
+        c.offset = Some(offset);
+        c.reproduces = offset <= REPRODUCES;
+    }
+    c.state = Some(state);
+    c
 }
 
 /// A number for the summary: finite values as they are, anything else as 0 (never NaN).

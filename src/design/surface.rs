@@ -248,6 +248,17 @@ struct Pairs {
 }
 
 impl Surface {
+    /// Whether the shape is compared after the best rigid motion.
+    pub fn aligns(&self) -> bool {
+        self.align
+    }
+
+    /// The shape side's Gauss–Newton weights `½ w_v/L²` ([`super::objective::DistanceTerm::model_weights`]).
+    pub fn model_weights(&self) -> Vec<Real> {
+        let l2 = self.size * self.size;
+        self.weights.iter().map(|w| 0.5 * w / l2).collect()
+    }
+
     /// The distance to the target `(positions, faces)` of a shape on `mesh`'s connectivity
     /// (whose reference areas weigh its vertices).
     pub fn new(

@@ -226,6 +226,96 @@ impl Chain {
         }
     }
 
+    /// Face `f`'s design numbers whose rest forms are nearest the target forms `(a*, b*)`
+    /// (barycentric, m², m): the minimiser over the box `[lower, upper]` of the rest-form
+    /// mismatch `½|ā − a*|² + ½ w |b̄ − b*|²` in the target's own metric,
+    /// `|M|² = tr(a*⁻¹ M a*⁻¹ M)`, with `w = h²/12` (Koiter's bending-to-stretching ratio, `h`
+    /// in m). Projected Levenberg–Marquardt from `start` on the chain's exact Jacobian; a
+    /// director, whose mismatch is not convex in θ, also from `start + kπ/4`, `k = 1, 2, 3`,
+    /// keeping the best. Returns the numbers and the mismatch reached (dimensionless).
+    pub fn fit(
+        &self,
+        f: usize,
+        start: &[Real],
+        target: &(Sym2, Sym2),
+        w: Real,
+        (lower, upper): (Real, Real),
+    ) -> (Vec<Real>, Real) {
+        let inv = crate::math::sym_to_mat(&target.0)
+            .try_inverse()
+            .unwrap_or_else(Mat2::zeros);
+        // The metric on symmetric matrices, `Q_ij = tr(A E_i A E_j)` over the basis of Sym2.
+        let basis = [0, 1, 2].map(|i| inv * crate::math::sym_to_mat(&Sym2::ith(i, 1.0)));
+        let q = nalgebra::Matrix3::from_fn(|i, j| (basis[i] * basis[j]).trace());
+        let norm = |m: &Sym2| 0.5 * m.dot(&(q * m));
+        let mismatch = |p: &[Real]| {
+            let r = self.face(f, p);
+            let (da, db) = (r.forms.0 - target.0, r.forms.1 - target.1);
+            (norm(&da) + w * norm(&db), r, da, db)
+        };
+        let clamp = |x: Real| x.clamp(lower, upper);
+        let k = start.len();
+        let starts: Vec<Vec<Real>> = match self {
+            Chain::Director { .. } => (0..4)
+                .map(|j| vec![clamp(start[0] + j as Real * std::f64::consts::FRAC_PI_4)])
+                .collect(),
+            _ => vec![start.iter().map(|&x| clamp(x)).collect()],
+        };
+        let mut best: Option<(Vec<Real>, Real)> = None;
+        for mut p in starts {
+            let (mut e, mut r, mut da, mut db) = mismatch(&p);
+            let mut mu = 1e-3;
+            for _ in 0..200 {
+                let mut h = nalgebra::DMatrix::<Real>::zeros(k, k);
+                let mut g = nalgebra::DVector::<Real>::zeros(k);
+                let ja: Vec<Sym2> = r.jac.iter().map(|j| Sym2::new(j[0], j[1], j[2])).collect();
+                let jb: Vec<Sym2> = r.jac.iter().map(|j| Sym2::new(j[3], j[4], j[5])).collect();
+                for i in 0..k {
+                    g[i] = ja[i].dot(&(q * da)) + w * jb[i].dot(&(q * db));
+                    for l in 0..k {
+                        h[(i, l)] = ja[i].dot(&(q * ja[l])) + w * jb[i].dot(&(q * jb[l]));
+                    }
+                }
+                let scale = (0..k).fold(0.0 as Real, |m, i| m.max(h[(i, i)]));
+                if scale == 0.0 {
+                    break;
+                }
+                let mut damped = h.clone();
+                for i in 0..k {
+                    damped[(i, i)] += mu * (h[(i, i)] + 1e-12 * scale);
+                }
+                let Some(step) = damped.lu().solve(&(-&g)) else {
+                    mu *= 10.0;
+                    continue;
+                };
+                let trial: Vec<Real> = p
+                    .iter()
+                    .zip(step.iter())
+                    .map(|(a, d)| clamp(a + d))
+                    .collect();
+                let moved = p
+                    .iter()
+                    .zip(&trial)
+                    .fold(0.0 as Real, |m, (a, b)| m.max((a - b).abs()));
+                let (e1, r1, da1, db1) = mismatch(&trial);
+                if e1 < e {
+                    (p, e, r, da, db) = (trial, e1, r1, da1, db1);
+                    mu = (mu / 3.0).max(1e-12);
+                } else {
+                    mu *= 4.0;
+                }
+                let size = p.iter().fold(1.0 as Real, |m, x| m.max(x.abs()));
+                if moved <= 1e-14 * size || mu > 1e12 {
+                    break;
+                }
+            }
+            if best.as_ref().is_none_or(|b| e < b.1) {
+                best = Some((p, e));
+            }
+        }
+        best.expect("at least one start")
+    }
+
     /// The swelling chain of a bilayer face: the law's forms at stretches (0, 0), (1, 0) and
     /// (0, 1) of its layers, over the face's through-thickness swelling `lambda`.
     pub fn swelling_basis(
@@ -255,13 +345,12 @@ impl Chain {
 mod tests {
     use super::*;
 
-    /// Each chain's Jacobian against central differences of its own forms (O(ε²) ≈ 1e-12).
-    #[test]
-    fn chain_jacobians_match_differences() {
+    /// One chain of each kind on one face, with design numbers away from the neutral ones.
+    fn sample_chains() -> Vec<(Chain, Vec<Real>)> {
         let t = Mat2::new(0.3, 0.1, -0.05, 0.25);
         let a0 = pull_back(&t, &Sym2::new(1.0, 0.0, 1.0));
         let b0 = Sym2::new(0.02, -0.01, 0.03);
-        let chains = [
+        [
             (
                 Chain::growth(GrowthLaw::Isotropic, vec![(a0, b0)]),
                 vec![0.3],
@@ -321,8 +410,14 @@ mod tests {
                 },
                 vec![0.015],
             ),
-        ];
-        for (chain, p) in chains {
+        ]
+        .into()
+    }
+
+    /// Each chain's Jacobian against central differences of its own forms (O(ε²) ≈ 1e-12).
+    #[test]
+    fn chain_jacobians_match_differences() {
+        for (chain, p) in sample_chains() {
             let at = chain.face(0, &p);
             for k in 0..p.len() {
                 let eps = 1e-6;
@@ -343,6 +438,45 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The fit recovers every chain's numbers from the forms they make, from the neutral
+    /// start (a director up to a half turn, the same director), to round-off; with an upper
+    /// bound below the true growth it stops on the bound. A thickness does not change the forms,
+    /// so its fit is not asked for (`design.start = "target"` refuses it).
+    #[test]
+    fn the_fit_recovers_each_chains_numbers_from_their_forms() {
+        for (chain, p) in sample_chains() {
+            if matches!(chain, Chain::Thickness { .. }) {
+                continue;
+            }
+            let target = chain.face(0, &p).forms;
+            let start = match chain {
+                Chain::Forms { .. } => vec![1.0, 0.0, 1.0, 0.0, 0.0, 0.0],
+                _ => vec![0.0; p.len()],
+            };
+            let w = 0.01 * 0.01 / 12.0;
+            let (got, e) = chain.fit(0, &start, &target, w, (-10.0, 10.0));
+            assert!(e < 1e-24, "{chain:?}: mismatch {e:e} at {got:?}");
+            for (a, b) in got.iter().zip(&p) {
+                let off = match chain {
+                    Chain::Director { .. } => {
+                        let d = (a - b).rem_euclid(std::f64::consts::PI);
+                        d.min(std::f64::consts::PI - d)
+                    }
+                    _ => (a - b).abs(),
+                };
+                assert!(
+                    off < 1e-9 * (1.0 + b.abs()),
+                    "{chain:?}: {got:?} against {p:?}"
+                );
+            }
+        }
+        let (chain, p) = &sample_chains()[0];
+        let target = chain.face(0, p).forms;
+        let (got, e) = chain.fit(0, &[0.0], &target, 1e-5, (-1.0, 0.2));
+        assert_eq!(got, vec![0.2]);
+        assert!(e > 0.0);
     }
 
     /// The swelling chain gives the bilayer law's own forms at any stretches.
