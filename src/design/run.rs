@@ -987,7 +987,11 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
             && last_iteration + 1 < d.max_iterations;
         if again {
             if let Some(state) = c.state.take() {
-                if problem.restart_from(&p, state).is_ok() {
+                let restarted = problem.restart_from(&p, state);
+                if let Err(e) = &restarted {
+                    c.restart = Some(e.clone());
+                }
+                if restarted.is_ok() {
                     if !req.quiet {
                         eprintln!(
                             "design: the forward run of the design found another equilibrium, \
@@ -1138,6 +1142,8 @@ struct ForwardCheck {
     state: Option<crate::solve::State>,
     /// The checks made so far.
     rounds: usize,
+    /// Why the design could not go on from the forward run's equilibrium, when it could not.
+    restart: Option<String>,
 }
 
 impl ForwardCheck {
@@ -1155,6 +1161,9 @@ impl ForwardCheck {
         if let Some(e) = &self.error {
             m.insert("error".into(), e.clone().into());
         }
+        if let Some(e) = &self.restart {
+            m.insert("restart_error".into(), e.clone().into());
+        }
         serde_json::Value::Object(m)
     }
 
@@ -1171,10 +1180,15 @@ impl ForwardCheck {
         if target_distance > 0.0 && distance <= target_distance {
             return None;
         }
+        let restart = self
+            .restart
+            .as_ref()
+            .map(|e| format!(" (the design could not go on from it: {e})"))
+            .unwrap_or_default();
         Some(format!(
             "the written design run forward from the mesh (`shellsim settings.toml designed.vtk`) \
              ends on another equilibrium, {} of the size from the designed one and {} from the \
-             target",
+             target{restart}",
             crate::math::human(self.offset.unwrap_or(0.0)),
             crate::math::human(distance)
         ))
@@ -1229,6 +1243,7 @@ fn forward_check(prep: &Prepared, problem: &Problem, p: &[Real]) -> ForwardCheck
         error: None,
         state: None,
         rounds: 0,
+        restart: None,
     };
     let run = || -> Result<crate::solve::State, String> {
         let (mesh, table) = designed(prep, p);
