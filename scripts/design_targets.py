@@ -2,6 +2,7 @@
 
     python3 scripts/design_targets.py vase DISK.vtk OUT.vtk [--height H]
     python3 scripts/design_targets.py saddle DISK.vtk OUT.vtk [--curvature C]
+    python3 scripts/design_targets.py helix STRIP.vtk OUT.vtk [--radius R] [--angle DEG]
 
 * `vase`: a surface of revolution with a flat bottom, a bulge, a neck and a flared lip,
   reached from the unit disk by its conformal map: with the profile (R(σ), Z(σ)) by arc length
@@ -11,6 +12,12 @@
   connectivity, and the growth that makes it is isotropic; no closed form gives it.
 * `saddle`: the disk's vertices lifted onto z = C (x² − y²) (the target of a surface design:
   its in-plane positions are not those of any growth).
+
+* `helix`: a flat strip along x (centred on the origin) wrapped onto a cylinder of radius R
+  about the y axis turned by the angle DEG: each vertex (x, y) goes to the point at arc length
+  u = x cos α + y sin α around the cylinder and height v = −x sin α + y cos α along its axis, an
+  isometry (the strip's metric is kept; its curvature is 1/R along the turned direction), so the
+  strip's long edges become helices.
 
 Needs the project's virtual environment (`vtk`, `numpy`).
 """
@@ -102,18 +109,37 @@ def saddle(disk, c):
     return x
 
 
+def helix(strip, radius, angle):
+    x = vtk_to_numpy(strip.GetPoints().GetData()).astype(float)
+    a = math.radians(angle)
+    u = x[:, 0] * math.cos(a) + x[:, 1] * math.sin(a)
+    v = -x[:, 0] * math.sin(a) + x[:, 1] * math.cos(a)
+    out = np.zeros_like(x)
+    out[:, 0] = radius * np.sin(u / radius)
+    out[:, 1] = v
+    out[:, 2] = radius * (1.0 - np.cos(u / radius))
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("shape", choices=["vase", "saddle"])
+    ap.add_argument("shape", choices=["vase", "saddle", "helix"])
     ap.add_argument("disk")
     ap.add_argument("out")
     ap.add_argument("--height", type=float, default=0.45)
     ap.add_argument("--curvature", type=float, default=0.3)
+    ap.add_argument("--radius", type=float, default=0.5)
+    ap.add_argument("--angle", type=float, default=30.0)
     a = ap.parse_args()
     disk = read(a.disk)
     if disk is None or disk.GetNumberOfCells() == 0:
         sys.exit(f"{a.disk}: no faces")
-    pts = vase(disk, a.height) if a.shape == "vase" else saddle(disk, a.curvature)
+    if a.shape == "vase":
+        pts = vase(disk, a.height)
+    elif a.shape == "saddle":
+        pts = saddle(disk, a.curvature)
+    else:
+        pts = helix(disk, a.radius, a.angle)
     write(disk, pts, a.out)
     print(f"{a.out}: {a.shape}, {disk.GetNumberOfPoints()} vertices, {disk.GetNumberOfCells()} faces")
 
