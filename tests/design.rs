@@ -1067,20 +1067,11 @@ fn shellsim_design_writes_swelling_and_thickness_designs_that_reproduce() {
 fn bbar_is_recovered_from_the_gcm_cone() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
+    let sweep = format!("{}", shellsim::cases::gcm_cone_sweep().to_degrees());
     let sector = |extra: &[&str], out: &str| {
         let mut args = vec![
-            "mesh",
-            "annulus",
-            "--inner",
-            "1",
-            "--radius",
-            "1.4",
-            "--sweep",
-            "321.9937887599697",
-            "--edge",
-            "0.1",
-            "-o",
-            out,
+            "mesh", "annulus", "--inner", "1", "--radius", "1.4", "--sweep", &sweep, "--edge",
+            "0.1", "-o", out,
         ];
         args.extend_from_slice(extra);
         succeeds(d, &args);

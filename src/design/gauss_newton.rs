@@ -28,7 +28,8 @@
 //! of being learnt over many.
 
 use super::lbfgs::{
-    after_step, amax, backtrack, dot, projected, zero_gradient, Iterate, Options, Problem, Stop,
+    after_step, amax, backtrack, dot, free, projected, start, zero_gradient, Iterate, Options,
+    Problem, Stop,
 };
 use crate::math::Real;
 
@@ -123,34 +124,17 @@ pub fn minimise<P: Model>(
     o: &Options,
     report: &mut dyn FnMut(&Iterate, &P) -> Option<String>,
 ) -> Result<(Stop, Vec<Real>, Real), String> {
-    let mut p: Vec<Real> = p.iter().map(|x| x.clamp(o.lower, o.upper)).collect();
-    let (mut f, mut g) = problem.eval(&p)?;
-    problem.accept();
-    let pg0 = projected(&p, &g, o);
-    if let Some(why) = report(
-        &Iterate {
-            iteration: 0,
-            p: &p,
-            value: f,
-            gradient: amax(&pg0),
-            step: 0.0,
-            trials: 1,
-        },
-        problem,
-    ) {
-        return Ok((Stop::Converged(why), p, f));
-    }
+    let (mut p, mut f, mut g) = match start(problem, p, o, report)? {
+        Ok(s) => s,
+        Err(done) => return Ok(done),
+    };
     let mut mu: Option<Real> = None;
     for it in 1..=o.max_iterations {
         let pg = projected(&p, &g, o);
         if amax(&pg) == 0.0 {
             return Ok((zero_gradient(it, f), p, f));
         }
-        let free: Vec<bool> = pg
-            .iter()
-            .zip(&g)
-            .map(|(a, b)| *a != 0.0 || *b == 0.0)
-            .collect();
+        let free = free(&pg, &g);
         // The first damping: a thousandth of the model's curvature along the gradient, relative
         // to the metric's.
         let damping = match mu {

@@ -124,34 +124,17 @@ pub fn minimise<P: Problem>(
     o: &Options,
     report: &mut dyn FnMut(&Iterate, &P) -> Option<String>,
 ) -> Result<(Stop, Vec<Real>, Real), String> {
-    let mut p: Vec<Real> = p.iter().map(|x| x.clamp(o.lower, o.upper)).collect();
-    let (mut f, mut g) = problem.eval(&p)?;
-    problem.accept();
+    let (mut p, mut f, mut g) = match start(problem, p, o, report)? {
+        Ok(s) => s,
+        Err(done) => return Ok(done),
+    };
     let mut pairs: VecDeque<(Vec<Real>, Vec<Real>, Real)> = VecDeque::new();
-    let pg = projected(&p, &g, o);
-    if let Some(why) = report(
-        &Iterate {
-            iteration: 0,
-            p: &p,
-            value: f,
-            gradient: amax(&pg),
-            step: 0.0,
-            trials: 1,
-        },
-        problem,
-    ) {
-        return Ok((Stop::Converged(why), p, f));
-    }
     for it in 1..=o.max_iterations {
         let pg = projected(&p, &g, o);
         if amax(&pg) == 0.0 {
             return Ok((zero_gradient(it, f), p, f));
         }
-        let free: Vec<bool> = pg
-            .iter()
-            .zip(&g)
-            .map(|(a, b)| *a != 0.0 || *b == 0.0)
-            .collect();
+        let free = free(&pg, &g);
         let mut d = two_loop(&pg, &pairs, &free, &|v: &mut [Real]| {
             problem.precondition(v)
         });
@@ -191,6 +174,37 @@ pub fn minimise<P: Problem>(
         }
     }
     Ok((Stop::Limit, p, f))
+}
+
+/// The start of either optimiser: `p` clamped into the bounds, evaluated, accepted and reported
+/// as iteration 0. `Ok(Err(…))` when the report stops it there (converged); `Err` when the start
+/// cannot be evaluated.
+#[allow(clippy::type_complexity)]
+pub(super) fn start<P: Problem>(
+    problem: &mut P,
+    p: Vec<Real>,
+    o: &Options,
+    report: &mut dyn FnMut(&Iterate, &P) -> Option<String>,
+) -> Result<Result<(Vec<Real>, Real, Vec<Real>), (Stop, Vec<Real>, Real)>, String> {
+    let p: Vec<Real> = p.iter().map(|x| x.clamp(o.lower, o.upper)).collect();
+    let (f, g) = problem.eval(&p)?;
+    problem.accept();
+    // The relative change of an iteration that has not happened: never below the tolerance.
+    Ok(
+        match after_step(problem, report, o, (0, &p, f, &g), (0.0, 1), Real::INFINITY) {
+            Some(stop) => Err((stop, p, f)),
+            None => Ok((p, f, g)),
+        },
+    )
+}
+
+/// The variables free in this iteration: those not held at a bound by a gradient pushing
+/// outward (their projected gradient `pg` is zero while the gradient `g` is not).
+pub(super) fn free(pg: &[Real], g: &[Real]) -> Vec<bool> {
+    pg.iter()
+        .zip(g)
+        .map(|(a, b)| *a != 0.0 || *b == 0.0)
+        .collect()
 }
 
 /// The accepted trial of a backtracking line search: the variables, objective, gradient, the

@@ -88,6 +88,23 @@ fn factor_exact(pot: &Potential, lin: &mut LinearSolver, state: &State) -> Optio
     wb.keeps_positive_definite().then_some(wb)
 }
 
+/// Solves `H v = b` in place with the factorisation `lin` and its low-rank part `held`, the
+/// fixed DOFs masked on both sides (their rows of `H` are the identity, their right-hand side
+/// zero); false when nothing is held or the system is singular.
+fn solve_held(
+    pot: &Potential,
+    held: Option<&Woodbury>,
+    lin: &mut LinearSolver,
+    v: &mut [Real],
+) -> bool {
+    pot.mask_fixed(v);
+    let solved = held.is_some_and(|wb| wb.solve_in_place(lin, v));
+    if solved {
+        pot.mask_fixed(v);
+    }
+    solved
+}
+
 /// Where the time of the evaluations went (s).
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
 pub struct DesignTiming {
@@ -443,12 +460,7 @@ impl<'s> Problem<'s> {
             self.gravity,
             (&cur.forms, &cur.ratio, &mass),
         );
-        pot.mask_fixed(&mut dx);
-        if !self.held.as_ref()?.solve_in_place(&mut self.lin, &mut dx) {
-            return None;
-        }
-        pot.mask_fixed(&mut dx);
-        Some(dx)
+        solve_held(&pot, self.held.as_ref(), &mut self.lin, &mut dx).then_some(dx)
     }
 
     /// Makes `lin` and `held` the factorisation at the current equilibrium again (after a trial
@@ -488,11 +500,9 @@ impl<'s> Problem<'s> {
             self.gravity,
             (&cur.forms, &cur.ratio, &mass),
         );
-        pot.mask_fixed(&mut u);
-        if !self.held.as_ref()?.solve_in_place(&mut self.lin, &mut u) {
+        if !solve_held(&pot, self.held.as_ref(), &mut self.lin, &mut u) {
             return None;
         }
-        pot.mask_fixed(&mut u);
         let rest = self.rest(&self.current_p);
         self.rest_gradient(&pot, &cur.state, &rest, &u).ok()
     }
@@ -637,16 +647,10 @@ impl<'s> Problem<'s> {
             self.gravity,
             (&forms, &ratio, &mass),
         );
-        pot.mask_fixed(&mut lambda);
-        let solved = match &self.held {
-            Some(wb) => wb.solve_in_place(&mut self.lin, &mut lambda),
-            None => false,
-        };
-        if !solved {
+        if !solve_held(&pot, self.held.as_ref(), &mut self.lin, &mut lambda) {
             self.timing.refused += 1;
             return Err("the Hessian with its low-rank part is singular at the equilibrium".into());
         }
-        pot.mask_fixed(&mut lambda);
         self.timing.adjoint += clock.elapsed().as_secs_f64();
         let clock = Instant::now();
         let mut grad = self.rest_gradient(&pot, &state, &rest, &lambda)?;
