@@ -349,8 +349,8 @@ fn surface_and_curvature_sensitivities_match_differences() {
 
 /// The bilayer's layer strains and the rest thickness as design variables: adjoint gradients
 /// against central differences of re-solved equilibria, 1e-6 of the largest entry. A free
-/// bilayer strip (unequal layers with a printed stripe, swelling through the thickness too)
-/// curls; the thickness is designed on a grown dome under its weight (which follows the
+/// bilayer strip (unequal layers that swell differently along and across a diagonal machine
+/// direction, with a printed stripe, swelling through the thickness too) curls; the thickness is designed on a grown dome under its weight (which follows the
 /// thickness).
 #[test]
 fn swelling_and_thickness_sensitivities_match_differences() {
@@ -358,35 +358,14 @@ fn swelling_and_thickness_sensitivities_match_differences() {
     let text = "[material]\nyoung = 1e5\npoisson = 0.3\nthickness = 0.01\n\
                 [growth]\nlaw = \"bilayer\"\nmu_top = 0.04\nmu_bottom = 0.01\nmu_through = 0.02\n\
                 moisture_top = 1.0\nmoisture_bottom = 0.5\ntop_fraction = 0.4\nmodulus_ratio = 2.0\n\
+                mu_top_perp = 0.01\nmu_bottom_perp = -0.02\nmachine_direction = [1, 1, 0]\n\
                 [[growth.regions]]\ninside = { min = [-0.1, -1, -1], max = [0.1, 1, 1] }\n\
                 print_thickness = 0.002\nprint_modulus_ratio = 5.0\n\
                 [solver]\nmode = \"static\"\ntolerance = 1e-13\n";
     let sc = scene(mesh.clone(), text);
-    let body = &sc.body;
-    let g = &body.growth;
-    let laminate = match sc.settings.growth.model() {
-        shellsim::config::growth::GrowthModel::Bilayer { laminate, .. } => laminate,
-        _ => unreachable!(),
-    };
+    let design = shellsim::config::design::parse("[design]\nvariable = \"swelling\"\n").unwrap();
+    let (chain, _) = shellsim::design::run::chain_and_start(&sc, &design).unwrap();
     let nf = mesh.faces.len();
-    let (mut basis, mut ratio) = (Vec::new(), Vec::new());
-    for f in 0..nf {
-        let c = g.coef.get(f).copied().unwrap_or(g.uniform);
-        let print = (c.print_thickness > 0.0).then_some(shellsim::rest::laws::bilayer::Print {
-            thickness: c.print_thickness,
-            modulus_ratio: c.print_modulus_ratio,
-        });
-        let lambda = 1.0 + c.mu_through * 0.5 * (g.moisture_top[f] + g.moisture_bottom[f]);
-        basis.push(Chain::swelling_basis(
-            &body.rest.abar0[f],
-            &body.rest.bbar0[f],
-            body.thickness[f],
-            &laminate,
-            print,
-            lambda,
-        ));
-        ratio.push(lambda);
-    }
     let p: Vec<Real> = (0..nf)
         .flat_map(|f| [0.04 + 0.01 * (f as Real).sin(), 0.005])
         .collect();
@@ -394,7 +373,7 @@ fn swelling_and_thickness_sensitivities_match_differences() {
     let topo = Topology::build(&mesh).unwrap();
     let mut prob = Problem::new(
         &sc,
-        Chain::Swelling { basis, ratio },
+        chain,
         distance(DistanceTerm::Points(Points::new(&mesh, target, true))),
         Smoothness::new(&mesh, &topo, 0.01, false, vec![1.0, 1.0]),
     )
@@ -939,8 +918,9 @@ fn shellsim_design_reaches_for_a_surface_and_for_curvature_fields() {
     assert!(err.contains("critical point"), "{err}");
 }
 
-/// `shellsim design` of the bilayer's layer strains and of the rest thickness: each design
-/// lowers the distance to a shape the scene makes with other values (a strip that curls more;
+/// `shellsim design` of the bilayer's layer strains (layers that swell alike in every
+/// direction, and layers that do not) and of the rest thickness: each design lowers the
+/// distance to a shape the scene makes with other values (a strip that curls more;
 /// a clamped strip that sags more under its weight, being thinner), and its written mesh and
 /// settings reproduce the designed shape through the ordinary run (within 1e-6 of the size).
 #[test]
@@ -969,6 +949,17 @@ fn shellsim_design_writes_swelling_and_thickness_designs_that_reproduce() {
              moisture_top = 1.0\nmoisture_bottom = 1.0\n[solver]\nmode = \"static\"\n"
         )
     };
+    // Layers that swell unequally along and across a diagonal machine direction, the bottom
+    // mostly across it: the strip curls and twists.
+    let crossed = |mu_top: Real| {
+        format!(
+            "[material]\nyoung = 1e5\npoisson = 0.3\nthickness = 0.01\n\
+             [growth]\nlaw = \"bilayer\"\nmu_top = {mu_top}\nmu_top_perp = {}\n\
+             mu_bottom = 0.002\nmu_bottom_perp = 0.008\nmachine_direction = [1, 1, 0]\n\
+             moisture_top = 1.0\nmoisture_bottom = 1.0\n[solver]\nmode = \"static\"\n",
+            mu_top / 4.0
+        )
+    };
     let hanging = |h: Real| {
         format!(
             "[material]\nyoung = 1e6\npoisson = 0.3\nthickness = {h}\ndensity = 500.0\n\
@@ -982,6 +973,12 @@ fn shellsim_design_writes_swelling_and_thickness_designs_that_reproduce() {
             "swelling",
             bilayer(0.02),
             bilayer(0.03),
+            "[design]\nvariable = \"swelling\"\nmax_iterations = 5\nsmoothing_length = 0.1\n",
+        ),
+        (
+            "anisotropic",
+            crossed(0.02),
+            crossed(0.03),
             "[design]\nvariable = \"swelling\"\nmax_iterations = 5\nsmoothing_length = 0.1\n",
         ),
         (
@@ -1043,6 +1040,21 @@ fn shellsim_design_writes_swelling_and_thickness_designs_that_reproduce() {
                 "-q",
             ],
         );
+        // Anisotropic layers are written with their coefficients across the machine direction,
+        // in the scene's own ratio (1/4 on top).
+        let designed = shellsim::mesh::io::read_mesh(&d.join(&out).join("designed.vtk")).unwrap();
+        let field = |n: &str| designed.face_fields.get(n).map(|f| f.data.clone());
+        if name == "anisotropic" {
+            let (top, perp) = (
+                field("growth_mu_top").unwrap(),
+                field("growth_mu_top_perp").unwrap(),
+            );
+            for (t, p) in top.iter().zip(&perp) {
+                assert!((p - t / 4.0).abs() <= 1e-15 * t.abs(), "{t} {p}");
+            }
+        } else {
+            assert!(field("growth_mu_top_perp").is_none());
+        }
         let shape = shellsim::mesh::io::read_mesh(&d.join(&out).join("shape.vtk")).unwrap();
         let again = shellsim::mesh::io::read_mesh(&d.join(format!("{name}_again/frame_00001.vtu")))
             .unwrap();

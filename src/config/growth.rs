@@ -105,6 +105,9 @@ pub enum GrowthModel {
         mu_bottom: Real,
         /// The layers' thicknesses and moduli.
         laminate: Laminate,
+        /// Some layer swells differently across the machine direction than along it
+        /// (`mu_top_perp` or `mu_bottom_perp` given in `[growth]` or a region).
+        anisotropic: bool,
     },
     /// Linear swelling with a machine direction.
     MachineDirection {
@@ -165,6 +168,10 @@ pub struct GrowthRegion {
     pub mu_top: Option<Real>,
     /// See [`Growth::mu_bottom`].
     pub mu_bottom: Option<Real>,
+    /// See [`Growth::mu_top_perp`].
+    pub mu_top_perp: Option<Real>,
+    /// See [`Growth::mu_bottom_perp`].
+    pub mu_bottom_perp: Option<Real>,
     /// See [`Growth::mu_through`].
     pub mu_through: Option<Real>,
     /// See [`Growth::print_thickness`].
@@ -175,13 +182,16 @@ pub struct GrowthRegion {
 
 impl GrowthRegion {
     /// The coefficients as `(key, value)` in the order mu, mu_perp, mu_top, mu_bottom,
-    /// mu_through, print_thickness, print_modulus_ratio (`None`: not given).
-    pub fn values(&self) -> [(&'static str, Option<Real>); 7] {
+    /// mu_top_perp, mu_bottom_perp, mu_through, print_thickness, print_modulus_ratio (`None`:
+    /// not given).
+    pub fn values(&self) -> [(&'static str, Option<Real>); 9] {
         [
             ("mu", self.mu),
             ("mu_perp", self.mu_perp),
             ("mu_top", self.mu_top),
             ("mu_bottom", self.mu_bottom),
+            ("mu_top_perp", self.mu_top_perp),
+            ("mu_bottom_perp", self.mu_bottom_perp),
             ("mu_through", self.mu_through),
             ("print_thickness", self.print_thickness),
             ("print_modulus_ratio", self.print_modulus_ratio),
@@ -308,6 +318,12 @@ pub struct Growth {
     pub mu_top: Option<Real>,
     /// Bilayer: coefficient of the bottom layer (required by `"bilayer"`).
     pub mu_bottom: Option<Real>,
+    /// Bilayer: coefficient of the top layer across the machine direction (default
+    /// `mu_top`: the layer swells alike in every direction); `mu_top` is then along it.
+    pub mu_top_perp: Option<Real>,
+    /// Bilayer: coefficient of the bottom layer across the machine direction (default
+    /// `mu_bottom`).
+    pub mu_bottom_perp: Option<Real>,
     /// Moisture–thickness coefficient of the moisture laws (per unit moisture, default `0`:
     /// the thickness is kept): the rest thickness is `h (1 + μ_n (m⁺ + m⁻)/2)`.
     pub mu_through: Option<Real>,
@@ -361,6 +377,8 @@ impl Default for Growth {
             mu_perp: None,
             mu_top: None,
             mu_bottom: None,
+            mu_top_perp: None,
+            mu_bottom_perp: None,
             mu_through: None,
             top_fraction: None,
             modulus_ratio: None,
@@ -395,6 +413,7 @@ impl Growth {
                 mu_top: c(self.mu_top),
                 mu_bottom: c(self.mu_bottom),
                 laminate: self.laminate(),
+                anisotropic: self.anisotropic_layers(),
             },
             GrowthLaw::MachineDirection => GrowthModel::MachineDirection {
                 mu: c(self.mu),
@@ -407,6 +426,17 @@ impl Growth {
                 relax: self.relax_moisture.unwrap_or([0.0, 1.0]),
             },
         }
+    }
+
+    /// True when `[growth]` or a region gives a bilayer layer's coefficient across the machine
+    /// direction (`mu_top_perp`, `mu_bottom_perp`).
+    pub fn anisotropic_layers(&self) -> bool {
+        self.mu_top_perp.is_some()
+            || self.mu_bottom_perp.is_some()
+            || self
+                .regions
+                .iter()
+                .any(|r| r.mu_top_perp.is_some() || r.mu_bottom_perp.is_some())
     }
 
     /// The bilayer's layers (defaults where not given).
@@ -427,7 +457,14 @@ impl Growth {
             (r.print_thickness.is_some() || r.print_modulus_ratio.is_some())
                 .then(|| format!("growth.regions[{i}]"))
         });
+        let region_perp = self.regions.iter().enumerate().find_map(|(i, r)| {
+            (r.mu_top_perp.is_some() || r.mu_bottom_perp.is_some())
+                .then(|| format!("growth.regions[{i}]"))
+        });
         let given = [
+            ("growth.mu_top_perp", self.mu_top_perp.is_some()),
+            ("growth.mu_bottom_perp", self.mu_bottom_perp.is_some()),
+            (region_perp.as_deref().unwrap_or(""), region_perp.is_some()),
             ("growth.top_fraction", self.top_fraction.is_some()),
             ("growth.modulus_ratio", self.modulus_ratio.is_some()),
             ("growth.isotropic_layers", self.isotropic_layers.is_some()),
@@ -446,8 +483,8 @@ impl Growth {
                 return ck.inv(
                     k,
                     format!(
-                        "describes the layers of growth.law = \"bilayer\" (print keys too), not \
-                         of \"{}\"",
+                        "describes the layers of growth.law = \"bilayer\" (print keys and \
+                         mu_top_perp, mu_bottom_perp too), not of \"{}\"",
                         self.law.name()
                     ),
                 );
@@ -489,6 +526,20 @@ impl Growth {
             .iter()
             .position(|r| r.mu_through.is_some())
             .map(|i| format!("growth.regions[{i}].mu_through"));
+        if self.isotropic_layers == Some(true) && self.anisotropic_layers() {
+            let key = match (self.mu_top_perp, self.mu_bottom_perp) {
+                (Some(_), _) => "growth.mu_top_perp".to_string(),
+                (None, Some(_)) => "growth.mu_bottom_perp".to_string(),
+                _ => region_perp.unwrap_or_default(),
+            };
+            return ck.inv(
+                &key,
+                "isotropic_layers grows each layer's thickness by its in-plane stretch, which \
+                 must then be the same in every direction; give isotropic_layers or the \
+                 coefficients across the machine direction, not both"
+                    .into(),
+            );
+        }
         if self.isotropic_layers == Some(true) && (self.mu_through.is_some() || region.is_some()) {
             return ck.inv(
                 &region.unwrap_or_else(|| "growth.mu_through".into()),
@@ -662,6 +713,8 @@ impl Growth {
             ("growth.mu_perp", g.mu_perp.unwrap_or(0.0)),
             ("growth.mu_top", g.mu_top.unwrap_or(0.0)),
             ("growth.mu_bottom", g.mu_bottom.unwrap_or(0.0)),
+            ("growth.mu_top_perp", g.mu_top_perp.unwrap_or(0.0)),
+            ("growth.mu_bottom_perp", g.mu_bottom_perp.unwrap_or(0.0)),
             ("growth.mu_through", g.mu_through.unwrap_or(0.0)),
             ("growth.moisture_top", g.moisture_top),
             ("growth.moisture_bottom", g.moisture_bottom),

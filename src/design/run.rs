@@ -377,8 +377,8 @@ fn curvature_targets(
 }
 
 /// The chain of the design's variable and where it starts: `design.start` everywhere, or the
-/// scene's own design (its growth factor, director or rest forms).
-fn chain_and_start(scene: &Scene, d: &Design) -> Result<(Chain, Vec<Real>), (String, String)> {
+/// scene's own design (its growth factor, director or rest forms). Errors: (key, why).
+pub fn chain_and_start(scene: &Scene, d: &Design) -> Result<(Chain, Vec<Real>), (String, String)> {
     let body = &scene.body;
     let nf = body.num_faces();
     let rest = &body.rest;
@@ -462,9 +462,13 @@ fn chain_and_start(scene: &Scene, d: &Design) -> Result<(Chain, Vec<Real>), (Str
             let g = &body.growth;
             let mut basis = Vec::with_capacity(nf);
             let mut ratio = Vec::with_capacity(nf);
+            let mut shapes = Vec::with_capacity(nf);
             let mut own = Vec::with_capacity(2 * nf);
             for f in 0..nf {
                 let c = g.coef.get(f).copied().unwrap_or(g.uniform);
+                let (top, bottom) = (c.top_layer(), c.bottom_layer());
+                let shape = [Chain::layer_shape(top), Chain::layer_shape(bottom)];
+                let d = g.direction.get(f).map_or([1.0, 0.0], |d| d.0);
                 let (mt, mb) = (g.moisture_top[f], g.moisture_bottom[f]);
                 if mt == 0.0 || mb == 0.0 {
                     return Err((
@@ -491,11 +495,23 @@ fn chain_and_start(scene: &Scene, d: &Design) -> Result<(Chain, Vec<Real>), (Str
                     &laminate,
                     print,
                     lambda,
+                    shape,
+                    d,
                 ));
                 ratio.push(lambda);
-                own.extend([c.mu_top * mt, c.mu_bottom * mb]);
+                shapes.push(shape);
+                // The strain in each layer's direction of largest swelling.
+                let largest = |mu: (Real, Real)| if mu.0.abs() >= mu.1.abs() { mu.0 } else { mu.1 };
+                own.extend([largest(top) * mt, largest(bottom) * mb]);
             }
-            (Chain::Swelling { basis, ratio }, own)
+            (
+                Chain::Swelling {
+                    basis,
+                    ratio,
+                    shape: shapes,
+                },
+                own,
+            )
         }
         Variable::Thickness => {
             let law_ratio = |f: usize| body.grown_thickness.get(f).copied().unwrap_or(1.0);
@@ -551,7 +567,7 @@ fn fitted_start(
     let k = chain.per_face();
     let bounds = (
         d.lower.unwrap_or_else(|| default_lower(d.variable, own)),
-        d.upper.unwrap_or(Real::INFINITY),
+        d.upper.unwrap_or_else(|| default_upper(chain)),
     );
     let mut start = Vec::with_capacity(own.len());
     for (f, face) in body.mesh.faces.iter().enumerate() {
@@ -579,12 +595,26 @@ fn fitted_start(
 }
 
 /// The lower bound of a variable without `design.lower`: none, except where the law needs one:
-/// a layer's stretch `1 + ε` at least 0.5, a thickness at least 1% of the thinnest start.
+/// a layer's stretch `1 + α ε` at least 0.5 (`|α| ≤ 1`), a thickness at least 1% of the thinnest start.
 fn default_lower(v: Variable, start: &[Real]) -> Real {
     match v {
         Variable::Swelling => -0.5,
         Variable::Thickness => 0.01 * start.iter().copied().fold(Real::INFINITY, Real::min),
         _ => Real::NEG_INFINITY,
+    }
+}
+
+/// The upper bound of a variable without `design.upper`: none, except for a bilayer layer that
+/// shrinks in one direction as it swells in the other (a negative `α` or `γ`), whose stretch
+/// `1 + α ε` stays at least 0.5 with `ε ≤ 0.5`.
+fn default_upper(chain: &Chain) -> Real {
+    match chain {
+        Chain::Swelling { shape, .. }
+            if shape.iter().flatten().any(|&(a, c)| a < 0.0 || c < 0.0) =>
+        {
+            0.5
+        }
+        _ => Real::INFINITY,
     }
 }
 
@@ -719,19 +749,34 @@ fn designed(prep: &Prepared, p: &[Real]) -> (Mesh, toml::Table) {
             r.insert("target".into(), "mesh".into());
             table.insert("rest".into(), toml::Value::Table(r));
         }
-        Chain::Swelling { .. } => {
+        Chain::Swelling { shape, .. } => {
             // The strains as the law's face coefficients over the scene's own moisture (the
-            // face fields take precedence over [growth]'s and the regions' coefficients).
+            // face fields take precedence over [growth]'s and the regions' coefficients); the
+            // coefficients across the machine direction when some layer is anisotropic.
             let g = &prep.scene.body.growth;
-            let (mut top, mut bottom) = (Vec::new(), Vec::new());
+            let mut fields: [Vec<Real>; 4] = Default::default();
             for (f, c) in p.chunks_exact(2).enumerate() {
-                top.push(c[0] / g.moisture_top[f]);
-                bottom.push(c[1] / g.moisture_bottom[f]);
+                let [(at, ct), (ab, cb)] = shape[f];
+                let (mt, mb) = (g.moisture_top[f], g.moisture_bottom[f]);
+                fields[0].push(c[0] * at / mt);
+                fields[1].push(c[1] * ab / mb);
+                fields[2].push(c[0] * ct / mt);
+                fields[3].push(c[1] * cb / mb);
             }
-            mesh.face_fields
-                .insert("growth_mu_top".into(), Field::scalar(top));
-            mesh.face_fields
-                .insert("growth_mu_bottom".into(), Field::scalar(bottom));
+            let anisotropic = shape.iter().any(|s| s[0].0 != s[0].1 || s[1].0 != s[1].1);
+            let names = [
+                "growth_mu_top",
+                "growth_mu_bottom",
+                "growth_mu_top_perp",
+                "growth_mu_bottom_perp",
+            ];
+            for (name, v) in names
+                .into_iter()
+                .zip(fields)
+                .take(if anisotropic { 4 } else { 2 })
+            {
+                mesh.face_fields.insert(name.into(), Field::scalar(v));
+            }
         }
         Chain::Thickness { .. } => {
             // The reference thickness the law scales into the designed one.
@@ -892,7 +937,7 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
         lower: d
             .lower
             .unwrap_or_else(|| default_lower(d.variable, &prep.start)),
-        upper: d.upper.unwrap_or(Real::INFINITY),
+        upper: d.upper.unwrap_or_else(|| default_upper(&prep.chain)),
     };
     let mut log = String::from(LOG_HEADER);
     let mut series: Vec<(Real, String)> = Vec::new();

@@ -13,13 +13,16 @@
 //!   face's frame `T` (`ā = Tᵀ ā_c T`, linear), `h̄ = h`.
 //! * **Bbar** (three per face): b̄ alone in reference Cartesian coordinates, each face's ā kept.
 //! * **Swelling** (`ε⁺`, `ε⁻`, two per face), the bilayer law ([`crate::rest::laws::bilayer`])
-//!   with layers that keep their thickness: each layer's metric is its stretch `s± = 1 + ε±`
-//!   squared times the reference one, and the projection's weights and heights do not depend on
-//!   `s±`, so the forms are exactly quadratic in the stretches,
-//!   `r(s⁺, s⁻) = r₀₀ + s⁺²(r₁₀ − r₀₀) + s⁻²(r₀₁ − r₀₀)` with `r_ab` the law's forms at
-//!   stretches `(a, b)` (the printed layer, which does not swell, is in `r₀₀`), and
-//!   `∂r/∂ε± = 2 s± (r₁₀ − r₀₀)` or `2 s⁻ (r₀₁ − r₀₀)`. The through-thickness swelling `λ` of the
-//!   face's own moisture divides `b̄` and sets `h̄ = λ h`, both fixed.
+//!   with layers that keep their thickness. Each layer stretches by `1 + α ε` along the machine
+//!   direction and `1 + γ ε` across it, where `(α, γ)` is the face's own `(μ, μ⊥)` over the
+//!   larger of them in size (`(1, 1)` for a layer that swells alike in every direction, or has
+//!   no coefficient): `ε` is the layer's strain in its direction of largest swelling. The
+//!   layer's metric is then quadratic in `ε`, and the projection's weights and heights do not
+//!   depend on it, so the forms are exactly `r = r₀ + Σ± (ε± L± + ε±² Q±)` with
+//!   `L = (r(1) − r(−1))/2`, `Q = (r(1) + r(−1))/2 − r₀` from the law's forms at `ε = ±1` of one
+//!   layer (the printed layer, which does not swell, is in `r₀`), and `∂r/∂ε± = L± + 2ε± Q±`.
+//!   The through-thickness swelling `λ` of the face's own moisture divides `b̄` and sets
+//!   `h̄ = λ h`, both fixed.
 //! * **Thickness** (`h̄`, one per face): the rest forms are the scene's own, `∂h̄/∂h̄ = 1`.
 //!
 //! Units: s dimensionless, θ in rad, Cartesian ā dimensionless, Cartesian b̄ in 1/m, ε±
@@ -60,11 +63,13 @@ pub enum Chain {
         /// The kept ā per face (barycentric, m²).
         abar: Vec<Sym2>,
     },
-    /// The bilayer's layer strains: per face `r₀₀`, `r₁₀ − r₀₀`, `r₀₁ − r₀₀` (forms, with `b̄`
+    /// The bilayer's layer strains: per face `r₀`, `L⁺`, `Q⁺`, `L⁻`, `Q⁻` (forms, with `b̄`
     /// already over λ) and the fixed thickness ratio λ.
     Swelling {
-        /// The three bases per face.
-        basis: Vec<[(Sym2, Sym2); 3]>,
+        /// The five bases per face.
+        basis: Vec<[(Sym2, Sym2); 5]>,
+        /// Each layer's `(α, γ)` per face, top and bottom.
+        shape: Vec<[(Real, Real); 2]>,
         /// `h̄/h` per face.
         ratio: Vec<Real>,
     },
@@ -201,18 +206,18 @@ impl Chain {
                     jac,
                 }
             }
-            Chain::Swelling { basis, ratio } => {
-                let [(a0, b0), (at, bt), (ab, bb)] = basis[f];
-                let (st, sb) = (1.0 + p[0], 1.0 + p[1]);
+            Chain::Swelling { basis, ratio, .. } => {
+                let [(a0, b0), (lt, mt), (qt, nt), (lb, mb), (qb, nb)] = basis[f];
+                let (et, eb) = (p[0], p[1]);
                 FaceRest {
                     forms: (
-                        a0 + at * (st * st) + ab * (sb * sb),
-                        b0 + bt * (st * st) + bb * (sb * sb),
+                        a0 + lt * et + qt * (et * et) + lb * eb + qb * (eb * eb),
+                        b0 + mt * et + nt * (et * et) + mb * eb + nb * (eb * eb),
                     ),
                     ratio: ratio[f],
                     jac: vec![
-                        sym_row(at * (2.0 * st), bt * (2.0 * st), 0.0),
-                        sym_row(ab * (2.0 * sb), bb * (2.0 * sb), 0.0),
+                        sym_row(lt + qt * (2.0 * et), mt + nt * (2.0 * et), 0.0),
+                        sym_row(lb + qb * (2.0 * eb), mb + nb * (2.0 * eb), 0.0),
                     ],
                 }
             }
@@ -316,8 +321,11 @@ impl Chain {
         best.expect("at least one start")
     }
 
-    /// The swelling chain of a bilayer face: the law's forms at stretches (0, 0), (1, 0) and
-    /// (0, 1) of its layers, over the face's through-thickness swelling `lambda`.
+    /// The swelling chain of a bilayer face: `r₀`, `L⁺`, `Q⁺`, `L⁻`, `Q⁻` (see the module
+    /// doc) from the law's forms at `ε = 0` and at `ε = ±1` of each layer, over the face's
+    /// through-thickness swelling `lambda`. `shape` is each layer's `(α, γ)` (top, bottom) and
+    /// `d` the machine direction (barycentric).
+    #[allow(clippy::too_many_arguments)]
     pub fn swelling_basis(
         a0: &Sym2,
         b0: &Sym2,
@@ -325,19 +333,39 @@ impl Chain {
         laminate: &crate::config::growth::Laminate,
         print: Option<crate::rest::laws::bilayer::Print>,
         lambda: Real,
-    ) -> [(Sym2, Sym2); 3] {
-        let at = |st: Real, sb: Real| {
-            let (a, b, _) = crate::rest::laws::bilayer::bilayer(a0, b0, h, st, sb, laminate, print);
+        shape: [(Real, Real); 2],
+        d: [Real; 2],
+    ) -> [(Sym2, Sym2); 5] {
+        use crate::rest::laws::bilayer::{bilayer, Stretch};
+        let at = |et: Real, eb: Real| {
+            let (top, bottom) = (Stretch::of(shape[0], et), Stretch::of(shape[1], eb));
+            let (a, b, _) = bilayer(a0, b0, h, top, bottom, d, laminate, print);
             (a, b / lambda)
         };
-        let r00 = at(0.0, 0.0);
-        let r10 = at(1.0, 0.0);
-        let r01 = at(0.0, 1.0);
-        [
-            r00,
-            (r10.0 - r00.0, r10.1 - r00.1),
-            (r01.0 - r00.0, r01.1 - r00.1),
-        ]
+        let r0 = at(0.0, 0.0);
+        let split = |plus: (Sym2, Sym2), minus: (Sym2, Sym2)| {
+            [
+                ((plus.0 - minus.0) * 0.5, (plus.1 - minus.1) * 0.5),
+                (
+                    (plus.0 + minus.0) * 0.5 - r0.0,
+                    (plus.1 + minus.1) * 0.5 - r0.1,
+                ),
+            ]
+        };
+        let [lt, qt] = split(at(1.0, 0.0), at(-1.0, 0.0));
+        let [lb, qb] = split(at(0.0, 1.0), at(0.0, -1.0));
+        [r0, lt, qt, lb, qb]
+    }
+
+    /// A bilayer layer's `(α, γ)` from its coefficients `(μ, μ⊥)` along and across the machine
+    /// direction: both over the one larger in size, or `(1, 1)` when both are 0.
+    pub fn layer_shape(mu: (Real, Real)) -> (Real, Real) {
+        let m = if mu.0.abs() >= mu.1.abs() { mu.0 } else { mu.1 };
+        if m == 0.0 {
+            (1.0, 1.0)
+        } else {
+            (mu.0 / m, mu.1 / m)
+        }
     }
 }
 
@@ -390,8 +418,11 @@ mod tests {
                             modulus_ratio: 5.0,
                         }),
                         1.1,
+                        [(1.0, 0.25), (-0.5, 1.0)],
+                        [0.6, -0.2],
                     )],
                     ratio: vec![1.1],
+                    shape: vec![[(1.0, 0.25), (-0.5, 1.0)]],
                 },
                 vec![0.04, -0.02],
             ),
@@ -479,9 +510,11 @@ mod tests {
         assert!(e > 0.0);
     }
 
-    /// The swelling chain gives the bilayer law's own forms at any stretches.
+    /// The swelling chain gives the bilayer law's own forms at any strains, for layers that
+    /// swell alike in every direction and for anisotropic ones.
     #[test]
     fn the_swelling_chain_is_the_bilayer_law() {
+        use crate::rest::laws::bilayer::{bilayer, Stretch};
         let a0 = Sym2::new(1.2, 0.1, 0.9);
         let b0 = Sym2::new(0.3, 0.0, -0.1);
         let lam = crate::config::growth::Laminate {
@@ -493,23 +526,26 @@ mod tests {
             thickness: 0.002,
             modulus_ratio: 4.0,
         });
-        let chain = Chain::Swelling {
-            basis: vec![Chain::swelling_basis(&a0, &b0, 0.01, &lam, print, 1.0)],
-            ratio: vec![1.0],
-        };
-        for (et, eb) in [(0.05, -0.03), (0.2, 0.1), (-0.1, 0.0)] {
-            let got = chain.face(0, &[et, eb]).forms;
-            let (a, b, _) = crate::rest::laws::bilayer::bilayer(
-                &a0,
-                &b0,
-                0.01,
-                1.0 + et,
-                1.0 + eb,
-                &lam,
-                print,
-            );
-            assert!((got.0 - a).amax() < 1e-14 * a.amax(), "{got:?} {a:?}");
-            assert!((got.1 - b).amax() < 1e-12 * b.amax(), "{got:?} {b:?}");
+        let d = [0.4, 0.9];
+        for mu in [[(0.3, 0.3), (-0.2, -0.2)], [(0.3, 0.0), (0.05, -0.2)]] {
+            let shape = [Chain::layer_shape(mu[0]), Chain::layer_shape(mu[1])];
+            let chain = Chain::Swelling {
+                basis: vec![Chain::swelling_basis(
+                    &a0, &b0, 0.01, &lam, print, 1.0, shape, d,
+                )],
+                ratio: vec![1.0],
+                shape: vec![shape],
+            };
+            for (mt, mb) in [(0.05, -0.03), (0.2, 0.1), (-0.1, 0.0)] {
+                // The scene's own strains: ε = (largest coefficient) × moisture.
+                let eps =
+                    |m: (Real, Real), x: Real| x * if m.0.abs() >= m.1.abs() { m.0 } else { m.1 };
+                let got = chain.face(0, &[eps(mu[0], mt), eps(mu[1], mb)]).forms;
+                let (top, bottom) = (Stretch::of(mu[0], mt), Stretch::of(mu[1], mb));
+                let (a, b, _) = bilayer(&a0, &b0, 0.01, top, bottom, d, &lam, print);
+                assert!((got.0 - a).amax() < 1e-14 * a.amax(), "{got:?} {a:?}");
+                assert!((got.1 - b).amax() < 1e-12 * b.amax(), "{got:?} {b:?}");
+            }
         }
     }
 

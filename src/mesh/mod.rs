@@ -191,7 +191,7 @@ pub struct Mesh {
 pub const MAX_COORDINATE: Real = 1e30;
 
 /// The per-face fields shellsim reads from a mesh (docs/files.md describes each).
-pub const INPUT_FACE_FIELDS: [&str; 20] = [
+pub const INPUT_FACE_FIELDS: [&str; 22] = [
     "abar_info",
     "bbar_info",
     "ref_thicknesses",
@@ -206,6 +206,8 @@ pub const INPUT_FACE_FIELDS: [&str; 20] = [
     "growth_mu_perp",
     "growth_mu_top",
     "growth_mu_bottom",
+    "growth_mu_top_perp",
+    "growth_mu_bottom_perp",
     "growth_mu_through",
     "growth_print_thickness",
     "growth_print_modulus_ratio",

@@ -24,6 +24,14 @@
 //! (the film is the rest); it enters the same projection, so a stiff print pins the neutral plane
 //! near itself and keeps the face from curling or growing. Coefficients: `growth.mu_top`,
 //! `growth.mu_bottom` (per unit moisture), per face when regions or face fields give them.
+//!
+//! A layer may swell differently along the machine direction `d` than across it (fibres, a
+//! stretched polymer, paper's grain; Armon et al., Science 2011, whose seed pods coil into
+//! helices from two such layers crossed): `growth.mu_top_perp`, `growth.mu_bottom_perp` are the
+//! coefficients across `d`, and `mu_top`, `mu_bottom` are then along it. Such a layer's metric
+//! is `P⁻ᵀ M Pᵀ (a⁰ + 2z b⁰) P M P⁻¹` with `P = [d d⊥]` and `M = diag(1 + μ m, 1 + μ⊥ m)`, as in
+//! [`super::machine_direction`]; it enters the same projection. Layers that grow through their
+//! thickness (`isotropic_layers`) must swell alike in every direction.
 //! Units: ā in m², b̄ in m, h in m.
 
 use super::{
@@ -33,17 +41,22 @@ use super::{
 use crate::config::growth::{GrowthLaw, GrowthModel, Laminate};
 use crate::math::{mat_to_sym, Mat2, Real, Sym2};
 
-/// The bilayer law with its layers and each face's `mu_top` and `mu_bottom`
+/// The bilayer law with its layers, whether some layer is anisotropic (it then reads the
+/// machine direction), and each face's `mu_top`, `mu_bottom` and the coefficients across
 /// ([`super::Coefficients`]).
 #[derive(Debug)]
-pub struct Bilayer(pub Laminate);
+pub struct Bilayer(pub Laminate, pub bool);
 
 /// The registry's entry ([`super::LAWS`]).
 pub const ENTRY: LawEntry = LawEntry {
     law: GrowthLaw::Bilayer,
     example: "mu_top = 0.05\nmu_bottom = 0.01\nmoisture_top = 0.4\nmoisture_bottom = 0.3",
     build: |m| match m {
-        GrowthModel::Bilayer { laminate, .. } => Some(Box::new(Bilayer(*laminate))),
+        GrowthModel::Bilayer {
+            laminate,
+            anisotropic,
+            ..
+        } => Some(Box::new(Bilayer(*laminate, *anisotropic))),
         _ => None,
     },
 };
@@ -58,43 +71,87 @@ pub struct Print {
     pub modulus_ratio: Real,
 }
 
+/// A layer's in-plane stretch along the machine direction and across it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stretch {
+    /// Along the machine direction.
+    pub along: Real,
+    /// Across it.
+    pub across: Real,
+}
+
+impl Stretch {
+    /// The same stretch in every direction.
+    pub fn iso(s: Real) -> Stretch {
+        Stretch {
+            along: s,
+            across: s,
+        }
+    }
+
+    /// `1 + μ m` along and `1 + μ⊥ m` across, for coefficients `(μ, μ⊥)`.
+    pub fn of(coefficients: (Real, Real), m: Real) -> Stretch {
+        Stretch {
+            along: 1.0 + coefficients.0 * m,
+            across: 1.0 + coefficients.1 * m,
+        }
+    }
+
+    /// True when it is the same in every direction.
+    pub fn is_iso(&self) -> bool {
+        self.along == self.across
+    }
+}
+
 /// The bilayer's rest forms `(ā, b̄)` and rest thickness over `h`, for in-plane stretches
-/// `s_top`, `s_bottom` of the two layers, and an optional printed layer on top that does not
-/// swell, part of the thickness `h` (see the module doc).
+/// `top`, `bottom` of the two layers about the machine direction `d` (barycentric; unread when
+/// both layers stretch alike in every direction), and an optional printed layer on top that
+/// does not swell, part of the thickness `h` (see the module doc).
+#[allow(clippy::too_many_arguments)]
 pub fn bilayer(
     a0: &Sym2,
     b0: &Sym2,
     h: Real,
-    s_top: Real,
-    s_bottom: Real,
+    top: Stretch,
+    bottom: Stretch,
+    d: [Real; 2],
     laminate: &Laminate,
     print: Option<Print>,
 ) -> (Sym2, Sym2, Real) {
     let phi = laminate.top_fraction;
     let n = laminate.modulus_ratio;
-    let through = |s: Real| if laminate.isotropic { s } else { 1.0 };
+    // Layers that grow through their thickness swell alike in every direction (checked by
+    // the law): their thickness stretch is the in-plane one.
+    let through = |s: Stretch| if laminate.isotropic { s.along } else { 1.0 };
+    let frame = (!(top.is_iso() && bottom.is_iso()))
+        .then(|| super::machine_direction::direction_frame(a0, d));
+    // A layer's metric at reference height z.
+    let metric = |s: Stretch, z: Real| {
+        let g = reference_metric(a0, b0, z);
+        match frame {
+            Some((p, pinv)) if !s.is_iso() => {
+                let m = Mat2::new(s.along, 0.0, 0.0, s.across);
+                pinv.transpose() * m * p.transpose() * g * p * m * pinv
+            }
+            _ => g * (s.along * s.along),
+        }
+    };
     let tp = print.map_or(0.0, |p| p.thickness);
     let film = h - tp;
     // Each layer: (reference bottom z, reference thickness, in-plane stretch, thickness
     // stretch, modulus weight), bottom to top.
     let mut layers = vec![
-        (
-            -0.5 * h,
-            (1.0 - phi) * film,
-            s_bottom,
-            through(s_bottom),
-            1.0,
-        ),
+        (-0.5 * h, (1.0 - phi) * film, bottom, through(bottom), 1.0),
         (
             -0.5 * h + (1.0 - phi) * film,
             phi * film,
-            s_top,
-            through(s_top),
+            top,
+            through(top),
             n,
         ),
     ];
     if let Some(p) = print.filter(|p| p.thickness > 0.0) {
-        layers.push((0.5 * h - tp, tp, 1.0, 1.0, p.modulus_ratio));
+        layers.push((0.5 * h - tp, tp, Stretch::iso(1.0), 1.0, p.modulus_ratio));
     }
     // The reference laminate's neutral plane, where the mesh lies: heights are measured from it.
     let ref_stiffness: Real = layers.iter().map(|l| l.1 * l.4).sum();
@@ -110,8 +167,8 @@ pub fn bilayer(
         let grown = t * l;
         for &(x, w) in &GAUSS3 {
             let u = 0.5 * (x + 1.0);
-            let metric = reference_metric(a0, b0, z0 + u * t - z_n) * (s * s);
-            points.push((base + u * grown, metric, 0.5 * w * grown * e));
+            let g = metric(s, z0 + u * t - z_n);
+            points.push((base + u * grown, g, 0.5 * w * grown * e));
         }
         base += grown;
     }
@@ -135,9 +192,16 @@ pub fn bilayer(
 
 impl RestLaw for Bilayer {
     fn grow(&self, i: &FaceInput) -> Result<Grown, GrowthError> {
-        let (mt, mb) = (i.coef.mu_top, i.coef.mu_bottom);
-        check_stretch(i, mt, true, false)?;
-        check_stretch(i, mb, false, true)?;
+        let (top, bottom) = (i.coef.top_layer(), i.coef.bottom_layer());
+        for mu in [top.0, top.1] {
+            check_stretch(i, mu, true, false)?;
+        }
+        for mu in [bottom.0, bottom.1] {
+            check_stretch(i, mu, false, true)?;
+        }
+        if self.0.isotropic && (top.0 != top.1 || bottom.0 != bottom.1) {
+            return Err(GrowthError::AnisotropicGel { face: i.face });
+        }
         let tp = i.coef.print_thickness;
         if tp >= i.h {
             return Err(GrowthError::Print {
@@ -150,8 +214,8 @@ impl RestLaw for Bilayer {
             thickness: tp,
             modulus_ratio: i.coef.print_modulus_ratio,
         });
-        let (st, sb) = (1.0 + mt * i.m_top, 1.0 + mb * i.m_bottom);
-        let (abar, bbar, ratio) = bilayer(&i.a0, &i.b0, i.h, st, sb, &self.0, print);
+        let (st, sb) = (Stretch::of(top, i.m_top), Stretch::of(bottom, i.m_bottom));
+        let (abar, bbar, ratio) = bilayer(&i.a0, &i.b0, i.h, st, sb, i.direction, &self.0, print);
         if self.0.isotropic {
             return Ok(Grown {
                 abar,
@@ -161,12 +225,22 @@ impl RestLaw for Bilayer {
         }
         through_thickness(i, (abar, bbar))
     }
+
+    fn needs_direction(&self) -> bool {
+        self.1
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::super::close;
     use super::*;
+
+    const D: [Real; 2] = [1.0, 0.0];
+
+    fn iso(s: Real) -> Stretch {
+        Stretch::iso(s)
+    }
 
     fn equal() -> Laminate {
         Laminate::default()
@@ -181,8 +255,9 @@ mod tests {
             &a0,
             &Sym2::zeros(),
             h,
-            1.0 + de / 2.0,
-            1.0 - de / 2.0,
+            iso(1.0 + de / 2.0),
+            iso(1.0 - de / 2.0),
+            D,
             &equal(),
             None,
         );
@@ -213,7 +288,16 @@ mod tests {
                     modulus_ratio: n,
                     isotropic,
                 };
-                let (a, b, _) = bilayer(&a0, &Sym2::zeros(), h, 1.0 + de, 1.0, &lam, None);
+                let (a, b, _) = bilayer(
+                    &a0,
+                    &Sym2::zeros(),
+                    h,
+                    iso(1.0 + de),
+                    iso(1.0),
+                    D,
+                    &lam,
+                    None,
+                );
                 let kappa = b[0] / a[0];
                 let t = timoshenko(de, h, phi / (1.0 - phi), n);
                 // First order in Δε: the error is O(Δε) relative.
@@ -247,8 +331,9 @@ mod tests {
                     &a0,
                     &Sym2::zeros(),
                     h,
-                    1.0 + de,
-                    1.0 + de,
+                    iso(1.0 + de),
+                    iso(1.0 + de),
+                    D,
                     &lam,
                     Some(print),
                 );
@@ -262,7 +347,16 @@ mod tests {
             thickness: 0.1e-3,
             modulus_ratio: 1e6,
         };
-        let (a, b, _) = bilayer(&a0, &Sym2::zeros(), h, 1.3, 1.1, &equal(), Some(stiff));
+        let (a, b, _) = bilayer(
+            &a0,
+            &Sym2::zeros(),
+            h,
+            iso(1.3),
+            iso(1.1),
+            D,
+            &equal(),
+            Some(stiff),
+        );
         assert!(
             (a[0] - 1.0).abs() < 1e-3 && b[0].abs() * h < 1e-3,
             "{a:?} {b:?}"
@@ -280,7 +374,7 @@ mod tests {
             isotropic: true,
         };
         let s = 1.4;
-        let (a, b, r) = bilayer(&a0, &b0, 0.01, s, s, &lam, None);
+        let (a, b, r) = bilayer(&a0, &b0, 0.01, iso(s), iso(s), D, &lam, None);
         assert!((r - s).abs() < 1e-15);
         // Heights from the neutral plane grow by s: ḡ = s²(a⁰ + 2(ζ/s) b⁰), ā = s² a⁰, b̄ = s b⁰.
         assert!(close(&a, &(a0 * (s * s)), 1e-13), "{a:?}");
@@ -290,7 +384,7 @@ mod tests {
             isotropic: false,
             ..lam
         };
-        let (a, b, r) = bilayer(&a0, &b0, 0.01, s, s, &kept, None);
+        let (a, b, r) = bilayer(&a0, &b0, 0.01, iso(s), iso(s), D, &kept, None);
         assert!(close(&a, &(a0 * (s * s)), 1e-13) && close(&b, &(b0 * (s * s)), 1e-12));
         assert_eq!(r, 1.0);
     }
@@ -299,11 +393,11 @@ mod tests {
     fn isotropic_layers_thicken_the_swollen_side() {
         let a0 = Sym2::new(1.0, 0.0, 1.0);
         let h = 1.0;
-        let iso = Laminate {
+        let gel = Laminate {
             isotropic: true,
             ..equal()
         };
-        let (a, b, r) = bilayer(&a0, &Sym2::zeros(), h, 1.5, 1.0, &iso, None);
+        let (a, b, r) = bilayer(&a0, &Sym2::zeros(), h, iso(1.5), iso(1.0), D, &gel, None);
         assert!((r - 1.25).abs() < 1e-15);
         // Closed form: layers of grown thickness 0.75 (ḡ = 2.25) over 0.5 (ḡ = 1), neutral
         // plane at the centroid ζₙ = (0.5·0.25 + 0.75·0.875)/1.25 = 0.625.
@@ -320,7 +414,104 @@ mod tests {
             m1 / (2.0 * i)
         );
         // Thicker: less curvature than at a kept thickness.
-        let (a2, b2, _) = bilayer(&a0, &Sym2::zeros(), h, 1.5, 1.0, &equal(), None);
+        let (a2, b2, _) = bilayer(
+            &a0,
+            &Sym2::zeros(),
+            h,
+            iso(1.5),
+            iso(1.0),
+            D,
+            &equal(),
+            None,
+        );
         assert!(b[0] / a[0] < b2[0] / a2[0]);
+    }
+
+    /// Layers that swell along the machine direction only curl the face along it alone; crossed
+    /// layers (Armon et al. 2011) program a saddle along `d` and `d⊥`. Equal layers on a flat
+    /// face: each layer's metric is `diag(s², 1)` in the `(d, d⊥)` frame, so van Rees'
+    /// equivalence is exact: `ā = (ḡ⁺ + ḡ⁻)/2`, `b̄ = 3(ḡ⁺ − ḡ⁻)/(4h)`.
+    #[test]
+    fn anisotropic_layers_curl_along_their_direction() {
+        let a0 = Sym2::new(1.0, 0.0, 1.0);
+        let h = 0.002;
+        let (c, s) = (0.3f64.cos(), 0.3f64.sin());
+        let d = [2.0 * c, 2.0 * s]; // its length does not matter
+        let dd = Sym2::new(c * c, c * s, s * s);
+        let pp = Sym2::new(s * s, -c * s, c * c);
+        let e: Real = 0.01;
+        let along = |v: Real| Stretch {
+            along: v,
+            across: 1.0,
+        };
+        let across = |v: Real| Stretch {
+            along: 1.0,
+            across: v,
+        };
+        let (gp, gm) = ((1.0 + e).powi(2), (1.0 - e).powi(2));
+        // Both layers along d, one swelling, one shrinking.
+        let (a, b, _) = bilayer(
+            &a0,
+            &Sym2::zeros(),
+            h,
+            along(1.0 + e),
+            along(1.0 - e),
+            d,
+            &equal(),
+            None,
+        );
+        let a_want = dd * ((gp + gm) / 2.0) + pp;
+        assert!(close(&a, &a_want, 1e-14), "{a:?} vs {a_want:?}");
+        let b_want = dd * (3.0 * (gp - gm) / (4.0 * h));
+        assert!(close(&b, &b_want, 1e-12), "{b:?} vs {b_want:?}");
+        // Crossed: the top along d, the bottom across it, both swelling by e.
+        let (a, b, _) = bilayer(
+            &a0,
+            &Sym2::zeros(),
+            h,
+            along(1.0 + e),
+            across(1.0 + e),
+            d,
+            &equal(),
+            None,
+        );
+        let a_want = a0 * ((gp + 1.0) / 2.0);
+        assert!(close(&a, &a_want, 1e-14), "{a:?}");
+        let b_want = (dd - pp) * (3.0 * (gp - 1.0) / (4.0 * h));
+        assert!(close(&b, &b_want, 1e-12), "{b:?} vs {b_want:?}");
+        // On a curved, sheared face the law is the machine-direction law's metric per layer:
+        // with both layers alike it is a single layer swelling by a uniform moisture, at any
+        // direction, and it differs from the isotropic layer.
+        let (a0, b0) = (Sym2::new(1.0, 0.3, 1.2), Sym2::new(0.2, 0.05, -0.1));
+        let layer = Stretch {
+            along: 1.02,
+            across: 1.07,
+        };
+        let (a, b, _) = bilayer(&a0, &b0, h, layer, layer, [0.3, 0.7], &equal(), None);
+        let (am, bm) = super::super::machine_direction::machine_direction(
+            &a0,
+            &b0,
+            h,
+            1.0,
+            1.0,
+            0.02,
+            0.07,
+            [0.3, 0.7],
+        );
+        assert!(
+            close(&a, &am, 1e-13) && close(&b, &bm, 1e-10),
+            "{a:?} {am:?} {b:?} {bm:?}"
+        );
+        let (ai, _, _) = bilayer(
+            &a0,
+            &b0,
+            h,
+            iso(1.02),
+            iso(1.02),
+            [0.3, 0.7],
+            &equal(),
+            None,
+        );
+        assert!((a - ai).amax() > 1e-3);
     }
 }

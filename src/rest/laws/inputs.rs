@@ -78,6 +78,8 @@ impl GrowthInputs {
                 mu_perp: g.mu_perp.unwrap_or(0.0),
                 mu_top: g.mu_top.unwrap_or(0.0),
                 mu_bottom: g.mu_bottom.unwrap_or(0.0),
+                mu_top_perp: g.mu_top_perp,
+                mu_bottom_perp: g.mu_bottom_perp,
                 mu_through: g.mu_through.unwrap_or(0.0),
                 print_thickness: g.print_thickness.unwrap_or(0.0),
                 print_modulus_ratio: g.print_modulus_ratio.unwrap_or(1.0),
@@ -87,7 +89,11 @@ impl GrowthInputs {
             relaxed: Vec::new(),
         };
         out.coef = per_face_coefficients(mesh, settings, out.uniform)?;
+        let perp_fields = ["growth_mu_top_perp", "growth_mu_bottom_perp"]
+            .iter()
+            .any(|n| mesh.face_fields.contains_key(*n));
         if law.as_ref().is_some_and(|l| l.needs_direction())
+            || (perp_fields && g.law == crate::config::growth::GrowthLaw::Bilayer)
             || settings.moisture.enabled
             || settings.temperature.enabled
         {
@@ -116,19 +122,23 @@ impl GrowthInputs {
     }
 }
 
-/// Where a coefficient sits in [`super::Coefficients`].
-type Slot = fn(&mut super::Coefficients) -> &mut Real;
+/// Sets one coefficient of [`super::Coefficients`].
+type Slot = fn(&mut super::Coefficients, Real);
 
 /// The face fields of the per-face coefficients, and which coefficient each sets, in the order
 /// of [`crate::config::growth::GrowthRegion::values`].
-const COEFFICIENT_FIELDS: [(&str, Slot); 7] = [
-    ("growth_mu", |c| &mut c.mu),
-    ("growth_mu_perp", |c| &mut c.mu_perp),
-    ("growth_mu_top", |c| &mut c.mu_top),
-    ("growth_mu_bottom", |c| &mut c.mu_bottom),
-    ("growth_mu_through", |c| &mut c.mu_through),
-    ("growth_print_thickness", |c| &mut c.print_thickness),
-    ("growth_print_modulus_ratio", |c| &mut c.print_modulus_ratio),
+pub(crate) const COEFFICIENT_FIELDS: [(&str, Slot); 9] = [
+    ("growth_mu", |c, v| c.mu = v),
+    ("growth_mu_perp", |c, v| c.mu_perp = v),
+    ("growth_mu_top", |c, v| c.mu_top = v),
+    ("growth_mu_bottom", |c, v| c.mu_bottom = v),
+    ("growth_mu_top_perp", |c, v| c.mu_top_perp = Some(v)),
+    ("growth_mu_bottom_perp", |c, v| c.mu_bottom_perp = Some(v)),
+    ("growth_mu_through", |c, v| c.mu_through = v),
+    ("growth_print_thickness", |c, v| c.print_thickness = v),
+    ("growth_print_modulus_ratio", |c, v| {
+        c.print_modulus_ratio = v
+    }),
 ];
 
 /// Per-face coefficients: `uniform`, replaced on each `growth.regions` entry's faces by the
@@ -159,7 +169,7 @@ fn per_face_coefficients(
         for f in faces {
             for ((_, v), (_, slot)) in r.values().into_iter().zip(COEFFICIENT_FIELDS) {
                 if let Some(v) = v {
-                    *slot(&mut coef[f]) = v;
+                    slot(&mut coef[f], v);
                 }
             }
         }
@@ -176,7 +186,7 @@ fn per_face_coefficients(
             if let Err(e) = crate::config::growth::print_range(name, name, v) {
                 return Err(mesh.invalid(format!("face field '{name}' at face {f}: {}", e.reason)));
             }
-            *slot(&mut coef[f]) = v;
+            slot(&mut coef[f], v);
         }
     }
     Ok(coef)

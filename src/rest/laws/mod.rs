@@ -133,12 +133,32 @@ pub struct Coefficients {
     pub mu_top: Real,
     /// The bilayer's bottom layer.
     pub mu_bottom: Real,
+    /// The bilayer's top layer across the machine direction (`None`: `mu_top`, the layer
+    /// swells alike in every direction).
+    pub mu_top_perp: Option<Real>,
+    /// The bilayer's bottom layer across the machine direction (`None`: `mu_bottom`).
+    pub mu_bottom_perp: Option<Real>,
     /// μ_n through the thickness: `h̄ = h (1 + μ_n (m⁺ + m⁻)/2)`.
     pub mu_through: Real,
     /// The bilayer's printed top layer: its thickness (m, 0: none), part of the face's.
     pub print_thickness: Real,
     /// The printed layer's Young's modulus over the bottom layer's.
     pub print_modulus_ratio: Real,
+}
+
+impl Coefficients {
+    /// The bilayer's top layer's coefficients `(along, across)` the machine direction.
+    pub fn top_layer(&self) -> (Real, Real) {
+        (self.mu_top, self.mu_top_perp.unwrap_or(self.mu_top))
+    }
+
+    /// The bilayer's bottom layer's coefficients `(along, across)` the machine direction.
+    pub fn bottom_layer(&self) -> (Real, Real) {
+        (
+            self.mu_bottom,
+            self.mu_bottom_perp.unwrap_or(self.mu_bottom),
+        )
+    }
 }
 
 /// The forms `(ā, b̄)` of a moisture law at the reference thickness, with the thickness grown
@@ -417,6 +437,16 @@ pub enum GrowthError {
         print: Real,
         /// The face's thickness (m).
         thickness: Real,
+    },
+    /// A gel bilayer's layer that swells differently across the machine direction.
+    #[error(
+        "growth at face {face}: growth.isotropic_layers grows each layer's thickness by its \
+         in-plane stretch, so a layer must swell alike along and across the machine direction \
+         (mu_top_perp = mu_top, mu_bottom_perp = mu_bottom)"
+    )]
+    AnisotropicGel {
+        /// The face.
+        face: usize,
     },
     /// The law's `ā` is not positive definite (or `b̄` or the thickness is not finite).
     #[error(
