@@ -3,6 +3,7 @@
     python3 scripts/design_targets.py vase DISK.vtk OUT.vtk [--height H]
     python3 scripts/design_targets.py saddle DISK.vtk OUT.vtk [--curvature C]
     python3 scripts/design_targets.py helix STRIP.vtk OUT.vtk [--radius R] [--angle DEG]
+    python3 scripts/design_targets.py cap DISK.vtk OUT.vtk [--radius R] [--area A]
 
 * `vase`: a surface of revolution with a flat bottom, a bulge, a neck and a flared lip,
   reached from the unit disk by its conformal map: with the profile (R(σ), Z(σ)) by arc length
@@ -18,6 +19,11 @@
   u = x cos α + y sin α around the cylinder and height v = −x sin α + y cos α along its axis, an
   isometry (the strip's metric is kept; its curvature is 1/R along the turned direction), so the
   strip's long edges become helices.
+
+* `cap`: a spherical cap of radius R whose area is A times the unit disk's (a liquid-crystal
+  sheet's actuated area is λ^(1−ν) times its own: A = 0.9487 for λ = 0.9, ν = 0.5): each disk
+  vertex (ρ, φ) goes to polar angle ρ t₁ on the sphere, cos t₁ = 1 − A/(2R²) (the target of a
+  surface design: its in-plane positions are not those of the design's).
 
 Needs the project's virtual environment (`vtk`, `numpy`).
 """
@@ -121,15 +127,26 @@ def helix(strip, radius, angle):
     return out
 
 
+def cap(disk, radius, area):
+    x = vtk_to_numpy(disk.GetPoints().GetData()).astype(float)
+    c = 1.0 - area / (2.0 * radius**2)
+    if not -1.0 < c < 1.0:
+        sys.exit(f"no cap of radius {radius} has area {area}π")
+    t = np.hypot(x[:, 0], x[:, 1]) * math.acos(c)
+    phi = np.arctan2(x[:, 1], x[:, 0])
+    return np.c_[radius * np.sin(t) * np.cos(phi), radius * np.sin(t) * np.sin(phi), radius * (1.0 - np.cos(t))]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("shape", choices=["vase", "saddle", "helix"])
+    ap.add_argument("shape", choices=["vase", "saddle", "helix", "cap"])
     ap.add_argument("disk")
     ap.add_argument("out")
     ap.add_argument("--height", type=float, default=0.45)
     ap.add_argument("--curvature", type=float, default=0.3)
     ap.add_argument("--radius", type=float, default=0.5)
     ap.add_argument("--angle", type=float, default=30.0)
+    ap.add_argument("--area", type=float, default=1.0)
     a = ap.parse_args()
     disk = read(a.disk)
     if disk is None or disk.GetNumberOfCells() == 0:
@@ -138,8 +155,10 @@ def main():
         pts = vase(disk, a.height)
     elif a.shape == "saddle":
         pts = saddle(disk, a.curvature)
-    else:
+    elif a.shape == "helix":
         pts = helix(disk, a.radius, a.angle)
+    else:
+        pts = cap(disk, a.radius, a.area)
     write(disk, pts, a.out)
     print(f"{a.out}: {a.shape}, {disk.GetNumberOfPoints()} vertices, {disk.GetNumberOfCells()} faces")
 

@@ -1401,3 +1401,138 @@ fn the_circumferential_director_is_recovered_from_its_cone() {
     assert_eq!(sum["converged"], true, "{sum}");
     assert!(worst < 2.0, "director recovered to {worst}°");
 }
+
+/// The director angle `α(r)` to the radius that makes a nematic sheet (λ, ν) a spherical cap of
+/// radius `big_r` (Warner & Mostajeran, Proc. R. Soc. A 2018): with `C = λ² sin²α +
+/// λ^{−2ν} cos²α`, the actuated metric is `λ^{2−2ν}/C dr² + r² C dψ²`, a surface of revolution
+/// with circle radius `ρ = r√C` at arc length `σ`, `dσ/dr = λ^{1−ν}/√C`; a sphere has
+/// `dρ/dσ = √(1 − ρ²/R²)`, so `u = √C` solves `r u' = (λ^{1−ν}/u)√(1 − r²u²/R²) − u` from
+/// `u(0) = λ^{(1−ν)/2}` (a smooth centre). RK4 in 4000 steps to `r`.
+fn spherical_cap_director(lambda: Real, nu: Real, big_r: Real, r: Real) -> Real {
+    let c0 = lambda.powf(1.0 - nu);
+    let f = |r: Real, u: Real| {
+        if r == 0.0 {
+            0.0
+        } else {
+            ((c0 / u) * (1.0 - (r * u / big_r).powi(2)).max(0.0).sqrt() - u) / r
+        }
+    };
+    let n = 4000;
+    let dr = r / n as Real;
+    let mut u = c0.sqrt();
+    for i in 0..n {
+        let x = i as Real * dr;
+        let k1 = f(x, u);
+        let k2 = f(x + 0.5 * dr, u + 0.5 * dr * k1);
+        let k3 = f(x + 0.5 * dr, u + 0.5 * dr * k2);
+        let k4 = f(x + dr, u + dr * k3);
+        u += dr / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    }
+    let (lo, hi) = (lambda * lambda, lambda.powf(-2.0 * nu));
+    ((hi - u * u) / (hi - lo)).clamp(0.0, 1.0).sqrt().asin()
+}
+
+/// `shellsim design` of a liquid-crystal disk into a spherical cap (`designs/lc_cap.toml` at
+/// h = 0.02 on a 420-face disk): from the neutral spiral director (the one whose actuated
+/// sheet stays flat, 2.1% of the size from the cap), Gauss–Newton reaches the cap of radius
+/// 2.5 within 0.2% of its size surface to surface (measured 0.11% in 4 iterations, 1 s), the
+/// written design actuates forward onto it, and the director is within 5° (RMS, measured 3.2°)
+/// of the closed-form spiral for r > 0.2 (the design is not unique: the shape pins the
+/// director only to a few degrees on this mesh; on 1015 faces at h = 0.01 it is 1.3°).
+#[test]
+fn a_liquid_crystal_disk_is_designed_into_a_spherical_cap() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    succeeds(
+        d,
+        &[
+            "mesh", "disk", "--radius", "1", "--edge", "0.12", "-o", "disk.vtk",
+        ],
+    );
+    let disk = shellsim::mesh::io::read_mesh(&d.join("disk.vtk")).unwrap();
+    let (lambda, nu, big_r): (Real, Real, Real) = (0.9, 0.5, 2.5);
+    // The cap of the actuated sheet's area, λ^{1−ν} π, the disk's radius mapped to polar angle.
+    let t1 = (1.0 - lambda.powf(1.0 - nu) / (2.0 * big_r * big_r)).acos();
+    let mut cap = disk.clone();
+    for p in &mut cap.positions {
+        let (t, phi) = (p.x.hypot(p.y) * t1, p.y.atan2(p.x));
+        *p = Vec3::new(
+            big_r * t.sin() * phi.cos(),
+            big_r * t.sin() * phi.sin(),
+            big_r * (1.0 - t.cos()),
+        );
+    }
+    shellsim::mesh::io::write_mesh(
+        &d.join("cap.vtk"),
+        &cap,
+        shellsim::mesh::io::Format::VtkAscii,
+        "cap",
+    )
+    .unwrap();
+    let text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/lc_cap.toml"))
+            .unwrap()
+            .replace("thickness = 0.01", "thickness = 0.02")
+            .replace("target_distance = 1e-3", "target_distance = 2e-3");
+    write(d, "lc.toml", &text);
+    succeeds(
+        d,
+        &[
+            "design", "lc.toml", "disk.vtk", "cap.vtk", "--out", "des", "-q",
+        ],
+    );
+    let sum: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("des/design_summary.json")).unwrap())
+            .unwrap();
+    let dist = sum["distance"].as_f64().unwrap();
+    let fwd = &sum["forward_check"];
+    println!(
+        "lc cap: {dist:.3e} in {} iterations; forward {fwd}",
+        sum["iterations"]
+    );
+    assert!(dist <= 2e-3, "{sum}");
+    assert!(fwd["distance"].as_f64().unwrap() <= 2e-3, "{sum}");
+    // The designed director against the closed form, away from the centre.
+    let designed = shellsim::mesh::io::read_mesh(&d.join("des/designed.vtk")).unwrap();
+    let info = &designed.face_fields["abar_info"].data;
+    let (mut sq, mut n) = (0.0, 0);
+    for (f, face) in designed.faces.iter().enumerate() {
+        let c = face.iter().map(|&v| designed.positions[v]).sum::<Vec3>() / 3.0;
+        let r = c.x.hypot(c.y);
+        if r <= 0.2 {
+            continue;
+        }
+        let alpha = info[3 * f] - c.y.atan2(c.x);
+        let exact = spherical_cap_director(lambda, nu, big_r, r);
+        // Directors are nematic: θ and θ + π are one.
+        let e = (alpha - exact + std::f64::consts::FRAC_PI_2).rem_euclid(std::f64::consts::PI)
+            - std::f64::consts::FRAC_PI_2;
+        sq += e * e;
+        n += 1;
+    }
+    let rms = (sq / n as Real).sqrt().to_degrees();
+    println!("lc cap: director {rms:.2}° (RMS, r > 0.2) from the closed form");
+    assert!(rms < 5.0, "{rms}°");
+}
+
+/// Every example design file is a scene and a `[design]` section that parse and validate.
+#[test]
+fn the_example_design_files_parse() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&root).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap();
+        let (scene, design) = shellsim::config::design::split(&text);
+        let name = path.display().to_string();
+        Settings::from_str_with(&scene, &name, &[]).unwrap_or_else(|e| panic!("{name}: {e}"));
+        if !design.trim().is_empty() {
+            shellsim::config::design::parse(&design).unwrap_or_else(|e| panic!("{name}: {e}"));
+        }
+        n += 1;
+    }
+    assert!(n >= 6, "{n} design files");
+}
