@@ -18,7 +18,8 @@
 //! stays within a tenth of the target's size (the re-solve starts from the prediction
 //! `x + S δ`, which is exact to first order), and backtracked (halving) until the Armijo
 //! condition holds, a trial whose equilibrium is not found counting as a failure. The damping
-//! falls by 3 after a full step whose decrease is at least ¾ of the model's, and doubles on
+//! falls by 3 after a full step whose decrease is at least ¾ of the model's (along the step
+//! taken: `−gᵀδ (c − c²/2)` for a step shortened by `c`), and doubles on
 //! every halving or a decrease under ¼ of the model's. Variables at a bound whose gradient pushes
 //! outward are fixed for the iteration, as in [`super::lbfgs`].
 //!
@@ -155,13 +156,16 @@ pub fn minimise<P: Model>(
                 f,
             ));
         };
-        let predicted = -0.5 * dot(&pg, &d);
+        // The model's decrease along c·δ, with δᵀBδ ≈ −gᵀδ at the model's minimiser:
+        // −gᵀδ (c − c²/2); c < 1 when the step is shortened to the displacement bound.
+        let mut c = 1.0;
         if let Some(size) = problem.response_size(&d) {
             if size > MAX_RESPONSE {
-                let c = MAX_RESPONSE / size;
+                c = MAX_RESPONSE / size;
                 d.iter_mut().for_each(|x| *x *= c);
             }
         }
+        let predicted = -dot(&pg, &d) * (1.0 - 0.5 * c);
         let (trial, ft, gt, alpha, trials) = match backtrack(problem, &p, &d, f, &g, o, 30) {
             Ok(a) => a,
             Err(why) => return Ok((Stop::Stalled(why), p, f)),
