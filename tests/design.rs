@@ -350,38 +350,50 @@ fn surface_and_curvature_sensitivities_match_differences() {
 /// The bilayer's layer strains and the rest thickness as design variables: adjoint gradients
 /// against central differences of re-solved equilibria, 1e-6 of the largest entry. A free
 /// bilayer strip (unequal layers that swell differently along and across a diagonal machine
-/// direction, with a printed stripe, swelling through the thickness too) curls; the thickness is designed on a grown dome under its weight (which follows the
+/// direction, with a printed stripe, swelling through the thickness too; and gel layers whose
+/// thickness grows with their stretch) curls; the thickness is designed on a grown dome under its weight (which follows the
 /// thickness).
 #[test]
 fn swelling_and_thickness_sensitivities_match_differences() {
     let mesh = shellsim::mesh::generate::rectangle(-0.5, -0.1, 1.0, 0.2, 0.07, Spacing::default());
-    let text = "[material]\nyoung = 1e5\npoisson = 0.3\nthickness = 0.01\n\
+    let kept = "[material]\nyoung = 1e5\npoisson = 0.3\nthickness = 0.01\n\
                 [growth]\nlaw = \"bilayer\"\nmu_top = 0.04\nmu_bottom = 0.01\nmu_through = 0.02\n\
                 moisture_top = 1.0\nmoisture_bottom = 0.5\ntop_fraction = 0.4\nmodulus_ratio = 2.0\n\
                 mu_top_perp = 0.01\nmu_bottom_perp = -0.02\nmachine_direction = [1, 1, 0]\n\
                 [[growth.regions]]\ninside = { min = [-0.1, -1, -1], max = [0.1, 1, 1] }\n\
                 print_thickness = 0.002\nprint_modulus_ratio = 5.0\n\
                 [solver]\nmode = \"static\"\ntolerance = 1e-13\n";
-    let sc = scene(mesh.clone(), text);
-    let design = shellsim::config::design::parse("[design]\nvariable = \"swelling\"\n").unwrap();
-    let (chain, _) = shellsim::design::run::chain_and_start(&sc, &design).unwrap();
-    let nf = mesh.faces.len();
-    let p: Vec<Real> = (0..nf)
-        .flat_map(|f| [0.04 + 0.01 * (f as Real).sin(), 0.005])
-        .collect();
-    let target = bumpy(&mesh, 0.5);
-    let topo = Topology::build(&mesh).unwrap();
-    let mut prob = Problem::new(
-        &sc,
-        chain,
-        distance(DistanceTerm::Points(Points::new(&mesh, target, true))),
-        Smoothness::new(&mesh, &topo, 0.01, false, vec![1.0, 1.0]),
-    )
-    .unwrap();
-    let n = p.len();
-    let which = [0, 1, n / 2, n / 2 + 1, n - 2, n - 1];
-    let worst = worst_difference(&mut prob, &p, &which, 1e-6, "swelling");
-    assert!(worst < 1e-6, "swelling: worst relative error {worst:e}");
+    // Gel layers: each layer's thickness grows with its stretch, so the heights and weights
+    // of the law's projection move too.
+    let gel = "[material]\nyoung = 1e5\npoisson = 0.3\nthickness = 0.01\n\
+               [growth]\nlaw = \"bilayer\"\nmu_top = 0.04\nmu_bottom = 0.01\nisotropic_layers = true\n\
+               moisture_top = 1.0\nmoisture_bottom = 0.5\ntop_fraction = 0.4\nmodulus_ratio = 2.0\n\
+               [[growth.regions]]\ninside = { min = [-0.1, -1, -1], max = [0.1, 1, 1] }\n\
+               print_thickness = 0.002\nprint_modulus_ratio = 5.0\n\
+               [solver]\nmode = \"static\"\ntolerance = 1e-13\n";
+    for (name, text) in [("swelling", kept), ("gel swelling", gel)] {
+        let sc = scene(mesh.clone(), text);
+        let design =
+            shellsim::config::design::parse("[design]\nvariable = \"swelling\"\n").unwrap();
+        let (chain, _) = shellsim::design::run::chain_and_start(&sc, &design).unwrap();
+        let nf = mesh.faces.len();
+        let p: Vec<Real> = (0..nf)
+            .flat_map(|f| [0.04 + 0.01 * (f as Real).sin(), 0.005])
+            .collect();
+        let target = bumpy(&mesh, 0.5);
+        let topo = Topology::build(&mesh).unwrap();
+        let mut prob = Problem::new(
+            &sc,
+            chain,
+            distance(DistanceTerm::Points(Points::new(&mesh, target, true))),
+            Smoothness::new(&mesh, &topo, 0.01, false, vec![1.0, 1.0]),
+        )
+        .unwrap();
+        let n = p.len();
+        let which = [0, 1, n / 2, n / 2 + 1, n - 2, n - 1];
+        let worst = worst_difference(&mut prob, &p, &which, 1e-6, name);
+        assert!(worst < 1e-6, "{name}: worst relative error {worst:e}");
+    }
 
     // The thickness of a strip clamped along one side and hanging under its weight (which
     // follows the thickness), with rest forms of its own.
@@ -919,7 +931,8 @@ fn shellsim_design_reaches_for_a_surface_and_for_curvature_fields() {
 }
 
 /// `shellsim design` of the bilayer's layer strains (layers that swell alike in every
-/// direction, and layers that do not) and of the rest thickness: each design lowers the
+/// direction, layers that do not, and gel layers that thicken as they swell) and of the rest
+/// thickness: each design lowers the
 /// distance to a shape the scene makes with other values (a strip that curls more;
 /// a clamped strip that sags more under its weight, being thinner), and its written mesh and
 /// settings reproduce the designed shape through the ordinary run (within 1e-6 of the size).
@@ -942,11 +955,11 @@ fn shellsim_design_writes_swelling_and_thickness_designs_that_reproduce() {
             "strip.vtk",
         ],
     );
-    let bilayer = |mu_top: Real| {
+    let bilayer = |mu_top: Real, gel: bool| {
         format!(
             "[material]\nyoung = 1e5\npoisson = 0.3\nthickness = 0.01\n\
              [growth]\nlaw = \"bilayer\"\nmu_top = {mu_top}\nmu_bottom = 0.01\n\
-             moisture_top = 1.0\nmoisture_bottom = 1.0\n[solver]\nmode = \"static\"\n"
+             isotropic_layers = {gel}\nmoisture_top = 1.0\nmoisture_bottom = 1.0\n[solver]\nmode = \"static\"\n"
         )
     };
     // Layers that swell unequally along and across a diagonal machine direction, the bottom
@@ -971,8 +984,14 @@ fn shellsim_design_writes_swelling_and_thickness_designs_that_reproduce() {
     for (name, scene, target, design) in [
         (
             "swelling",
-            bilayer(0.02),
-            bilayer(0.03),
+            bilayer(0.02, false),
+            bilayer(0.03, false),
+            "[design]\nvariable = \"swelling\"\nmax_iterations = 5\nsmoothing_length = 0.1\n",
+        ),
+        (
+            "gel",
+            bilayer(0.02, true),
+            bilayer(0.03, true),
             "[design]\nvariable = \"swelling\"\nmax_iterations = 5\nsmoothing_length = 0.1\n",
         ),
         (

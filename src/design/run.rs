@@ -450,19 +450,11 @@ pub fn chain_and_start(scene: &Scene, d: &Design) -> Result<(Chain, Vec<Real>), 
             else {
                 unreachable!("designable() checked the law")
             };
-            if laminate.isotropic {
-                return Err((
-                    "growth.isotropic_layers".into(),
-                    "\"swelling\" designs layers that keep their thickness (the forms are then \
-                     exactly quadratic in the stretches); layers that swell through their \
-                     thickness too are not designed"
-                        .into(),
-                ));
-            }
             let g = &body.growth;
             let mut basis = Vec::with_capacity(nf);
             let mut ratio = Vec::with_capacity(nf);
             let mut shapes = Vec::with_capacity(nf);
+            let mut gel_faces = Vec::with_capacity(nf);
             let mut own = Vec::with_capacity(2 * nf);
             for f in 0..nf {
                 let c = g.coef.get(f).copied().unwrap_or(g.uniform);
@@ -488,18 +480,21 @@ pub fn chain_and_start(scene: &Scene, d: &Design) -> Result<(Chain, Vec<Real>), 
                         modulus_ratio: c.print_modulus_ratio,
                     });
                 let lambda = 1.0 + c.mu_through * 0.5 * (mt + mb);
-                basis.push(Chain::swelling_basis(
-                    &rest.abar0[f],
-                    &rest.bbar0[f],
-                    body.thickness[f],
-                    &laminate,
-                    print,
-                    lambda,
-                    shape,
-                    d,
-                ));
+                if !laminate.isotropic {
+                    basis.push(Chain::swelling_basis(
+                        &rest.abar0[f],
+                        &rest.bbar0[f],
+                        body.thickness[f],
+                        &laminate,
+                        print,
+                        lambda,
+                        shape,
+                        d,
+                    ));
+                }
                 ratio.push(lambda);
                 shapes.push(shape);
+                gel_faces.push((rest.abar0[f], rest.bbar0[f], body.thickness[f], print));
                 // The strain in each layer's direction of largest swelling.
                 let largest = |mu: (Real, Real)| if mu.0.abs() >= mu.1.abs() { mu.0 } else { mu.1 };
                 own.extend([largest(top) * mt, largest(bottom) * mb]);
@@ -509,6 +504,12 @@ pub fn chain_and_start(scene: &Scene, d: &Design) -> Result<(Chain, Vec<Real>), 
                     basis,
                     ratio,
                     shape: shapes,
+                    // Gel layers swell alike in every direction (the law refuses others), and
+                    // take no through-thickness swelling.
+                    gel: laminate.isotropic.then_some(crate::design::variables::Gel {
+                        laminate,
+                        faces: gel_faces,
+                    }),
                 },
                 own,
             )

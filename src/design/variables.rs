@@ -23,6 +23,8 @@
 //!   layer (the printed layer, which does not swell, is in `r₀`), and `∂r/∂ε± = L± + 2ε± Q±`.
 //!   The through-thickness swelling `λ` of the face's own moisture divides `b̄` and sets
 //!   `h̄ = λ h`, both fixed.
+//!   Gel layers (`isotropic_layers`), whose thickness grows by `s± = 1 + ε±` too: the law's
+//!   forms and `h̄/h` with its exact stretch derivatives at every evaluation ([`Gel`]).
 //! * **Thickness** (`h̄`, one per face): the rest forms are the scene's own, `∂h̄/∂h̄ = 1`.
 //!
 //! Units: s dimensionless, θ in rad, Cartesian ā dimensionless, Cartesian b̄ in 1/m, ε±
@@ -70,6 +72,9 @@ pub enum Chain {
         basis: Vec<[(Sym2, Sym2); 5]>,
         /// Each layer's `(α, γ)` per face, top and bottom.
         shape: Vec<[(Real, Real); 2]>,
+        /// Gel layers (`isotropic_layers`), whose forms come from the law itself; `None` for
+        /// layers that keep their thickness (the bases above).
+        gel: Option<Gel>,
         /// `h̄/h` per face.
         ratio: Vec<Real>,
     },
@@ -83,6 +88,20 @@ pub enum Chain {
         /// reference thickness is `h̄` over it, and the mass follows the written thickness.
         law_ratio: Vec<Real>,
     },
+}
+
+/// The swelling chain of gel layers (`growth.isotropic_layers`): each layer's thickness grows
+/// by its in-plane stretch `s± = 1 + ε±`, so the heights and weights of the law's projection
+/// move with the stretches and the forms are not quadratic in them. The forms, the thickness
+/// ratio and their exact derivatives come from the law
+/// ([`crate::rest::laws::bilayer::bilayer_jacobian`]) at every evaluation.
+#[derive(Clone, Debug)]
+pub struct Gel {
+    /// The layers.
+    pub laminate: crate::config::growth::Laminate,
+    /// Per face: the reference forms `(a⁰, b⁰)` (m², m), the reference thickness (m) and the
+    /// printed layer.
+    pub faces: Vec<(Sym2, Sym2, Real, Option<crate::rest::laws::bilayer::Print>)>,
 }
 
 /// One face's rest data and their Jacobian: `forms = (ā, b̄)`, the thickness ratio `h̄/h`, and
@@ -204,6 +223,18 @@ impl Chain {
                     forms: (abar[f], pull_back(t, &bc)),
                     ratio: 1.0,
                     jac,
+                }
+            }
+            Chain::Swelling { gel: Some(g), .. } => {
+                use crate::rest::laws::bilayer::{bilayer_jacobian, Stretch};
+                let (a0, b0, h, print) = g.faces[f];
+                let (top, bottom) = (Stretch::iso(1.0 + p[0]), Stretch::iso(1.0 + p[1]));
+                let ((abar, bbar, ratio), jac) =
+                    bilayer_jacobian(&a0, &b0, h, top, bottom, [1.0, 0.0], &g.laminate, print);
+                FaceRest {
+                    forms: (abar, bbar),
+                    ratio,
+                    jac: jac.iter().map(|j| sym_row(j.0, j.1, j.2)).collect(),
                 }
             }
             Chain::Swelling { basis, ratio, .. } => {
@@ -423,6 +454,31 @@ mod tests {
                     )],
                     ratio: vec![1.1],
                     shape: vec![[(1.0, 0.25), (-0.5, 1.0)]],
+                    gel: None,
+                },
+                vec![0.04, -0.02],
+            ),
+            (
+                Chain::Swelling {
+                    basis: Vec::new(),
+                    ratio: Vec::new(),
+                    shape: vec![[(1.0, 1.0); 2]],
+                    gel: Some(Gel {
+                        laminate: crate::config::growth::Laminate {
+                            top_fraction: 0.3,
+                            modulus_ratio: 2.0,
+                            isotropic: true,
+                        },
+                        faces: vec![(
+                            a0,
+                            b0,
+                            0.01,
+                            Some(crate::rest::laws::bilayer::Print {
+                                thickness: 0.001,
+                                modulus_ratio: 5.0,
+                            }),
+                        )],
+                    }),
                 },
                 vec![0.04, -0.02],
             ),
@@ -535,6 +591,7 @@ mod tests {
                 )],
                 ratio: vec![1.0],
                 shape: vec![shape],
+                gel: None,
             };
             for (mt, mb) in [(0.05, -0.03), (0.2, 0.1), (-0.1, 0.0)] {
                 // The scene's own strains: ε = (largest coefficient) × moisture.
