@@ -19,7 +19,7 @@ connectivity, else the design's own forward check (surface to surface).
 
 Writes scripts/results/design_numbers.csv (case, faces, iterations, seconds, design distance,
 forward distance RMS and max over the target's size, and a case's own check). Needs the
-project's virtual environment (vtk, numpy). About 5 minutes on 2 cores.
+project's virtual environment (vtk, numpy). About 4 minutes on 2 cores.
 """
 
 import argparse

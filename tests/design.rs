@@ -988,6 +988,17 @@ fn shellsim_design_writes_swelling_and_thickness_designs_that_reproduce() {
             bilayer(0.03, false),
             "[design]\nvariable = \"swelling\"\nmax_iterations = 5\nsmoothing_length = 0.1\n",
         ),
+        // Isotropic layers with their coefficients across spelled out: the design writes the
+        // coefficients across too, or the forward run would read the scene's.
+        (
+            "spelled",
+            bilayer(0.02, false).replace(
+                "mu_bottom = 0.01\n",
+                "mu_bottom = 0.01\nmu_top_perp = 0.02\n",
+            ),
+            bilayer(0.03, false),
+            "[design]\nvariable = \"swelling\"\nmax_iterations = 5\nsmoothing_length = 0.1\n",
+        ),
         (
             "gel",
             bilayer(0.02, true),
@@ -1060,16 +1071,17 @@ fn shellsim_design_writes_swelling_and_thickness_designs_that_reproduce() {
             ],
         );
         // Anisotropic layers are written with their coefficients across the machine direction,
-        // in the scene's own ratio (1/4 on top).
+        // in the scene's own ratio (1/4 on top), and so are layers whose scene spells them out.
         let designed = shellsim::mesh::io::read_mesh(&d.join(&out).join("designed.vtk")).unwrap();
         let field = |n: &str| designed.face_fields.get(n).map(|f| f.data.clone());
-        if name == "anisotropic" {
+        if name == "anisotropic" || name == "spelled" {
+            let ratio = if name == "spelled" { 1.0 } else { 0.25 };
             let (top, perp) = (
                 field("growth_mu_top").unwrap(),
                 field("growth_mu_top_perp").unwrap(),
             );
             for (t, p) in top.iter().zip(&perp) {
-                assert!((p - t / 4.0).abs() <= 1e-15 * t.abs(), "{t} {p}");
+                assert!((p - t * ratio).abs() <= 1e-15 * t.abs(), "{t} {p}");
             }
         } else {
             assert!(field("growth_mu_top_perp").is_none());
@@ -1227,8 +1239,40 @@ fn bad_design_input_is_refused_and_nothing_is_written() {
         "fit_typo.toml",
         &format!("{scene}[design]\nstart = \"targte\"\n"),
     );
+    // A layer that shrinks across as it swells along (γ = −1/2): the default upper bound 0.5
+    // keeps its stretch positive, a lower bound above it is refused, and so is an upper bound
+    // at which the stretch across would vanish.
+    let layered = "[material]\nyoung = 1e4\npoisson = 0.4\nthickness = 0.01\n\
+                   [growth]\nlaw = \"bilayer\"\nmu_top = 0.02\nmu_top_perp = -0.01\n\
+                   mu_bottom = 0.0\nmoisture_top = 1.0\nmoisture_bottom = 1.0\n\
+                   [solver]\nmode = \"static\"\n";
+    write(
+        d,
+        "above_default.toml",
+        &format!("{layered}[design]\nvariable = \"swelling\"\nlower = 0.6\n"),
+    );
+    write(
+        d,
+        "vanishing.toml",
+        &format!("{layered}[design]\nvariable = \"swelling\"\nupper = 2.5\n"),
+    );
     write(d, "empty.vtk", "# vtk DataFile Version 4.2\nempty\nASCII\nDATASET POLYDATA\nPOINTS 0 double\nPOLYGONS 0 0\n");
-    let cases: [(&str, &str, &[&str]); 8] = [
+    let cases: [(&str, &str, &[&str]); 10] = [
+        (
+            "above_default.toml",
+            "disk.vtk",
+            &[
+                "above_default.toml",
+                "design.lower",
+                "above the upper bound",
+                "default",
+            ],
+        ),
+        (
+            "vanishing.toml",
+            "disk.vtk",
+            &["vanishing.toml", "design.upper", "top layer", "≤ 0"],
+        ),
         ("good.toml", "other.vtk", &["other.vtk", "connectivity"]),
         (
             "fit_surface.toml",
@@ -1504,11 +1548,15 @@ fn a_liquid_crystal_disk_is_designed_into_a_spherical_cap() {
         "cap",
     )
     .unwrap();
-    let text =
+    let example =
         std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/lc_cap.toml"))
-            .unwrap()
-            .replace("thickness = 0.01", "thickness = 0.02")
-            .replace("target_distance = 1e-3", "target_distance = 2e-3");
+            .unwrap();
+    for key in ["thickness = 0.01", "target_distance = 1e-3"] {
+        assert!(example.contains(key), "designs/lc_cap.toml has no '{key}'");
+    }
+    let text = example
+        .replace("thickness = 0.01", "thickness = 0.02")
+        .replace("target_distance = 1e-3", "target_distance = 2e-3");
     write(d, "lc.toml", &text);
     succeeds(
         d,

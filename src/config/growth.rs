@@ -334,7 +334,8 @@ pub struct Growth {
     /// stiffness of the shell as a whole.
     pub modulus_ratio: Option<Real>,
     /// Bilayer: each layer's thickness grows by the same stretch as its length (isotropic
-    /// swelling, as in a gel; default `false`: the thickness is kept). Excludes `mu_through`.
+    /// swelling, as in a gel; default `false`: the thickness is kept). Excludes `mu_through` and
+    /// the coefficients across the machine direction.
     pub isotropic_layers: Option<bool>,
     /// Bilayer: thickness of a printed layer on top that does not swell (m, default `0`: none),
     /// included in the face's thickness (the film is the rest).
@@ -346,8 +347,11 @@ pub struct Growth {
     /// original one, linearly.
     pub relax_moisture: Option<[Real; 2]>,
     /// Coefficients on regions of faces (veins, a printed layer), over the uniform ones; the
-    /// face fields `growth_mu`, `growth_mu_perp`, `growth_mu_top`, `growth_mu_bottom` and
-    /// `growth_mu_through` take precedence over both.
+    /// face fields `growth_mu`, `growth_mu_perp`, `growth_mu_top`, `growth_mu_bottom`,
+    /// `growth_mu_top_perp`, `growth_mu_bottom_perp`, `growth_mu_through` and the print's take
+    /// precedence over both. A region or field that gives `mu_top` without `mu_top_perp` keeps
+    /// the uniform `mu_top_perp` where `[growth]` gives one, else that layer swells alike in
+    /// every direction (the same for the bottom).
     pub regions: Vec<GrowthRegion>,
     /// Uniform moisture at the top surface (dimensionless fraction, default `0`).
     pub moisture_top: Real,

@@ -141,6 +141,8 @@ pub fn prepare(req: &Request) -> Result<Prepared, DesignError> {
     let curvature_targets = curvature_targets(&req.target, &target, &scene, &design)?;
     let (chain, mut start) = chain_and_start(&scene, &design)
         .map_err(|(k, r)| DesignError(format!("{name}: invalid '{k}': {r}")))?;
+    check_bounds(&design, &chain, &start)
+        .map_err(|(k, r)| DesignError(format!("{name}: invalid '{k}': {r}")))?;
     if design.start == Some(Start::Target) {
         start = fitted_start(&req.target, &target, &scene, &design, &chain, &start)?;
     }
@@ -566,10 +568,7 @@ fn fitted_start(
     let body = &scene.body;
     let x = &target.positions;
     let k = chain.per_face();
-    let bounds = (
-        d.lower.unwrap_or_else(|| default_lower(d.variable, own)),
-        d.upper.unwrap_or_else(|| default_upper(chain)),
-    );
+    let bounds = bounds(d, chain, own);
     let mut start = Vec::with_capacity(own.len());
     for (f, face) in body.mesh.faces.iter().enumerate() {
         let o = body.topo.opposite_vertex[f];
@@ -603,6 +602,66 @@ fn default_lower(v: Variable, start: &[Real]) -> Real {
         Variable::Thickness => 0.01 * start.iter().copied().fold(Real::INFINITY, Real::min),
         _ => Real::NEG_INFINITY,
     }
+}
+
+/// The bounds on every design number: `design.lower` and `design.upper`, else the variable's
+/// defaults.
+fn bounds(d: &Design, chain: &Chain, start: &[Real]) -> (Real, Real) {
+    (
+        d.lower.unwrap_or_else(|| default_lower(d.variable, start)),
+        d.upper.unwrap_or_else(|| default_upper(chain)),
+    )
+}
+
+/// Checks the bounds as they apply, defaults included: lower ≤ upper, and for layer strains a
+/// stretch `1 + α ε` and `1 + γ ε` that stays positive over the box on every face (the law
+/// refuses a length ≤ 0). Errors: (key, why).
+fn check_bounds(d: &Design, chain: &Chain, start: &[Real]) -> Result<(), (String, String)> {
+    let (lo, hi) = bounds(d, chain, start);
+    let h = crate::math::human;
+    if lo > hi {
+        // Name the bound the user gave (both are checked against each other in the file).
+        let k = if d.lower.is_some() {
+            "design.lower"
+        } else {
+            "design.upper"
+        };
+        return Err((
+            k.into(),
+            format!(
+                "the lower bound {} is above the upper bound {} ({} is the default of \
+                 variable = \"{}\")",
+                h(lo),
+                h(hi),
+                if d.lower.is_some() { h(hi) } else { h(lo) },
+                d.variable.name()
+            ),
+        ));
+    }
+    if let Chain::Swelling { shape, .. } = chain {
+        for (f, layers) in shape.iter().enumerate() {
+            for (layer, &(a, c)) in ["top", "bottom"].iter().zip(layers) {
+                for (bound, e) in [("design.lower", lo), ("design.upper", hi)] {
+                    let worst = (1.0 + a * e).min(1.0 + c * e);
+                    if e.is_finite() && worst <= 0.0 {
+                        return Err((
+                            bound.into(),
+                            format!(
+                                "at {} the {layer} layer of face {f} would stretch by {} (its \
+                                 coefficients along and across the machine direction are in \
+                                 the ratio {} : {}): a length cannot become ≤ 0",
+                                h(e),
+                                h(worst),
+                                h(a),
+                                h(c)
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The upper bound of a variable without `design.upper`: none, except for a bilayer layer that
@@ -752,8 +811,7 @@ fn designed(prep: &Prepared, p: &[Real]) -> (Mesh, toml::Table) {
         }
         Chain::Swelling { shape, .. } => {
             // The strains as the law's face coefficients over the scene's own moisture (the
-            // face fields take precedence over [growth]'s and the regions' coefficients); the
-            // coefficients across the machine direction when some layer is anisotropic.
+            // face fields take precedence over [growth]'s and the regions' coefficients).
             let g = &prep.scene.body.growth;
             let mut fields: [Vec<Real>; 4] = Default::default();
             for (f, c) in p.chunks_exact(2).enumerate() {
@@ -764,7 +822,14 @@ fn designed(prep: &Prepared, p: &[Real]) -> (Mesh, toml::Table) {
                 fields[2].push(c[0] * ct / mt);
                 fields[3].push(c[1] * cb / mb);
             }
-            let anisotropic = shape.iter().any(|s| s[0].0 != s[0].1 || s[1].0 != s[1].1);
+            // The coefficients across too when any layer is anisotropic, or when the scene gives
+            // them anywhere ([growth], a region, a face field), which the written fields must
+            // then replace on every face.
+            let anisotropic = shape.iter().any(|s| s[0].0 != s[0].1 || s[1].0 != s[1].1)
+                || prep.scene.settings.growth.anisotropic_layers()
+                || ["growth_mu_top_perp", "growth_mu_bottom_perp"]
+                    .iter()
+                    .any(|n| prep.input.face_fields.contains_key(*n));
             let names = [
                 "growth_mu_top",
                 "growth_mu_bottom",
@@ -935,10 +1000,8 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
         max_iterations: d.max_iterations,
         tolerance: d.tolerance,
         first_step: d.first_step,
-        lower: d
-            .lower
-            .unwrap_or_else(|| default_lower(d.variable, &prep.start)),
-        upper: d.upper.unwrap_or_else(|| default_upper(&prep.chain)),
+        lower: bounds(d, &prep.chain, &prep.start).0,
+        upper: bounds(d, &prep.chain, &prep.start).1,
     };
     let mut log = String::from(LOG_HEADER);
     let mut series: Vec<(Real, String)> = Vec::new();

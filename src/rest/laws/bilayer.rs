@@ -621,8 +621,7 @@ mod tests {
             };
             let (st, sb) = (1.3, 0.9);
             let law = |st: Real, sb: Real| bilayer(&a0, &b0, h, iso(st), iso(sb), D, &lam, print);
-            let (value, jac) = bilayer_jacobian(&a0, &b0, h, iso(st), iso(sb), D, &lam, print);
-            assert_eq!(value, law(st, sb));
+            let (_, jac) = bilayer_jacobian(&a0, &b0, h, iso(st), iso(sb), D, &lam, print);
             let e = 1e-5;
             for (k, (p, m)) in [
                 (law(st + e, sb), law(st - e, sb)),
