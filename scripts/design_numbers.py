@@ -32,22 +32,14 @@ import sys
 import tempfile
 
 import numpy as np
-import vtk
 from vtk.util.numpy_support import vtk_to_numpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from design_targets import read  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TARGETS = os.path.join(ROOT, "scripts", "design_targets.py")
 LAMBDA, NU = 0.9, 0.5
-
-
-def read(path):
-    if path.endswith(".vtu"):
-        r = vtk.vtkXMLUnstructuredGridReader()
-    else:
-        r = vtk.vtkGenericDataObjectReader()
-    r.SetFileName(path)
-    r.Update()
-    return r.GetOutput()
 
 
 def points(data):

@@ -560,6 +560,13 @@ fn cap_dir() -> tempfile::TempDir {
     dir
 }
 
+/// `out/design_summary.json`, parsed.
+fn design_summary(out: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(out.join("design_summary.json"))
+        .unwrap_or_else(|e| panic!("{}: design_summary.json: {e}", out.display()));
+    serde_json::from_str(&text).unwrap()
+}
+
 /// Runs `shellsim args` in `dir` and asserts exit 0.
 fn succeeds(dir: &Path, args: &[&str]) {
     let (code, _, err) = run_status(args, dir);
@@ -607,9 +614,7 @@ fn shellsim_design_designs_the_cap_and_its_output_reproduces_the_shape() {
             "{f} differs between 2 threads and 1"
         );
     }
-    let sum: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(d.join("des/design_summary.json")).unwrap())
-            .unwrap();
+    let sum = design_summary(&d.join("des"));
     assert_eq!(sum["converged"], true, "{sum}");
     assert!(sum["distance"].as_f64().unwrap() <= 1e-3, "{sum}");
     let log = std::fs::read_to_string(d.join("des/design_log.csv")).unwrap();
@@ -742,10 +747,7 @@ fn gauss_newton_designs_the_cap_in_fewer_iterations() {
                 "-q",
             ],
         );
-        let sum: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string(d.join(name).join("design_summary.json")).unwrap(),
-        )
-        .unwrap();
+        let sum = design_summary(&d.join(name));
         assert_eq!(sum["converged"], true, "{sum}");
         assert!(sum["distance"].as_f64().unwrap() <= 1e-4, "{sum}");
         assert_eq!(sum["forward_check"]["reproduces"], true, "{sum}");
@@ -1167,9 +1169,7 @@ fn bbar_is_recovered_from_the_gcm_cone() {
         }
     }
     let rel = (err / norm).sqrt();
-    let sum: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(d.join("des/design_summary.json")).unwrap())
-            .unwrap();
+    let sum = design_summary(&d.join("des"));
     println!(
         "b̄ recovered within {rel:.3e} (RMS, relative), {} iterations, shape {}",
         sum["iterations"], sum["distance"]
@@ -1468,10 +1468,7 @@ fn the_circumferential_director_is_recovered_from_its_cone() {
                 worst = worst.max(e);
             }
         }
-        let sum: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string(d.join(&out).join("design_summary.json")).unwrap(),
-        )
-        .unwrap();
+        let sum = design_summary(&d.join(&out));
         println!(
             "{tag}: director recovered: worst {worst:.3}° (r > 0.3), {} iterations, shape {}",
             sum["iterations"], sum["distance"]
@@ -1564,9 +1561,7 @@ fn a_liquid_crystal_disk_is_designed_into_a_spherical_cap() {
             "design", "lc.toml", "disk.vtk", "cap.vtk", "--out", "des", "-q",
         ],
     );
-    let sum: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(d.join("des/design_summary.json")).unwrap())
-            .unwrap();
+    let sum = design_summary(&d.join("des"));
     let dist = sum["distance"].as_f64().unwrap();
     let fwd = &sum["forward_check"];
     println!(

@@ -105,9 +105,6 @@ pub enum GrowthModel {
         mu_bottom: Real,
         /// The layers' thicknesses and moduli.
         laminate: Laminate,
-        /// Some layer swells differently across the machine direction than along it
-        /// (`mu_top_perp` or `mu_bottom_perp` given in `[growth]` or a region).
-        anisotropic: bool,
     },
     /// Linear swelling with a machine direction.
     MachineDirection {
@@ -417,7 +414,6 @@ impl Growth {
                 mu_top: c(self.mu_top),
                 mu_bottom: c(self.mu_bottom),
                 laminate: self.laminate(),
-                anisotropic: self.anisotropic_layers(),
             },
             GrowthLaw::MachineDirection => GrowthModel::MachineDirection {
                 mu: c(self.mu),

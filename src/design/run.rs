@@ -498,8 +498,10 @@ pub fn chain_and_start(scene: &Scene, d: &Design) -> Result<(Chain, Vec<Real>), 
                 shapes.push(shape);
                 gel_faces.push((rest.abar0[f], rest.bbar0[f], body.thickness[f], print));
                 // The strain in each layer's direction of largest swelling.
-                let largest = |mu: (Real, Real)| if mu.0.abs() >= mu.1.abs() { mu.0 } else { mu.1 };
-                own.extend([largest(top) * mt, largest(bottom) * mb]);
+                own.extend([
+                    Chain::layer_scale(top) * mt,
+                    Chain::layer_scale(bottom) * mb,
+                ]);
             }
             (
                 Chain::Swelling {
@@ -825,11 +827,8 @@ fn designed(prep: &Prepared, p: &[Real]) -> (Mesh, toml::Table) {
             // The coefficients across too when any layer is anisotropic, or when the scene gives
             // them anywhere ([growth], a region, a face field), which the written fields must
             // then replace on every face.
-            let anisotropic = shape.iter().any(|s| s[0].0 != s[0].1 || s[1].0 != s[1].1)
-                || prep.scene.settings.growth.anisotropic_layers()
-                || ["growth_mu_top_perp", "growth_mu_bottom_perp"]
-                    .iter()
-                    .any(|n| prep.input.face_fields.contains_key(*n));
+            let anisotropic =
+                shape.iter().any(|s| s[0].0 != s[0].1 || s[1].0 != s[1].1) || g.gives_across();
             let names = [
                 "growth_mu_top",
                 "growth_mu_bottom",
@@ -995,13 +994,14 @@ pub fn run(req: &Request) -> Result<Outcome, DesignError> {
             chain.per_face(),
         ));
     }
+    let (lower, upper) = bounds(d, &prep.chain, &prep.start);
     let opts = Options {
         memory: d.memory,
         max_iterations: d.max_iterations,
         tolerance: d.tolerance,
         first_step: d.first_step,
-        lower: bounds(d, &prep.chain, &prep.start).0,
-        upper: bounds(d, &prep.chain, &prep.start).1,
+        lower,
+        upper,
     };
     let mut log = String::from(LOG_HEADER);
     let mut series: Vec<(Real, String)> = Vec::new();

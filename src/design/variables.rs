@@ -388,10 +388,21 @@ impl Chain {
         [r0, lt, qt, lb, qb]
     }
 
+    /// A bilayer layer's coefficient of largest swelling: whichever of `(μ, μ⊥)` (along and
+    /// across the machine direction) is larger in size, with its sign (per unit moisture). The
+    /// layer's strain `ε` is this times its moisture.
+    pub fn layer_scale(mu: (Real, Real)) -> Real {
+        if mu.0.abs() >= mu.1.abs() {
+            mu.0
+        } else {
+            mu.1
+        }
+    }
+
     /// A bilayer layer's `(α, γ)` from its coefficients `(μ, μ⊥)` along and across the machine
-    /// direction: both over the one larger in size, or `(1, 1)` when both are 0.
+    /// direction: both over [`Chain::layer_scale`], or `(1, 1)` when both are 0.
     pub fn layer_shape(mu: (Real, Real)) -> (Real, Real) {
-        let m = if mu.0.abs() >= mu.1.abs() { mu.0 } else { mu.1 };
+        let m = Chain::layer_scale(mu);
         if m == 0.0 {
             (1.0, 1.0)
         } else {
@@ -595,8 +606,7 @@ mod tests {
             };
             for (mt, mb) in [(0.05, -0.03), (0.2, 0.1), (-0.1, 0.0)] {
                 // The scene's own strains: ε = (largest coefficient) × moisture.
-                let eps =
-                    |m: (Real, Real), x: Real| x * if m.0.abs() >= m.1.abs() { m.0 } else { m.1 };
+                let eps = |m: (Real, Real), x: Real| x * Chain::layer_scale(m);
                 let got = chain.face(0, &[eps(mu[0], mt), eps(mu[1], mb)]).forms;
                 let (top, bottom) = (Stretch::of(mu[0], mt), Stretch::of(mu[1], mb));
                 let (a, b, _) = bilayer(&a0, &b0, 0.01, top, bottom, d, &lam, print);

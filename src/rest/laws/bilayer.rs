@@ -41,22 +41,18 @@ use super::{
 use crate::config::growth::{GrowthLaw, GrowthModel, Laminate};
 use crate::math::{mat_to_sym, Mat2, Real, Sym2};
 
-/// The bilayer law with its layers, whether some layer is anisotropic (it then reads the
-/// machine direction), and each face's `mu_top`, `mu_bottom` and the coefficients across
-/// ([`super::Coefficients`]).
+/// The bilayer law with its layers and each face's `mu_top`, `mu_bottom` and the coefficients
+/// across the machine direction ([`super::Coefficients`]; the direction is read where those are
+/// given, [`super::GrowthInputs::gives_across`]).
 #[derive(Debug)]
-pub struct Bilayer(pub Laminate, pub bool);
+pub struct Bilayer(pub Laminate);
 
 /// The registry's entry ([`super::LAWS`]).
 pub const ENTRY: LawEntry = LawEntry {
     law: GrowthLaw::Bilayer,
     example: "mu_top = 0.05\nmu_bottom = 0.01\nmoisture_top = 0.4\nmoisture_bottom = 0.3",
     build: |m| match m {
-        GrowthModel::Bilayer {
-            laminate,
-            anisotropic,
-            ..
-        } => Some(Box::new(Bilayer(*laminate, *anisotropic))),
+        GrowthModel::Bilayer { laminate, .. } => Some(Box::new(Bilayer(*laminate))),
         _ => None,
     },
 };
@@ -310,10 +306,6 @@ impl RestLaw for Bilayer {
             });
         }
         through_thickness(i, (abar, bbar))
-    }
-
-    fn needs_direction(&self) -> bool {
-        self.1
     }
 }
 

@@ -50,6 +50,12 @@ pub struct GrowthInputs {
 }
 
 impl GrowthInputs {
+    /// True when the uniform or some face's coefficients give a bilayer layer's coefficient
+    /// across the machine direction ([`super::Coefficients::gives_across`]).
+    pub fn gives_across(&self) -> bool {
+        self.uniform.gives_across() || self.coef.iter().any(super::Coefficients::gives_across)
+    }
+
     /// Reads them for `settings.growth.law` (the machine direction also for `[moisture]`, whose
     /// diffusivity follows it). Errors name the field or key and the face.
     pub fn read(mesh: &Mesh, settings: &Settings) -> Result<Self, MeshError> {
@@ -89,11 +95,10 @@ impl GrowthInputs {
             relaxed: Vec::new(),
         };
         out.coef = per_face_coefficients(mesh, settings, out.uniform)?;
-        let perp_fields = ["growth_mu_top_perp", "growth_mu_bottom_perp"]
-            .iter()
-            .any(|n| mesh.face_fields.contains_key(*n));
+        // A bilayer reads the machine direction where its layers' coefficients across it are
+        // given, from any source.
         if law.as_ref().is_some_and(|l| l.needs_direction())
-            || (perp_fields && g.law == crate::config::growth::GrowthLaw::Bilayer)
+            || (g.law == crate::config::growth::GrowthLaw::Bilayer && out.gives_across())
             || settings.moisture.enabled
             || settings.temperature.enabled
         {

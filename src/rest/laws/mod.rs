@@ -159,6 +159,12 @@ impl Coefficients {
             self.mu_bottom_perp.unwrap_or(self.mu_bottom),
         )
     }
+
+    /// True when a layer's coefficient across the machine direction is given (by `[growth]`, a
+    /// region or a face field), whatever its value.
+    pub fn gives_across(&self) -> bool {
+        self.mu_top_perp.is_some() || self.mu_bottom_perp.is_some()
+    }
 }
 
 /// The forms `(ā, b̄)` of a moisture law at the reference thickness, with the thickness grown
